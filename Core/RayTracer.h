@@ -1,0 +1,64 @@
+// Ray queries against the scene's elements, cast by Embree.
+#pragma once
+
+#include "Scene.h"
+#include "Vec3.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace mlr
+{
+
+/// The nearest surface point a ray reaches.
+struct RayHit
+{
+  std::uint32_t element = 0;
+  Side side = Side::Front; ///< the side facing the incoming ray
+  Vec3 point;              ///< on the element's plane (from barycentrics, not origin + t dir)
+  double distance = 0;
+};
+
+/**
+ * Nearest-hit and visibility queries over a Scene's elements.
+ *
+ * Wraps one robust Embree scene (RTC_SCENE_FLAG_ROBUST) built on the process-wide Embree
+ * device, whose error callback is registered once. Queries are thread-safe. Rays can slip
+ * between two elements in rare cases (Embree's robust mode narrows this, it does not
+ * close it): intersect() then reports a miss, and callers treat it as power leaving the
+ * scene. The Scene must outlive the tracer.
+ */
+class RayTracer
+{
+public:
+  explicit RayTracer(const Scene& scene);
+  ~RayTracer();
+  RayTracer(const RayTracer&) = delete;
+  RayTracer& operator=(const RayTracer&) = delete;
+
+  /// Nearest hit of origin + t * direction for t > 0 (direction need not be unit).
+  bool intersect(const Vec3& origin, const Vec3& direction, RayHit& hit) const;
+
+  /**
+   * Visibility of the segments origin -> targets[i] (endpoints excluded), for `count`
+   * targets, written to visible[i]. Coherent segments from one origin go through Embree's
+   * 16-wide packet query, not one call per segment.
+   */
+  void visibleFrom(
+    const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const;
+
+  /// The distance rays leaving a surface start above it, so that they do not hit it again.
+  double surfaceOffset() const { return this->Offset; }
+
+  /// The point `offset` above p on the side whose normal is n.
+  Vec3 liftOff(const Vec3& p, const Vec3& n) const { return p + n * this->Offset; }
+
+private:
+  struct Embree;
+  const Scene& SceneRef;
+  std::unique_ptr<Embree> Impl;
+  double Offset = 0;
+};
+
+} // namespace mlr

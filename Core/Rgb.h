@@ -1,0 +1,57 @@
+// An RGB triplet of doubles: reflectance, power (W) or radiosity (W/m^2) per channel.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace mlr
+{
+
+struct Rgb
+{
+  double r = 0, g = 0, b = 0;
+
+  constexpr Rgb() = default;
+  constexpr Rgb(double r_, double g_, double b_)
+    : r(r_)
+    , g(g_)
+    , b(b_)
+  {
+  }
+  constexpr explicit Rgb(double grey)
+    : r(grey)
+    , g(grey)
+    , b(grey)
+  {
+  }
+
+  constexpr double operator[](int i) const { return i == 0 ? r : (i == 1 ? g : b); }
+  double& operator[](int i) { return i == 0 ? r : (i == 1 ? g : b); }
+
+  constexpr Rgb operator+(const Rgb& o) const { return { r + o.r, g + o.g, b + o.b }; }
+  constexpr Rgb operator-(const Rgb& o) const { return { r - o.r, g - o.g, b - o.b }; }
+  constexpr Rgb operator*(const Rgb& o) const { return { r * o.r, g * o.g, b * o.b }; }
+  constexpr Rgb operator*(double s) const { return { r * s, g * s, b * s }; }
+  constexpr Rgb operator/(double s) const { return { r / s, g / s, b / s }; }
+  Rgb& operator+=(const Rgb& o)
+  {
+    r += o.r;
+    g += o.g;
+    b += o.b;
+    return *this;
+  }
+  constexpr bool operator==(const Rgb& o) const { return r == o.r && g == o.g && b == o.b; }
+  constexpr bool operator!=(const Rgb& o) const { return !(*this == o); }
+
+  constexpr double maxComponent() const { return std::max(r, std::max(g, b)); }
+  constexpr double minComponent() const { return std::min(r, std::min(g, b)); }
+  constexpr double sum() const { return r + g + b; }
+  bool isFinite() const { return std::isfinite(r) && std::isfinite(g) && std::isfinite(b); }
+};
+
+constexpr Rgb operator*(double s, const Rgb& c)
+{
+  return c * s;
+}
+
+} // namespace mlr

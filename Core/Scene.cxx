@@ -1,0 +1,140 @@
+#include "Scene.h"
+
+#include "Error.h"
+
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+namespace mlr
+{
+
+namespace
+{
+std::string describe(const Rgb& c)
+{
+  std::ostringstream s;
+  s << "(" << c.r << ", " << c.g << ", " << c.b << ")";
+  return s.str();
+}
+}
+
+Scene Scene::fromPatchMesh(const PatchMesh& mesh)
+{
+  if (mesh.triangles.empty())
+  {
+    throw Error("the scene is empty: it has no patches (give at least one triangle)");
+  }
+  if (mesh.reflectance.size() != mesh.triangles.size())
+  {
+    std::ostringstream s;
+    s << "the scene has " << mesh.triangles.size() << " patches but " << mesh.reflectance.size()
+      << " reflectances: give exactly one reflectance per patch";
+    throw Error(s.str());
+  }
+  if (mesh.points.size() >= std::numeric_limits<std::uint32_t>::max() / 2 ||
+    mesh.triangles.size() >= (std::size_t(1) << 28))
+  {
+    throw Error("the scene is too large: it must have fewer than 2^28 patches and 2^31 points");
+  }
+  std::size_t nonFinite = 0;
+  for (const Vec3& p : mesh.points)
+  {
+    nonFinite += isFinite(p) ? 0 : 1;
+  }
+  if (nonFinite > 0)
+  {
+    std::ostringstream s;
+    s << "the scene has " << nonFinite
+      << " points with NaN or infinite coordinates: remove or fix them";
+    throw Error(s.str());
+  }
+
+  Scene scene;
+  scene.Points = mesh.points;
+  scene.PatchTriangles = mesh.triangles;
+  scene.Reflectance = mesh.reflectance;
+  const std::size_t patches = mesh.triangles.size();
+  scene.PatchNormals.resize(patches);
+  scene.PatchAreas.resize(patches);
+
+  scene.BoundsMin = Vec3(std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max());
+  scene.BoundsMax = -scene.BoundsMin;
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    const Triangle& t = mesh.triangles[p];
+    for (std::uint32_t v : t)
+    {
+      if (v >= mesh.points.size())
+      {
+        std::ostringstream s;
+        s << "patch " << p << " uses point " << v << " but the scene has only "
+          << mesh.points.size() << " points";
+        throw Error(s.str());
+      }
+      const Vec3& q = mesh.points[v];
+      for (int i = 0; i < 3; ++i)
+      {
+        scene.BoundsMin[i] = std::min(scene.BoundsMin[i], q[i]);
+        scene.BoundsMax[i] = std::max(scene.BoundsMax[i], q[i]);
+      }
+    }
+    const Rgb& rho = mesh.reflectance[p];
+    for (int c = 0; c < 3; ++c)
+    {
+      if (!(rho[c] >= 0.0 && rho[c] < 1.0))
+      {
+        throw Error("patch " + std::to_string(p) + " has reflectance " + describe(rho) +
+          ": every channel must be >= 0 and < 1 (a reflectance of 1 never absorbs, so the "
+          "random walk would not end)");
+      }
+    }
+    const Vec3 areaVector =
+      triangleAreaVector(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]]);
+    const double twiceArea = length(areaVector);
+    if (!(twiceArea > 0.0) || !std::isfinite(twiceArea))
+    {
+      throw Error("patch " + std::to_string(p) +
+        " is degenerate (zero area): remove zero-area triangles from the scene");
+    }
+    scene.PatchNormals[p] = areaVector / twiceArea;
+    scene.PatchAreas[p] = 0.5 * twiceArea;
+    scene.TotalArea += scene.PatchAreas[p];
+  }
+
+  // Split 1:4 at edge midpoints, sharing a midpoint between the patches of an edge.
+  std::unordered_map<std::uint64_t, std::uint32_t> midpointOfEdge;
+  midpointOfEdge.reserve(patches * 2);
+  auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+    auto found = midpointOfEdge.find(key);
+    if (found != midpointOfEdge.end())
+    {
+      return found->second;
+    }
+    const auto index = static_cast<std::uint32_t>(scene.Points.size());
+    scene.Points.push_back((scene.Points[a] + scene.Points[b]) * 0.5);
+    midpointOfEdge.emplace(key, index);
+    return index;
+  };
+  scene.ElementTriangles.reserve(patches * ElementsPerPatch);
+  scene.ElementAreas.reserve(patches * ElementsPerPatch);
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    const auto [a, b, c] = mesh.triangles[p];
+    const std::uint32_t ab = midpoint(a, b);
+    const std::uint32_t bc = midpoint(b, c);
+    const std::uint32_t ca = midpoint(c, a);
+    for (const Triangle& e : { Triangle{ a, ab, ca }, Triangle{ ab, b, bc }, Triangle{ ca, bc, c },
+           Triangle{ ab, bc, ca } })
+    {
+      scene.ElementTriangles.push_back(e);
+      scene.ElementAreas.push_back(
+        0.5 * length(triangleAreaVector(scene.Points[e[0]], scene.Points[e[1]], scene.Points[e[2]])));
+    }
+  }
+  return scene;
+}
+
+} // namespace mlr

@@ -1,0 +1,92 @@
+// The radiosity scene: triangular patches, each split 1:4 into elements.
+#pragma once
+
+#include "Rgb.h"
+#include "Vec3.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace mlr
+{
+
+/// The side of a surface: Front is the side the right-hand-rule normal points to.
+enum class Side : std::uint8_t
+{
+  Front = 0,
+  Back = 1,
+};
+
+using Triangle = std::array<std::uint32_t, 3>;
+
+/// Patches as given by the caller (or by remeshing): one triangle and one reflectance each.
+struct PatchMesh
+{
+  std::vector<Vec3> points;
+  std::vector<Triangle> triangles;
+  std::vector<Rgb> reflectance; ///< one per triangle, every channel in [0, 1)
+};
+
+/**
+ * Patches and elements with their geometry and materials.
+ *
+ * Patch p owns elements 4p .. 4p+3, made by splitting it at its edge midpoints:
+ * three corner triangles and the middle one, all oriented like the patch. Midpoints of
+ * edges shared by two patches are shared too, so the element mesh is as connected as the
+ * patch mesh. A Scene is immutable and always valid: fromPatchMesh throws mlr::Error
+ * naming the first problem it finds.
+ */
+class Scene
+{
+public:
+  static constexpr std::size_t ElementsPerPatch = 4;
+
+  static Scene fromPatchMesh(const PatchMesh& mesh);
+
+  std::size_t patchCount() const { return this->PatchTriangles.size(); }
+  std::size_t elementCount() const { return this->ElementTriangles.size(); }
+  static std::size_t patchOfElement(std::size_t element) { return element / ElementsPerPatch; }
+
+  /// Patch corners first (same indices as the input), then edge midpoints.
+  const std::vector<Vec3>& points() const { return this->Points; }
+  const std::vector<Triangle>& patchTriangles() const { return this->PatchTriangles; }
+  const std::vector<Triangle>& elementTriangles() const { return this->ElementTriangles; }
+
+  const Vec3& patchNormal(std::size_t p) const { return this->PatchNormals[p]; }
+  double patchArea(std::size_t p) const { return this->PatchAreas[p]; }
+  const Rgb& patchReflectance(std::size_t p) const { return this->Reflectance[p]; }
+
+  const Vec3& elementNormal(std::size_t e) const { return this->PatchNormals[patchOfElement(e)]; }
+  double elementArea(std::size_t e) const { return this->ElementAreas[e]; }
+  const Rgb& elementReflectance(std::size_t e) const
+  {
+    return this->Reflectance[patchOfElement(e)];
+  }
+
+  /// The unit normal on the given side of element e.
+  Vec3 elementSideNormal(std::size_t e, Side side) const
+  {
+    return side == Side::Front ? this->elementNormal(e) : -this->elementNormal(e);
+  }
+
+  double totalArea() const { return this->TotalArea; }
+  const Vec3& boundsMin() const { return this->BoundsMin; }
+  const Vec3& boundsMax() const { return this->BoundsMax; }
+  /// Length of the bounding box diagonal: the scale for ray offsets.
+  double diagonal() const { return length(this->BoundsMax - this->BoundsMin); }
+
+private:
+  std::vector<Vec3> Points;
+  std::vector<Triangle> PatchTriangles;
+  std::vector<Triangle> ElementTriangles;
+  std::vector<Vec3> PatchNormals;
+  std::vector<double> PatchAreas;
+  std::vector<double> ElementAreas;
+  std::vector<Rgb> Reflectance;
+  double TotalArea = 0;
+  Vec3 BoundsMin, BoundsMax;
+};
+
+} // namespace mlr

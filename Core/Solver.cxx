@@ -1,0 +1,721 @@
+#include "Solver.h"
+
+#include "Error.h"
+#include "FixedPointAccumulator.h"
+#include "Parallel.h"
+#include "Random.h"
+#include "RayTracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <unistd.h>
+
+namespace mlr
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string gibibytes(std::uint64_t bytes)
+{
+  std::ostringstream s;
+  s.precision(3);
+  s << static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0) << " GiB";
+  return s.str();
+}
+
+std::uint64_t defaultMemoryLimit()
+{
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long pageSize = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || pageSize <= 0)
+  {
+    return 4ULL << 30;
+  }
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 2;
+}
+
+/// A walk longer than this is cut: with reflectance < 1 it is astronomically unlikely,
+/// and the cut bounds the time between two cancellation checks.
+constexpr int MaximumBounces = 100000;
+
+/// Shooting paths per task: small enough that cancellation is noticed within
+/// milliseconds, large enough that scheduling costs nothing.
+constexpr std::uint64_t ReusedPathsPerTask = 256;
+constexpr std::uint64_t ClassicPathsPerTask = 2048;
+constexpr std::size_t GatheringSidesPerTask = 32;
+
+struct alignas(64) WorkerCounters
+{
+  std::uint64_t shootingRays = 0;
+  std::uint64_t shadowRays = 0;
+  std::uint64_t gatheringRays = 0;
+  std::uint64_t missedRays = 0;
+  std::uint64_t firstHits = 0;
+  std::uint64_t firstHitsOnBack = 0; ///< one-sided mode: first hits absorbed by a back face
+};
+
+/// Scratch vectors one worker reuses for every path.
+struct WorkerScratch
+{
+  std::vector<Rgb> packets;
+  std::vector<double> kernel;
+  std::vector<Vec3> targets;
+  std::vector<std::uint32_t> targetFrames;
+  std::vector<std::uint8_t> visible;
+  std::vector<Rgb> gathered;
+};
+
+/// Everything one solve shares between its phases and workers.
+class SolveRun
+{
+public:
+  SolveRun(const Scene& scene, const MovingLight& light, const SolverOptions& options,
+    const RayTracer& tracer, int workers)
+    : SceneRef(scene)
+    , Light(light)
+    , Options(options)
+    , Tracer(tracer)
+    , Frames(light.frameCount())
+    , Workers(workers)
+    , ElementPower(workers, scene.elementCount(), light.frameCount(), light.power().maxComponent())
+    , PatchPower(workers, scene.patchCount(), light.frameCount(), light.power().maxComponent())
+    , Counters(static_cast<std::size_t>(workers))
+    , Scratch(static_cast<std::size_t>(workers))
+  {
+    for (WorkerScratch& s : this->Scratch)
+    {
+      s.packets.resize(this->Frames);
+      s.kernel.resize(this->Frames);
+      s.targets.resize(this->Frames);
+      s.targetFrames.resize(this->Frames);
+      s.visible.resize(this->Frames);
+      s.gathered.resize(this->Frames);
+    }
+    // M_k paths start from position k; they add up to N exactly.
+    const std::uint64_t n = this->Frames;
+    const std::uint64_t N = options.pathsPerFrame;
+    this->PathsFromPosition.resize(this->Frames);
+    for (std::uint64_t k = 0; k < n; ++k)
+    {
+      this->PathsFromPosition[k] = static_cast<double>(N / n + (k < N % n ? 1 : 0));
+    }
+  }
+
+  void shootReused(std::uint64_t path, int worker);
+  void shootClassic(std::uint64_t frame, std::uint64_t path, int worker);
+  void finishShooting(Solution& solution) const;
+  std::vector<std::uint32_t> gatheringSides(std::uint64_t& rays, std::uint64_t total) const;
+  void gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse, const Solution& solution,
+    Solution& out, int worker);
+
+  const std::vector<WorkerCounters>& counters() const { return this->Counters; }
+
+  /// Which position path `path` of a reuse solve starts from.
+  std::size_t positionOfPath(std::uint64_t path) const
+  {
+    const std::uint64_t n = this->Frames;
+    const std::uint64_t base = this->Options.pathsPerFrame / n;
+    const std::uint64_t extra = this->Options.pathsPerFrame % n;
+    const std::uint64_t firstBlock = extra * (base + 1);
+    if (path < firstBlock)
+    {
+      return static_cast<std::size_t>(path / (base + 1));
+    }
+    return static_cast<std::size_t>(extra + (path - firstBlock) / base);
+  }
+
+private:
+  void scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* packets,
+    std::size_t firstFrame, std::size_t frameCount, int worker);
+
+  const Scene& SceneRef;
+  const MovingLight& Light;
+  const SolverOptions& Options;
+  const RayTracer& Tracer;
+  std::size_t Frames;
+  int Workers;
+  FixedPointAccumulator ElementPower;
+  FixedPointAccumulator PatchPower;
+  std::vector<WorkerCounters> Counters;
+  std::vector<WorkerScratch> Scratch;
+  std::vector<double> PathsFromPosition;
+};
+
+/**
+ * Scores a walk's first hit on the element (direct) and patch, then follows it: continue
+ * with probability lambda, and at every later hit score the patch and play Russian
+ * roulette with the maximum reflectance channel. `packets` hold the power arriving at the
+ * first hit for frames [firstFrame, firstFrame + frameCount).
+ *
+ * METHOD.md writes step 3 as P <- P / lambda; the power that leaves the first hit is the
+ * reflected power, so we carry rho * P / lambda (the energy balance test checks this).
+ */
+void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* packets,
+  std::size_t firstFrame, std::size_t frameCount, int worker)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  const int side = static_cast<int>(firstHit.side);
+  {
+    const std::size_t patch = Scene::patchOfElement(firstHit.element);
+    const Rgb& rho = this->SceneRef.patchReflectance(patch);
+    std::int64_t* elementSlots = this->ElementPower.slots(worker, firstHit.element, side);
+    std::int64_t* patchSlots = this->PatchPower.slots(worker, patch, side);
+    for (std::size_t f = 0; f < frameCount; ++f)
+    {
+      const Rgb reflected = rho * packets[f];
+      this->ElementPower.add(elementSlots, firstFrame + f, reflected);
+      this->PatchPower.add(patchSlots, firstFrame + f, reflected);
+    }
+    const double lambda = this->Options.firstBounceSurvival;
+    if (random.uniform() >= lambda)
+    {
+      return;
+    }
+    for (std::size_t f = 0; f < frameCount; ++f)
+    {
+      packets[f] = rho * packets[f] / lambda;
+    }
+  }
+
+  RayHit hit = firstHit;
+  for (int bounce = 0; bounce < MaximumBounces; ++bounce)
+  {
+    const Vec3 normal = this->SceneRef.elementSideNormal(hit.element, hit.side);
+    const double u1 = random.uniform(), u2 = random.uniform();
+    const Vec3 direction = sampleCosineDirection(normal, u1, u2);
+    ++counters.shootingRays;
+    RayHit next;
+    if (!this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next))
+    {
+      ++counters.missedRays;
+      return;
+    }
+    if (!this->Options.twoSided && next.side == Side::Back)
+    {
+      return;
+    }
+    const std::size_t patch = Scene::patchOfElement(next.element);
+    const Rgb& rho = this->SceneRef.patchReflectance(patch);
+    std::int64_t* patchSlots = this->PatchPower.slots(worker, patch, static_cast<int>(next.side));
+    for (std::size_t f = 0; f < frameCount; ++f)
+    {
+      this->PatchPower.add(patchSlots, firstFrame + f, rho * packets[f]);
+    }
+    const double survival = rho.maxComponent();
+    if (!(survival > 0) || random.uniform() >= survival)
+    {
+      return;
+    }
+    const Rgb carry = rho / survival;
+    for (std::size_t f = 0; f < frameCount; ++f)
+    {
+      packets[f] = carry * packets[f];
+    }
+    hit = next;
+  }
+}
+
+void SolveRun::shootReused(std::uint64_t path, int worker)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  WorkerScratch& scratch = this->Scratch[static_cast<std::size_t>(worker)];
+  const std::size_t origin = this->positionOfPath(path);
+  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, 0);
+
+  Vec3 x, lightNormal;
+  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
+  const double v1 = random.uniform(), v2 = random.uniform();
+  const Vec3 direction = sampleCosineDirection(lightNormal, v1, v2);
+  const Vec3 start = x + this->Light.translation(origin);
+  ++counters.shootingRays;
+  RayHit hit;
+  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  {
+    ++counters.missedRays;
+    return;
+  }
+  ++counters.firstHits;
+  if (!this->Options.twoSided && hit.side == Side::Back)
+  {
+    ++counters.firstHitsOnBack;
+    return;
+  }
+
+  // Mixture weights w_j = G(x_j, y) / sum_k M_k G(x_k, y), with real visibility. The pi of
+  // G cancels; with d = y - x_j unnormalised, cos_x cos_y / r^2 = (n_x.d)(-n_y.d) / |d|^4.
+  const Vec3 ny = this->SceneRef.elementSideNormal(hit.element, hit.side);
+  std::size_t shadowCount = 0;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    const Vec3 d = hit.point - (x + this->Light.translation(j));
+    const double cosX = dot(lightNormal, d);
+    const double cosY = -dot(ny, d);
+    const double r2 = lengthSquared(d);
+    const double g = cosX > 0 && cosY > 0 && r2 > 0 ? cosX * cosY / (r2 * r2) : 0.0;
+    scratch.kernel[j] = g;
+    if (g > 0 && j != origin)
+    {
+      scratch.targets[shadowCount] = x + this->Light.translation(j);
+      scratch.targetFrames[shadowCount] = static_cast<std::uint32_t>(j);
+      ++shadowCount;
+    }
+  }
+  if (shadowCount > 0)
+  {
+    this->Tracer.visibleFrom(
+      this->Tracer.liftOff(hit.point, ny), scratch.targets.data(), shadowCount, scratch.visible.data());
+    counters.shadowRays += shadowCount;
+    for (std::size_t s = 0; s < shadowCount; ++s)
+    {
+      if (!scratch.visible[s])
+      {
+        scratch.kernel[scratch.targetFrames[s]] = 0;
+      }
+    }
+  }
+  double mixture = 0;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    mixture += this->PathsFromPosition[j] * scratch.kernel[j];
+  }
+  if (!(mixture > 0))
+  {
+    return; // grazing to the last bit: the path carries nothing
+  }
+  const Rgb& power = this->Light.power();
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    scratch.packets[j] = power * (scratch.kernel[j] / mixture);
+  }
+  this->scoreAndWalk(random, hit, scratch.packets.data(), 0, this->Frames, worker);
+}
+
+void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, frame + 1);
+  Vec3 x, lightNormal;
+  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
+  const double v1 = random.uniform(), v2 = random.uniform();
+  const Vec3 direction = sampleCosineDirection(lightNormal, v1, v2);
+  const Vec3 start = x + this->Light.translation(static_cast<std::size_t>(frame));
+  ++counters.shootingRays;
+  RayHit hit;
+  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  {
+    ++counters.missedRays;
+    return;
+  }
+  ++counters.firstHits;
+  if (!this->Options.twoSided && hit.side == Side::Back)
+  {
+    ++counters.firstHitsOnBack;
+    return;
+  }
+  Rgb packet = this->Light.power() / static_cast<double>(this->Options.pathsPerFrame);
+  this->scoreAndWalk(random, hit, &packet, static_cast<std::size_t>(frame), 1, worker);
+}
+
+/// Turns the accumulated power into radiosity (W/m^2) in the solution.
+void SolveRun::finishShooting(Solution& solution) const
+{
+  const std::size_t elements = this->SceneRef.elementCount();
+  const std::size_t patches = this->SceneRef.patchCount();
+  std::vector<Rgb>& direct = solution.directData();
+  std::vector<Rgb>& patch = solution.patchData();
+  for (std::size_t e = 0; e < elements; ++e)
+  {
+    const double inverseArea = 1.0 / this->SceneRef.elementArea(e);
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < this->Frames; ++f)
+      {
+        direct[solution.elementIndex(f, e, static_cast<Side>(s))] =
+          this->ElementPower.total(e, s, f) * inverseArea;
+      }
+    }
+  }
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < this->Frames; ++f)
+      {
+        patch[solution.patchIndex(f, p, static_cast<Side>(s))] =
+          this->PatchPower.total(p, s, f) * inverseArea;
+      }
+    }
+  }
+}
+
+/**
+ * The element sides that gather: those whose patch side received shooting power (the
+ * inside of a closed block never does). Returns them as element * 2 + side, in element
+ * order, and sets `rays` to the rays each casts so that together they cast about `total`
+ * (at least one each: equal counts keep every side's estimate equally accurate).
+ */
+std::vector<std::uint32_t> SolveRun::gatheringSides(std::uint64_t& rays, std::uint64_t total) const
+{
+  std::vector<std::uint32_t> sides;
+  const std::size_t patches = this->SceneRef.patchCount();
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    for (int s = 0; s < 2; ++s)
+    {
+      if (this->PatchPower.received(p, s))
+      {
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        {
+          sides.push_back(static_cast<std::uint32_t>(e * 2 + static_cast<std::size_t>(s)));
+        }
+      }
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  rays = sides.empty()
+    ? 0
+    : static_cast<std::uint64_t>(std::max<long long>(
+        1, std::llround(static_cast<double>(total) / static_cast<double>(sides.size()))));
+  return sides;
+}
+
+/**
+ * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
+ * on it; each ray that reaches a patch side adds that side's shooting radiosity. With reuse
+ * one set of rays serves every frame; otherwise each frame casts its own.
+ */
+void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
+  const Solution& shooting, Solution& out, int worker)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  std::vector<Rgb>& sum = this->Scratch[static_cast<std::size_t>(worker)].gathered;
+  const std::size_t element = elementSide / 2;
+  const Side side = static_cast<Side>(elementSide % 2);
+  const Triangle& t = this->SceneRef.elementTriangles()[element];
+  const auto& points = this->SceneRef.points();
+  const Vec3 normal = this->SceneRef.elementSideNormal(element, side);
+  std::fill(sum.begin(), sum.end(), Rgb());
+
+  const std::size_t passes = reuse ? 1 : this->Frames;
+  for (std::size_t pass = 0; pass < passes; ++pass)
+  {
+    RandomStream random(this->Options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
+    for (std::uint64_t r = 0; r < rays; ++r)
+    {
+      const double u1 = random.uniform(), u2 = random.uniform();
+      const double v1 = random.uniform(), v2 = random.uniform();
+      const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
+      const Vec3 direction = sampleCosineDirection(normal, v1, v2);
+      ++counters.gatheringRays;
+      RayHit hit;
+      if (!this->Tracer.intersect(this->Tracer.liftOff(origin, normal), direction, hit))
+      {
+        ++counters.missedRays;
+        continue;
+      }
+      if (!this->Options.twoSided && hit.side == Side::Back)
+      {
+        continue;
+      }
+      const std::size_t patch = Scene::patchOfElement(hit.element);
+      if (reuse)
+      {
+        const Rgb* b = &shooting.patchRadiosity(0, patch, hit.side);
+        for (std::size_t f = 0; f < this->Frames; ++f)
+        {
+          sum[f] += b[f];
+        }
+      }
+      else
+      {
+        sum[pass] += shooting.patchRadiosity(pass, patch, hit.side);
+      }
+    }
+  }
+  const Rgb scale = this->SceneRef.elementReflectance(element) / static_cast<double>(rays);
+  for (std::size_t f = 0; f < this->Frames; ++f)
+  {
+    out.indirectData()[out.elementIndex(f, element, side)] = scale * sum[f];
+  }
+}
+
+/// Without gathering (k = 0) an element's indirect light is its patch's shooting solution
+/// minus the patch's direct part (the area-weighted direct of its four elements).
+void indirectFromPatches(const Scene& scene, Solution& solution)
+{
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < solution.frameCount(); ++f)
+      {
+        Rgb directPower;
+        for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
+        {
+          directPower += solution.direct(f, e, static_cast<Side>(s)) * scene.elementArea(e);
+        }
+        const Rgb patchDirect = directPower / scene.patchArea(p);
+        const Rgb& b = solution.patchRadiosity(f, p, static_cast<Side>(s));
+        const Rgb rest(std::max(0.0, b.r - patchDirect.r), std::max(0.0, b.g - patchDirect.g),
+          std::max(0.0, b.b - patchDirect.b));
+        for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
+        {
+          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] = rest;
+        }
+      }
+    }
+  }
+}
+
+void chooseLitSides(const Scene& scene, Solution& solution)
+{
+  std::vector<Side>& lit = solution.litSideData();
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    double front = 0, back = 0;
+    for (std::size_t f = 0; f < solution.frameCount(); ++f)
+    {
+      front += solution.total(f, e, Side::Front).sum();
+      back += solution.total(f, e, Side::Back).sum();
+    }
+    lit[e] = back > front ? Side::Back : Side::Front;
+  }
+}
+}
+
+Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches)
+  : Frames(frames)
+  , Elements(elements)
+  , Patches(patches)
+  , Direct(frames * elements * 2)
+  , Indirect(frames * elements * 2)
+  , Patch(frames * patches * 2)
+  , LitSide(elements, Side::Front)
+{
+}
+
+double predictedSpeedup(
+  std::size_t frames, double gatheringRatio, double lambda, double meanPathLength)
+{
+  const double n = static_cast<double>(frames);
+  const double walk = lambda * (meanPathLength - 1.0);
+  return (n * (1.0 + walk) + gatheringRatio * n) / (n + walk + gatheringRatio);
+}
+
+void validateOptions(const SolverOptions& options)
+{
+  if (options.pathsPerFrame == 0)
+  {
+    throw Error("the number of paths per frame is 0: give at least 1 (600000 is typical)");
+  }
+  if (options.pathsPerFrame > MaximumPathsPerFrame)
+  {
+    throw Error("the number of paths per frame, " + std::to_string(options.pathsPerFrame) +
+      ", is over the maximum of " + std::to_string(MaximumPathsPerFrame) +
+      ": such a solve would not finish");
+  }
+  if (!(options.firstBounceSurvival > 0.0 && options.firstBounceSurvival <= 1.0))
+  {
+    throw Error("the first-bounce survival probability lambda is " +
+      std::to_string(options.firstBounceSurvival) + ": it must be in (0, 1] (0.25 is typical)");
+  }
+  if (!(options.gatheringRatio >= 0.0) || !std::isfinite(options.gatheringRatio))
+  {
+    throw Error("the gathering ratio k is " + std::to_string(options.gatheringRatio) +
+      ": it must be 0 (no final gathering) or positive (1 is typical)");
+  }
+  if (options.gatheringRatio * static_cast<double>(options.pathsPerFrame) >
+    static_cast<double>(MaximumPathsPerFrame))
+  {
+    throw Error("the gathering ratio k times the paths per frame is over the maximum of " +
+      std::to_string(MaximumPathsPerFrame) + " rays per frame");
+  }
+  if (options.threads < 0 || options.threads > 1024)
+  {
+    throw Error("the thread count is " + std::to_string(options.threads) +
+      ": give 0 (every core) or a count from 1 to 1024");
+  }
+}
+
+std::uint64_t estimateSolveMemory(
+  const Scene& scene, std::size_t frames, const SolverOptions& options)
+{
+  const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
+  const std::uint64_t elements = scene.elementCount();
+  const std::uint64_t patches = scene.patchCount();
+  // Results: direct and indirect per element side, shooting radiosity per patch side.
+  const std::uint64_t results = frames * (elements * 2 * 2 + patches * 2) * sizeof(Rgb);
+  const std::uint64_t accumulators =
+    FixedPointAccumulator::bytes(static_cast<int>(workers), elements + patches, frames);
+  const std::uint64_t scratch = workers * frames * (2 * sizeof(Rgb) + sizeof(Vec3) + 16);
+  // Embree's BVH and buffers, generously.
+  const std::uint64_t tracing = elements * 256 + scene.points().size() * 16;
+  return results + accumulators + scratch + tracing;
+}
+
+Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
+  const ProgressCallback& progress)
+{
+  const auto start = Clock::now();
+  validateOptions(options);
+  const std::size_t frames = light.frameCount();
+  const int workers = resolveThreadCount(options.threads);
+  const std::uint64_t memory = estimateSolveMemory(scene, frames, options);
+  const std::uint64_t limit =
+    options.memoryLimitBytes > 0 ? options.memoryLimitBytes : defaultMemoryLimit();
+  if (memory > limit)
+  {
+    std::ostringstream s;
+    s << "the solve needs an estimated " << gibibytes(memory) << " (" << frames << " frames x ("
+      << scene.patchCount() << " patches + " << scene.elementCount()
+      << " elements) x 2 sides x RGB, plus per-thread buffers), over the memory limit of "
+      << gibibytes(limit)
+      << ": use fewer frames, a larger patch size or fewer threads, or raise the limit";
+    throw Error(s.str());
+  }
+
+  // Progress: phases weighted by their expected ray counts.
+  const double n = static_cast<double>(frames);
+  const double N = static_cast<double>(options.pathsPerFrame);
+  const double lambda = options.firstBounceSurvival;
+  const double shootingCost = options.reuseShooting ? N * (1 + 1.5 * lambda + 0.2 * (n - 1))
+                                                    : n * N * (1 + 1.5 * lambda);
+  const double gatheringCost =
+    options.gatheringRatio * N * (options.reuseGathering ? 1.0 : n);
+  const double shootingShare = shootingCost / (shootingCost + gatheringCost);
+  auto phaseTick = [&](double base, double share, std::size_t total) {
+    return [&progress, base, share, total](std::size_t done) {
+      return !progress ||
+        progress(base + share * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)));
+    };
+  };
+  if (progress && !progress(0.0))
+  {
+    throw Cancelled();
+  }
+
+  RayTracer tracer(scene);
+  SolveRun run(scene, light, options, tracer, workers);
+  Solution solution(frames, scene.elementCount(), scene.patchCount());
+  SolverStatistics& stats = solution.statistics;
+  stats.secondsSetup = secondsSince(start);
+
+  // Shooting.
+  const auto shootingStart = Clock::now();
+  if (options.reuseShooting)
+  {
+    const std::uint64_t paths = options.pathsPerFrame;
+    const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
+    parallelFor(tasks, workers,
+      [&](std::size_t task, int worker) {
+        const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
+        for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
+        {
+          run.shootReused(p, worker);
+        }
+      },
+      phaseTick(0.0, shootingShare, tasks));
+    stats.pathsCast = paths;
+  }
+  else
+  {
+    const std::uint64_t paths = options.pathsPerFrame;
+    const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
+    const std::uint64_t tasks = tasksPerFrame * frames;
+    parallelFor(tasks, workers,
+      [&](std::size_t task, int worker) {
+        const std::uint64_t frame = task / tasksPerFrame;
+        const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
+        const std::uint64_t end = std::min<std::uint64_t>(paths, first + ClassicPathsPerTask);
+        for (std::uint64_t p = first; p < end; ++p)
+        {
+          run.shootClassic(frame, p, worker);
+        }
+      },
+      phaseTick(0.0, shootingShare, tasks));
+    stats.pathsCast = paths * frames;
+  }
+  run.finishShooting(solution);
+  stats.secondsShooting = secondsSince(shootingStart);
+
+  // Final gathering.
+  const auto gatheringStart = Clock::now();
+  if (options.gatheringRatio > 0)
+  {
+    std::uint64_t raysPerSide = 0;
+    const auto total = static_cast<std::uint64_t>(std::llround(options.gatheringRatio * N));
+    const std::vector<std::uint32_t> sides = run.gatheringSides(raysPerSide, total);
+    stats.gatheringSides = sides.size();
+    const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
+    parallelFor(tasks, workers,
+      [&](std::size_t task, int worker) {
+        const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
+        for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
+        {
+          run.gather(sides[i], raysPerSide, options.reuseGathering, solution, solution, worker);
+        }
+      },
+      phaseTick(shootingShare, 1.0 - shootingShare, tasks));
+  }
+  else
+  {
+    indirectFromPatches(scene, solution);
+  }
+  stats.secondsGathering = secondsSince(gatheringStart);
+  chooseLitSides(scene, solution);
+
+  std::uint64_t firstHits = 0, backAbsorbed = 0;
+  for (const WorkerCounters& c : run.counters())
+  {
+    stats.shootingRays += c.shootingRays;
+    stats.shadowRays += c.shadowRays;
+    stats.gatheringRays += c.gatheringRays;
+    stats.missedRays += c.missedRays;
+    firstHits += c.firstHits;
+    backAbsorbed += c.firstHitsOnBack;
+  }
+  stats.frames = frames;
+  stats.patches = scene.patchCount();
+  stats.elements = scene.elementCount();
+  stats.effectivePathsPerFrame = options.pathsPerFrame;
+  stats.meanPathLength = stats.pathsCast > 0
+    ? 1.0 + (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) / lambda
+    : 0.0;
+  stats.memoryEstimateBytes = memory;
+  stats.threads = workers;
+  stats.reuseShooting = options.reuseShooting;
+  stats.reuseGathering = options.reuseGathering;
+  stats.twoSided = options.twoSided;
+  stats.secondsTotal = secondsSince(start);
+
+  if (firstHits == 0)
+  {
+    solution.warnings.push_back(
+      "no light reached the scene: the light may face away from it (it emits along its "
+      "normal) or lie outside it; the result is all zero");
+  }
+  else if (!options.twoSided && backAbsorbed * 2 > firstHits)
+  {
+    std::ostringstream s;
+    s << "one-sided surfaces: " << backAbsorbed << " of " << firstHits
+      << " first hits reached back faces, which absorb everything; the surfaces probably face "
+         "away from the light: flip their normals or turn two-sided surfaces on";
+    solution.warnings.push_back(s.str());
+  }
+  return solution;
+}
+
+} // namespace mlr

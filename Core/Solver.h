@@ -1,0 +1,154 @@
+// The moving-light radiosity solver: shooting random walks and final gathering, with reuse
+// of both across all light positions (Sbert & Castro; see shared/docs/METHOD.md).
+#pragma once
+
+#include "MovingLight.h"
+#include "Rgb.h"
+#include "Scene.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace mlr
+{
+
+struct SolverOptions
+{
+  /// N: effective shooting paths per frame.
+  std::uint64_t pathsPerFrame = 600000;
+  /// k: gathering rays per frame = k * N, shared over the element sides that gather.
+  double gatheringRatio = 1.0;
+  /// lambda: probability that a path continues after its first hit, in (0, 1].
+  double firstBounceSurvival = 0.25;
+  /// Cast M = N/n paths from each position and weight them for every frame.
+  bool reuseShooting = true;
+  /// Cast one set of gathering rays and use every ray for every frame.
+  bool reuseGathering = true;
+  /// Surfaces scatter light on both sides; when false, back faces absorb everything.
+  bool twoSided = true;
+  std::uint64_t seed = 0;
+  /// Worker threads; 0 means every core. The result does not depend on it.
+  int threads = 0;
+  /// Refuse solves whose memory estimate exceeds this many bytes; 0 means half of the
+  /// physical memory.
+  std::uint64_t memoryLimitBytes = 0;
+};
+
+/// The largest pathsPerFrame accepted: past it a solve would run for months.
+constexpr std::uint64_t MaximumPathsPerFrame = 100000000000ULL;
+
+struct SolverStatistics
+{
+  std::uint64_t frames = 0;
+  std::uint64_t patches = 0;
+  std::uint64_t elements = 0;
+  std::uint64_t effectivePathsPerFrame = 0;
+  std::uint64_t pathsCast = 0;      ///< shooting paths actually traced, all frames
+  std::uint64_t shootingRays = 0;   ///< nearest-hit rays of the shooting walks
+  std::uint64_t shadowRays = 0;     ///< visibility rays for the reuse weights
+  std::uint64_t gatheringRays = 0;  ///< nearest-hit rays of the final gathering
+  std::uint64_t missedRays = 0;     ///< nearest-hit rays that hit nothing
+  std::uint64_t gatheringSides = 0; ///< element sides that gathered
+  /// l of the paper: mean number of hits of a path without the lambda cut, from
+  /// shootingRays / pathsCast = 1 + lambda (l - 1).
+  double meanPathLength = 0;
+  double secondsRemeshing = 0; ///< set by callers that remesh before solving
+  double secondsSetup = 0;     ///< validation, allocation and building the BVH
+  double secondsShooting = 0;
+  double secondsGathering = 0;
+  double secondsTotal = 0;
+  std::uint64_t memoryEstimateBytes = 0;
+  int threads = 0;
+  bool reuseShooting = false;
+  bool reuseGathering = false;
+  bool twoSided = true;
+};
+
+/// Paper eq. (4): predicted speed-up of full reuse over classic, in ray casts.
+double predictedSpeedup(std::size_t frames, double gatheringRatio, double lambda,
+  double meanPathLength);
+
+/**
+ * Radiosity (W/m^2) of every element and patch side, for every frame.
+ *
+ * B_total = B_direct + B_indirect for elements (no self-emission: only the light emits).
+ * B_direct comes from the shooting walks' first hits; B_indirect from final gathering of
+ * the patches' shooting solution. Both sides are kept; litSide() picks the one to show.
+ */
+class Solution
+{
+public:
+  Solution() = default;
+  Solution(std::size_t frames, std::size_t elements, std::size_t patches);
+
+  std::size_t frameCount() const { return this->Frames; }
+  std::size_t elementCount() const { return this->Elements; }
+  std::size_t patchCount() const { return this->Patches; }
+
+  const Rgb& direct(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Direct[this->elementIndex(frame, element, side)];
+  }
+  const Rgb& indirect(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Indirect[this->elementIndex(frame, element, side)];
+  }
+  Rgb total(std::size_t frame, std::size_t element, Side side) const
+  {
+    const std::size_t i = this->elementIndex(frame, element, side);
+    return this->Direct[i] + this->Indirect[i];
+  }
+  /// The patch-level shooting solution (all bounces), which gathering reads.
+  const Rgb& patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
+  {
+    return this->Patch[this->patchIndex(frame, patch, side)];
+  }
+  /// The side of an element that received more power over the whole animation.
+  Side litSide(std::size_t element) const { return this->LitSide[element]; }
+
+  SolverStatistics statistics;
+  std::vector<std::string> warnings;
+
+  // Storage is element- (patch-) major with frames innermost: scoring one hit for all
+  // frames touches one contiguous run.
+  std::size_t elementIndex(std::size_t frame, std::size_t element, Side side) const
+  {
+    return (element * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+  }
+  std::size_t patchIndex(std::size_t frame, std::size_t patch, Side side) const
+  {
+    return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+  }
+  std::vector<Rgb>& directData() { return this->Direct; }
+  std::vector<Rgb>& indirectData() { return this->Indirect; }
+  std::vector<Rgb>& patchData() { return this->Patch; }
+  std::vector<Side>& litSideData() { return this->LitSide; }
+
+private:
+  std::size_t Frames = 0, Elements = 0, Patches = 0;
+  std::vector<Rgb> Direct, Indirect, Patch;
+  std::vector<Side> LitSide;
+};
+
+/// Receives the fraction done in [0, 1]; return false to cancel the solve.
+using ProgressCallback = std::function<bool(double fraction)>;
+
+/// Bytes a solve will allocate (results, per-thread accumulators, ray-tracing scene).
+std::uint64_t estimateSolveMemory(
+  const Scene& scene, std::size_t frames, const SolverOptions& options);
+
+/// Throws mlr::Error naming the first option that is out of range.
+void validateOptions(const SolverOptions& options);
+
+/**
+ * Solves every frame of the animation. Throws mlr::Error on bad options or a memory estimate
+ * over the limit (checked before allocating), and mlr::Cancelled when the progress callback
+ * asks to stop (within a few milliseconds: tasks are small).
+ */
+Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
+  const ProgressCallback& progress = {});
+
+} // namespace mlr

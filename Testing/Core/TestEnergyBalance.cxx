@@ -1,0 +1,119 @@
+// A closed box absorbs all the light's power: sum_i A_i (1-rho_i)/rho_i B_i = Phi.
+#include "GeneratedScenes.h"
+#include "Solver.h"
+
+#include <gtest/gtest.h>
+
+using namespace mlr;
+
+namespace
+{
+struct Balance
+{
+  Rgb absorbed;     ///< sum_i A_i (1 - rho_i) / rho_i B_i over element sides
+  Rgb radiantPower; ///< sum_i A_i B_i
+};
+
+Balance balanceOfFrame(const Scene& scene, const Solution& solution, std::size_t frame)
+{
+  Balance b;
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    const Rgb& rho = scene.elementReflectance(e);
+    for (Side side : { Side::Front, Side::Back })
+    {
+      const Rgb B = solution.total(frame, e, side);
+      for (int c = 0; c < 3; ++c)
+      {
+        b.absorbed[c] += scene.elementArea(e) * (1 - rho[c]) / rho[c] * B[c];
+        b.radiantPower[c] += scene.elementArea(e) * B[c];
+      }
+    }
+  }
+  return b;
+}
+
+std::vector<Vec3> boxTrajectory(std::size_t frames)
+{
+  return scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.25, 0.3, 0.9 }, { 0.75, 0.7, 0.8 }, frames);
+}
+
+void expectAbsorbsAllPower(bool reuseShooting, bool reuseGathering)
+{
+  // Walls of different colours, so that channels and walls weigh differently.
+  const std::vector<Rgb> walls = { Rgb(0.6, 0.2, 0.3), Rgb(0.3, 0.6, 0.2), Rgb(0.5, 0.5, 0.5),
+    Rgb(0.7, 0.4, 0.6), Rgb(0.4, 0.3, 0.7), Rgb(0.55, 0.65, 0.45) };
+  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(6, true, walls));
+  const Rgb power(3, 5, 7);
+  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(4));
+  SolverOptions options;
+  options.pathsPerFrame = 400000;
+  options.reuseShooting = reuseShooting;
+  options.reuseGathering = reuseGathering;
+  const Solution solution = solve(scene, light, options);
+  for (std::size_t f = 0; f < light.frameCount(); ++f)
+  {
+    const Balance b = balanceOfFrame(scene, solution, f);
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_NEAR(b.absorbed[c] / power[c], 1.0, 0.01) << "frame " << f << " channel " << c;
+    }
+  }
+}
+}
+
+TEST(EnergyBalance, ClosedBoxAbsorbsAllPowerClassic)
+{
+  expectAbsorbsAllPower(false, false);
+}
+
+TEST(EnergyBalance, ClosedBoxAbsorbsAllPowerFullReuse)
+{
+  expectAbsorbsAllPower(true, true);
+}
+
+TEST(EnergyBalance, ClosedBoxAbsorbsAllPowerShootingReuseOnly)
+{
+  expectAbsorbsAllPower(true, false);
+}
+
+TEST(EnergyBalance, ClosedBoxAbsorbsAllPowerGatheringReuseOnly)
+{
+  expectAbsorbsAllPower(false, true);
+}
+
+TEST(EnergyBalance, UniformReflectanceGivesGeometricSeries)
+{
+  // With one reflectance rho everywhere, the power leaving all surfaces is
+  // Phi (rho + rho^2 + ...) = Phi rho / (1 - rho).
+  for (double rho : { 0.3, 0.5, 0.8 })
+  {
+    const Scene scene = Scene::fromPatchMesh(scenes::closedBox(6, true, { Rgb(rho) }));
+    const Rgb power(2, 2, 2);
+    const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(3));
+    SolverOptions options;
+    options.pathsPerFrame = 300000;
+    const Solution solution = solve(scene, light, options);
+    for (std::size_t f = 0; f < light.frameCount(); ++f)
+    {
+      const Balance b = balanceOfFrame(scene, solution, f);
+      EXPECT_NEAR(b.radiantPower.r / (power.r * rho / (1 - rho)), 1.0, 0.01) << "rho " << rho << " frame " << f;
+    }
+  }
+}
+
+TEST(EnergyBalance, WithoutGatheringPatchSolutionStillBalances)
+{
+  // k = 0: no final gathering, the elements take their patch's shooting solution.
+  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(5, true, { Rgb(0.5) }));
+  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1), boxTrajectory(2));
+  SolverOptions options;
+  options.pathsPerFrame = 300000;
+  options.gatheringRatio = 0;
+  const Solution solution = solve(scene, light, options);
+  EXPECT_EQ(solution.statistics.gatheringRays, 0u);
+  for (std::size_t f = 0; f < 2; ++f)
+  {
+    EXPECT_NEAR(balanceOfFrame(scene, solution, f).radiantPower.g, 1.0, 0.01);
+  }
+}

@@ -1,0 +1,47 @@
+// Procedural scenes for tests and benchmarks: gridded quads, boxes and a paper-scale room.
+#pragma once
+
+#include "MovingLight.h"
+#include "Scene.h"
+
+#include <vector>
+
+namespace mlr::scenes
+{
+
+/// Appends the quad origin + s*u + t*v (s, t in [0,1]) as nu x nv cells of 2 triangles,
+/// facing u x v.
+void addGriddedQuad(PatchMesh& mesh, const Vec3& origin, const Vec3& u, const Vec3& v, int nu,
+  int nv, const Rgb& reflectance);
+
+/// Appends an axis-aligned box [lo, hi], each face cut into cells of about `cell` size,
+/// with normals facing out (or in). `faceReflectance` is indexed -x,+x,-y,+y,-z,+z.
+void addBox(PatchMesh& mesh, const Vec3& lo, const Vec3& hi, double cell, bool inward,
+  const std::vector<Rgb>& faceReflectance, bool skipBottom = false);
+
+/// A closed unit-ish box [0,1]^3 of uniform or per-face reflectance, cells per edge `n`.
+PatchMesh closedBox(int n, bool inward, const std::vector<Rgb>& faceReflectance);
+
+/// A horizontal square light of side `side` centred at `centre`, facing down (-z).
+std::vector<std::vector<Vec3>> squareLightFacingDown(const Vec3& centre, double side);
+
+/// `count` positions on the segment from `from` to `to`, as translations of a light
+/// whose centroid is `centroid`.
+std::vector<Vec3> translationsAlong(const Vec3& centroid, const Vec3& from, const Vec3& to,
+  std::size_t count);
+
+/**
+ * The paper's configuration, generated: a Cornell-like closed room (5.5 m, white with a red
+ * and a green wall, inward normals) with a short and a tall block, about 2,700 patches
+ * (10,800 elements), and a small ceiling light (1.3 x 1.05 m, facing down) whose 30 positions
+ * run along a diagonal just below the ceiling.
+ */
+struct PaperRoom
+{
+  PatchMesh mesh;
+  std::vector<std::vector<Vec3>> light;
+  std::vector<Vec3> translations;
+};
+PaperRoom paperScaleRoom(std::size_t frames = 30, double cell = 0.385);
+
+} // namespace mlr::scenes
