@@ -22,7 +22,7 @@ class Cancelled : public Error
 {
 public:
   Cancelled()
-    : Error("the solve was cancelled before it completed; no result was produced")
+    : Error("cancelled before completion: no result was produced")
   {
   }
 };

@@ -1,0 +1,83 @@
+// From any polygonal surface with per-polygon materials to the solver's patches.
+#pragma once
+
+#include "Rgb.h"
+#include "Scene.h"
+#include "Vec3.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace mlr
+{
+
+/// What a surface is made of. One per input polygon; room for more attributes later.
+struct Material
+{
+  Rgb reflectance{ 0.5, 0.5, 0.5 };
+
+  bool operator==(const Material& o) const { return this->reflectance == o.reflectance; }
+  bool operator!=(const Material& o) const { return !(*this == o); }
+};
+
+/// A raw polygonal surface as users have it: any vertex count, possibly concave, slightly
+/// non-planar, duplicated, open or non-manifold.
+struct PolygonSoup
+{
+  std::vector<Vec3> points;
+  std::vector<std::vector<std::uint32_t>> polygons;
+  std::vector<Material> materials; ///< one per polygon
+};
+
+struct RemeshOptions
+{
+  /// h: target patch edge length. 0 derives it from targetPatchCount.
+  double targetEdgeLength = 0;
+  /// Patches aimed at when targetEdgeLength is 0.
+  std::size_t targetPatchCount = 3000;
+  /// Edges whose dihedral angle exceeds this (degrees) are kept as sharp features.
+  double sharpEdgeAngle = 30;
+  /// Remesh with CGAL; when false every region is only refined (split to size).
+  bool useCgal = true;
+};
+
+struct RemeshStatistics
+{
+  std::size_t inputPolygons = 0;
+  std::size_t inputTriangles = 0; ///< after triangulating the polygons
+  std::size_t droppedPolygons = 0; ///< fewer than 3 points, zero area or not simple
+  std::size_t regions = 0;        ///< connected faces of one material
+  std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only
+  std::size_t patches = 0;
+  double targetEdgeLength = 0; ///< the h actually used
+  double inputArea = 0;
+  double outputArea = 0;
+  double seconds = 0;
+};
+
+struct RemeshResult
+{
+  PatchMesh mesh;
+  RemeshStatistics statistics;
+  std::vector<std::string> warnings;
+};
+
+/// Receives the fraction done in [0, 1]; return false to cancel (mlr::Cancelled is thrown).
+using RemeshProgress = std::function<bool(double fraction)>;
+
+/**
+ * Turns a polygon soup into well-shaped triangular patches of about edge length h, each with
+ * exactly one material. Throws mlr::Error for input that cannot give a scene (NaN/Inf
+ * points, no polygon with area, bad indices, mismatched materials) and mlr::Cancelled.
+ * Recoverable oddities (dropped polygons, regions only refined) become warnings.
+ */
+RemeshResult remesh(
+  const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
+
+/// The h that gives about `patches` equilateral patches over `area`.
+double edgeLengthForPatchCount(double area, std::size_t patches);
+
+} // namespace mlr
