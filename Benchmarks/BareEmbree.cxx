@@ -137,7 +137,7 @@ BareRates measureBareEmbree(
     Vec3 x, n;
     light.samplePoint(r.uniform(), r.uniform(), r.uniform(), x, n);
     x += light.translation(std::min(frames - 1, std::size_t(r.uniform() * double(frames))));
-    rays[i] = makeRay(x + n * offset, sampleCosineDirection(n, r.uniform(), r.uniform()));
+    rays[i] = makeRay(x + n * offset, sampleCosineDirection(n, r));
   }
   rates.lightRays = traceNearest(bare.handle(), rays, threads);
 
@@ -162,7 +162,7 @@ BareRates measureBareEmbree(
     RandomStream r(2, StreamPurpose::Gathering, i);
     Vec3 p, n;
     surfacePoint(r, p, n);
-    rays[i] = makeRay(p, sampleCosineDirection(n, r.uniform(), r.uniform()));
+    rays[i] = makeRay(p, sampleCosineDirection(n, r));
   }
   rates.surfaceRays = traceNearest(bare.handle(), rays, threads);
 

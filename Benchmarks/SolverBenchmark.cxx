@@ -23,11 +23,13 @@ struct Arguments
   std::size_t frames = 30;
   int threads = 0;
   std::string json;
+  std::string only; ///< run just this mode (for profiling)
 };
 
 void usage()
 {
   std::printf("usage: mlr-benchmark [--paths N] [--frames n] [--threads T] [--json FILE]\n"
+              "                     [--only classic|gathering|shooting|full]\n"
               "Solves the generated paper-scale room (about 2,800 patches, a small ceiling light\n"
               "on a diagonal) in the four reuse modes and compares with bare Embree.\n");
 }
@@ -53,6 +55,10 @@ bool parse(int argc, char** argv, Arguments& a)
     else if (flag == "--json" && hasValue)
     {
       a.json = argv[++i];
+    }
+    else if (flag == "--only" && hasValue)
+    {
+      a.only = argv[++i];
     }
     else
     {
@@ -103,6 +109,17 @@ int main(int argc, char** argv)
     std::vector<ModeResult> modes = { { "classic", false, false, {} },
       { "gathering reuse", false, true, {} }, { "shooting reuse", true, false, {} },
       { "full reuse", true, true, {} } };
+    if (!args.only.empty())
+    {
+      // Profiling: one mode, no comparison.
+      SolverOptions o = options;
+      o.reuseShooting = args.only == "shooting" || args.only == "full";
+      o.reuseGathering = args.only == "gathering" || args.only == "full";
+      const SolverStatistics s = solve(scene, light, o).statistics;
+      std::printf("%s: %.3f s (shooting %.3f s, gathering %.3f s)\n", args.only.c_str(),
+        s.secondsTotal, s.secondsShooting, s.secondsGathering);
+      return 0;
+    }
     for (ModeResult& m : modes)
     {
       SolverOptions o = options;

@@ -5,9 +5,6 @@
 // any thread count, without atomics in the hot loop.
 #pragma once
 
-#include "Rgb.h"
-
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -15,66 +12,109 @@
 namespace mlr
 {
 
+/// How the frames of one (record, side) are laid out.
+enum class FrameLayout
+{
+  /// Frames contiguous per record: reuse scores every frame of one record at once.
+  FramesInner,
+  /// One block per frame: a classic solve scores one frame at a time, and one frame's block
+  /// stays in cache where the whole buffer would not.
+  FramesOuter,
+};
+
+/**
+ * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), one copy per worker.
+ * The caller picks the quantum: values are rounded to multiples of it, and a slot holds up
+ * to 2^63 quanta.
+ */
+template <int Channels>
 class FixedPointAccumulator
 {
 public:
-  /// `records` items with 2 sides and `frames` RGB slots each, one copy per worker. A
-  /// quantum of 2^-40 of the largest power keeps ~12 significant digits per score and
-  /// leaves 2^23 times that power of headroom per slot.
-  FixedPointAccumulator(int workers, std::size_t records, std::size_t frames, double maxPower)
+  FixedPointAccumulator(
+    int workers, std::size_t records, std::size_t frames, double quantum, FrameLayout layout)
     : Frames(frames)
-    , Stride(records * 2 * frames * 3)
-    , Quantum((maxPower > 0 ? maxPower : 1.0) * 0x1.0p-40)
+    , Stride(records * 2 * frames * Channels)
+    , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
+    , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
+    , FrameStride(layout == FrameLayout::FramesInner ? Channels : records * 2 * Channels)
+    , Quantum(quantum)
     , Values(static_cast<std::size_t>(workers) * Stride, 0)
   {
   }
 
-  /// The slots of (record, side) for frames [0, frames) of one worker.
+  /// The slots of (record, side) at frame 0 for one worker; add() steps to other frames.
   std::int64_t* slots(int worker, std::size_t record, int side)
   {
     return this->Values.data() + static_cast<std::size_t>(worker) * this->Stride +
-      (record * 2 + static_cast<std::size_t>(side)) * this->Frames * 3;
+      this->offset(record, side, 0);
   }
 
-  /// Adds a non-negative power to one frame's RGB slot.
-  void add(std::int64_t* frameSlots, std::size_t frame, const Rgb& power) const
+  /// Adds non-negative values to one frame's slot (`values` has Channels entries).
+  void add(std::int64_t* recordSlots, std::size_t frame, const double* values) const
   {
-    std::int64_t* s = frameSlots + frame * 3;
+    std::int64_t* s = recordSlots + frame * this->FrameStride;
     const double scale = 1.0 / this->Quantum;
-    // Values are >= 0, so truncating x + 0.5 rounds to nearest.
-    s[0] += static_cast<std::int64_t>(power.r * scale + 0.5);
-    s[1] += static_cast<std::int64_t>(power.g * scale + 0.5);
-    s[2] += static_cast<std::int64_t>(power.b * scale + 0.5);
+    for (int c = 0; c < Channels; ++c)
+    {
+      // Values are >= 0, so truncating x + 0.5 rounds to nearest.
+      s[c] += static_cast<std::int64_t>(values[c] * scale + 0.5);
+    }
   }
 
-  /// The power of (record, side, frame) summed over workers.
-  Rgb total(std::size_t record, int side, std::size_t frame) const
+  /// Asks the cache for the slots add() will touch for frames [first, first + count), so
+  /// that the miss overlaps work done before the add.
+  void prefetch(const std::int64_t* recordSlots, std::size_t first, std::size_t count) const
   {
-    const std::size_t offset = ((record * 2 + static_cast<std::size_t>(side)) * this->Frames + frame) * 3;
-    std::int64_t sum[3] = { 0, 0, 0 };
-    for (std::size_t w = 0; w * this->Stride < this->Values.size(); ++w)
+    const std::int64_t* begin = recordSlots + first * this->FrameStride;
+    if (this->FrameStride == Channels)
     {
-      const std::int64_t* v = this->Values.data() + w * this->Stride + offset;
-      sum[0] += v[0];
-      sum[1] += v[1];
-      sum[2] += v[2];
+      const std::int64_t* end = begin + count * Channels;
+      for (const std::int64_t* p = begin; p < end; p += 8)
+      {
+        __builtin_prefetch(p, 1);
+      }
+      __builtin_prefetch(end - 1, 1);
+      return;
     }
-    return { static_cast<double>(sum[0]) * this->Quantum,
-      static_cast<double>(sum[1]) * this->Quantum, static_cast<double>(sum[2]) * this->Quantum };
+    for (std::size_t f = 0; f < count; ++f)
+    {
+      __builtin_prefetch(begin + f * this->FrameStride, 1);
+    }
+  }
+
+  /// The sums of (record, side, frame) over workers, written to `out` (Channels entries).
+  void total(std::size_t record, int side, std::size_t frame, double* out) const
+  {
+    const std::int64_t* v = this->Values.data() + this->offset(record, side, frame);
+    std::int64_t sum[Channels] = {};
+    for (std::size_t w = 0; w * this->Stride < this->Values.size(); ++w, v += this->Stride)
+    {
+      for (int c = 0; c < Channels; ++c)
+      {
+        sum[c] += v[c];
+      }
+    }
+    for (int c = 0; c < Channels; ++c)
+    {
+      out[c] = static_cast<double>(sum[c]) * this->Quantum;
+    }
   }
 
   /// True if any worker scored anything on (record, side) in any frame.
   bool received(std::size_t record, int side) const
   {
-    const std::size_t offset = (record * 2 + static_cast<std::size_t>(side)) * this->Frames * 3;
-    for (std::size_t w = 0; w * this->Stride < this->Values.size(); ++w)
+    for (std::size_t f = 0; f < this->Frames; ++f)
     {
-      const std::int64_t* v = this->Values.data() + w * this->Stride + offset;
-      for (std::size_t i = 0; i < this->Frames * 3; ++i)
+      const std::int64_t* v = this->Values.data() + this->offset(record, side, f);
+      for (std::size_t w = 0; w * this->Stride < this->Values.size(); ++w, v += this->Stride)
       {
-        if (v[i] != 0)
+        for (int c = 0; c < Channels; ++c)
         {
-          return true;
+          if (v[c] != 0)
+          {
+            return true;
+          }
         }
       }
     }
@@ -83,12 +123,22 @@ public:
 
   static std::uint64_t bytes(int workers, std::size_t records, std::size_t frames)
   {
-    return static_cast<std::uint64_t>(workers) * records * 2 * frames * 3 * sizeof(std::int64_t);
+    return static_cast<std::uint64_t>(workers) * records * 2 * frames * Channels *
+      sizeof(std::int64_t);
   }
 
 private:
+  std::size_t offset(std::size_t record, int side, std::size_t frame) const
+  {
+    return record * this->RecordStride + static_cast<std::size_t>(side) * this->SideStride +
+      frame * this->FrameStride;
+  }
+
   std::size_t Frames;
   std::size_t Stride;
+  std::size_t RecordStride;
+  std::size_t SideStride;
+  std::size_t FrameStride;
   double Quantum;
   std::vector<std::int64_t> Values;
 };

@@ -55,16 +55,21 @@ private:
   std::uint64_t State;
 };
 
-/// A cosine-distributed direction around the unit normal n (pdf cos(theta)/pi).
-inline Vec3 sampleCosineDirection(const Vec3& n, double u1, double u2)
+/// A cosine-distributed direction around the unit normal n (pdf cos(theta)/pi), by
+/// Malley's method: a uniform point of the unit disk, lifted to the hemisphere. The disk
+/// point comes from rejection, which costs fewer cycles than sin and cos.
+inline Vec3 sampleCosineDirection(const Vec3& n, RandomStream& random)
 {
-  constexpr double twoPi = 6.283185307179586476925286766559;
-  const double r = std::sqrt(u1);
-  const double phi = twoPi * u2;
-  Vec3 t, b;
-  orthonormalBasis(n, t, b);
-  const double z = std::sqrt(std::max(0.0, 1.0 - u1));
-  return t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * z;
+  double a, b, s;
+  do
+  {
+    a = 2.0 * random.uniform() - 1.0;
+    b = 2.0 * random.uniform() - 1.0;
+    s = a * a + b * b;
+  } while (s >= 1.0);
+  Vec3 t, bt;
+  orthonormalBasis(n, t, bt);
+  return t * a + bt * b + n * std::sqrt(1.0 - s);
 }
 
 /// A uniformly distributed point on triangle (a, b, c).

@@ -67,7 +67,6 @@ struct alignas(64) WorkerCounters
 /// Scratch vectors one worker reuses for every path.
 struct WorkerScratch
 {
-  std::vector<Rgb> packets;
   std::vector<double> kernel;
   std::vector<Vec3> targets;
   std::vector<std::uint32_t> targetFrames;
@@ -87,14 +86,16 @@ public:
     , Tracer(tracer)
     , Frames(light.frameCount())
     , Workers(workers)
-    , ElementPower(workers, scene.elementCount(), light.frameCount(), light.power().maxComponent())
-    , PatchPower(workers, scene.patchCount(), light.frameCount(), light.power().maxComponent())
+    , ElementShare(workers, scene.elementCount(), light.frameCount(), 0x1.0p-50,
+        options.reuseShooting ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+    , PatchPower(workers, scene.patchCount(), light.frameCount(),
+        (light.power().maxComponent() > 0 ? light.power().maxComponent() : 1.0) * 0x1.0p-40,
+        options.reuseShooting ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
     , Counters(static_cast<std::size_t>(workers))
     , Scratch(static_cast<std::size_t>(workers))
   {
     for (WorkerScratch& s : this->Scratch)
     {
-      s.packets.resize(this->Frames);
       s.kernel.resize(this->Frames);
       s.targets.resize(this->Frames);
       s.targetFrames.resize(this->Frames);
@@ -135,8 +136,10 @@ public:
   }
 
 private:
-  void scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* packets,
+  void scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
     std::size_t firstFrame, std::size_t frameCount, int worker);
+  void prefetchFirstHit(
+    const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker);
 
   const Scene& SceneRef;
   const MovingLight& Light;
@@ -144,8 +147,12 @@ private:
   const RayTracer& Tracer;
   std::size_t Frames;
   int Workers;
-  FixedPointAccumulator ElementPower;
-  FixedPointAccumulator PatchPower;
+  // Direct light needs one scalar per element side and frame: the share of the light's
+  // power whose first hit lands there. Its colour rho_e Phi is the same for every hit, and
+  // a scalar is a third of the memory traffic of RGB in the hottest loop.
+  FixedPointAccumulator<1> ElementShare;
+  // The patch solution: reflected power (W), RGB, all bounces.
+  FixedPointAccumulator<3> PatchPower;
   std::vector<WorkerCounters> Counters;
   std::vector<WorkerScratch> Scratch;
   std::vector<double> PathsFromPosition;
@@ -154,26 +161,29 @@ private:
 /**
  * Scores a walk's first hit on the element (direct) and patch, then follows it: continue
  * with probability lambda, and at every later hit score the patch and play Russian
- * roulette with the maximum reflectance channel. `packets` hold the power arriving at the
- * first hit for frames [firstFrame, firstFrame + frameCount).
+ * roulette with the maximum reflectance channel. shares[f] is the fraction of the light's
+ * power the walk carries to its first hit in frame firstFrame + f: 1/N for a classic path,
+ * G(x_j,y) / sum_k M_k G(x_k,y) for a reused one. A walk's power in frame f is then
+ * colour * shares[f], with one RGB colour for all frames: the frames differ only by scalar
+ * weights.
  *
  * METHOD.md writes step 3 as P <- P / lambda; the power that leaves the first hit is the
  * reflected power, so we carry rho * P / lambda (the energy balance test checks this).
  */
-void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* packets,
+void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
   std::size_t firstFrame, std::size_t frameCount, int worker)
 {
-  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
-  const int side = static_cast<int>(firstHit.side);
+  const int firstSide = static_cast<int>(firstHit.side);
+  const std::size_t firstPatch = Scene::patchOfElement(firstHit.element);
+  const Rgb& firstRho = this->SceneRef.patchReflectance(firstPatch);
+  Rgb colour = firstRho * this->Light.power();
   {
-    const std::size_t patch = Scene::patchOfElement(firstHit.element);
-    const Rgb& rho = this->SceneRef.patchReflectance(patch);
-    std::int64_t* elementSlots = this->ElementPower.slots(worker, firstHit.element, side);
-    std::int64_t* patchSlots = this->PatchPower.slots(worker, patch, side);
+    std::int64_t* elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
+    std::int64_t* patchSlots = this->PatchPower.slots(worker, firstPatch, firstSide);
     for (std::size_t f = 0; f < frameCount; ++f)
     {
-      const Rgb reflected = rho * packets[f];
-      this->ElementPower.add(elementSlots, firstFrame + f, reflected);
+      const double reflected[3] = { colour.r * shares[f], colour.g * shares[f], colour.b * shares[f] };
+      this->ElementShare.add(elementSlots, firstFrame + f, &shares[f]);
       this->PatchPower.add(patchSlots, firstFrame + f, reflected);
     }
     const double lambda = this->Options.firstBounceSurvival;
@@ -181,21 +191,36 @@ void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* p
     {
       return;
     }
-    for (std::size_t f = 0; f < frameCount; ++f)
-    {
-      packets[f] = rho * packets[f] / lambda;
-    }
+    colour = colour / lambda;
   }
 
+  // A bounce's score is written after the next ray is traced: its slots were prefetched
+  // when the hit was found, so the trace hides the cache miss.
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  std::int64_t* pendingSlots = nullptr;
+  Rgb pendingPower;
+  auto scorePending = [&] {
+    if (pendingSlots)
+    {
+      for (std::size_t f = 0; f < frameCount; ++f)
+      {
+        const double power[3] = { pendingPower.r * shares[f], pendingPower.g * shares[f],
+          pendingPower.b * shares[f] };
+        this->PatchPower.add(pendingSlots, firstFrame + f, power);
+      }
+      pendingSlots = nullptr;
+    }
+  };
   RayHit hit = firstHit;
   for (int bounce = 0; bounce < MaximumBounces; ++bounce)
   {
     const Vec3 normal = this->SceneRef.elementSideNormal(hit.element, hit.side);
-    const double u1 = random.uniform(), u2 = random.uniform();
-    const Vec3 direction = sampleCosineDirection(normal, u1, u2);
+    const Vec3 direction = sampleCosineDirection(normal, random);
     ++counters.shootingRays;
     RayHit next;
-    if (!this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next))
+    const bool found = this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next);
+    scorePending();
+    if (!found)
     {
       ++counters.missedRays;
       return;
@@ -206,23 +231,30 @@ void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, Rgb* p
     }
     const std::size_t patch = Scene::patchOfElement(next.element);
     const Rgb& rho = this->SceneRef.patchReflectance(patch);
-    std::int64_t* patchSlots = this->PatchPower.slots(worker, patch, static_cast<int>(next.side));
-    for (std::size_t f = 0; f < frameCount; ++f)
-    {
-      this->PatchPower.add(patchSlots, firstFrame + f, rho * packets[f]);
-    }
+    pendingPower = rho * colour;
+    pendingSlots = this->PatchPower.slots(worker, patch, static_cast<int>(next.side));
+    this->PatchPower.prefetch(pendingSlots, firstFrame, frameCount);
     const double survival = rho.maxComponent();
     if (!(survival > 0) || random.uniform() >= survival)
     {
+      scorePending();
       return;
     }
-    const Rgb carry = rho / survival;
-    for (std::size_t f = 0; f < frameCount; ++f)
-    {
-      packets[f] = carry * packets[f];
-    }
+    colour = pendingPower / survival;
     hit = next;
   }
+  scorePending();
+}
+
+/// Called as soon as a walk's first hit is known, so that the weights and shadow rays
+/// computed before scoring hide the cache misses of the slots it will score.
+void SolveRun::prefetchFirstHit(
+  const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker)
+{
+  const int side = static_cast<int>(hit.side);
+  this->ElementShare.prefetch(this->ElementShare.slots(worker, hit.element, side), firstFrame, frameCount);
+  this->PatchPower.prefetch(
+    this->PatchPower.slots(worker, Scene::patchOfElement(hit.element), side), firstFrame, frameCount);
 }
 
 void SolveRun::shootReused(std::uint64_t path, int worker)
@@ -235,8 +267,7 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   Vec3 x, lightNormal;
   const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
   this->Light.samplePoint(u0, u1, u2, x, lightNormal);
-  const double v1 = random.uniform(), v2 = random.uniform();
-  const Vec3 direction = sampleCosineDirection(lightNormal, v1, v2);
+  const Vec3 direction = sampleCosineDirection(lightNormal, random);
   const Vec3 start = x + this->Light.translation(origin);
   ++counters.shootingRays;
   RayHit hit;
@@ -251,6 +282,7 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
     ++counters.firstHitsOnBack;
     return;
   }
+  this->prefetchFirstHit(hit, 0, this->Frames, worker);
 
   // Mixture weights w_j = G(x_j, y) / sum_k M_k G(x_k, y), with real visibility. The pi of
   // G cancels; with d = y - x_j unnormalised, cos_x cos_y / r^2 = (n_x.d)(-n_y.d) / |d|^4.
@@ -293,12 +325,11 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   {
     return; // grazing to the last bit: the path carries nothing
   }
-  const Rgb& power = this->Light.power();
   for (std::size_t j = 0; j < this->Frames; ++j)
   {
-    scratch.packets[j] = power * (scratch.kernel[j] / mixture);
+    scratch.kernel[j] /= mixture;
   }
-  this->scoreAndWalk(random, hit, scratch.packets.data(), 0, this->Frames, worker);
+  this->scoreAndWalk(random, hit, scratch.kernel.data(), 0, this->Frames, worker);
 }
 
 void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
@@ -308,8 +339,7 @@ void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
   Vec3 x, lightNormal;
   const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
   this->Light.samplePoint(u0, u1, u2, x, lightNormal);
-  const double v1 = random.uniform(), v2 = random.uniform();
-  const Vec3 direction = sampleCosineDirection(lightNormal, v1, v2);
+  const Vec3 direction = sampleCosineDirection(lightNormal, random);
   const Vec3 start = x + this->Light.translation(static_cast<std::size_t>(frame));
   ++counters.shootingRays;
   RayHit hit;
@@ -324,8 +354,8 @@ void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
     ++counters.firstHitsOnBack;
     return;
   }
-  Rgb packet = this->Light.power() / static_cast<double>(this->Options.pathsPerFrame);
-  this->scoreAndWalk(random, hit, &packet, static_cast<std::size_t>(frame), 1, worker);
+  const double share = 1.0 / static_cast<double>(this->Options.pathsPerFrame);
+  this->scoreAndWalk(random, hit, &share, static_cast<std::size_t>(frame), 1, worker);
 }
 
 /// Turns the accumulated power into radiosity (W/m^2) in the solution.
@@ -337,13 +367,15 @@ void SolveRun::finishShooting(Solution& solution) const
   std::vector<Rgb>& patch = solution.patchData();
   for (std::size_t e = 0; e < elements; ++e)
   {
-    const double inverseArea = 1.0 / this->SceneRef.elementArea(e);
+    const Rgb exitance =
+      this->SceneRef.elementReflectance(e) * this->Light.power() / this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
       for (std::size_t f = 0; f < this->Frames; ++f)
       {
-        direct[solution.elementIndex(f, e, static_cast<Side>(s))] =
-          this->ElementPower.total(e, s, f) * inverseArea;
+        double share = 0;
+        this->ElementShare.total(e, s, f, &share);
+        direct[solution.elementIndex(f, e, static_cast<Side>(s))] = exitance * share;
       }
     }
   }
@@ -354,8 +386,10 @@ void SolveRun::finishShooting(Solution& solution) const
     {
       for (std::size_t f = 0; f < this->Frames; ++f)
       {
+        double power[3];
+        this->PatchPower.total(p, s, f, power);
         patch[solution.patchIndex(f, p, static_cast<Side>(s))] =
-          this->PatchPower.total(p, s, f) * inverseArea;
+          Rgb(power[0], power[1], power[2]) * inverseArea;
       }
     }
   }
@@ -416,9 +450,8 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
     for (std::uint64_t r = 0; r < rays; ++r)
     {
       const double u1 = random.uniform(), u2 = random.uniform();
-      const double v1 = random.uniform(), v2 = random.uniform();
       const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
-      const Vec3 direction = sampleCosineDirection(normal, v1, v2);
+      const Vec3 direction = sampleCosineDirection(normal, random);
       ++counters.gatheringRays;
       RayHit hit;
       if (!this->Tracer.intersect(this->Tracer.liftOff(origin, normal), direction, hit))
@@ -559,7 +592,8 @@ std::uint64_t estimateSolveMemory(
   // Results: direct and indirect per element side, shooting radiosity per patch side.
   const std::uint64_t results = frames * (elements * 2 * 2 + patches * 2) * sizeof(Rgb);
   const std::uint64_t accumulators =
-    FixedPointAccumulator::bytes(static_cast<int>(workers), elements + patches, frames);
+    FixedPointAccumulator<1>::bytes(static_cast<int>(workers), elements, frames) +
+    FixedPointAccumulator<3>::bytes(static_cast<int>(workers), patches, frames);
   const std::uint64_t scratch = workers * frames * (2 * sizeof(Rgb) + sizeof(Vec3) + 16);
   // Embree's BVH and buffers, generously.
   const std::uint64_t tracing = elements * 256 + scene.points().size() * 16;
