@@ -1,8 +1,10 @@
 #include "Remeshing.h"
 
+#include "CgalRemeshing.h"
 #include "Error.h"
 #include "PolygonTriangulation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -14,6 +16,8 @@ namespace
 {
 /// Patches past this many would exhaust memory long before the solve: refuse early.
 constexpr double MaximumPatches = 1 << 26;
+/// Share of the progress taken by CGAL; refining what it refused takes the rest.
+constexpr double CgalShare = 0.95;
 
 /// Uniform 1:m^2 split of a triangle, m = ceil(longest edge / h). Neighbours split with
 /// different m meet at T-junctions, which are harmless to ray casting.
@@ -50,21 +54,38 @@ void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const
     }
   }
 }
+
+double triangleArea(const std::vector<Vec3>& points, const Triangle& t)
+{
+  return 0.5 * length(triangleAreaVector(points[t[0]], points[t[1]], points[t[2]]));
 }
 
-double edgeLengthForPatchCount(double area, std::size_t patches)
+void checkProgress(const RemeshProgress& progress, double fraction)
 {
-  const double count = static_cast<double>(std::max<std::size_t>(1, patches));
-  return std::sqrt(4.0 * area / (std::sqrt(3.0) * count));
+  if (progress && !progress(fraction))
+  {
+    throw Cancelled();
+  }
 }
 
-RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress)
+void validateOptions(const RemeshOptions& options)
 {
-  const auto start = std::chrono::steady_clock::now();
-  RemeshResult result;
-  RemeshStatistics& stats = result.statistics;
-  stats.inputPolygons = soup.polygons.size();
+  if (!(options.targetEdgeLength >= 0) || !std::isfinite(options.targetEdgeLength))
+  {
+    throw Error("the patch size must be 0 (automatic) or a positive length");
+  }
+  if (options.targetEdgeLength == 0 && options.targetPatchCount == 0)
+  {
+    throw Error("the target patch count must be positive when the patch size is 0 (automatic)");
+  }
+  if (!(options.sharpEdgeAngle >= 0 && options.sharpEdgeAngle <= 180))
+  {
+    throw Error("the sharp edge angle must be between 0 and 180 degrees");
+  }
+}
 
+void validateSoup(const PolygonSoup& soup)
+{
   if (soup.materials.size() != soup.polygons.size())
   {
     std::ostringstream s;
@@ -82,21 +103,8 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
     throw Error("the scene has " + std::to_string(nonFinite) +
       " points with NaN or infinite coordinates: remove or fix them");
   }
-  if (!(options.targetEdgeLength >= 0) || !std::isfinite(options.targetEdgeLength))
-  {
-    throw Error("the patch size must be 0 (automatic) or a positive length");
-  }
-
-  // Triangulate every polygon in its own plane.
-  struct SoupTriangle
-  {
-    Vec3 a, b, c;
-    std::size_t polygon;
-  };
-  std::vector<SoupTriangle> triangles;
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
-    const auto& polygon = soup.polygons[i];
     const Rgb& rho = soup.materials[i].reflectance;
     for (int c = 0; c < 3; ++c)
     {
@@ -108,9 +116,7 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
         throw Error(s.str());
       }
     }
-    std::vector<Vec3> corners;
-    corners.reserve(polygon.size());
-    for (std::uint32_t v : polygon)
+    for (std::uint32_t v : soup.polygons[i])
     {
       if (v >= soup.points.size())
       {
@@ -119,40 +125,121 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
           << soup.points.size() << " points";
         throw Error(s.str());
       }
+    }
+  }
+}
+
+/// The distinct materials, and each polygon's index among them: regions are made of faces of
+/// one material, so equal materials must get equal indices.
+std::vector<Material> distinctMaterials(const PolygonSoup& soup, std::vector<std::uint32_t>& index)
+{
+  std::vector<Material> distinct;
+  index.resize(soup.polygons.size());
+  for (std::size_t i = 0; i < soup.polygons.size(); ++i)
+  {
+    // Scenes have few materials, and the last one found is the likely match.
+    std::size_t found = distinct.size();
+    for (std::size_t k = distinct.size(); k-- > 0;)
+    {
+      if (distinct[k] == soup.materials[i])
+      {
+        found = k;
+        break;
+      }
+    }
+    if (found == distinct.size())
+    {
+      distinct.push_back(soup.materials[i]);
+    }
+    index[i] = static_cast<std::uint32_t>(found);
+  }
+  return distinct;
+}
+
+/// The polygons as triangles (indices into the input points), with the count of what was
+/// dropped and why.
+struct Triangulation
+{
+  detail::TriangleSoup soup;
+  std::size_t linesAndPoints = 0;
+  std::size_t zeroArea = 0;
+  std::size_t selfCrossing = 0;
+  double area = 0;
+};
+
+/// True when the polygon has no area at the scale of its own edges (ear clipping cannot tell
+/// it from a self-crossing polygon).
+bool hasZeroArea(const std::vector<Vec3>& corners)
+{
+  double longest = 0;
+  for (std::size_t i = 0; i < corners.size(); ++i)
+  {
+    longest = std::max(longest, lengthSquared(corners[(i + 1) % corners.size()] - corners[i]));
+  }
+  return !(length(newellNormal(corners)) > 1e-10 * longest);
+}
+
+Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32_t>& materialOfPolygon)
+{
+  Triangulation out;
+  std::vector<Vec3> corners;
+  for (std::size_t i = 0; i < soup.polygons.size(); ++i)
+  {
+    const auto& polygon = soup.polygons[i];
+    if (polygon.size() < 3)
+    {
+      ++out.linesAndPoints;
+      continue;
+    }
+    corners.clear();
+    for (std::uint32_t v : polygon)
+    {
       corners.push_back(soup.points[v]);
     }
-    const auto ears = polygon.size() >= 3 ? triangulatePolygon(corners) : decltype(triangulatePolygon(corners)){};
+    const auto ears = triangulatePolygon(corners);
     if (ears.empty())
     {
-      ++stats.droppedPolygons;
+      ++(hasZeroArea(corners) ? out.zeroArea : out.selfCrossing);
       continue;
     }
     for (const auto& t : ears)
     {
-      triangles.push_back({ corners[t[0]], corners[t[1]], corners[t[2]], i });
-      stats.inputArea += 0.5 * length(triangleAreaVector(corners[t[0]], corners[t[1]], corners[t[2]]));
+      const Triangle triangle{ polygon[t[0]], polygon[t[1]], polygon[t[2]] };
+      out.soup.triangles.push_back(triangle);
+      out.soup.material.push_back(materialOfPolygon[i]);
+      out.area += triangleArea(soup.points, triangle);
     }
   }
-  stats.inputTriangles = triangles.size();
-  if (triangles.empty())
-  {
-    throw Error("the scene has no polygon with an area (" + std::to_string(soup.polygons.size()) +
-      " polygons, all degenerate): give at least one triangle or polygon that encloses area");
-  }
-  if (stats.droppedPolygons > 0)
-  {
-    result.warnings.push_back("ignored " + std::to_string(stats.droppedPolygons) +
-      " polygons with fewer than 3 points, zero area or crossing edges");
-  }
+  return out;
+}
 
-  const double h = options.targetEdgeLength > 0
-    ? options.targetEdgeLength
-    : edgeLengthForPatchCount(stats.inputArea, options.targetPatchCount);
-  stats.targetEdgeLength = h;
-  double expected = 0;
-  for (const SoupTriangle& t : triangles)
+void addTriangulationWarnings(const Triangulation& t, std::vector<std::string>& warnings)
+{
+  if (t.linesAndPoints > 0)
   {
-    const double longest = std::max({ length(t.b - t.a), length(t.c - t.b), length(t.a - t.c) });
+    warnings.push_back("ignored " + std::to_string(t.linesAndPoints) +
+      " lines or vertices (polygons with fewer than 3 points): only surfaces are remeshed");
+  }
+  if (t.zeroArea > 0)
+  {
+    warnings.push_back("ignored " + std::to_string(t.zeroArea) +
+      " polygons with zero area (all their points on one line)");
+  }
+  if (t.selfCrossing > 0)
+  {
+    warnings.push_back("ignored " + std::to_string(t.selfCrossing) +
+      " self-crossing polygons: split them into simple polygons to keep them");
+  }
+}
+
+/// Refuses an h that would cut the scene into more patches than memory allows.
+void checkPatchBudget(const std::vector<Vec3>& points, const detail::TriangleSoup& soup, double h)
+{
+  double expected = 0;
+  for (const Triangle& t : soup.triangles)
+  {
+    const Vec3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
+    const double longest = std::max({ length(b - a), length(c - b), length(a - c) });
     const double m = std::max(1.0, std::ceil(longest / h - 1e-9));
     expected += m * m;
   }
@@ -163,29 +250,113 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
       << " patches (the maximum is " << MaximumPatches << "): give a larger patch size";
     throw Error(s.str());
   }
+}
 
-  for (std::size_t i = 0; i < triangles.size(); ++i)
+/// Splits the given input triangles only; progress runs from `from` to 1.
+void refineOnly(const std::vector<Vec3>& points, const detail::TriangleSoup& soup,
+  const std::vector<std::size_t>& which, const std::vector<Material>& materials, double h,
+  const RemeshProgress& progress, double from, PatchMesh& out)
+{
+  for (std::size_t i = 0; i < which.size(); ++i)
   {
-    const SoupTriangle& t = triangles[i];
-    refineTriangle(t.a, t.b, t.c, h, soup.materials[t.polygon].reflectance, result.mesh);
-    if (progress && i % 4096 == 0 && !progress(double(i) / double(triangles.size())))
+    const Triangle& t = soup.triangles[which[i]];
+    refineTriangle(points[t[0]], points[t[1]], points[t[2]], h,
+      materials[soup.material[which[i]]].reflectance, out);
+    if (i % 4096 == 0)
     {
-      throw Cancelled();
+      checkProgress(progress, from + (1 - from) * double(i) / double(which.size()));
     }
   }
-  stats.regions = 0;
-  stats.fallbackRegions = 0;
+}
+
+void appendCgalPatches(
+  const detail::CgalRemeshOutput& cgal, const std::vector<Material>& materials, PatchMesh& out)
+{
+  const auto base = static_cast<std::uint32_t>(out.points.size());
+  out.points.insert(out.points.end(), cgal.points.begin(), cgal.points.end());
+  for (std::size_t i = 0; i < cgal.triangles.size(); ++i)
+  {
+    const Triangle& t = cgal.triangles[i];
+    out.triangles.push_back({ base + t[0], base + t[1], base + t[2] });
+    out.reflectance.push_back(materials[cgal.material[i]].reflectance);
+  }
+}
+}
+
+double edgeLengthForPatchCount(double area, std::size_t patches)
+{
+  const double count = static_cast<double>(std::max<std::size_t>(1, patches));
+  return std::sqrt(4.0 * area / (std::sqrt(3.0) * count));
+}
+
+RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress)
+{
+  const auto start = std::chrono::steady_clock::now();
+  validateOptions(options);
+  validateSoup(soup);
+  RemeshResult result;
+  RemeshStatistics& stats = result.statistics;
+  stats.inputPolygons = soup.polygons.size();
+
+  std::vector<std::uint32_t> materialOfPolygon;
+  const std::vector<Material> materials = distinctMaterials(soup, materialOfPolygon);
+  const Triangulation triangulation = triangulate(soup, materialOfPolygon);
+  const detail::TriangleSoup& triangles = triangulation.soup;
+  stats.inputTriangles = triangles.triangles.size();
+  stats.inputArea = triangulation.area;
+  stats.droppedPolygons = triangulation.linesAndPoints + triangulation.zeroArea + triangulation.selfCrossing;
+  if (triangles.triangles.empty())
+  {
+    throw Error("the scene has no polygon with an area (" + std::to_string(soup.polygons.size()) +
+      " polygons, all degenerate): give at least one triangle or polygon that encloses area");
+  }
+  addTriangulationWarnings(triangulation, result.warnings);
+
+  const double h = options.targetEdgeLength > 0
+    ? options.targetEdgeLength
+    : edgeLengthForPatchCount(stats.inputArea, options.targetPatchCount);
+  stats.targetEdgeLength = h;
+  checkPatchBudget(soup.points, triangles, h);
+
+  std::vector<std::size_t> refined;
+  if (options.useCgal)
+  {
+    detail::CgalRemeshSettings settings;
+    settings.targetEdgeLength = h;
+    settings.sharpEdgeAngle = options.sharpEdgeAngle;
+    const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
+      settings, [&](double f) { return !progress || progress(CgalShare * f); });
+    appendCgalPatches(cgal, materials, result.mesh);
+    refined = cgal.refineOnly;
+    stats.regions = cgal.regions;
+    stats.fallbackRegions = cgal.fallbackRegions;
+    stats.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
+    result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
+  }
+  else
+  {
+    refined.resize(triangles.triangles.size());
+    for (std::size_t i = 0; i < refined.size(); ++i)
+    {
+      refined[i] = i;
+    }
+  }
+  refineOnly(soup.points, triangles, refined, materials, h, progress,
+    options.useCgal ? CgalShare : 0.0, result.mesh);
+
+  if (result.mesh.triangles.empty())
+  {
+    throw Error("the scene has no surface left after merging duplicate points (" +
+      std::to_string(stats.removedTriangles) + " triangles became degenerate or duplicates): "
+      "give at least one triangle with an area");
+  }
   stats.patches = result.mesh.triangles.size();
   for (const Triangle& t : result.mesh.triangles)
   {
-    stats.outputArea += 0.5 *
-      length(triangleAreaVector(result.mesh.points[t[0]], result.mesh.points[t[1]], result.mesh.points[t[2]]));
+    stats.outputArea += triangleArea(result.mesh.points, t);
   }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (progress && !progress(1.0))
-  {
-    throw Cancelled();
-  }
+  checkProgress(progress, 1.0);
   return result;
 }
 
