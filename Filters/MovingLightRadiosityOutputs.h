@@ -1,0 +1,46 @@
+// From Core's scene and solution to the filter's VTK outputs: the meshes (built once per
+// solve), the arrays of one frame (built per time request) and the statistics.
+#pragma once
+
+#include "Scene.h"
+#include "Solver.h"
+
+#include "vtkSmartPointer.h"
+
+#include <cstddef>
+#include <vector>
+
+class vtkCellData;
+class vtkFieldData;
+class vtkPolyData;
+
+namespace mlr::vtkoutputs
+{
+
+/// The element triangles with `Reflectance` and `PatchId`: everything of the Elements output
+/// that does not depend on the frame.
+vtkSmartPointer<vtkPolyData> elementMesh(const Scene& scene);
+
+/// The patch triangles (on the first `cornerCount` points of the scene, the patch corners)
+/// with `Reflectance`.
+vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCount);
+
+/// Adds `Radiosity`, `DirectRadiosity` and `IndirectRadiosity` of each element's lit side in
+/// `frame`, and `RadiosityFront`/`RadiosityBack` when `twoSided`.
+void addElementRadiosity(
+  const Solution& solution, std::size_t frame, bool twoSided, vtkCellData* cellData);
+
+/// The side of each patch that received more power over the animation (the patch-level
+/// counterpart of Solution::litSide).
+std::vector<Side> patchLitSides(const Solution& solution);
+
+/// Adds `Radiosity`, the patch shooting solution of each patch's lit side in `frame`.
+void addPatchRadiosity(const Solution& solution, const std::vector<Side>& litSides,
+  std::size_t frame, vtkCellData* cellData);
+
+/// One single-value array per statistic (counts, seconds, reuse modes), plus the predicted
+/// speed-up of full reuse over classic for these frames, k and lambda (paper eq. 4).
+vtkSmartPointer<vtkFieldData> statisticsFieldData(
+  const SolverStatistics& statistics, const SolverOptions& options);
+
+} // namespace mlr::vtkoutputs

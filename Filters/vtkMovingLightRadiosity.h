@@ -1,0 +1,263 @@
+/**
+ * @class   vtkMovingLightRadiosity
+ * @brief   radiosity of a polygonal scene lit by a light that moves along a trajectory
+ *
+ * vtkMovingLightRadiosity computes the diffuse illumination (radiosity, W/m^2) of a scene for
+ * every position of a moving area light, with the reuse of shooting and gathering paths of
+ * Sbert & Castro ("Reuse of Paths in Final Gathering Step with Moving Light Sources"): one
+ * run solves all the frames, each path serving every light position.
+ *
+ * Inputs:
+ * - port 0, Scene (required): polygons and triangle strips; vertices and lines are ignored
+ *   with a warning. The cell array `Reflectance` gives each cell's reflectance (3 components,
+ *   RGB, or 1 component, grey; every value >= 0 and < 1). Without it the scene is grey 0.5
+ *   and a warning says so. The scene is remeshed into patches of about PatchSize.
+ * - port 1, Light (required): one or more planar polygons emitting diffusely along their
+ *   normals (right-hand rule) with total power LightPower. Its area centroid is the light's
+ *   reference point. The light does not cast shadows.
+ * - port 2, Trajectory (optional): the points, in order, are the positions of the light's
+ *   centroid, one per frame. An optional point array `Time` (1 component, increasing) gives
+ *   the frame times, else they are 0, 1, ..., n-1. Without this input the light moves in a
+ *   straight line from PathStart to PathEnd in NumberOfPositions frames.
+ *
+ * Outputs:
+ * - port 0, Elements: the element mesh (triangles, four per patch) with the cell arrays
+ *   `Radiosity`, `DirectRadiosity`, `IndirectRadiosity` (3 components, W/m^2, of the
+ *   element's lit side: the side that received more power over the whole animation, so
+ *   that a room made of outward-facing polygons still shows its lit walls), `RadiosityFront`
+ *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`. Its field data holds
+ *   the solver statistics (paths, rays by kind, seconds by phase, patches, elements, frames,
+ *   reuse modes, predicted speed-up), the frame shown (`FrameIndex`) and `SolveCount`.
+ * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
+ *   the patch's lit side) and `Reflectance`.
+ *
+ * Time: the outputs have one time step per light position (TIME_STEPS, TIME_RANGE). The
+ * first update solves every frame at once and keeps the result; requests for other times
+ * are served from it without solving again, until an input or a property changes. A time
+ * between two steps shows the step at or below it. The filter's time is not passed
+ * upstream: the inputs are used as they are.
+ *
+ * Progress is reported through UpdateProgress; setting AbortExecute stops the solve within
+ * a fraction of a second, with empty outputs and an error. Bad input (NaN points, a wrong
+ * `Reflectance`, a light without polygons, ...) gives an error naming what to fix and empty
+ * outputs. An empty scene gives empty outputs and no error.
+ *
+ * @warning
+ * The solve uses NumberOfThreads threads of its own (0: every core), whatever the
+ * vtkSMPTools backend.
+ *
+ * @sa
+ * The method is described in shared/docs/METHOD.md of the MovingLightRadiosity project.
+ */
+
+#ifndef vtkMovingLightRadiosity_h
+#define vtkMovingLightRadiosity_h
+
+#include "MovingLightRadiosityFiltersModule.h" // For export macro
+#include "vtkPolyDataAlgorithm.h"
+
+#include <memory> // For std::unique_ptr
+
+class MOVINGLIGHTRADIOSITYFILTERS_EXPORT vtkMovingLightRadiosity : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMovingLightRadiosity* New();
+  vtkTypeMacro(vtkMovingLightRadiosity, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The input ports, in order.
+  enum InputPorts
+  {
+    SCENE_PORT = 0,
+    LIGHT_PORT = 1,
+    TRAJECTORY_PORT = 2
+  };
+
+  /// The output ports, in order.
+  enum OutputPorts
+  {
+    ELEMENTS_PORT = 0,
+    PATCHES_PORT = 1
+  };
+
+  ///@{
+  /**
+   * Connect the scene (port 0), the light (port 1) and the optional trajectory (port 2).
+   */
+  void SetSceneConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(0, output); }
+  void SetLightConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+  void SetTrajectoryConnection(vtkAlgorithmOutput* output)
+  {
+    this->SetInputConnection(2, output);
+  }
+  void SetSceneData(vtkDataObject* data) { this->SetInputData(0, data); }
+  void SetLightData(vtkDataObject* data) { this->SetInputData(1, data); }
+  void SetTrajectoryData(vtkDataObject* data) { this->SetInputData(2, data); }
+  ///@}
+
+  ///@{
+  /**
+   * Total power of the light, per channel (RGB, W). Default 100, 100, 100.
+   */
+  vtkSetVector3Macro(LightPower, double);
+  vtkGetVector3Macro(LightPower, double);
+  ///@}
+
+  ///@{
+  /**
+   * Effective shooting paths per frame, N. Default 600000.
+   */
+  vtkSetClampMacro(NumberOfPaths, vtkIdType, 1, 100000000000LL);
+  vtkGetMacro(NumberOfPaths, vtkIdType);
+  ///@}
+
+  ///@{
+  /**
+   * Gathering rays per frame as a multiple k of NumberOfPaths; 0 skips final gathering and
+   * the elements show their patch's shooting solution. Default 1.
+   */
+  vtkSetClampMacro(GatheringRatio, double, 0.0, 1000.0);
+  vtkGetMacro(GatheringRatio, double);
+  ///@}
+
+  ///@{
+  /**
+   * Probability lambda that a shooting path continues after its first hit. Default 0.25.
+   */
+  vtkSetClampMacro(FirstBounceSurvival, double, 0.001, 1.0);
+  vtkGetMacro(FirstBounceSurvival, double);
+  ///@}
+
+  ///@{
+  /**
+   * Reuse every shooting path for all light positions (else each frame shoots its own).
+   * Default on.
+   */
+  vtkSetMacro(ReuseShooting, vtkTypeBool);
+  vtkGetMacro(ReuseShooting, vtkTypeBool);
+  vtkBooleanMacro(ReuseShooting, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Reuse one set of gathering rays for all frames (else each frame gathers its own).
+   * Default on.
+   */
+  vtkSetMacro(ReuseGathering, vtkTypeBool);
+  vtkGetMacro(ReuseGathering, vtkTypeBool);
+  vtkBooleanMacro(ReuseGathering, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Target patch edge length, in scene units; 0 picks one that gives about 3000 patches.
+   * Default 0.
+   */
+  vtkSetClampMacro(PatchSize, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(PatchSize, double);
+  ///@}
+
+  ///@{
+  /**
+   * Seed of the random numbers: the same seed gives the same result. Default 0.
+   */
+  vtkSetClampMacro(Seed, int, 0, VTK_INT_MAX);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /**
+   * Threads of the solve; 0 uses every core. The result does not depend on it. Default 0.
+   */
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
+  ///@{
+  /**
+   * Surfaces scatter light on both sides (else back faces absorb all). Default on.
+   */
+  vtkSetMacro(TwoSided, vtkTypeBool);
+  vtkGetMacro(TwoSided, vtkTypeBool);
+  vtkBooleanMacro(TwoSided, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * First light centroid position when no Trajectory is connected. Default 0, 0, 0.
+   */
+  vtkSetVector3Macro(PathStart, double);
+  vtkGetVector3Macro(PathStart, double);
+  ///@}
+
+  ///@{
+  /**
+   * Last light centroid position when no Trajectory is connected. Default 1, 0, 0.
+   */
+  vtkSetVector3Macro(PathEnd, double);
+  vtkGetVector3Macro(PathEnd, double);
+  ///@}
+
+  ///@{
+  /**
+   * Light positions (frames) from PathStart to PathEnd when no Trajectory is connected.
+   * Default 10.
+   */
+  vtkSetClampMacro(NumberOfPositions, int, 1, 100000);
+  vtkGetMacro(NumberOfPositions, int);
+  ///@}
+
+  ///@{
+  /**
+   * Refuse solves estimated to need more memory than this (MiB); 0 means half of the
+   * physical memory. Default 0.
+   */
+  vtkSetClampMacro(MemoryLimit, int, 0, VTK_INT_MAX);
+  vtkGetMacro(MemoryLimit, int);
+  ///@}
+
+  /**
+   * Number of solves performed so far by this filter (new times do not solve again).
+   */
+  vtkGetMacro(SolveCount, vtkIdType);
+
+protected:
+  vtkMovingLightRadiosity();
+  ~vtkMovingLightRadiosity() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  int RequestUpdateExtent(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+
+  double LightPower[3];
+  vtkIdType NumberOfPaths;
+  double GatheringRatio;
+  double FirstBounceSurvival;
+  vtkTypeBool ReuseShooting;
+  vtkTypeBool ReuseGathering;
+  double PatchSize;
+  int Seed;
+  int NumberOfThreads;
+  vtkTypeBool TwoSided;
+  double PathStart[3];
+  double PathEnd[3];
+  int NumberOfPositions;
+  int MemoryLimit;
+  vtkIdType SolveCount;
+
+private:
+  vtkMovingLightRadiosity(const vtkMovingLightRadiosity&) = delete;
+  void operator=(const vtkMovingLightRadiosity&) = delete;
+
+  /// Solves every frame and caches the result; returns false (after an error) on failure.
+  bool Solve(vtkInformationVector** inputVector);
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
+};
+
+#endif
