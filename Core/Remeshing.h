@@ -78,7 +78,8 @@ using RemeshProgress = std::function<bool(double fraction)>;
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
 
-/// The h that gives about `patches` equilateral patches over `area`.
+/// The h at which remeshing cuts `area` into about `patches` patches (a little more than the
+/// side of `patches` equilateral triangles covering it).
 double edgeLengthForPatchCount(double area, std::size_t patches);
 
 } // namespace mlr
