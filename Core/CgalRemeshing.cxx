@@ -93,6 +93,11 @@ double triangleArea(const Point& a, const Point& b, const Point& c)
   return 0.5 * length(triangleAreaVector(toVec3(a), toVec3(b), toVec3(c)));
 }
 
+std::string countOf(std::size_t n, const std::string& noun)
+{
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 std::string describe(const Rgb& c)
 {
   std::ostringstream s;
@@ -104,7 +109,7 @@ std::string describeRegion(const Region& region, const std::vector<Material>& ma
 {
   std::ostringstream s;
   s << "region " << region.id << " (reflectance " << describe(materials[region.material].reflectance)
-    << ", " << region.inputTriangles.size() << " input triangles)";
+    << ", " << countOf(region.inputTriangles.size(), "input triangle") << ")";
   return s.str();
 }
 
@@ -620,25 +625,25 @@ void addRepairWarnings(CgalRemeshOutput& out)
 {
   if (out.degenerateTriangles > 0)
   {
-    out.warnings.push_back("removed " + std::to_string(out.degenerateTriangles) +
-      " triangles that became degenerate when duplicate points were merged");
+    out.warnings.push_back("removed " + countOf(out.degenerateTriangles, "triangle") +
+      " that became degenerate when duplicate points were merged");
   }
   if (out.duplicateTriangles > 0)
   {
-    out.warnings.push_back("removed " + std::to_string(out.duplicateTriangles) +
-      " duplicate triangles (on the same 3 points as another; the first one's material was kept)");
+    out.warnings.push_back("removed " + countOf(out.duplicateTriangles, "duplicate triangle") +
+      " (on the same 3 points as an earlier one, whose material was kept)");
   }
   if (out.splitPoints > 0)
   {
-    out.warnings.push_back("split " + std::to_string(out.splitPoints) +
-      " points where the surface is not a manifold (an edge shared by more than two faces, "
+    out.warnings.push_back("split " + countOf(out.splitPoints, "point") +
+      " where the surface is not a manifold (an edge shared by more than two faces, "
       "faces meeting only at a point, or opposite orientations): the surfaces meeting there "
       "were remeshed separately");
   }
   if (out.fallbackRegions > MaximumRegionWarnings)
   {
-    out.warnings.push_back("... and " + std::to_string(out.fallbackRegions - MaximumRegionWarnings) +
-      " more regions were only refined, not remeshed");
+    out.warnings.push_back("... and " + countOf(out.fallbackRegions - MaximumRegionWarnings, "more region") +
+      " only refined, not remeshed");
   }
 }
 }
@@ -665,7 +670,7 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
     out.refineOnly.resize(input.triangles.size());
     std::iota(out.refineOnly.begin(), out.refineOnly.end(), std::size_t(0));
     out.warnings.push_back(std::string("CGAL could not repair the surface (") + e.what() +
-      "): all " + std::to_string(input.triangles.size()) + " triangles were only refined, not remeshed");
+      "): all " + countOf(input.triangles.size(), "triangle") + " were only refined, not remeshed");
     return out;
   }
   constexpr double RepairShare = 0.05;

@@ -5,6 +5,7 @@
 #include "PolygonTriangulation.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -60,6 +61,11 @@ double triangleArea(const std::vector<Vec3>& points, const Triangle& t)
   return 0.5 * length(triangleAreaVector(points[t[0]], points[t[1]], points[t[2]]));
 }
 
+std::string countOf(std::size_t n, const std::string& noun, const std::string& nouns = {})
+{
+  return std::to_string(n) + " " + (n == 1 ? noun : (nouns.empty() ? noun + "s" : nouns));
+}
+
 void checkProgress(const RemeshProgress& progress, double fraction)
 {
   if (progress && !progress(fraction))
@@ -100,8 +106,8 @@ void validateSoup(const PolygonSoup& soup)
   }
   if (nonFinite > 0)
   {
-    throw Error("the scene has " + std::to_string(nonFinite) +
-      " points with NaN or infinite coordinates: remove or fix them");
+    throw Error("the scene has " + countOf(nonFinite, "point") +
+      " with NaN or infinite coordinates: remove or fix them");
   }
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
@@ -162,33 +168,74 @@ struct Triangulation
 {
   detail::TriangleSoup soup;
   std::size_t linesAndPoints = 0;
+  std::size_t duplicates = 0;
   std::size_t zeroArea = 0;
   std::size_t selfCrossing = 0;
   double area = 0;
 };
 
-/// True when the polygon has no area at the scale of its own edges (ear clipping cannot tell
-/// it from a self-crossing polygon).
-bool hasZeroArea(const std::vector<Vec3>& corners)
+/// Polygons on the same points as an earlier one, whatever their order: exporters write
+/// two-sided walls twice, and two coincident surfaces cannot both be remeshed.
+std::vector<bool> duplicatePolygons(const PolygonSoup& soup)
 {
-  double longest = 0;
-  for (std::size_t i = 0; i < corners.size(); ++i)
+  using Key = std::vector<std::array<double, 3>>;
+  std::vector<std::pair<Key, std::size_t>> keys;
+  for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
-    longest = std::max(longest, lengthSquared(corners[(i + 1) % corners.size()] - corners[i]));
+    if (soup.polygons[i].size() < 3)
+    {
+      continue;
+    }
+    Key key;
+    for (std::uint32_t v : soup.polygons[i])
+    {
+      const Vec3& p = soup.points[v];
+      key.push_back({ p.x, p.y, p.z });
+    }
+    std::sort(key.begin(), key.end());
+    key.erase(std::unique(key.begin(), key.end()), key.end());
+    keys.emplace_back(std::move(key), i);
   }
-  return !(length(newellNormal(corners)) > 1e-10 * longest);
+  std::sort(keys.begin(), keys.end());
+  std::vector<bool> duplicate(soup.polygons.size(), false);
+  for (std::size_t k = 1; k < keys.size(); ++k)
+  {
+    duplicate[keys[k].second] = keys[k].first == keys[k - 1].first;
+  }
+  return duplicate;
+}
+
+/// True when all corners lie on one line (ear clipping cannot tell a polygon without area
+/// from a self-crossing one).
+bool isCollinear(const std::vector<Vec3>& corners)
+{
+  Vec3 far = corners[0];
+  for (const Vec3& p : corners)
+  {
+    far = lengthSquared(p - corners[0]) > lengthSquared(far - corners[0]) ? p : far;
+  }
+  const Vec3 axis = far - corners[0];
+  for (const Vec3& p : corners)
+  {
+    if (length(cross(p - corners[0], axis)) > 1e-10 * lengthSquared(axis))
+    {
+      return false;
+    }
+  }
+  return true;
 }
 
 Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32_t>& materialOfPolygon)
 {
   Triangulation out;
+  const std::vector<bool> duplicate = duplicatePolygons(soup);
   std::vector<Vec3> corners;
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
     const auto& polygon = soup.polygons[i];
-    if (polygon.size() < 3)
+    if (polygon.size() < 3 || duplicate[i])
     {
-      ++out.linesAndPoints;
+      ++(duplicate[i] ? out.duplicates : out.linesAndPoints);
       continue;
     }
     corners.clear();
@@ -199,7 +246,7 @@ Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32
     const auto ears = triangulatePolygon(corners);
     if (ears.empty())
     {
-      ++(hasZeroArea(corners) ? out.zeroArea : out.selfCrossing);
+      ++(isCollinear(corners) ? out.zeroArea : out.selfCrossing);
       continue;
     }
     for (const auto& t : ears)
@@ -217,18 +264,23 @@ void addTriangulationWarnings(const Triangulation& t, std::vector<std::string>& 
 {
   if (t.linesAndPoints > 0)
   {
-    warnings.push_back("ignored " + std::to_string(t.linesAndPoints) +
-      " lines or vertices (polygons with fewer than 3 points): only surfaces are remeshed");
+    warnings.push_back("ignored " + countOf(t.linesAndPoints, "line or vertex", "lines or vertices") +
+      " (polygons with fewer than 3 points): only surfaces are remeshed");
+  }
+  if (t.duplicates > 0)
+  {
+    warnings.push_back("ignored " + countOf(t.duplicates, "duplicate polygon") +
+      " (on the same points as an earlier polygon, whose material was kept)");
   }
   if (t.zeroArea > 0)
   {
-    warnings.push_back("ignored " + std::to_string(t.zeroArea) +
-      " polygons with zero area (all their points on one line)");
+    warnings.push_back("ignored " + countOf(t.zeroArea, "polygon") +
+      " with zero area (all points on one line)");
   }
   if (t.selfCrossing > 0)
   {
-    warnings.push_back("ignored " + std::to_string(t.selfCrossing) +
-      " self-crossing polygons: split them into simple polygons to keep them");
+    warnings.push_back("ignored " + countOf(t.selfCrossing, "self-crossing polygon") +
+      ": split such polygons into simple ones to keep them");
   }
 }
 
@@ -308,7 +360,8 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
   const detail::TriangleSoup& triangles = triangulation.soup;
   stats.inputTriangles = triangles.triangles.size();
   stats.inputArea = triangulation.area;
-  stats.droppedPolygons = triangulation.linesAndPoints + triangulation.zeroArea + triangulation.selfCrossing;
+  stats.droppedPolygons = triangulation.linesAndPoints + triangulation.duplicates +
+    triangulation.zeroArea + triangulation.selfCrossing;
   if (triangles.triangles.empty())
   {
     throw Error("the scene has no polygon with an area (" + std::to_string(soup.polygons.size()) +

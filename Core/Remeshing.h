@@ -48,7 +48,7 @@ struct RemeshStatistics
 {
   std::size_t inputPolygons = 0;
   std::size_t inputTriangles = 0; ///< after triangulating the polygons
-  std::size_t droppedPolygons = 0; ///< fewer than 3 points, zero area or not simple
+  std::size_t droppedPolygons = 0; ///< fewer than 3 points, duplicate, zero area or self-crossing
   std::size_t removedTriangles = 0; ///< degenerate or duplicate once duplicate points merged
   std::size_t regions = 0;        ///< connected faces of one material
   std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only

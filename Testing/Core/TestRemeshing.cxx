@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -332,21 +333,22 @@ TEST(Remeshing, EveryElementCarriesTheReflectanceOfItsWall)
 
 TEST(Remeshing, OutputKeepsTheOrientationOfEachInputPolygon)
 {
-  // Inward walls, except one facing out by mistake: orientation repair must not change
-  // what the user gave.
-  PolygonSoup soup = boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }, true);
-  std::reverse(soup.polygons[3].begin(), soup.polygons[3].end());
-  const RemeshResult result = remesh(soup, withEdgeLength(0.15));
-  const PatchMesh& mesh = result.mesh;
-  for (std::size_t p = 0; p < mesh.triangles.size(); ++p)
+  // Inward walls, except one facing out by mistake: orientation repair must not change what
+  // the user gave, whichever wall it starts from.
+  for (std::size_t odd = 0; odd < 6; ++odd)
   {
-    const std::vector<int> faces = commonCubeFaces(mesh, p);
-    ASSERT_EQ(faces.size(), 1u);
-    const int axis = faces[0] / 2;
-    Vec3 inward;
-    inward[axis] = faces[0] % 2 == 0 ? 1 : -1;
-    const double expected = faces[0] == 3 ? -1 : 1;
-    EXPECT_NEAR(dot(normal(mesh, p), inward), expected, 1e-9) << "patch " << p << " on face " << faces[0];
+    PolygonSoup soup = boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }, true);
+    std::reverse(soup.polygons[odd].begin(), soup.polygons[odd].end());
+    const PatchMesh mesh = remesh(soup, withEdgeLength(0.15)).mesh;
+    for (std::size_t p = 0; p < mesh.triangles.size(); ++p)
+    {
+      const std::vector<int> faces = commonCubeFaces(mesh, p);
+      ASSERT_EQ(faces.size(), 1u);
+      Vec3 inward;
+      inward[faces[0] / 2] = faces[0] % 2 == 0 ? 1 : -1;
+      const double expected = faces[0] == static_cast<int>(odd) ? -1 : 1;
+      EXPECT_NEAR(dot(normal(mesh, p), inward), expected, 1e-9) << "odd wall " << odd << ", patch " << p;
+    }
   }
 }
 
@@ -366,7 +368,355 @@ TEST(Remeshing, FineIcosphereCoarsensToAboutTheTargetCount)
   {
     EXPECT_NEAR(length(p), 1.0, 1e-3);
   }
-  std::printf("icosphere: %zu -> %zu patches in %.2f s, area ratio %.5f\n",
-    sphere.polygons.size(), result.statistics.patches, result.statistics.seconds,
-    result.statistics.outputArea / result.statistics.inputArea);
+}
+
+TEST(Remeshing, PaperScaleRoomGivenAsBigQuads)
+{
+  const Rgb white(0.75), red(0.63, 0.065, 0.05), green(0.14, 0.45, 0.091);
+  PolygonSoup room = boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
+  append(room, boxOfQuads({ 1.3, 0.65, 0 }, { 2.95, 2.3, 1.65 }, { white }, false, true));
+  append(room, boxOfQuads({ 2.65, 2.95, 0 }, { 4.3, 4.6, 3.3 }, { white }, false, true));
+  RemeshOptions options;
+  options.targetPatchCount = 2700;
+  const RemeshResult result = remesh(room, options);
+  EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
+  EXPECT_GE(result.statistics.patches, 2200u);
+  EXPECT_LE(result.statistics.patches, 3300u);
+  EXPECT_NEAR(result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  double redArea = 0;
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    if (result.mesh.reflectance[p] == red)
+    {
+      redArea += area(result.mesh, p);
+      for (std::uint32_t v : result.mesh.triangles[p])
+      {
+        EXPECT_EQ(result.mesh.points[v].x, 0.0);
+      }
+    }
+  }
+  EXPECT_NEAR(redArea, 5.5 * 5.5, 1e-9);
+}
+
+// --- Messy input ---------------------------------------------------------------------------
+
+TEST(RemeshingMessyInput, EdgeSharedByThreeFacesIsSplitAndRemeshed)
+{
+  // Three pages of a book on one spine.
+  PolygonSoup soup;
+  soup.points = { { 0, 0, 0 }, { 0, 0, 1 }, { 1, 0, 0 }, { 1, 0, 1 }, { 0, 1, 0 }, { 0, 1, 1 },
+    { -1, 0, 0 }, { -1, 0, 1 } };
+  soup.polygons = { { 0, 2, 3, 1 }, { 0, 1, 5, 4 }, { 0, 6, 7, 1 } };
+  soup.materials.assign(3, Material{ Rgb(0.5) });
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "where the surface is not a manifold")) << joined(result.warnings);
+  EXPECT_EQ(result.statistics.fallbackRegions, 0u);
+  EXPECT_NEAR(result.statistics.outputArea, 3.0, 3.0 * 0.005);
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    const Vec3 n = normal(result.mesh, p);
+    EXPECT_NEAR(std::abs(n.x) + std::abs(n.y), 1.0, 1e-9) << "patch " << p << " leaves its page";
+  }
+}
+
+TEST(RemeshingMessyInput, FacesMeetingAtOnePointAreSplitThere)
+{
+  PolygonSoup soup;
+  soup.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { -1, 0, 1 }, { -1, -1, 1 }, { 0, -1, 1 } };
+  soup.polygons = { { 0, 1, 2, 3 }, { 0, 4, 5, 6 } };
+  soup.materials.assign(2, Material{ Rgb(0.5) });
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "split 1 point where the surface is not a manifold")) << joined(result.warnings);
+  EXPECT_EQ(result.statistics.fallbackRegions, 0u);
+  EXPECT_NEAR(result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+}
+
+TEST(RemeshingMessyInput, OpenSurfaceKeepsItsBorderAndCorners)
+{
+  PolygonSoup soup;
+  const std::vector<Vec3> corners = { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 0, 1, 0 } };
+  addPolygon(soup, corners, Rgb(0.5));
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 2.0, 2.0 * 0.005);
+  for (const Vec3& c : corners)
+  {
+    EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), c) != result.mesh.points.end());
+  }
+  for (const Vec3& p : result.mesh.points)
+  {
+    EXPECT_EQ(p.z, 0.0);
+    EXPECT_TRUE(p.x >= 0 && p.x <= 2 && p.y >= 0 && p.y <= 1) << p.x << " " << p.y;
+  }
+}
+
+TEST(RemeshingMessyInput, TJunctionsAreRemeshedWithoutLosingArea)
+{
+  // A unit quad next to two half quads whose shared point lies on the quad's edge.
+  PolygonSoup soup;
+  soup.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 2, 0, 0 }, { 2, 0.5, 0 },
+    { 1, 0.5, 0 }, { 2, 1, 0 } };
+  soup.polygons = { { 0, 1, 2, 3 }, { 1, 4, 5, 6 }, { 6, 5, 7, 2 } };
+  soup.materials.assign(3, Material{ Rgb(0.5) });
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_EQ(result.statistics.fallbackRegions, 0u) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 2.0, 2.0 * 0.005);
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    EXPECT_NEAR(normal(result.mesh, p).z, 1.0, 1e-12);
+  }
+}
+
+TEST(RemeshingMessyInput, SelfIntersectingSurfacesAreRemeshedAsGiven)
+{
+  PolygonSoup crossing;
+  addPolygon(crossing, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } }, Rgb(0.5));
+  addPolygon(crossing, { { 0.5, -0.2, -0.5 }, { 0.5, 1.2, -0.5 }, { 0.5, 1.2, 0.5 }, { 0.5, -0.2, 0.5 } }, Rgb(0.5));
+  // A strip that folds back through its own first face.
+  PolygonSoup folded;
+  folded.points = { { 0, 0, 0 }, { 0, 1, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 1, 0, 1 }, { 1, 1, 1 },
+    { 0.5, 0, -0.5 }, { 0.5, 1, -0.5 } };
+  folded.polygons = { { 0, 2, 3, 1 }, { 2, 4, 5, 3 }, { 4, 6, 7, 5 } };
+  folded.materials.assign(3, Material{ Rgb(0.5) });
+  for (const PolygonSoup& soup : { crossing, folded })
+  {
+    const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+    EXPECT_EQ(result.statistics.fallbackRegions, 0u) << joined(result.warnings);
+    EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  }
+}
+
+TEST(RemeshingMessyInput, ZeroAreaPolygonsAreIgnoredWithACount)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } }, Rgb(0.5));
+  addPolygon(soup, { { 0, 0, 1 }, { 1, 0, 1 }, { 2, 0, 1 }, { 3, 0, 1 } }, Rgb(0.5));
+  soup.polygons.push_back({ 0, 0, 1 });
+  soup.materials.push_back(Material{ Rgb(0.5) });
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "ignored 2 polygons with zero area")) << joined(result.warnings);
+  EXPECT_EQ(result.statistics.droppedPolygons, 2u);
+  EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
+}
+
+TEST(RemeshingMessyInput, LinesAndVerticesAreIgnoredWithACount)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } }, Rgb(0.5));
+  soup.polygons.push_back({ 0 });
+  soup.polygons.push_back({ 1, 2 });
+  soup.polygons.push_back({});
+  soup.materials.resize(4, Material{ Rgb(0.5) });
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "ignored 3 lines or vertices")) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
+}
+
+TEST(RemeshingMessyInput, DuplicatePolygonsAreIgnoredKeepingTheFirstMaterial)
+{
+  PolygonSoup soup;
+  const std::vector<Vec3> quad = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } };
+  addPolygon(soup, quad, Rgb(0.5));
+  addPolygon(soup, quad, Rgb(0.3));
+  addPolygon(soup, { quad.rbegin(), quad.rend() }, Rgb(0.5)); // the back face, as exporters write it
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "ignored 2 duplicate polygons")) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    EXPECT_EQ(result.mesh.reflectance[p], Rgb(0.5));
+    EXPECT_NEAR(normal(result.mesh, p).z, 1.0, 1e-12);
+  }
+}
+
+TEST(RemeshingMessyInput, SelfCrossingPolygonIsIgnoredWithAWarning)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 1, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, Rgb(0.5)); // a bow tie
+  addPolygon(soup, { { 0, 0, 1 }, { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } }, Rgb(0.5));
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "ignored 1 self-crossing polygon")) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
+}
+
+TEST(RemeshingMessyInput, ConcaveAndNonPlanarPolygonsAreKept)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 1, 1, 0 }, { 1, 2, 0 }, { 0, 2, 0 } }, Rgb(0.5));
+  addPolygon(soup, { { 3, 0, 0 }, { 4, 0, 0.05 }, { 4, 1, 0 }, { 3, 1, 0.05 } }, Rgb(0.5));
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  // The reflex corner of the L stays, and nothing fills the notch.
+  const Vec3 reflex(1, 1, 0);
+  EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), reflex) != result.mesh.points.end());
+  for (const Vec3& p : result.mesh.points)
+  {
+    EXPECT_FALSE(p.x > 1 + 1e-12 && p.x < 2 && p.y > 1 + 1e-12) << p.x << " " << p.y;
+  }
+}
+
+TEST(RemeshingMessyInput, NanOrInfinitePointsAreRefusedWithTheirCount)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 } }, Rgb(0.5));
+  soup.points.push_back({ std::numeric_limits<double>::quiet_NaN(), 0, 0 });
+  soup.points.push_back({ 0, std::numeric_limits<double>::infinity(), 0 });
+  expectError([&] { remesh(soup, RemeshOptions{}); }, "2 points with NaN or infinite coordinates");
+}
+
+TEST(RemeshingMessyInput, RegionTooCurvedForThePatchSizeIsOnlyRefined)
+{
+  // A 5 cm ball of 2,000 triangles in a unit box remeshed at 10 cm would shrink to a few
+  // triangles: it keeps its own triangles instead, and a warning says so.
+  PolygonSoup soup = boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) });
+  PolygonSoup ball = icosphere(10, 0.05);
+  for (Vec3& p : ball.points)
+  {
+    p += Vec3(0.5, 0.5, 0.5);
+  }
+  for (Material& m : ball.materials)
+  {
+    m.reflectance = Rgb(0.2);
+  }
+  append(soup, ball);
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_EQ(result.statistics.fallbackRegions, 1u);
+  EXPECT_TRUE(contains(result.warnings, "(reflectance (0.2, 0.2, 0.2), 2000 input triangles) was only refined, not remeshed: remeshing changed its area by"))
+    << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  std::size_t ballPatches = 0;
+  for (const Rgb& rho : result.mesh.reflectance)
+  {
+    ballPatches += rho == Rgb(0.2) ? 1 : 0;
+  }
+  EXPECT_EQ(ballPatches, 2000u);
+}
+
+TEST(RemeshingMessyInput, BadInputIsRefusedWithAMessage)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 } }, Rgb(0.5));
+  PolygonSoup noMaterial = soup;
+  noMaterial.materials.clear();
+  expectError([&] { remesh(noMaterial, RemeshOptions{}); }, "1 polygons but 0 materials");
+  PolygonSoup badIndex = soup;
+  badIndex.polygons[0][2] = 7;
+  expectError([&] { remesh(badIndex, RemeshOptions{}); }, "polygon 0 uses point 7");
+  PolygonSoup white = soup;
+  white.materials[0].reflectance = Rgb(1.0);
+  expectError([&] { remesh(white, RemeshOptions{}); }, "polygon 0 has reflectance");
+  expectError([&] { remesh(soup, withEdgeLength(-1)); }, "patch size must be 0");
+  RemeshOptions angle;
+  angle.sharpEdgeAngle = 200;
+  expectError([&] { remesh(soup, angle); }, "sharp edge angle");
+  PolygonSoup flat;
+  addPolygon(flat, { { 0, 0, 0 }, { 1, 0, 0 }, { 2, 0, 0 } }, Rgb(0.5));
+  expectError([&] { remesh(flat, RemeshOptions{}); }, "no polygon with an area");
+  expectError([&] { remesh(soup, withEdgeLength(1e-6)); }, "give a larger patch size");
+}
+
+// --- Progress and the refine-only path -----------------------------------------------------
+
+namespace
+{
+PolygonSoup paperRoomSoup()
+{
+  const PatchMesh mesh = scenes::paperScaleRoom().mesh;
+  PolygonSoup soup;
+  soup.points = mesh.points;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+  {
+    soup.polygons.push_back({ mesh.triangles[t].begin(), mesh.triangles[t].end() });
+    soup.materials.push_back(Material{ mesh.reflectance[t] });
+  }
+  return soup;
+}
+}
+
+TEST(Remeshing, ProgressRisesToOneAndCancellingStopsQuickly)
+{
+  const PolygonSoup room = paperRoomSoup();
+  std::vector<double> reported;
+  const RemeshResult result = remesh(room, RemeshOptions{}, [&](double f) {
+    reported.push_back(f);
+    return true;
+  });
+  EXPECT_EQ(result.statistics.fallbackRegions, 0u) << joined(result.warnings);
+  ASSERT_GE(reported.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+  EXPECT_EQ(reported.back(), 1.0);
+  EXPECT_GT(result.statistics.seconds, 0.0);
+
+  for (double cancelAt : { 0.0, 0.3, 0.9 })
+  {
+    std::chrono::steady_clock::time_point asked;
+    bool cancelled = false;
+    try
+    {
+      remesh(room, RemeshOptions{}, [&](double f) {
+        if (f < cancelAt)
+        {
+          return true;
+        }
+        asked = std::chrono::steady_clock::now();
+        return false;
+      });
+    }
+    catch (const Cancelled&)
+    {
+      cancelled = true;
+      const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+      EXPECT_LT(latency, 0.5) << "cancelled at " << cancelAt;
+    }
+    EXPECT_TRUE(cancelled) << "cancelled at " << cancelAt;
+  }
+}
+
+TEST(Remeshing, WithoutCgalEveryTriangleIsOnlyRefined)
+{
+  RemeshOptions options = withEdgeLength(0.1);
+  options.useCgal = false;
+  const RemeshResult result = remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls), options);
+  EXPECT_EQ(result.statistics.regions, 0u);
+  EXPECT_EQ(result.statistics.patches, 12u * 15u * 15u); // diagonals of sqrt(2) in 15 steps
+  EXPECT_NEAR(totalArea(result.mesh), 6.0, 1e-9);
+}
+
+// --- The energy balance on a remeshed scene --------------------------------------------------
+
+TEST(Remeshing, RemeshedClosedBoxAbsorbsAllPower)
+{
+  // TestEnergyBalance's closed box, given as 6 big inward quads and remeshed.
+  RemeshOptions options;
+  options.targetPatchCount = 500;
+  const RemeshResult remeshed = remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls, true), options);
+  ASSERT_EQ(remeshed.statistics.fallbackRegions, 0u) << joined(remeshed.warnings);
+  const Scene scene = Scene::fromPatchMesh(remeshed.mesh);
+  const Rgb power(3, 5, 7);
+  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power,
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.25, 0.3, 0.9 }, { 0.75, 0.7, 0.8 }, 3));
+  SolverOptions solverOptions;
+  solverOptions.pathsPerFrame = 400000;
+  const Solution solution = solve(scene, light, solverOptions);
+  for (std::size_t f = 0; f < light.frameCount(); ++f)
+  {
+    Rgb absorbed;
+    for (std::size_t e = 0; e < scene.elementCount(); ++e)
+    {
+      const Rgb& rho = scene.elementReflectance(e);
+      for (Side side : { Side::Front, Side::Back })
+      {
+        const Rgb B = solution.total(f, e, side);
+        for (int c = 0; c < 3; ++c)
+        {
+          absorbed[c] += scene.elementArea(e) * (1 - rho[c]) / rho[c] * B[c];
+        }
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_NEAR(absorbed[c] / power[c], 1.0, 0.01) << "frame " << f << " channel " << c;
+    }
+  }
 }
