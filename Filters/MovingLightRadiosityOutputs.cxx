@@ -213,4 +213,20 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   return fieldData;
 }
 
+void addFrameFieldData(vtkFieldData* fieldData, std::size_t frame, const Vec3& lightPosition,
+  const Vec3& lightTranslation, std::int64_t solveCount)
+{
+  addValue<vtkIdTypeArray>(fieldData, "FrameIndex", static_cast<vtkIdType>(frame));
+  for (const auto& vector : { std::make_pair("LightPosition", lightPosition),
+         std::make_pair("LightTranslation", lightTranslation) })
+  {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(vector.first);
+    array->SetNumberOfComponents(3);
+    array->InsertNextTuple3(vector.second.x, vector.second.y, vector.second.z);
+    fieldData->AddArray(array);
+  }
+  addValue<vtkIdTypeArray>(fieldData, "SolveCount", static_cast<vtkIdType>(solveCount));
+}
+
 } // namespace mlr::vtkoutputs

@@ -8,6 +8,7 @@
 #include "vtkSmartPointer.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 class vtkCellData;
@@ -42,5 +43,11 @@ void addPatchRadiosity(const Solution& solution, const std::vector<Side>& litSid
 /// speed-up of full reuse over classic for these frames, k and lambda (paper eq. 4).
 vtkSmartPointer<vtkFieldData> statisticsFieldData(
   const SolverStatistics& statistics, const SolverOptions& options);
+
+/// The arrays of field data that change with the frame: `FrameIndex`, `LightPosition` (the
+/// light's centroid) and `LightTranslation` (from the Light input to this frame), and
+/// `SolveCount`, the number of solves so far.
+void addFrameFieldData(vtkFieldData* fieldData, std::size_t frame, const Vec3& lightPosition,
+  const Vec3& lightTranslation, std::int64_t solveCount);
 
 } // namespace mlr::vtkoutputs

@@ -12,7 +12,6 @@
 #include "vtkCellData.h"
 #include "vtkDataObject.h"
 #include "vtkFieldData.h"
-#include "vtkIdTypeArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
@@ -43,6 +42,8 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// Taken just before the inputs and properties were read for the solve.
   vtkTimeStamp SolveTime;
   std::vector<double> Times;
+  std::vector<mlr::Vec3> LightPositions;
+  mlr::Vec3 LightCentroid;
   /// Null when the scene had nothing to light: the outputs are then empty.
   vtkSmartPointer<vtkPolyData> Elements;
   vtkSmartPointer<vtkPolyData> Patches;
@@ -211,14 +212,9 @@ int vtkMovingLightRadiosity::RequestData(
       }
       vtkNew<vtkFieldData> fieldData;
       fieldData->ShallowCopy(cache.Statistics);
-      for (const auto& value : { std::make_pair("FrameIndex", static_cast<vtkIdType>(frame)),
-             std::make_pair("SolveCount", this->SolveCount) })
-      {
-        vtkNew<vtkIdTypeArray> array;
-        array->SetName(value.first);
-        array->InsertNextValue(value.second);
-        fieldData->AddArray(array);
-      }
+      const mlr::Vec3& position = cache.LightPositions[frame];
+      mlr::vtkoutputs::addFrameFieldData(
+        fieldData, frame, position, position - cache.LightCentroid, this->SolveCount);
       output->SetFieldData(fieldData);
     }
     output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
@@ -269,6 +265,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       translations.push_back(position - centroid);
     }
     const mlr::MovingLight light(polygons, power, translations);
+    cache.LightPositions = trajectory.positions;
+    cache.LightCentroid = centroid;
 
     mlr::SolverOptions options;
     options.pathsPerFrame = static_cast<std::uint64_t>(this->NumberOfPaths);

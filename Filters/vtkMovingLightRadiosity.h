@@ -27,7 +27,9 @@
  *   that a room made of outward-facing polygons still shows its lit walls), `RadiosityFront`
  *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`. Its field data holds
  *   the solver statistics (paths, rays by kind, seconds by phase, patches, elements, frames,
- *   reuse modes, predicted speed-up), the frame shown (`FrameIndex`) and `SolveCount`.
+ *   reuse modes, predicted speed-up), the frame shown (`FrameIndex`), where the light is in
+ *   it (`LightPosition`, its centroid, and `LightTranslation`, from the Light input) and
+ *   `SolveCount`.
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
  *

@@ -1,0 +1,364 @@
+#include "CommandLine.h"
+
+#include "vtkMovingLightRadiosity.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace mlr::cli
+{
+
+namespace
+{
+std::string lowercase(std::string text)
+{
+  for (char& c : text)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return text;
+}
+
+bool endsWith(const std::string& text, const std::string& suffix)
+{
+  return text.size() >= suffix.size() &&
+    lowercase(text.substr(text.size() - suffix.size())) == suffix;
+}
+
+double parseNumber(const std::string& option, const std::string& text)
+{
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE ||
+    !std::isfinite(value))
+  {
+    throw UsageError(option + " needs a number, not '" + text + "'");
+  }
+  return value;
+}
+
+long long parseInteger(const std::string& option, const std::string& text)
+{
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE)
+  {
+    throw UsageError(option + " needs a whole number, not '" + text + "'");
+  }
+  return value;
+}
+
+Triple parseTriple(const std::string& option, const std::string& text)
+{
+  Triple values{};
+  std::size_t start = 0;
+  for (int i = 0; i < 3; ++i)
+  {
+    const std::size_t comma = text.find(',', start);
+    const bool last = i == 2;
+    if (last != (comma == std::string::npos))
+    {
+      throw UsageError(option + " needs three numbers X,Y,Z, not '" + text + "'");
+    }
+    values[i] = parseNumber(option, text.substr(start, last ? std::string::npos : comma - start));
+    start = comma + 1;
+  }
+  return values;
+}
+
+struct OptionSpec
+{
+  const char* value; ///< what to give, for messages
+  std::function<void(Options&, const std::string& option, const std::string& value)> apply;
+};
+
+const std::map<std::string, OptionSpec>& optionSpecs()
+{
+  static const std::map<std::string, OptionSpec> specs = {
+    { "--scene", { "FILE", [](Options& o, const auto&, const auto& v) { o.scene = v; } } },
+    { "--light", { "FILE", [](Options& o, const auto&, const auto& v) { o.light = v; } } },
+    { "--trajectory",
+      { "FILE", [](Options& o, const auto&, const auto& v) { o.trajectory = v; } } },
+    { "--from",
+      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.from = parseTriple(n, v); } } },
+    { "--to",
+      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.to = parseTriple(n, v); } } },
+    { "--frames",
+      { "N", [](Options& o, const auto& n, const auto& v) { o.frames = parseInteger(n, v); } } },
+    { "--light-power",
+      { "R,G,B",
+        [](Options& o, const auto& n, const auto& v) {
+          // One number is a white light of that power per channel.
+          if (v.find(',') != std::string::npos)
+          {
+            o.lightPower = parseTriple(n, v);
+            return;
+          }
+          const double power = parseNumber(n, v);
+          o.lightPower = Triple{ power, power, power };
+        } } },
+    { "--paths",
+      { "N", [](Options& o, const auto& n, const auto& v) { o.paths = parseInteger(n, v); } } },
+    { "--gather-ratio",
+      { "K", [](Options& o, const auto& n, const auto& v) { o.gatherRatio = parseNumber(n, v); } } },
+    { "--survival",
+      { "L", [](Options& o, const auto& n, const auto& v) { o.survival = parseNumber(n, v); } } },
+    { "--reuse",
+      { "none|gathering|shooting|both",
+        [](Options& o, const auto& n, const auto& v) {
+          if (v != "none" && v != "gathering" && v != "shooting" && v != "both")
+          {
+            throw UsageError(n + " is '" + v + "': give none, gathering, shooting or both");
+          }
+          o.reuse = v;
+        } } },
+    { "--patch-size",
+      { "H", [](Options& o, const auto& n, const auto& v) { o.patchSize = parseNumber(n, v); } } },
+    { "--seed",
+      { "S", [](Options& o, const auto& n, const auto& v) { o.seed = parseInteger(n, v); } } },
+    { "--threads",
+      { "T", [](Options& o, const auto& n, const auto& v) { o.threads = parseInteger(n, v); } } },
+    { "--output",
+      { "PATH.pvd",
+        [](Options& o, const auto& n, const auto& v) {
+          if (!endsWith(v, ".pvd") || v.size() <= 4 || endsWith(v, "/.pvd"))
+          {
+            throw UsageError(n + " is '" + v + "': give a file name ending in .pvd");
+          }
+          o.output = v;
+        } } },
+    { "--stats", { "FILE.json", [](Options& o, const auto&, const auto& v) { o.stats = v; } } },
+    { "--png", { "DIR", [](Options& o, const auto&, const auto& v) { o.png = v; } } },
+  };
+  return specs;
+}
+
+std::string stem(const std::string& path)
+{
+  const std::size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = name.find_last_of('.');
+  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
+}
+
+template <typename T>
+void checkRange(const std::string& option, T value, T minimum, T maximum)
+{
+  if (value < minimum || value > maximum)
+  {
+    std::ostringstream s;
+    s << option << " is " << value << ": give a value from " << minimum << " to " << maximum;
+    throw UsageError(s.str());
+  }
+}
+}
+
+Options parseCommandLine(int argc, const char* const* argv)
+{
+  Options o;
+  o.defaultRun = argc <= 1;
+  std::set<std::string> seen;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h")
+    {
+      o.help = true;
+      continue;
+    }
+    if (arg.rfind("--", 0) != 0)
+    {
+      throw UsageError("unexpected argument '" + arg + "': every option starts with --");
+    }
+    const std::size_t equals = arg.find('=');
+    const std::string name = arg.substr(0, equals);
+    const auto spec = optionSpecs().find(name);
+    if (spec == optionSpecs().end())
+    {
+      throw UsageError("unknown option " + name);
+    }
+    if (!seen.insert(name).second)
+    {
+      throw UsageError(name + " is given twice");
+    }
+    std::string value;
+    if (equals != std::string::npos)
+    {
+      value = arg.substr(equals + 1);
+    }
+    else if (i + 1 < argc)
+    {
+      value = argv[++i];
+    }
+    else
+    {
+      throw UsageError(name + " needs a value: " + name + " " + spec->second.value);
+    }
+    if (value.empty())
+    {
+      throw UsageError(name + " needs a value: " + name + " " + spec->second.value);
+    }
+    spec->second.apply(o, name, value);
+  }
+  if (o.help)
+  {
+    return o;
+  }
+
+  if (!o.trajectory.empty() && (o.from || o.to))
+  {
+    throw UsageError("give either --trajectory FILE or --from X,Y,Z --to X,Y,Z, not both");
+  }
+  if (o.from.has_value() != o.to.has_value())
+  {
+    throw UsageError("--from and --to go together: give both ends of the light's path");
+  }
+  if (o.frames && !o.from)
+  {
+    throw UsageError("--frames needs --from and --to (a trajectory file has its own frames)");
+  }
+  if (o.from && !o.frames)
+  {
+    o.frames = 30;
+  }
+  if (!o.usesEmbeddedScene())
+  {
+    if (o.light.empty())
+    {
+      throw UsageError("--scene needs --light FILE: the built-in light belongs to the Cornell box");
+    }
+    if (o.trajectory.empty() && !o.from)
+    {
+      throw UsageError("--scene needs the light's path: --trajectory FILE or --from X,Y,Z "
+                       "--to X,Y,Z [--frames N]");
+    }
+  }
+  if (o.output.empty())
+  {
+    o.output = "output/" + (o.usesEmbeddedScene() ? std::string("cornell") : stem(o.scene)) + ".pvd";
+  }
+  if (o.defaultRun)
+  {
+    o.png = "output/png";
+  }
+  return o;
+}
+
+void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
+{
+  if (o.lightPower)
+  {
+    for (double p : *o.lightPower)
+    {
+      checkRange("--light-power", p, 0.0, 1e30);
+    }
+    filter->SetLightPower(o.lightPower->data());
+  }
+  if (o.paths)
+  {
+    checkRange<long long>("--paths", *o.paths, filter->GetNumberOfPathsMinValue(),
+      filter->GetNumberOfPathsMaxValue());
+    filter->SetNumberOfPaths(static_cast<vtkIdType>(*o.paths));
+  }
+  if (o.gatherRatio)
+  {
+    checkRange("--gather-ratio", *o.gatherRatio, filter->GetGatheringRatioMinValue(),
+      filter->GetGatheringRatioMaxValue());
+    filter->SetGatheringRatio(*o.gatherRatio);
+  }
+  if (o.survival)
+  {
+    checkRange("--survival", *o.survival, filter->GetFirstBounceSurvivalMinValue(),
+      filter->GetFirstBounceSurvivalMaxValue());
+    filter->SetFirstBounceSurvival(*o.survival);
+  }
+  if (o.reuse)
+  {
+    filter->SetReuseShooting(*o.reuse == "shooting" || *o.reuse == "both");
+    filter->SetReuseGathering(*o.reuse == "gathering" || *o.reuse == "both");
+  }
+  if (o.patchSize)
+  {
+    checkRange("--patch-size", *o.patchSize, filter->GetPatchSizeMinValue(),
+      filter->GetPatchSizeMaxValue());
+    filter->SetPatchSize(*o.patchSize);
+  }
+  if (o.seed)
+  {
+    checkRange<long long>(
+      "--seed", *o.seed, filter->GetSeedMinValue(), filter->GetSeedMaxValue());
+    filter->SetSeed(static_cast<int>(*o.seed));
+  }
+  if (o.threads)
+  {
+    checkRange<long long>("--threads", *o.threads, filter->GetNumberOfThreadsMinValue(),
+      filter->GetNumberOfThreadsMaxValue());
+    filter->SetNumberOfThreads(static_cast<int>(*o.threads));
+  }
+  if (o.from)
+  {
+    checkRange<long long>("--frames", *o.frames, filter->GetNumberOfPositionsMinValue(),
+      filter->GetNumberOfPositionsMaxValue());
+    filter->SetPathStart(o.from->data());
+    filter->SetPathEnd(o.to->data());
+    filter->SetNumberOfPositions(static_cast<int>(*o.frames));
+  }
+}
+
+std::string helpText()
+{
+  return R"(Usage: moving-light-radiosity [OPTIONS]
+
+Computes the radiosity of a scene lit by a light that moves along a path, all light
+positions at once with reuse of paths, and writes the animation as a .pvd + .vtu series
+(one unstructured grid per frame with the cell arrays Radiosity, DirectRadiosity,
+IndirectRadiosity, RadiosityFront/RadiosityBack, Reflectance and PatchId).
+
+Without any option it runs the built-in example: the Cornell box with its ceiling light
+moving through 30 positions along a diagonal just below the ceiling, and writes
+output/cornell.pvd, output/cornell_0000.vtu ... and output/png/cornell_0000.png ...
+under the current directory.
+
+Scene and light:
+  --scene FILE          surfaces to light: .vtp .vtu .vtk .obj .ply .stl; a cell array
+                        Reflectance (RGB or grey, in [0,1)) gives their colour, else grey 0.5
+                        (default: the built-in Cornell box)
+  --light FILE          the light's polygons, emitting along their normals (required with
+                        --scene; default: the Cornell box's ceiling light)
+  --light-power R,G,B   total power of the light in W, per channel, or one number for all
+                        (default 100,100,100)
+Light path (the positions of the light's area centroid, one per frame):
+  --trajectory FILE     the points of a .vtp .vtu .vtk .obj .ply .stl file, in order; a
+                        point array Time gives the frame times (else 0, 1, 2, ...)
+  --from X,Y,Z --to X,Y,Z [--frames N]
+                        a straight path in N frames (default 30)
+Solver:
+  --paths N             effective shooting paths per frame (default 600000)
+  --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)
+  --survival L          probability that a path continues after its first hit (default 0.25)
+  --reuse MODE          none, gathering, shooting or both (default both)
+  --patch-size H        target patch edge length in scene units (default: about 3000 patches)
+  --seed S              seed of the random numbers (default 0)
+  --threads T           worker threads, 0 for every core (default 0)
+Output:
+  --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
+                        (default output/cornell.pvd, or output/SCENE.pvd with --scene)
+  --stats FILE.json     also write the options, times and solver statistics as JSON
+  --png DIR             also render one picture per frame into DIR (needs an X display;
+                        without DISPLAY the program runs itself under xvfb-run -a)
+  --help                show this text
+
+Files are written under temporary names and renamed once all are complete: a failure
+leaves any earlier series untouched. Exit status: 0 on success, 1 when the inputs cannot
+be read or solved, 2 for a bad command line.
+)";
+}
+
+} // namespace mlr::cli

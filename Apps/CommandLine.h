@@ -1,0 +1,62 @@
+// The options of moving-light-radiosity: parsing, checking and the help text.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+class vtkMovingLightRadiosity;
+
+namespace mlr::cli
+{
+
+/// A bad command line: the message says which option and what to give instead.
+class UsageError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+using Triple = std::array<double, 3>;
+
+/// What the command line asked for. Unset optionals keep the filter's defaults.
+struct Options
+{
+  bool help = false;
+  /// True when no argument was given: the embedded Cornell box with pictures.
+  bool defaultRun = false;
+
+  std::string scene; ///< empty: the embedded Cornell box (with its light and trajectory)
+  std::string light;
+  std::string trajectory;
+  std::optional<Triple> from, to;
+  std::optional<long long> frames;
+
+  std::optional<Triple> lightPower;
+  std::optional<long long> paths;
+  std::optional<double> gatherRatio;
+  std::optional<double> survival;
+  std::optional<std::string> reuse; ///< none, gathering, shooting or both
+  std::optional<double> patchSize;
+  std::optional<long long> seed;
+  std::optional<long long> threads;
+
+  std::string output; ///< PATH.pvd
+  std::string stats;  ///< FILE.json, or empty
+  std::string png;    ///< DIR, or empty for no pictures
+
+  bool usesEmbeddedScene() const { return this->scene.empty(); }
+};
+
+/// Parses argv, fills the defaults that depend on other options and checks the combinations.
+/// Throws UsageError.
+Options parseCommandLine(int argc, const char* const* argv);
+
+/// Sets the filter's properties from the options, refusing values outside the ranges the
+/// filter accepts (it would clamp them silently). Throws UsageError.
+void configureFilter(const Options& options, vtkMovingLightRadiosity* filter);
+
+std::string helpText();
+
+} // namespace mlr::cli

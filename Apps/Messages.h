@@ -1,0 +1,20 @@
+// How VTK's errors and warnings reach the user of the command line: one line each, on
+// stderr, prefixed with the program name, without source locations or object addresses.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace mlr::cli
+{
+
+/// Routes VTK's messages through a condensed output window. Call once, first thing.
+void installMessageWindow(const std::string& program);
+
+/// VTK errors reported so far (those shown and those dropped as repetitions).
+std::size_t vtkErrorCount();
+
+/// Prints "program: error: message" on stderr.
+void printError(const std::string& message);
+
+} // namespace mlr::cli

@@ -1,0 +1,114 @@
+#include "OutputTransaction.h"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace mlr::cli
+{
+
+OutputTransaction::~OutputTransaction()
+{
+  if (!this->Committed)
+  {
+    this->rollback();
+  }
+}
+
+void OutputTransaction::createDirectories(const fs::path& directory)
+{
+  if (directory.empty())
+  {
+    return;
+  }
+  // Remember each level that is missing, outermost first, to undo them innermost first.
+  std::vector<fs::path> missing;
+  for (fs::path p = directory; !p.empty() && !fs::exists(p); p = p.parent_path())
+  {
+    missing.insert(missing.begin(), p);
+    if (p == p.parent_path())
+    {
+      break;
+    }
+  }
+  std::error_code error;
+  fs::create_directories(directory, error);
+  if (error || !fs::is_directory(directory))
+  {
+    throw std::runtime_error("cannot create the directory '" + directory.string() +
+      "': " + (error ? error.message() : "a file of that name is in the way"));
+  }
+  this->CreatedDirectories.insert(this->CreatedDirectories.end(), missing.begin(), missing.end());
+}
+
+fs::path OutputTransaction::stage(const fs::path& finalPath)
+{
+  fs::path temporary = finalPath.parent_path() / ("." + finalPath.filename().string() + ".partial");
+  this->StagedFiles.push_back({ temporary, finalPath });
+  return temporary;
+}
+
+void OutputTransaction::replaceSeries(
+  const fs::path& directory, const std::string& prefix, const std::string& suffix)
+{
+  this->ReplacedSeries.push_back({ directory, prefix, suffix });
+}
+
+void OutputTransaction::commit()
+{
+  for (const Staged& file : this->StagedFiles)
+  {
+    std::error_code error;
+    fs::rename(file.temporary, file.final, error);
+    if (error)
+    {
+      throw std::runtime_error("cannot rename '" + file.temporary.string() + "' to '" +
+        file.final.string() + "': " + error.message());
+    }
+  }
+  this->Committed = true;
+
+  std::set<fs::path> kept;
+  for (const Staged& file : this->StagedFiles)
+  {
+    kept.insert(file.final.lexically_normal());
+  }
+  for (const Series& series : this->ReplacedSeries)
+  {
+    std::error_code error;
+    const fs::path directory = series.directory.empty() ? fs::path(".") : series.directory;
+    for (const fs::directory_entry& entry : fs::directory_iterator(directory, error))
+    {
+      const std::string name = entry.path().filename().string();
+      const std::size_t digits = name.size() - std::min(name.size(), series.prefix.size() + series.suffix.size());
+      const bool matches = digits > 0 && name.compare(0, series.prefix.size(), series.prefix) == 0 &&
+        name.compare(name.size() - series.suffix.size(), series.suffix.size(), series.suffix) == 0 &&
+        std::all_of(name.begin() + static_cast<long>(series.prefix.size()),
+          name.end() - static_cast<long>(series.suffix.size()),
+          [](unsigned char c) { return std::isdigit(c) != 0; });
+      const fs::path path = (series.directory / name).lexically_normal();
+      if (matches && entry.is_regular_file() && kept.count(path) == 0)
+      {
+        fs::remove(entry.path(), error);
+      }
+    }
+  }
+}
+
+void OutputTransaction::rollback() noexcept
+{
+  std::error_code error;
+  for (const Staged& file : this->StagedFiles)
+  {
+    fs::remove(file.temporary, error);
+  }
+  for (auto d = this->CreatedDirectories.rbegin(); d != this->CreatedDirectories.rend(); ++d)
+  {
+    fs::remove(*d, error); // only succeeds while empty, which is what we want
+  }
+}
+
+} // namespace mlr::cli

@@ -1,0 +1,58 @@
+// A set of output files that appears all at once or not at all.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace mlr::cli
+{
+
+/**
+ * Files are written under hidden temporary names next to their final ones and renamed when
+ * commit() is called; until then, destroying the transaction (an error, an exception) removes
+ * them, and the directories it created, so that a failure never leaves a half-written series
+ * and never touches an earlier one. Renames happen in staging order: stage the index file
+ * (.pvd) last so that it never names a frame that is not there yet.
+ */
+class OutputTransaction
+{
+public:
+  OutputTransaction() = default;
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+  ~OutputTransaction();
+
+  /// Creates `directory` and its missing parents (removed again on rollback if still empty).
+  void createDirectories(const std::filesystem::path& directory);
+
+  /// The temporary path to write the file that becomes `finalPath` at commit.
+  std::filesystem::path stage(const std::filesystem::path& finalPath);
+
+  /// At commit, also delete the files of `directory` named `prefix` + digits + `suffix` that
+  /// were not staged: the frames of an earlier, longer series of the same name.
+  void replaceSeries(
+    const std::filesystem::path& directory, const std::string& prefix, const std::string& suffix);
+
+  /// Renames every staged file to its final name. Throws std::runtime_error on failure.
+  void commit();
+
+private:
+  struct Staged
+  {
+    std::filesystem::path temporary, final;
+  };
+  struct Series
+  {
+    std::filesystem::path directory;
+    std::string prefix, suffix;
+  };
+  void rollback() noexcept;
+
+  std::vector<Staged> StagedFiles;
+  std::vector<Series> ReplacedSeries;
+  std::vector<std::filesystem::path> CreatedDirectories;
+  bool Committed = false;
+};
+
+} // namespace mlr::cli

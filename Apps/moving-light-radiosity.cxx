@@ -1,0 +1,318 @@
+// moving-light-radiosity: solves the animation of a moving light with the VTK filter and
+// writes it as a .pvd + .vtu series (and pictures). See helpText() in CommandLine.cxx.
+#include "CommandLine.h"
+#include "FrameRenderer.h"
+#include "InputFiles.h"
+#include "Messages.h"
+#include "OutputTransaction.h"
+#include "ProgressBar.h"
+#include "Report.h"
+#include "SeriesWriter.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkInformationDoubleVectorKey.h"
+#include "vtkMovingLightRadiosity.h"
+#include "vtkNew.h"
+#include "vtkOutputWindow.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace mlr::cli;
+
+namespace
+{
+constexpr int ExitFailure = 1;
+constexpr int ExitUsage = 2;
+
+/// The failure was already reported (by VTK's error output): just exit.
+struct AlreadyReported
+{
+};
+
+/// Set by SIGINT/SIGTERM; polled during the solve and between files, so that an interrupted
+/// run still removes its temporary files.
+std::atomic<bool> Interrupted{ false };
+
+extern "C" void onSignal(int)
+{
+  Interrupted = true;
+}
+
+void throwIfInterrupted()
+{
+  if (Interrupted)
+  {
+    throw InputError("interrupted: nothing was written");
+  }
+}
+
+std::string findInPath(const std::string& program)
+{
+  const char* path = std::getenv("PATH");
+  std::istringstream directories(path ? path : "/usr/bin:/bin");
+  std::string directory;
+  while (std::getline(directories, directory, ':'))
+  {
+    const std::string candidate = (directory.empty() ? "." : directory) + "/" + program;
+    if (access(candidate.c_str(), X_OK) == 0)
+    {
+      return candidate;
+    }
+  }
+  return {};
+}
+
+/// Pictures need an X display (ParaView's VTK renders through GLX). Without one, run this
+/// same command again under `xvfb-run -a`, once; this call then does not return.
+void ensureDisplay(int argc, char** argv)
+{
+  const char* display = std::getenv("DISPLAY");
+  if (display && *display)
+  {
+    return;
+  }
+  if (std::getenv("MLR_UNDER_XVFB"))
+  {
+    throw InputError("--png needs an X display and xvfb-run did not provide one: check that "
+                     "Xvfb runs on this machine");
+  }
+  const std::string xvfbRun = findInPath("xvfb-run");
+  if (xvfbRun.empty())
+  {
+    throw InputError("--png needs an X display: set DISPLAY, or install xvfb (xvfb-run) to "
+                     "render the pictures off-screen");
+  }
+  char self[PATH_MAX] = {};
+  const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (length <= 0)
+  {
+    throw InputError(std::string("cannot find this program to run it under xvfb-run: ") +
+      std::strerror(errno));
+  }
+  setenv("MLR_UNDER_XVFB", "1", 1);
+  std::vector<char*> arguments = { const_cast<char*>("xvfb-run"), const_cast<char*>("-a"),
+    self };
+  for (int i = 1; i < argc; ++i)
+  {
+    arguments.push_back(argv[i]);
+  }
+  arguments.push_back(nullptr);
+  std::cout.flush();
+  execv(xvfbRun.c_str(), arguments.data());
+  throw InputError(std::string("cannot run xvfb-run: ") + std::strerror(errno));
+}
+
+std::vector<double> timeSteps(vtkMovingLightRadiosity* filter)
+{
+  vtkInformation* info = filter->GetOutputInformation(vtkMovingLightRadiosity::ELEMENTS_PORT);
+  vtkInformationDoubleVectorKey* key = vtkStreamingDemandDrivenPipeline::TIME_STEPS();
+  if (!info->Has(key))
+  {
+    throw AlreadyReported();
+  }
+  const double* steps = info->Get(key);
+  return std::vector<double>(steps, steps + info->Length(key));
+}
+
+/// The frame at `time`, from the filter's cache after the first solve.
+vtkPolyData* frameAt(vtkMovingLightRadiosity* filter, double time)
+{
+  if (!filter->UpdateTimeStep(time))
+  {
+    throw AlreadyReported();
+  }
+  return filter->GetOutput(vtkMovingLightRadiosity::ELEMENTS_PORT);
+}
+
+void tripleOf(vtkFieldData* data, const char* name, double out[3])
+{
+  vtkDataArray* array = data->GetArray(name);
+  out[0] = out[1] = out[2] = 0;
+  if (array && array->GetNumberOfComponents() == 3 && array->GetNumberOfTuples() > 0)
+  {
+    array->GetTuple(0, out);
+  }
+}
+
+int run(int argc, char** argv)
+{
+  const Options options = parseCommandLine(argc, argv);
+  if (options.help)
+  {
+    std::cout << helpText();
+    return 0;
+  }
+  vtkNew<vtkMovingLightRadiosity> filter;
+  configureFilter(options, filter);
+  if (!options.png.empty())
+  {
+    ensureDisplay(argc, argv);
+  }
+
+  // Every input is read and checked before anything is written.
+  const auto scene = options.usesEmbeddedScene() ? readEmbeddedFile("cornell_box.vtp")
+                                                 : readSurfaceFile(options.scene, "scene");
+  const auto light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
+                                           : readSurfaceFile(options.light, "light");
+  vtkSmartPointer<vtkPolyData> trajectory;
+  if (!options.trajectory.empty())
+  {
+    trajectory = readSurfaceFile(options.trajectory, "trajectory");
+  }
+  else if (!options.from)
+  {
+    trajectory = readEmbeddedFile("cornell_trajectory.vtp");
+  }
+  filter->SetInputData(vtkMovingLightRadiosity::SCENE_PORT, scene);
+  filter->SetInputData(vtkMovingLightRadiosity::LIGHT_PORT, light);
+  if (trajectory)
+  {
+    filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectory);
+  }
+
+  ProgressBar bar;
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetClientData(&bar);
+  onProgress->SetCallback([](vtkObject* caller, unsigned long, void* bar, void*) {
+    auto* algorithm = static_cast<vtkMovingLightRadiosity*>(caller);
+    if (Interrupted)
+    {
+      algorithm->SetAbortExecute(1);
+    }
+    static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
+  });
+  filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  // Errors go below the bar, not into it.
+  vtkNew<vtkCallbackCommand> onError;
+  onError->SetClientData(&bar);
+  onError->SetCallback([](vtkObject*, unsigned long, void* bar, void* message) {
+    static_cast<ProgressBar*>(bar)->finish();
+    vtkOutputWindow::GetInstance()->DisplayErrorText(static_cast<const char*>(message));
+  });
+  filter->AddObserver(vtkCommand::ErrorEvent, onError);
+
+  filter->UpdateInformation();
+  const std::vector<double> times = timeSteps(filter);
+  vtkPolyData* first = frameAt(filter, times.front()); // the solve
+  bar.finish();
+  throwIfInterrupted();
+  if (first->GetNumberOfCells() == 0)
+  {
+    throw InputError("the scene has no polygons or triangle strips to light: nothing to write");
+  }
+  // A copy: the next update clears the output's field data in place.
+  vtkNew<vtkFieldData> statistics;
+  statistics->ShallowCopy(first->GetFieldData());
+
+  OutputTransaction output;
+  const fs::path collection = options.output;
+  const SeriesNaming naming(collection, times.size());
+  output.createDirectories(naming.directory);
+  std::vector<FrameRecord> records;
+  double brightLevel = 0;
+  for (std::size_t f = 0; f < times.size(); ++f)
+  {
+    throwIfInterrupted();
+    vtkPolyData* elements = frameAt(filter, times[f]);
+    FrameRecord record;
+    record.time = times[f];
+    record.file = naming.frameName(f, ".vtu");
+    tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+    writeFrame(elements, times[f], output.stage(naming.directory / record.file));
+    brightLevel = std::max(brightLevel, FrameRenderer::brightLevel(elements));
+    records.push_back(record);
+    bar.show(double(f + 1) / double(times.size()), "writing frames");
+  }
+  output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
+
+  if (!options.png.empty())
+  {
+    const fs::path pictures = options.png;
+    output.createDirectories(pictures);
+    FrameRenderer renderer(light, scene->GetBounds());
+    renderer.setBrightLevel(brightLevel);
+    for (std::size_t f = 0; f < times.size(); ++f)
+    {
+      throwIfInterrupted();
+      vtkPolyData* elements = frameAt(filter, times[f]);
+      double translation[3];
+      tripleOf(elements->GetFieldData(), "LightTranslation", translation);
+      records[f].picture = (pictures / naming.frameName(f, ".png")).string();
+      renderer.render(elements, translation, output.stage(records[f].picture));
+      bar.show(double(f + 1) / double(times.size()), "rendering pictures");
+    }
+    output.replaceSeries(pictures, naming.framePrefix(), ".png");
+  }
+
+  std::vector<std::pair<double, std::string>> entries;
+  for (const FrameRecord& record : records)
+  {
+    entries.emplace_back(record.time, record.file);
+  }
+  writeCollection(output.stage(collection), entries); // staged after its frames
+  if (!options.stats.empty())
+  {
+    const fs::path statsPath = options.stats;
+    output.createDirectories(statsPath.parent_path());
+    writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records);
+  }
+  throwIfInterrupted();
+  output.commit();
+  bar.finish();
+
+  std::cout << summaryLine(statistics) << "\nwrote " << collection.string() << " and "
+            << times.size() << " frames";
+  if (!options.png.empty())
+  {
+    std::cout << ", pictures in " << options.png;
+  }
+  if (!options.stats.empty())
+  {
+    std::cout << ", statistics in " << options.stats;
+  }
+  std::cout << std::endl;
+  return 0;
+}
+}
+
+int main(int argc, char** argv)
+{
+  installMessageWindow("moving-light-radiosity");
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  try
+  {
+    return run(argc, argv);
+  }
+  catch (const UsageError& e)
+  {
+    printError(std::string(e.what()) + " (see --help)");
+    return ExitUsage;
+  }
+  catch (const AlreadyReported&)
+  {
+    return ExitFailure;
+  }
+  catch (const std::exception& e)
+  {
+    printError(e.what());
+    return ExitFailure;
+  }
+}
