@@ -452,24 +452,20 @@ private:
   std::shared_ptr<std::vector<std::unique_ptr<Tree>>> Trees;
 };
 
-void remeshComponent(Mesh& mesh, ComponentLayout& layout, double h,
-  const std::function<void(double)>& afterPass)
+/// One remeshing pass over the whole component; passes run one by one so that progress can
+/// be reported and cancellation checked between them.
+void remeshPass(Mesh& mesh, ComponentLayout& layout, double h, const RegionProjection& projection)
 {
-  const RegionProjection projection(mesh, layout.region, layout.regions.size());
-  for (unsigned pass = 0; pass < Iterations; ++pass)
-  {
-    PMP::isotropic_remeshing(mesh.faces(), h, mesh,
-      CGAL::parameters::number_of_iterations(1)
-        .face_patch_map(layout.region)
-        .edge_is_constrained_map(layout.constrained)
-        .vertex_is_constrained_map(layout.corner)
-        .protect_constraints(false)
-        .collapse_constraints(true)
-        .relax_constraints(false)
-        .number_of_relaxation_steps(RelaxationSteps)
-        .projection_functor(projection));
-    afterPass(double(pass + 1) / Iterations);
-  }
+  PMP::isotropic_remeshing(mesh.faces(), h, mesh,
+    CGAL::parameters::number_of_iterations(1)
+      .face_patch_map(layout.region)
+      .edge_is_constrained_map(layout.constrained)
+      .vertex_is_constrained_map(layout.corner)
+      .protect_constraints(false)
+      .collapse_constraints(true)
+      .relax_constraints(false)
+      .number_of_relaxation_steps(RelaxationSteps)
+      .projection_functor(projection));
 }
 
 /// Why each region's remeshed faces cannot be kept (empty when they can).
@@ -556,35 +552,18 @@ void refuseRegion(const Region& region, const std::string& why,
   }
 }
 
-/// Remeshes one component; what CGAL refuses goes to out.refineOnly with a warning.
-void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
-  const std::vector<Material>& materials, const std::vector<std::size_t>& faces,
-  const CgalRemeshSettings& settings, std::vector<std::size_t>& localIndex,
-  const std::function<void(double)>& afterPass, CgalRemeshOutput& out)
+/**
+ * Runs `step`, which calls CGAL. Any exception becomes the reason to refuse the component
+ * (CGAL reports failed preconditions as exceptions, or not at all with CGAL_NDEBUG), except
+ * running out of memory, which no fallback would survive.
+ */
+template <typename Step>
+bool guarded(const Step& step, std::string& failure)
 {
-  std::vector<Region> regions;
-  std::vector<Refusal> refusals;
-  std::string failure;
-  Mesh mesh;
-  ComponentLayout layout;
   try
   {
-    mesh = buildComponentMesh(soup, faces, localIndex);
-    layout = layOutComponent(mesh, soup, input, faces, settings.sharpEdgeAngle, out.regions);
-    out.regions += layout.regions.size();
-    if (!CGAL::is_valid_polygon_mesh(mesh) || !CGAL::is_triangle_mesh(mesh))
-    {
-      failure = "its surface is not a valid triangle mesh after repair";
-    }
-    else
-    {
-      remeshComponent(mesh, layout, settings.targetEdgeLength, afterPass);
-      refusals = checkRegions(mesh, layout, settings.areaTolerance);
-    }
-  }
-  catch (const Cancelled&)
-  {
-    throw;
+    step();
+    return true;
   }
   catch (const std::bad_alloc&)
   {
@@ -593,25 +572,74 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   catch (const std::exception& e)
   {
     failure = std::string("CGAL failed (") + e.what() + ")";
+    return false;
   }
-  if (layout.regions.empty())
+}
+
+/// Refuses a component whose regions are not known yet, as one region.
+void refuseComponent(const RepairedSoup& soup, const TriangleSoup& input,
+  const std::vector<Material>& materials, const std::vector<std::size_t>& faces,
+  const std::string& why, CgalRemeshOutput& out)
+{
+  Region whole;
+  whole.id = out.regions++;
+  whole.material = input.material[soup.input[faces.front()]];
+  for (std::size_t f : faces)
   {
-    // Failed before regions were known: refuse the component as one region.
-    Region whole;
-    whole.id = out.regions++;
-    whole.material = input.material[soup.input[faces.front()]];
-    for (std::size_t f : faces)
-    {
-      whole.inputTriangles.push_back(soup.input[f]);
-    }
-    refuseRegion(whole, failure.empty() ? "its surface could not be built" : failure, materials, out);
+    whole.inputTriangles.push_back(soup.input[f]);
+  }
+  refuseRegion(whole, why, materials, out);
+}
+
+/// Remeshes one component; what CGAL refuses goes to out.refineOnly with a warning.
+/// `afterPass` reports progress outside the guarded CGAL calls, so cancelling is never
+/// mistaken for a failure.
+void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
+  const std::vector<Material>& materials, const std::vector<std::size_t>& faces,
+  const CgalRemeshSettings& settings, std::vector<std::size_t>& localIndex,
+  const std::function<void(double)>& afterPass, CgalRemeshOutput& out)
+{
+  Mesh mesh;
+  ComponentLayout layout;
+  bool valid = false;
+  std::string failure;
+  const bool built = guarded(
+    [&] {
+      mesh = buildComponentMesh(soup, faces, localIndex);
+      valid = CGAL::is_valid_polygon_mesh(mesh) && CGAL::is_triangle_mesh(mesh);
+    },
+    failure);
+  if (built && !valid)
+  {
+    failure = "its surface is not a valid triangle mesh after repair";
+  }
+  if (!built || !valid ||
+    !guarded([&] { layout = layOutComponent(mesh, soup, input, faces, settings.sharpEdgeAngle, out.regions); },
+      failure))
+  {
+    refuseComponent(soup, input, materials, faces, failure, out);
     return;
   }
-  if (!failure.empty())
+  out.regions += layout.regions.size();
+
+  std::unique_ptr<RegionProjection> projection;
+  bool ok = guarded(
+    [&] { projection = std::make_unique<RegionProjection>(mesh, layout.region, layout.regions.size()); },
+    failure);
+  for (unsigned pass = 0; ok && pass < Iterations; ++pass)
+  {
+    ok = guarded([&] { remeshPass(mesh, layout, settings.targetEdgeLength, *projection); }, failure);
+    afterPass(double(pass + 1) / Iterations);
+  }
+  std::vector<Refusal> refusals(layout.regions.size(), failure);
+  if (ok && guarded([&] { refusals = checkRegions(mesh, layout, settings.areaTolerance); }, failure))
+  {
+    emitRegions(mesh, layout, refusals, out);
+  }
+  else
   {
     refusals.assign(layout.regions.size(), failure);
   }
-  emitRegions(mesh, layout, refusals, out);
   for (std::size_t r = 0; r < layout.regions.size(); ++r)
   {
     if (!refusals[r].empty())
