@@ -704,19 +704,26 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
   constexpr double RepairShare = 0.05;
   checkProgress(progress, RepairShare);
 
-  // Progress in proportion to the faces remeshed, checked after every pass.
+  // Progress in proportion to the faces remeshed, checked after every pass, in steps of at
+  // least 0.1% so that thousands of tiny components do not flood the caller.
   const double total = static_cast<double>(std::max<std::size_t>(1, soup.triangles.size()));
   double done = 0;
+  double reported = RepairShare;
+  auto report = [&](double componentFraction) {
+    const double fraction = RepairShare + (1 - RepairShare) * componentFraction;
+    if (fraction - reported >= 0.001)
+    {
+      reported = fraction;
+      checkProgress(progress, fraction);
+    }
+  };
   std::vector<std::size_t> localIndex(soup.points.size(), std::numeric_limits<std::size_t>::max());
   for (const std::vector<std::size_t>& faces : components)
   {
     const double share = static_cast<double>(faces.size()) / total;
-    auto afterPass = [&](double passFraction) {
-      checkProgress(progress, RepairShare + (1 - RepairShare) * (done + share * passFraction));
-    };
+    auto afterPass = [&](double passFraction) { report(done + share * passFraction); };
     processComponent(soup, input, materials, faces, settings, localIndex, afterPass, out);
     done += share;
-    checkProgress(progress, RepairShare + (1 - RepairShare) * done);
   }
   addRepairWarnings(out);
   return out;

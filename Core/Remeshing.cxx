@@ -8,6 +8,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 namespace mlr
@@ -333,6 +334,44 @@ void appendCgalPatches(
     out.reflectance.push_back(materials[cgal.material[i]].reflectance);
   }
 }
+/// Remeshes with CGAL (unless told not to) and refines what it refused, or everything.
+void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles,
+  const std::vector<Material>& materials, double h, const RemeshOptions& options,
+  const RemeshProgress& progress, RemeshResult& result)
+{
+  std::vector<std::size_t> refined;
+  if (options.useCgal)
+  {
+    detail::CgalRemeshSettings settings;
+    settings.targetEdgeLength = h;
+    settings.sharpEdgeAngle = options.sharpEdgeAngle;
+    const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
+      settings, [&](double f) { return !progress || progress(CgalShare * f); });
+    appendCgalPatches(cgal, materials, result.mesh);
+    refined = cgal.refineOnly;
+    result.statistics.regions = cgal.regions;
+    result.statistics.fallbackRegions = cgal.fallbackRegions;
+    result.statistics.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
+    result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
+  }
+  else
+  {
+    refined.resize(triangles.triangles.size());
+    std::iota(refined.begin(), refined.end(), std::size_t(0));
+  }
+  refineOnly(soup.points, triangles, refined, materials, h, progress,
+    options.useCgal ? CgalShare : 0.0, result.mesh);
+}
+
+double totalArea(const PatchMesh& mesh)
+{
+  double sum = 0;
+  for (const Triangle& t : mesh.triangles)
+  {
+    sum += triangleArea(mesh.points, t);
+  }
+  return sum;
+}
 }
 
 double edgeLengthForPatchCount(double area, std::size_t patches)
@@ -375,32 +414,7 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
   stats.targetEdgeLength = h;
   checkPatchBudget(soup.points, triangles, h);
 
-  std::vector<std::size_t> refined;
-  if (options.useCgal)
-  {
-    detail::CgalRemeshSettings settings;
-    settings.targetEdgeLength = h;
-    settings.sharpEdgeAngle = options.sharpEdgeAngle;
-    const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
-      settings, [&](double f) { return !progress || progress(CgalShare * f); });
-    appendCgalPatches(cgal, materials, result.mesh);
-    refined = cgal.refineOnly;
-    stats.regions = cgal.regions;
-    stats.fallbackRegions = cgal.fallbackRegions;
-    stats.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
-    result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
-  }
-  else
-  {
-    refined.resize(triangles.triangles.size());
-    for (std::size_t i = 0; i < refined.size(); ++i)
-    {
-      refined[i] = i;
-    }
-  }
-  refineOnly(soup.points, triangles, refined, materials, h, progress,
-    options.useCgal ? CgalShare : 0.0, result.mesh);
-
+  buildPatches(soup, triangles, materials, h, options, progress, result);
   if (result.mesh.triangles.empty())
   {
     throw Error("the scene has no surface left after merging duplicate points (" +
@@ -408,10 +422,7 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
       "give at least one triangle with an area");
   }
   stats.patches = result.mesh.triangles.size();
-  for (const Triangle& t : result.mesh.triangles)
-  {
-    stats.outputArea += triangleArea(result.mesh.points, t);
-  }
+  stats.outputArea = totalArea(result.mesh);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   checkProgress(progress, 1.0);
   return result;
