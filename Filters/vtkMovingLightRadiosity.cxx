@@ -11,6 +11,7 @@
 
 #include "vtkCellData.h"
 #include "vtkDataObject.h"
+#include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -22,6 +23,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTimeStamp.h"
 
+#include <algorithm>
 #include <new>
 #include <string>
 #include <vector>
@@ -52,7 +54,15 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
-  void Clear() { *this = vtkInternals(); }
+  void Clear()
+  {
+    const bool aborted = this->Aborted;
+    *this = vtkInternals();
+    this->Aborted = aborted;
+  }
+
+  /// The last solve stopped because AbortExecute was set (it stays set: see RequestData).
+  bool Aborted = false;
 };
 
 vtkStandardNewMacro(vtkMovingLightRadiosity);
@@ -172,9 +182,17 @@ int vtkMovingLightRadiosity::RequestUpdateExtent(
 
 //------------------------------------------------------------------------------
 int vtkMovingLightRadiosity::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkInternals& cache = *this->Internals;
+  if (cache.Aborted)
+  {
+    // This VTK no longer clears AbortExecute when an execution starts: the flag that stopped
+    // the previous solve must not stop this one. Cleared directly, as the executive used to,
+    // so that the MTime (and with it the cache key) does not change.
+    this->AbortExecute = 0;
+    cache.Aborted = false;
+  }
   bool current = cache.HasResult && this->GetMTime() <= cache.SolveTime.GetMTime();
   for (int port = 0; current && port < this->GetNumberOfInputPorts(); ++port)
   {
@@ -186,15 +204,20 @@ int vtkMovingLightRadiosity::RequestData(
     return 0;
   }
 
+  // Both outputs show the frame asked for on the port whose update runs this request, so that
+  // UpdateTimeStep(t) followed by GetOutput(PATCHES_PORT) gives the patches of time t too.
+  const int fromPort = request->Has(vtkExecutive::FROM_OUTPUT_PORT())
+    ? std::max(request->Get(vtkExecutive::FROM_OUTPUT_PORT()), 0)
+    : 0;
+  vtkInformation* trigger = outputVector->GetInformationObject(fromPort);
+  const double requested = trigger->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    ? trigger->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+    : cache.Times.front();
+  const std::size_t frame = mlr::vtkinputs::frameAtOrBelow(cache.Times, requested);
+
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
-    vtkInformation* outInfo = outputVector->GetInformationObject(port);
-    vtkPolyData* output = vtkPolyData::GetData(outInfo);
-    const double requested = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-      ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-      : cache.Times.front();
-    const std::size_t frame = mlr::vtkinputs::frameAtOrBelow(cache.Times, requested);
-
+    vtkPolyData* output = vtkPolyData::GetData(outputVector, port);
     output->Initialize();
     if (cache.Elements)
     {
@@ -312,6 +335,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   catch (const mlr::Cancelled& e)
   {
     vtkErrorMacro(<< "aborted: " << e.what());
+    cache.Clear();
+    cache.Aborted = true;
+    return false;
   }
   catch (const mlr::Error& e)
   {

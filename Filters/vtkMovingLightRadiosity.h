@@ -36,11 +36,13 @@
  * Time: the outputs have one time step per light position (TIME_STEPS, TIME_RANGE). The
  * first update solves every frame at once and keeps the result; requests for other times
  * are served from it without solving again, until an input or a property changes. A time
- * between two steps shows the step at or below it. The filter's time is not passed
- * upstream: the inputs are used as they are.
+ * between two steps shows the step at or below it. Both outputs show the time requested on
+ * the port being updated. The filter's time is not passed upstream: the inputs are used as
+ * they are.
  *
- * Progress is reported through UpdateProgress; setting AbortExecute stops the solve within
- * a fraction of a second, with empty outputs and an error. Bad input (NaN points, a wrong
+ * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
+ * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with
+ * empty outputs and an error; the next update clears the flag and solves again. Bad input (NaN points, a wrong
  * `Reflectance`, a light without polygons, ...) gives an error naming what to fix and empty
  * outputs. An empty scene gives empty outputs and no error.
  *

@@ -1,0 +1,67 @@
+// Inputs and probes shared by the tests of vtkMovingLightRadiosity.
+#pragma once
+
+#include "MovingLight.h"
+#include "Scene.h"
+
+#include "vtkCommand.h"
+#include "vtkSmartPointer.h"
+
+#include <string>
+#include <vector>
+
+class vtkAlgorithm;
+class vtkDataObject;
+class vtkMovingLightRadiosity;
+class vtkPolyData;
+
+namespace mlr::testing
+{
+
+/// Core's patch mesh as the filter's Scene input: triangles with a cell array Reflectance.
+vtkSmartPointer<vtkPolyData> scenePolyData(const PatchMesh& mesh);
+
+/// Light polygons as the filter's Light input.
+vtkSmartPointer<vtkPolyData> lightPolyData(const std::vector<std::vector<Vec3>>& polygons);
+
+/// Points (and, when given, a point array Time) as the filter's Trajectory input.
+vtkSmartPointer<vtkPolyData> trajectoryPolyData(
+  const std::vector<Vec3>& positions, const std::vector<double>& times = {});
+
+/// The unit box of Core's tests, closed, inward normals, 4 cells per edge, grey 0.5, with a
+/// 0.2 m light facing down near its top and `frames` positions on a diagonal below it.
+struct BoxSetup
+{
+  vtkSmartPointer<vtkPolyData> scene, light, trajectory;
+  std::vector<Vec3> positions;
+};
+BoxSetup closedBoxSetup(std::size_t frames);
+
+/// A filter on `setup` with few paths and patches of the box's cell size: fast to solve.
+vtkSmartPointer<vtkMovingLightRadiosity> fastFilter(const BoxSetup& setup);
+
+/// The time steps the algorithm's output port 0 declares.
+std::vector<double> timeSteps(vtkAlgorithm* algorithm);
+
+/// The first value of the field data array `name`, or NaN when it is missing.
+double fieldValue(vtkDataObject* data, const char* name);
+
+/// Area of cell `cell` of a triangle mesh.
+double triangleArea(vtkPolyData* mesh, vtkIdType cell);
+
+/// Records the errors and warnings an object reports (instead of printing them).
+class MessageRecorder : public vtkCommand
+{
+public:
+  static MessageRecorder* New() { return new MessageRecorder; }
+  void Execute(vtkObject*, unsigned long event, void* data) override;
+  /// Starts recording from `object`.
+  void watch(vtkObject* object);
+
+  std::vector<std::string> errors, warnings;
+  /// All errors in one string, for assertions.
+  std::string allErrors() const;
+  std::string allWarnings() const;
+};
+
+} // namespace mlr::testing

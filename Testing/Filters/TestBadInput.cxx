@@ -1,0 +1,273 @@
+// Bad input and aborts: an error naming what to fix, empty outputs, no crash, no stale result.
+#include "FilterTestSupport.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkFloatArray.h"
+#include "vtkMovingLightRadiosity.h"
+#include "vtkNew.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStringArray.h"
+#include "vtkStripper.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+using namespace mlr;
+using namespace mlr::testing;
+
+namespace
+{
+struct FilterRun
+{
+  bool succeeded = false;
+  vtkSmartPointer<MessageRecorder> messages;
+  vtkIdType elements = 0, patches = 0;
+};
+
+FilterRun runFilter(vtkMovingLightRadiosity* filter)
+{
+  FilterRun run;
+  run.messages = vtkSmartPointer<MessageRecorder>::New();
+  run.messages->watch(filter);
+  run.succeeded = filter->UpdateTimeStep(0) != 0;
+  run.elements = filter->GetOutput(0)->GetNumberOfCells();
+  run.patches = filter->GetOutput(1)->GetNumberOfCells();
+  filter->RemoveAllObservers();
+  return run;
+}
+
+void expectError(const FilterRun& run, const std::string& expected)
+{
+  EXPECT_FALSE(run.succeeded);
+  ASSERT_FALSE(run.messages->errors.empty()) << "no error reported; expected: " << expected;
+  EXPECT_NE(run.messages->allErrors().find(expected), std::string::npos)
+    << run.messages->allErrors();
+  EXPECT_EQ(run.elements, 0);
+  EXPECT_EQ(run.patches, 0);
+}
+
+void setReflectance(vtkPolyData* scene, vtkAbstractArray* array)
+{
+  scene->GetCellData()->RemoveArray("Reflectance");
+  array->SetName("Reflectance");
+  scene->GetCellData()->AddArray(array);
+}
+}
+
+TEST(FilterBadInput, ReflectanceWithTwoComponents)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  vtkNew<vtkFloatArray> rho;
+  rho->SetNumberOfComponents(2);
+  rho->SetNumberOfTuples(setup.scene->GetNumberOfCells());
+  rho->FillValue(0.5f);
+  setReflectance(setup.scene, rho);
+  expectError(runFilter(fastFilter(setup)), "Reflectance has 2 components");
+}
+
+TEST(FilterBadInput, ReflectanceThatIsNotNumeric)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  vtkNew<vtkStringArray> rho;
+  rho->SetNumberOfValues(setup.scene->GetNumberOfCells());
+  setReflectance(setup.scene, rho);
+  expectError(runFilter(fastFilter(setup)), "give a numeric array");
+}
+
+TEST(FilterBadInput, ReflectanceOutOfRangeNamesTheCell)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene->GetCellData()->GetArray("Reflectance")->SetComponent(7, 1, 1.2);
+  expectError(runFilter(fastFilter(setup)), "Scene cell 7 has Reflectance (0.5, 1.2, 0.5)");
+}
+
+TEST(FilterBadInput, MissingReflectanceIsGreyWithAWarning)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene->GetCellData()->RemoveArray("Reflectance");
+  auto filter = fastFilter(setup);
+  const FilterRun run = runFilter(filter);
+  EXPECT_TRUE(run.succeeded);
+  EXPECT_NE(run.messages->allWarnings().find("no cell array Reflectance"), std::string::npos);
+  vtkDataArray* rho = filter->GetOutput()->GetCellData()->GetArray("Reflectance");
+  ASSERT_NE(rho, nullptr);
+  EXPECT_FLOAT_EQ(static_cast<float>(rho->GetRange(0)[0]), 0.5f);
+  EXPECT_FLOAT_EQ(static_cast<float>(rho->GetRange(2)[1]), 0.5f);
+}
+
+TEST(FilterBadInput, NaNPoints)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene->GetPoints()->SetPoint(3, std::numeric_limits<double>::quiet_NaN(), 0, 0);
+  expectError(runFilter(fastFilter(setup)), "NaN");
+}
+
+TEST(FilterBadInput, LightWithoutPolygons)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  vtkNew<vtkPolyData> line;
+  line->SetPoints(setup.light->GetPoints());
+  vtkNew<vtkCellArray> lines;
+  const vtkIdType ids[2] = { 0, 1 };
+  lines->InsertNextCell(2, ids);
+  line->SetLines(lines);
+  setup.light = line;
+  expectError(runFilter(fastFilter(setup)), "the light has no polygon");
+}
+
+TEST(FilterBadInput, NegativeLightPower)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  auto filter = fastFilter(setup);
+  filter->SetLightPower(1, -1, 1);
+  expectError(runFilter(filter), "light power");
+}
+
+TEST(FilterBadInput, TrajectoryTimesMustIncrease)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  setup.trajectory = trajectoryPolyData(setup.positions, { 0, 2, 1 });
+  auto filter = fastFilter(setup);
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(filter);
+  EXPECT_FALSE(filter->UpdateTimeStep(0));
+  EXPECT_NE(messages->allErrors().find("Time must increase strictly"), std::string::npos)
+    << messages->allErrors();
+}
+
+TEST(FilterBadInput, TrajectoryWithoutPoints)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  setup.trajectory = trajectoryPolyData({});
+  auto filter = fastFilter(setup);
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(filter);
+  EXPECT_FALSE(filter->UpdateTimeStep(0));
+  EXPECT_NE(messages->allErrors().find("the Trajectory has no points"), std::string::npos);
+}
+
+TEST(FilterBadInput, MemoryLimitRefusesTheSolveBeforeAllocating)
+{
+  BoxSetup setup = closedBoxSetup(1);
+  auto filter = fastFilter(setup);
+  filter->RemoveAllInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT);
+  filter->SetPathStart(0.3, 0.3, 0.9);
+  filter->SetPathEnd(0.7, 0.7, 0.9);
+  filter->SetNumberOfPositions(5000);
+  filter->SetMemoryLimit(1);
+  expectError(runFilter(filter), "memory limit");
+}
+
+TEST(FilterBadInput, EmptySceneGivesEmptyOutputsWithoutError)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene = vtkSmartPointer<vtkPolyData>::New();
+  const FilterRun run = runFilter(fastFilter(setup));
+  EXPECT_TRUE(run.succeeded);
+  EXPECT_TRUE(run.messages->errors.empty()) << run.messages->allErrors();
+  EXPECT_EQ(run.elements, 0);
+}
+
+TEST(FilterBadInput, VerticesAndLinesAreIgnoredWithAWarning)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  vtkNew<vtkCellArray> verts;
+  const vtkIdType vertex = 0;
+  verts->InsertNextCell(1, &vertex);
+  setup.scene->SetVerts(verts);
+  // Cell data follows the cells: one more (leading) value for the vertex.
+  vtkNew<vtkFloatArray> rho;
+  rho->SetNumberOfComponents(3);
+  rho->InsertNextTuple3(0.9, 0.9, 0.9);
+  vtkDataArray* old = setup.scene->GetCellData()->GetArray("Reflectance");
+  for (vtkIdType i = 0; i < old->GetNumberOfTuples(); ++i)
+  {
+    rho->InsertNextTuple(old->GetTuple(i));
+  }
+  setReflectance(setup.scene, rho);
+  const FilterRun run = runFilter(fastFilter(setup));
+  EXPECT_TRUE(run.succeeded);
+  EXPECT_NE(run.messages->allWarnings().find("ignored 1 vertices and 0 lines"), std::string::npos);
+  EXPECT_GT(run.elements, 0);
+}
+
+TEST(FilterBadInput, TriangleStripsAreSurfaces)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene->GetCellData()->RemoveArray("Reflectance"); // strips lose the per-cell values
+  vtkNew<vtkStripper> stripper;
+  stripper->SetInputData(setup.scene);
+  stripper->Update();
+  vtkPolyData* strips = stripper->GetOutput();
+  ASSERT_GT(strips->GetNumberOfStrips(), 0);
+
+  auto fromTriangles = fastFilter(setup);
+  const FilterRun reference = runFilter(fromTriangles);
+  setup.scene = strips;
+  const FilterRun run = runFilter(fastFilter(setup));
+  EXPECT_TRUE(run.succeeded) << run.messages->allErrors();
+  // The same surface, so about the same patches; and all strip triangles face inward as the
+  // polygons did: the box stays lit on the inside (its lit side is the front).
+  EXPECT_NEAR(double(run.patches), double(reference.patches), 0.1 * double(reference.patches));
+}
+
+TEST(FilterBadInput, AbortStopsQuicklyWithEmptyOutputsAndRecovers)
+{
+  BoxSetup setup = closedBoxSetup(5);
+  auto filter = fastFilter(setup);
+  filter->SetNumberOfPaths(50000000); // tens of seconds if it ran to the end
+
+  using Clock = std::chrono::steady_clock;
+  struct AbortState
+  {
+    vtkMovingLightRadiosity* filter;
+    Clock::time_point abortedAt{};
+    bool aborted = false;
+  } state{ filter };
+  vtkNew<vtkCallbackCommand> abortMidway;
+  abortMidway->SetClientData(&state);
+  abortMidway->SetCallback([](vtkObject*, unsigned long, void* data, void*) {
+    auto* s = static_cast<AbortState*>(data);
+    if (!s->aborted && s->filter->GetProgress() > 0.1)
+    {
+      s->aborted = true;
+      s->abortedAt = Clock::now();
+      s->filter->SetAbortExecute(1);
+    }
+  });
+  filter->AddObserver(vtkCommand::ProgressEvent, abortMidway);
+  const FilterRun run = runFilter(filter);
+  const double seconds = std::chrono::duration<double>(Clock::now() - state.abortedAt).count();
+  ASSERT_TRUE(state.aborted);
+  EXPECT_LT(seconds, 0.5);
+  expectError(run, "aborted");
+  EXPECT_EQ(filter->GetSolveCount(), 0);
+
+  // Nothing stale is kept: the next update solves again and succeeds.
+  filter->RemoveAllObservers();
+  filter->SetNumberOfPaths(20000);
+  const FilterRun again = runFilter(filter);
+  EXPECT_TRUE(again.succeeded) << again.messages->allErrors();
+  EXPECT_GT(again.elements, 0);
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+}
+
+TEST(FilterBadInput, AFixedInputSolvesAfterAnError)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  setup.scene->GetCellData()->GetArray("Reflectance")->SetComponent(0, 0, 1.5);
+  auto filter = fastFilter(setup);
+  expectError(runFilter(filter), "Scene cell 0");
+  setup.scene->GetCellData()->GetArray("Reflectance")->SetComponent(0, 0, 0.5);
+  setup.scene->GetCellData()->GetArray("Reflectance")->Modified();
+  const FilterRun run = runFilter(filter);
+  EXPECT_TRUE(run.succeeded) << run.messages->allErrors();
+  EXPECT_GT(run.elements, 0);
+}

@@ -1,0 +1,277 @@
+// Time steps are light positions: one solve serves every time until something changes.
+#include "FilterTestSupport.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkInformation.h"
+#include "vtkMovingLightRadiosity.h"
+#include "vtkNew.h"
+#include "vtkPlaneSource.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+using namespace mlr;
+using namespace mlr::testing;
+
+namespace
+{
+double dataTime(vtkPolyData* output)
+{
+  return output->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP());
+}
+
+std::vector<float> arrayValues(vtkPolyData* output, const char* name)
+{
+  vtkDataArray* array = output->GetCellData()->GetArray(name);
+  std::vector<float> values;
+  for (vtkIdType i = 0; array && i < array->GetNumberOfValues(); ++i)
+  {
+    values.push_back(static_cast<float>(array->GetComponent(i / 3, static_cast<int>(i % 3))));
+  }
+  return values;
+}
+
+/// How well the direct light on the floor (z = 0) matches a small light at `light`: the
+/// correlation of DirectRadiosity with the point-light shape h^2 / (h^2 + d^2)^2.
+double floorMatch(vtkPolyData* elements, const Vec3& light)
+{
+  vtkDataArray* direct = elements->GetCellData()->GetArray("DirectRadiosity");
+  std::vector<double> measured, predicted;
+  for (vtkIdType c = 0; c < elements->GetNumberOfCells(); ++c)
+  {
+    double bounds[6];
+    elements->GetCellBounds(c, bounds);
+    if (bounds[5] > 1e-6)
+    {
+      continue;
+    }
+    const double dx = 0.5 * (bounds[0] + bounds[1]) - light.x;
+    const double dy = 0.5 * (bounds[2] + bounds[3]) - light.y;
+    const double h2 = light.z * light.z;
+    measured.push_back(direct->GetComponent(c, 1));
+    predicted.push_back(h2 / std::pow(h2 + dx * dx + dy * dy, 2));
+  }
+  const auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v)
+    {
+      s += x;
+    }
+    return s / double(v.size());
+  };
+  const double mm = mean(measured), mp = mean(predicted);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (std::size_t i = 0; i < measured.size(); ++i)
+  {
+    sxy += (measured[i] - mm) * (predicted[i] - mp);
+    sxx += (measured[i] - mm) * (measured[i] - mm);
+    syy += (predicted[i] - mp) * (predicted[i] - mp);
+  }
+  return sxy / std::sqrt(sxx * syy);
+}
+}
+
+TEST(FilterTime, TimeStepsAreTheTrajectoryPointsOrItsTimeArray)
+{
+  BoxSetup setup = closedBoxSetup(5);
+  auto filter = fastFilter(setup);
+  EXPECT_EQ(timeSteps(filter), (std::vector<double>{ 0, 1, 2, 3, 4 }));
+  vtkInformation* info = filter->GetOutputInformation(1);
+  const double* range = info->Get(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  EXPECT_EQ(range[0], 0);
+  EXPECT_EQ(range[1], 4);
+
+  const std::vector<double> times = { 0.5, 1.0, 2.5, 4.0, 8.0 };
+  filter->SetInputData(
+    vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectoryPolyData(setup.positions, times));
+  EXPECT_EQ(timeSteps(filter), times);
+}
+
+TEST(FilterTime, WithoutTrajectoryTheLightMovesFromPathStartToPathEnd)
+{
+  BoxSetup setup = closedBoxSetup(1);
+  auto filter = fastFilter(setup);
+  filter->RemoveAllInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT);
+  filter->SetPathStart(0.3, 0.3, 0.9);
+  filter->SetPathEnd(0.7, 0.5, 0.9);
+  filter->SetNumberOfPositions(3);
+  ASSERT_EQ(timeSteps(filter), (std::vector<double>{ 0, 1, 2 }));
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  vtkDataArray* position = filter->GetOutput()->GetFieldData()->GetArray("LightPosition");
+  ASSERT_NE(position, nullptr);
+  EXPECT_NEAR(position->GetComponent(0, 0), 0.5, 1e-12);
+  EXPECT_NEAR(position->GetComponent(0, 1), 0.4, 1e-12);
+  EXPECT_NEAR(position->GetComponent(0, 2), 0.9, 1e-12);
+}
+
+TEST(FilterTime, EachTimeShowsItsOwnFrameAndLightPosition)
+{
+  BoxSetup setup = closedBoxSetup(4);
+  auto filter = fastFilter(setup);
+  filter->SetNumberOfPaths(100000);
+  const std::vector<double> times = timeSteps(filter);
+  ASSERT_EQ(times.size(), 4u);
+  for (std::size_t f = 0; f < times.size(); ++f)
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(times[f]));
+    for (int port : { 0, 1 })
+    {
+      EXPECT_EQ(dataTime(filter->GetOutput(port)), times[f]) << "port " << port;
+    }
+    vtkPolyData* elements = filter->GetOutput(0);
+    EXPECT_EQ(fieldValue(elements, "FrameIndex"), double(f));
+    vtkDataArray* position = elements->GetFieldData()->GetArray("LightPosition");
+    ASSERT_NE(position, nullptr);
+    EXPECT_NEAR(position->GetComponent(0, 0), setup.positions[f].x, 1e-12);
+    EXPECT_NEAR(position->GetComponent(0, 1), setup.positions[f].y, 1e-12);
+    // The light on the floor is that of this frame's position, not of another one.
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < setup.positions.size(); ++k)
+    {
+      if (floorMatch(elements, setup.positions[k]) > floorMatch(elements, setup.positions[best]))
+      {
+        best = k;
+      }
+    }
+    EXPECT_EQ(best, f);
+    EXPECT_GT(floorMatch(elements, setup.positions[f]), 0.9) << "frame " << f;
+  }
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+}
+
+TEST(FilterTime, TimesBetweenStepsShowTheStepAtOrBelow)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  filter->SetInputData(
+    vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectoryPolyData(setup.positions, { 1, 2, 4 }));
+  const std::vector<std::pair<double, double>> cases = { { 3.9, 2 }, { 4.5, 4 }, { 0.0, 1 },
+    { 2.0, 2 }, { 2.0 - 1e-12, 2 } };
+  for (const auto& [requested, shown] : cases)
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(requested));
+    EXPECT_EQ(dataTime(filter->GetOutput()), shown) << "requested " << requested;
+  }
+}
+
+TEST(FilterTime, SwitchingTimeServesTheCacheWithoutSolvingOrUpdatingInputs)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  const std::vector<float> frame1 = arrayValues(filter->GetOutput(), "Radiosity");
+  ASSERT_FALSE(frame1.empty());
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+  const vtkMTimeType sceneTime = filter->GetInputDataObject(0, 0)->GetMTime();
+
+  for (double t : { 2.0, 0.0, 1.0, 2.0, 1.0 })
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(t));
+    EXPECT_EQ(filter->GetSolveCount(), 1) << "time " << t;
+    EXPECT_EQ(fieldValue(filter->GetOutput(), "SolveCount"), 1);
+    EXPECT_EQ(fieldValue(filter->GetOutput(), "FrameIndex"), t);
+  }
+  EXPECT_EQ(arrayValues(filter->GetOutput(), "Radiosity"), frame1);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  EXPECT_NE(arrayValues(filter->GetOutput(), "Radiosity"), frame1);
+  EXPECT_EQ(filter->GetInputDataObject(0, 0)->GetMTime(), sceneTime);
+}
+
+TEST(FilterTime, TheFiltersTimeIsNotPassedUpstream)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  vtkNew<vtkPlaneSource> light;
+  light->SetOrigin(0.4, 0.4, 0.9);
+  light->SetPoint1(0.4, 0.6, 0.9); // normal (P1 - O) x (P2 - O) = -z: facing down
+  light->SetPoint2(0.6, 0.4, 0.9);
+  filter->SetInputConnection(vtkMovingLightRadiosity::LIGHT_PORT, light->GetOutputPort());
+  int executions = 0;
+  vtkNew<vtkCallbackCommand> count;
+  count->SetClientData(&executions);
+  count->SetCallback([](vtkObject*, unsigned long, void* n, void*) { ++*static_cast<int*>(n); });
+  light->AddObserver(vtkCommand::StartEvent, count);
+
+  for (double t : { 0.0, 2.0, 1.0, 0.0 })
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(t));
+  }
+  EXPECT_EQ(executions, 1);
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+  EXPECT_GT(filter->GetOutput()->GetNumberOfCells(), 0);
+}
+
+TEST(FilterTime, ChangingAPropertyOrAnInputSolvesAgain)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  ASSERT_EQ(filter->GetSolveCount(), 1);
+  const std::vector<float> seed0 = arrayValues(filter->GetOutput(), "Radiosity");
+
+  filter->SetSeed(0); // the same value: nothing changed
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+
+  filter->SetSeed(7);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  EXPECT_EQ(filter->GetSolveCount(), 2);
+  EXPECT_NE(arrayValues(filter->GetOutput(), "Radiosity"), seed0);
+  EXPECT_EQ(fieldValue(filter->GetOutput(), "SolveCount"), 2);
+
+  filter->SetLightPower(50, 50, 50);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  EXPECT_EQ(filter->GetSolveCount(), 3);
+
+  setup.light->Modified(); // an input that changed
+  ASSERT_TRUE(filter->UpdateTimeStep(2));
+  EXPECT_EQ(filter->GetSolveCount(), 4);
+
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  EXPECT_EQ(filter->GetSolveCount(), 4);
+}
+
+TEST(FilterTime, OutputsCarryTheDocumentedArrays)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  auto filter = fastFilter(setup);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  vtkPolyData* elements = filter->GetOutput(0);
+  vtkPolyData* patches = filter->GetOutput(1);
+  ASSERT_GT(elements->GetNumberOfCells(), 0);
+  EXPECT_EQ(elements->GetNumberOfCells(), 4 * patches->GetNumberOfCells());
+  for (const char* name : { "Radiosity", "DirectRadiosity", "IndirectRadiosity",
+         "RadiosityFront", "RadiosityBack", "Reflectance" })
+  {
+    vtkDataArray* array = elements->GetCellData()->GetArray(name);
+    ASSERT_NE(array, nullptr) << name;
+    EXPECT_EQ(array->GetNumberOfComponents(), 3) << name;
+  }
+  ASSERT_NE(elements->GetCellData()->GetArray("PatchId"), nullptr);
+  EXPECT_EQ(elements->GetCellData()->GetArray("PatchId")->GetNumberOfComponents(), 1);
+  for (const char* name : { "Radiosity", "Reflectance" })
+  {
+    ASSERT_NE(patches->GetCellData()->GetArray(name), nullptr) << name;
+  }
+  for (const char* name : { "Frames", "Patches", "Elements", "PathsPerFrame", "PathsCast",
+         "ShootingRays", "ShadowRays", "GatheringRays", "SecondsRemeshing", "SecondsShooting",
+         "SecondsGathering", "SecondsTotal", "ReuseShooting", "ReuseGathering",
+         "PredictedSpeedup", "FrameIndex", "SolveCount" })
+  {
+    EXPECT_FALSE(std::isnan(fieldValue(elements, name))) << name;
+  }
+  EXPECT_EQ(fieldValue(elements, "Frames"), 2);
+  EXPECT_EQ(fieldValue(elements, "Elements"), elements->GetNumberOfCells());
+  EXPECT_EQ(fieldValue(elements, "Patches"), patches->GetNumberOfCells());
+
+  filter->TwoSidedOff();
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  EXPECT_EQ(filter->GetOutput(0)->GetCellData()->GetArray("RadiosityFront"), nullptr);
+  EXPECT_NE(filter->GetOutput(0)->GetCellData()->GetArray("Radiosity"), nullptr);
+}
