@@ -404,7 +404,8 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
   if (triangles.triangles.empty())
   {
     throw Error("the scene has no polygon with an area (" + std::to_string(soup.polygons.size()) +
-      " polygons, all degenerate): give at least one triangle or polygon that encloses area");
+      " polygons, all degenerate or too large to measure): give at least one triangle or "
+      "polygon that encloses area");
   }
   addTriangulationWarnings(triangulation, result.warnings);
 

@@ -50,13 +50,14 @@ struct RemeshStatistics
   std::size_t inputTriangles = 0; ///< after triangulating the polygons
   std::size_t droppedPolygons = 0; ///< fewer than 3 points, duplicate, zero area or self-crossing
   std::size_t removedTriangles = 0; ///< degenerate or duplicate once duplicate points merged
-  std::size_t regions = 0;        ///< connected faces of one material
-  std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only
+  /// Connected faces of one material and orientation, bounded by sharp edges (CGAL only).
+  std::size_t regions = 0;
+  std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only (with a warning)
   std::size_t patches = 0;
   double targetEdgeLength = 0; ///< the h actually used
-  double inputArea = 0;
-  double outputArea = 0;
-  double seconds = 0;
+  double inputArea = 0;  ///< of the triangulated polygons, duplicates included
+  double outputArea = 0; ///< of the patches
+  double seconds = 0;    ///< wall-clock time of remesh(); callers copy it to secondsRemeshing
 };
 
 struct RemeshResult
@@ -74,6 +75,13 @@ using RemeshProgress = std::function<bool(double fraction)>;
  * exactly one material. Throws mlr::Error for input that cannot give a scene (NaN/Inf
  * points, no polygon with area, bad indices, mismatched materials) and mlr::Cancelled.
  * Recoverable oddities (dropped polygons, regions only refined) become warnings.
+ *
+ * With CGAL, polygons are triangulated, duplicate points merged, degenerate and duplicate
+ * triangles removed, and the soup oriented (points are split where it is not a manifold).
+ * Each region is then isotropically remeshed with its border, sharp edges and corners kept,
+ * its vertices projected onto its own input triangles. Every patch keeps the orientation of
+ * the polygon it lies on. A region whose remeshing fails or changes its area by more than
+ * 0.5% keeps its input triangles, only refined.
  */
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
