@@ -55,7 +55,7 @@ struct RemeshStatistics
   std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only (with a warning)
   std::size_t patches = 0;
   double targetEdgeLength = 0; ///< the h actually used
-  double inputArea = 0;  ///< of the triangulated polygons, duplicates included
+  double inputArea = 0;  ///< of the triangulated polygons that were kept
   double outputArea = 0; ///< of the patches
   double seconds = 0;    ///< wall-clock time of remesh(); callers copy it to secondsRemeshing
 };
