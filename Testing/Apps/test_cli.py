@@ -1,0 +1,233 @@
+"""The command line moving-light-radiosity: the series it writes reads back with VTK's readers,
+and bad options, unreadable files and failed solves leave no (or no new) files behind.
+
+ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
+    MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
+"""
+import json
+import os
+import shutil
+import subprocess
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+
+from vtkmodules.vtkCommonCore import vtkFloatArray
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+from vtkmodules.vtkCommonCore import vtkPoints, vtkDoubleArray
+from vtkmodules.vtkIOImage import vtkPNGReader
+from vtkmodules.vtkIOXML import (vtkXMLPolyDataReader, vtkXMLPolyDataWriter,
+                                 vtkXMLUnstructuredGridReader)
+from paraview.modules.vtkPVVTKExtensionsIOCore import vtkPVDReader
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CLI = os.path.abspath(os.environ.get("MLR_CLI", os.path.join(
+    HERE, os.pardir, os.pardir, "build", "bin", "moving-light-radiosity")))
+DATA = os.path.abspath(os.environ.get("MLR_DATA_DIR",
+                                     os.path.join(HERE, os.pardir, os.pardir, "Data")))
+SCENE = os.path.join(DATA, "cornell_box.vtp")
+LIGHT = os.path.join(DATA, "cornell_light.vtp")
+FAST = ["--paths", "20000", "--patch-size", "0.08"]
+PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40"]
+ARRAYS = ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "RadiosityFront",
+          "RadiosityBack", "Reflectance", "PatchId")
+
+
+def run(args, cwd, env=None):
+    return subprocess.run([CLI] + args, cwd=cwd, capture_output=True, text=True, timeout=300,
+                          env=env)
+
+
+def all_files(directory):
+    return sorted(os.path.relpath(os.path.join(root, name), directory)
+                  for root, _, names in os.walk(directory) for name in names)
+
+
+def read_grid(path):
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def field(data, name):
+    return data.GetFieldData().GetArray(name).GetValue(0)
+
+
+def write_polydata(data, path):
+    writer = vtkXMLPolyDataWriter()
+    writer.SetInputData(data)
+    writer.SetFileName(str(path))
+    assert writer.Write()
+
+
+def read_scene():
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(SCENE)
+    reader.Update()
+    scene = vtkPolyData()
+    scene.DeepCopy(reader.GetOutput())
+    return scene
+
+
+def test_help(tmp_path):
+    result = run(["--help"], tmp_path)
+    assert result.returncode == 0
+    assert "--scene FILE" in result.stdout and "--png DIR" in result.stdout
+    assert all_files(tmp_path) == []
+
+
+def test_series_reads_back_with_frames_arrays_and_times(tmp_path):
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", "4", "--output", "out/series.pvd", "--stats", "out/stats.json"] +
+                 FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "4 frames" in result.stdout and "predicted speed-up" in result.stdout
+    assert "\r" not in result.stdout  # no progress bar when stdout is not a terminal
+    assert all_files(tmp_path / "out") == [
+        "series.pvd", "series_0000.vtu", "series_0001.vtu", "series_0002.vtu",
+        "series_0003.vtu", "stats.json"]
+
+    reader = vtkPVDReader()
+    reader.SetFileName(str(tmp_path / "out" / "series.pvd"))
+    reader.UpdateInformation()
+    steps = reader.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+    assert steps == (0.0, 1.0, 2.0, 3.0)
+    for t in steps:
+        reader.UpdateTimeStep(t)
+        assert reader.GetOutputDataObject(0).GetNumberOfCells() > 0
+
+    datasets = ElementTree.parse(tmp_path / "out" / "series.pvd").findall(".//DataSet")
+    previous = None
+    for frame, dataset in enumerate(datasets):
+        grid = read_grid(tmp_path / "out" / dataset.get("file"))
+        assert grid.GetNumberOfCells() > 0
+        for name in ARRAYS:
+            assert grid.GetCellData().GetArray(name) is not None, name
+        assert field(grid, "TimeValue") == float(dataset.get("timestep")) == frame
+        assert field(grid, "FrameIndex") == frame
+        radiosity = grid.GetCellData().GetArray("Radiosity").GetRange(-1)
+        assert radiosity[1] > 0 and radiosity != previous
+        previous = radiosity
+
+    stats = json.loads((tmp_path / "out" / "stats.json").read_text())
+    assert stats["statistics"]["Frames"] == 4
+    assert stats["statistics"]["Elements"] == grid.GetNumberOfCells()
+    assert [f["time"] for f in stats["frames"]] == [0, 1, 2, 3]
+    assert stats["settings"]["paths"] == 20000
+
+
+def test_trajectory_file_gives_positions_and_times(tmp_path):
+    trajectory = vtkPolyData()
+    points = vtkPoints()
+    for x in (0.15, 0.25, 0.40):
+        points.InsertNextPoint(x, 0.5478, x)
+    trajectory.SetPoints(points)
+    times = vtkDoubleArray()
+    times.SetName("Time")
+    for t in (0.0, 0.5, 2.0):
+        times.InsertNextValue(t)
+    trajectory.GetPointData().AddArray(times)
+    write_polydata(trajectory, tmp_path / "path.vtp")
+
+    result = run(["--scene", SCENE, "--light", LIGHT, "--trajectory", "path.vtp",
+                  "--output", "series.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    datasets = ElementTree.parse(tmp_path / "series.pvd").findall(".//DataSet")
+    assert [float(d.get("timestep")) for d in datasets] == [0.0, 0.5, 2.0]
+    grid = read_grid(tmp_path / datasets[1].get("file"))
+    assert grid.GetFieldData().GetArray("LightPosition").GetTuple(0) == pytest.approx(
+        (0.25, 0.5478, 0.25))
+
+
+def test_shorter_run_replaces_the_whole_series(tmp_path):
+    base = ["--scene", SCENE, "--light", LIGHT, "--output", "s.pvd"] + PATH + FAST
+    assert run(base + ["--frames", "4"], tmp_path).returncode == 0
+    assert run(base + ["--frames", "2"], tmp_path).returncode == 0
+    assert all_files(tmp_path) == ["s.pvd", "s_0000.vtu", "s_0001.vtu"]
+    assert len(ElementTree.parse(tmp_path / "s.pvd").findall(".//DataSet")) == 2
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--bogus"], "unknown option --bogus"),
+    (["--paths", "many"], "--paths needs a whole number"),
+    (["--survival", "0"], "--survival is 0"),
+    (["--frames", "3"], "--frames needs --from and --to"),
+    (["--scene", SCENE], "--scene needs --light"),
+    (["--output", "series.vtu"], "ending in .pvd"),
+    (["--reuse", "sometimes"], "give none, gathering, shooting or both"),
+])
+def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, message):
+    result = run(args + ["--output", "out/x.pvd"] if "--output" not in args else args, tmp_path)
+    assert result.returncode == 2
+    assert message in result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_unreadable_files_fail_with_a_message_and_write_nothing(tmp_path):
+    (tmp_path / "inputs").mkdir()
+    garbage = tmp_path / "inputs" / "garbage.vtp"
+    garbage.write_text("this is not a VTK file\n")
+    for scene, message in ((str(garbage), "garbage.vtp' is not a VTK XML PolyData file"),
+                           ("missing.obj", "missing.obj' does not exist")):
+        result = run(["--scene", scene, "--light", LIGHT, "--output", "out/x.pvd"] + PATH + FAST,
+                     tmp_path)
+        assert result.returncode == 1
+        assert message in result.stderr
+        assert all_files(tmp_path) == ["inputs/garbage.vtp"]
+
+
+def test_failed_solve_keeps_the_previous_series(tmp_path):
+    base = ["--light", LIGHT, "--output", "s.pvd", "--frames", "3"] + PATH + FAST
+    assert run(["--scene", SCENE] + base, tmp_path).returncode == 0
+    before = {name: (tmp_path / name).read_bytes() for name in all_files(tmp_path)}
+
+    scene = read_scene()  # the same box with one reflectance out of range
+    scene.GetCellData().GetArray("Reflectance").SetComponent(2, 0, 1.5)
+    write_polydata(scene, tmp_path / "bad.vtp")
+    result = run(["--scene", "bad.vtp"] + base, tmp_path)
+    assert result.returncode == 1
+    assert "Scene cell 2 has Reflectance (1.5" in result.stderr
+    assert "returned failure" not in result.stderr  # no pipeline dump
+    after = {name: (tmp_path / name).read_bytes() for name in all_files(tmp_path)
+             if name != "bad.vtp"}
+    assert after == before
+
+
+@pytest.mark.skipif(shutil.which("xvfb-run") is None, reason="needs xvfb-run")
+def test_pictures_show_the_light_moving(tmp_path):
+    env = dict(os.environ)
+    env.pop("DISPLAY", None)  # exercises the re-run under xvfb-run
+    result = run(["--scene", SCENE, "--light", LIGHT, "--output", "s.pvd", "--png", "pictures",
+                  "--frames", "3"] + PATH + FAST, tmp_path, env=env)
+    assert result.returncode == 0, result.stderr
+    pictures = [tmp_path / "pictures" / f"s_000{i}.png" for i in range(3)]
+    assert all_files(tmp_path / "pictures") == [p.name for p in pictures]
+
+    def pixels(path):
+        reader = vtkPNGReader()
+        reader.SetFileName(str(path))
+        reader.Update()
+        scalars = reader.GetOutput().GetPointData().GetScalars()
+        return [scalars.GetComponent(i, 1) for i in range(0, scalars.GetNumberOfTuples(), 7)]
+
+    first, last = pixels(pictures[0]), pixels(pictures[2])
+    mean = sum(first) / len(first)
+    assert 20 < mean < 235  # neither blank nor blown out
+    assert max(first) - min(first) > 100
+    assert sum(abs(a - b) for a, b in zip(first, last)) / len(first) > 2
+
+
+def test_default_run_writes_the_cornell_box_animation(tmp_path):
+    env = dict(os.environ)
+    if shutil.which("xvfb-run") is None and not env.get("DISPLAY"):
+        pytest.skip("the default run renders pictures: needs xvfb-run or a display")
+    result = run([], tmp_path, env=env)
+    assert result.returncode == 0, result.stderr
+    assert "30 frames" in result.stdout
+    files = all_files(tmp_path / "output")
+    assert "cornell.pvd" in files
+    assert len([f for f in files if f.endswith(".vtu")]) == 30
+    assert len([f for f in files if f.startswith("png/") and f.endswith(".png")]) == 30
+    assert not [f for f in files if f.endswith(".partial")]

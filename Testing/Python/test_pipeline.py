@@ -1,0 +1,141 @@
+"""The filter in a plain VTK pipeline from Python: sources and readers in, a .pvd + .vtu time
+series out through VTK's writers, read back with VTK's readers.
+
+Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.txt), or by hand:
+    PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
+"""
+import os
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+
+from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+from vtkmodules.vtkFiltersCore import vtkAppendFilter
+from vtkmodules.vtkFiltersSources import vtkLineSource, vtkPlaneSource
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
+from paraview.modules.vtkPVVTKExtensionsIOCore import vtkPVDReader, vtkXMLPVDWriter
+
+from movinglightradiosity import vtkMovingLightRadiosity
+
+DATA = os.environ.get("MLR_DATA_DIR",
+                      os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "Data"))
+FRAMES = 5
+ELEMENT_ARRAYS = ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "RadiosityFront",
+                  "RadiosityBack", "Reflectance", "PatchId")
+
+
+def field(data, name):
+    array = data.GetFieldData().GetArray(name)
+    assert array is not None, f"no field array {name}"
+    return array.GetTuple(0) if array.GetNumberOfComponents() > 1 else array.GetValue(0)
+
+
+@pytest.fixture(scope="module")
+def pipeline():
+    """Cornell box from the shipped .vtp, a plane source as light, a line as trajectory."""
+    scene = vtkXMLPolyDataReader()
+    scene.SetFileName(os.path.join(DATA, "cornell_box.vtp"))
+
+    light = vtkPlaneSource()  # 0.13 x 0.105 m, just below the ceiling, facing down
+    light.SetOrigin(0.213, 0.5478, 0.227)
+    light.SetPoint1(0.343, 0.5478, 0.227)  # normal = (P1 - O) x (P2 - O) = -y
+    light.SetPoint2(0.213, 0.5478, 0.332)
+
+    trajectory = vtkLineSource()
+    trajectory.SetPoint1(0.15, 0.5478, 0.15)
+    trajectory.SetPoint2(0.40, 0.5478, 0.40)
+    trajectory.SetResolution(FRAMES - 1)
+
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetInputConnection(0, scene.GetOutputPort())
+    radiosity.SetInputConnection(1, light.GetOutputPort())
+    radiosity.SetInputConnection(2, trajectory.GetOutputPort())
+    radiosity.SetNumberOfPaths(30000)
+    radiosity.SetPatchSize(0.06)
+    # The sources must outlive this fixture: the filter holds only their outputs.
+    return {"scene": scene, "light": light, "trajectory": trajectory, "filter": radiosity}
+
+
+def test_light_normal_faces_down(pipeline):
+    pipeline["light"].Update()
+    assert pipeline["light"].GetNormal()[1] == pytest.approx(-1.0)
+
+
+def test_time_steps_match_the_trajectory(pipeline):
+    radiosity = pipeline["filter"]
+    radiosity.UpdateInformation()
+    info = radiosity.GetOutputInformation(0)
+    assert info.Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS()) == tuple(
+        float(i) for i in range(FRAMES))
+    assert info.Get(vtkStreamingDemandDrivenPipeline.TIME_RANGE()) == (0.0, FRAMES - 1.0)
+
+
+def test_stepping_through_time_solves_once(pipeline):
+    radiosity = pipeline["filter"]
+    line = pipeline["trajectory"]
+    line.Update()
+    totals = []
+    for frame in list(range(FRAMES)) + [3, 1]:
+        assert radiosity.UpdateTimeStep(float(frame))
+        elements = radiosity.GetOutput(0)
+        assert elements.GetInformation().Get(elements.DATA_TIME_STEP()) == frame
+        assert field(elements, "FrameIndex") == frame
+        assert field(elements, "LightPosition") == pytest.approx(
+            line.GetOutput().GetPoint(frame))
+        for name in ELEMENT_ARRAYS:
+            assert elements.GetCellData().GetArray(name) is not None, name
+        radiosity_range = elements.GetCellData().GetArray("Radiosity").GetRange(-1)
+        assert radiosity_range[1] > 0
+        totals.append(radiosity_range[1])
+        patches = radiosity.GetOutput(1)
+        assert patches.GetCellData().GetArray("Radiosity") is not None
+        assert elements.GetNumberOfCells() == 4 * patches.GetNumberOfCells()
+    assert radiosity.GetSolveCount() == 1
+    assert field(radiosity.GetOutput(0), "SolveCount") == 1
+    assert len(set(totals[:FRAMES])) == FRAMES  # every frame is its own
+
+
+def test_property_change_solves_again(pipeline):
+    radiosity = pipeline["filter"]
+    radiosity.UpdateTimeStep(0.0)
+    solves = radiosity.GetSolveCount()
+    radiosity.SetSeed(radiosity.GetSeed() + 1)
+    radiosity.UpdateTimeStep(0.0)
+    assert radiosity.GetSolveCount() == solves + 1
+
+
+def test_pvd_series_written_and_read_back(pipeline, tmp_path):
+    radiosity = pipeline["filter"]
+    grid = vtkAppendFilter()  # polygons -> unstructured grid, for .vtu
+    grid.SetInputConnection(radiosity.GetOutputPort(0))
+    writer = vtkXMLPVDWriter()
+    writer.SetInputConnection(grid.GetOutputPort())
+    writer.SetFileName(str(tmp_path / "series.pvd"))
+    writer.WriteAllTimeStepsOn()
+    solves = radiosity.GetSolveCount()
+    assert writer.Write()
+    assert radiosity.GetSolveCount() == solves  # the writer's time requests hit the cache
+
+    collection = ElementTree.parse(tmp_path / "series.pvd").getroot()
+    datasets = collection.findall("./Collection/DataSet")
+    assert [float(d.get("timestep")) for d in datasets] == [float(i) for i in range(FRAMES)]
+
+    reader = vtkPVDReader()
+    reader.SetFileName(str(tmp_path / "series.pvd"))
+    reader.UpdateInformation()
+    times = reader.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+    assert times == tuple(float(i) for i in range(FRAMES))
+
+    previous = None
+    for frame, dataset in enumerate(datasets):
+        piece = vtkXMLUnstructuredGridReader()
+        piece.SetFileName(str(tmp_path / dataset.get("file")))
+        piece.Update()
+        grid_frame = piece.GetOutput()
+        assert grid_frame.GetNumberOfCells() > 0
+        for name in ELEMENT_ARRAYS:
+            assert grid_frame.GetCellData().GetArray(name) is not None, name
+        assert field(grid_frame, "FrameIndex") == frame
+        values = grid_frame.GetCellData().GetArray("Radiosity").GetRange(-1)
+        assert values != previous
+        previous = values
