@@ -199,14 +199,23 @@ int run(int argc, char** argv)
     static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
   });
   filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
-  // Errors go below the bar, not into it.
-  vtkNew<vtkCallbackCommand> onError;
-  onError->SetClientData(&bar);
-  onError->SetCallback([](vtkObject*, unsigned long, void* bar, void* message) {
+  // Errors and warnings go below the bar, not into it.
+  vtkNew<vtkCallbackCommand> onMessage;
+  onMessage->SetClientData(&bar);
+  onMessage->SetCallback([](vtkObject*, unsigned long event, void* bar, void* message) {
     static_cast<ProgressBar*>(bar)->finish();
-    vtkOutputWindow::GetInstance()->DisplayErrorText(static_cast<const char*>(message));
+    const char* text = static_cast<const char*>(message);
+    if (event == vtkCommand::ErrorEvent)
+    {
+      vtkOutputWindow::GetInstance()->DisplayErrorText(text);
+    }
+    else
+    {
+      vtkOutputWindow::GetInstance()->DisplayWarningText(text);
+    }
   });
-  filter->AddObserver(vtkCommand::ErrorEvent, onError);
+  filter->AddObserver(vtkCommand::ErrorEvent, onMessage);
+  filter->AddObserver(vtkCommand::WarningEvent, onMessage);
 
   filter->UpdateInformation();
   const std::vector<double> times = timeSteps(filter);
