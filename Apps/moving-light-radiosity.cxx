@@ -198,7 +198,7 @@ int run(int argc, char** argv)
     }
     static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
   });
-  filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  const unsigned long solving = filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
   // Errors and warnings go below the bar, not into it.
   vtkNew<vtkCallbackCommand> onMessage;
   onMessage->SetClientData(&bar);
@@ -220,6 +220,8 @@ int run(int argc, char** argv)
   filter->UpdateInformation();
   const std::vector<double> times = timeSteps(filter);
   vtkPolyData* first = frameAt(filter, times.front()); // the solve
+  // Later updates only copy frames out of the filter's cache: their progress is not the solve's.
+  filter->RemoveObserver(solving);
   bar.finish();
   throwIfInterrupted();
   if (first->GetNumberOfCells() == 0)
