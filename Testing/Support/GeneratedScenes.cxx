@@ -1,6 +1,9 @@
 #include "GeneratedScenes.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 
 namespace mlr::scenes
 {
@@ -105,6 +108,133 @@ PaperRoom paperScaleRoom(std::size_t frames, double cell)
   room.light = squareLightFacingDown(centre, 1.15);
   room.translations =
     translationsAlong(centre, Vec3(1.9, 1.9, 5.49), Vec3(3.6, 3.6, 5.49), frames);
+  return room;
+}
+
+/// Appends a polygon through the given points (new points each time, as exporters do).
+void addPolygon(PolygonSoup& soup, const std::vector<Vec3>& corners, const Rgb& rho)
+{
+  std::vector<std::uint32_t> polygon;
+  for (const Vec3& p : corners)
+  {
+    polygon.push_back(static_cast<std::uint32_t>(soup.points.size()));
+    soup.points.push_back(p);
+  }
+  soup.polygons.push_back(polygon);
+  soup.materials.push_back(Material{ rho });
+}
+
+std::vector<Vec3> boxFace(const Vec3& lo, const Vec3& hi, int axis, bool high)
+{
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  auto corner = [&](bool su, bool sv) {
+    Vec3 p = high ? hi : lo;
+    p[u] = su ? hi[u] : lo[u];
+    p[v] = sv ? hi[v] : lo[v];
+    return p;
+  };
+  std::vector<Vec3> face = { corner(false, false), corner(true, false), corner(true, true), corner(false, true) };
+  if (!high)
+  {
+    std::reverse(face.begin(), face.end());
+  }
+  return face;
+}
+
+PolygonSoup boxOfQuads(const Vec3& lo, const Vec3& hi, const std::vector<Rgb>& walls,
+  bool inward, bool skipBottom)
+{
+  PolygonSoup soup;
+  for (int f = 0; f < 6; ++f)
+  {
+    if (skipBottom && f == 4)
+    {
+      continue;
+    }
+    std::vector<Vec3> face = boxFace(lo, hi, f / 2, f % 2 == 1);
+    if (inward)
+    {
+      std::reverse(face.begin(), face.end());
+    }
+    addPolygon(soup, face, walls[static_cast<std::size_t>(f) % walls.size()]);
+  }
+  return soup;
+}
+
+void append(PolygonSoup& to, const PolygonSoup& from)
+{
+  const auto base = static_cast<std::uint32_t>(to.points.size());
+  to.points.insert(to.points.end(), from.points.begin(), from.points.end());
+  for (auto polygon : from.polygons)
+  {
+    for (auto& v : polygon)
+    {
+      v += base;
+    }
+    to.polygons.push_back(polygon);
+  }
+  to.materials.insert(to.materials.end(), from.materials.begin(), from.materials.end());
+}
+
+PolygonSoup icosphere(int frequency, double radius)
+{
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  const std::vector<Vec3> ico = { { -1, t, 0 }, { 1, t, 0 }, { -1, -t, 0 }, { 1, -t, 0 },
+    { 0, -1, t }, { 0, 1, t }, { 0, -1, -t }, { 0, 1, -t }, { t, 0, -1 }, { t, 0, 1 },
+    { -t, 0, -1 }, { -t, 0, 1 } };
+  const std::vector<std::array<int, 3>> faces = { { 0, 11, 5 }, { 0, 5, 1 }, { 0, 1, 7 },
+    { 0, 7, 10 }, { 0, 10, 11 }, { 1, 5, 9 }, { 5, 11, 4 }, { 11, 10, 2 }, { 10, 7, 6 },
+    { 7, 1, 8 }, { 3, 9, 4 }, { 3, 4, 2 }, { 3, 2, 6 }, { 3, 6, 8 }, { 3, 8, 9 }, { 4, 9, 5 },
+    { 2, 4, 11 }, { 6, 2, 10 }, { 8, 6, 7 }, { 9, 8, 1 } };
+  PolygonSoup soup;
+  // A point is a weighted sum of icosahedron corners; keyed by its sorted (corner, weight)
+  // pairs so that faces sharing an edge share its points exactly.
+  std::map<std::vector<std::pair<int, int>>, std::uint32_t> pointOf;
+  auto point = [&](std::vector<std::pair<int, int>> weights) {
+    weights.erase(std::remove_if(weights.begin(), weights.end(), [](auto w) { return w.second == 0; }),
+      weights.end());
+    std::sort(weights.begin(), weights.end());
+    const auto found = pointOf.find(weights);
+    if (found != pointOf.end())
+    {
+      return found->second;
+    }
+    Vec3 p;
+    for (const auto& [corner, weight] : weights)
+    {
+      p += ico[static_cast<std::size_t>(corner)] * double(weight);
+    }
+    const auto index = static_cast<std::uint32_t>(soup.points.size());
+    soup.points.push_back(normalize(p) * radius);
+    pointOf.emplace(weights, index);
+    return index;
+  };
+  const int n = frequency;
+  for (const auto& [a, b, c] : faces)
+  {
+    auto at = [&](int i, int j) { return point({ { a, n - i - j }, { b, i }, { c, j } }); };
+    for (int j = 0; j < n; ++j)
+    {
+      for (int i = 0; i + j < n; ++i)
+      {
+        soup.polygons.push_back({ at(i, j), at(i + 1, j), at(i, j + 1) });
+        if (i + j + 1 < n)
+        {
+          soup.polygons.push_back({ at(i + 1, j), at(i + 1, j + 1), at(i, j + 1) });
+        }
+      }
+    }
+  }
+  soup.materials.assign(soup.polygons.size(), Material{ Rgb(0.5) });
+  return soup;
+}
+
+PolygonSoup paperRoomOfQuads()
+{
+  const Rgb white(0.75, 0.75, 0.75), red(0.63, 0.065, 0.05), green(0.14, 0.45, 0.091);
+  PolygonSoup room = boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
+  append(room, boxOfQuads({ 1.3, 0.65, 0 }, { 2.95, 2.3, 1.65 }, { white }, false, true));
+  append(room, boxOfQuads({ 2.65, 2.95, 0 }, { 4.3, 4.6, 3.3 }, { white }, false, true));
   return room;
 }
 

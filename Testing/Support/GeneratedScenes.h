@@ -2,6 +2,7 @@
 #pragma once
 
 #include "MovingLight.h"
+#include "Remeshing.h"
 #include "Scene.h"
 
 #include <vector>
@@ -43,5 +44,27 @@ struct PaperRoom
   std::vector<Vec3> translations;
 };
 PaperRoom paperScaleRoom(std::size_t frames = 30, double cell = 0.385);
+
+// --- Polygon soups, as users give them to remeshing ---------------------------------------
+
+/// Appends a polygon through the given points (new points each time, as exporters do).
+void addPolygon(PolygonSoup& soup, const std::vector<Vec3>& corners, const Rgb& rho);
+
+/// The corners of the face of box [lo, hi] on `axis` at its `high` side, counter-clockwise
+/// seen from outside (right-hand normal out of the box).
+std::vector<Vec3> boxFace(const Vec3& lo, const Vec3& hi, int axis, bool high);
+
+/// A box as 6 quads (faces -x, +x, -y, +y, -z, +z), normals out of the box unless `inward`.
+PolygonSoup boxOfQuads(const Vec3& lo, const Vec3& hi, const std::vector<Rgb>& walls,
+  bool inward = false, bool skipBottom = false);
+
+void append(PolygonSoup& to, const PolygonSoup& from);
+
+/// A geodesic sphere: the icosahedron's faces cut into frequency^2 triangles each and pushed
+/// onto the sphere, 20 frequency^2 triangles sharing their points.
+PolygonSoup icosphere(int frequency, double radius = 1.0);
+
+/// The paper-scale room of paperScaleRoom() as 16 big quads, before any remeshing.
+PolygonSoup paperRoomOfQuads();
 
 } // namespace mlr::scenes
