@@ -145,6 +145,12 @@ int vtkMovingLightRadiosity::RequestInformation(
   catch (const mlr::Error& e)
   {
     vtkErrorMacro(<< e.what());
+    // No RequestData follows: empty the outputs here rather than leave an earlier result.
+    this->Internals->Clear();
+    for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+    {
+      vtkPolyData::GetData(outputVector, port)->Initialize();
+    }
     return 0;
   }
 
@@ -184,6 +190,10 @@ int vtkMovingLightRadiosity::RequestUpdateExtent(
 int vtkMovingLightRadiosity::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
+  {
+    vtkPolyData::GetData(outputVector, port)->Initialize();
+  }
   vtkInternals& cache = *this->Internals;
   if (cache.Aborted)
   {
@@ -218,7 +228,6 @@ int vtkMovingLightRadiosity::RequestData(
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
     vtkPolyData* output = vtkPolyData::GetData(outputVector, port);
-    output->Initialize();
     if (cache.Elements)
     {
       if (port == ELEMENTS_PORT)

@@ -130,16 +130,22 @@ TEST(FilterBadInput, NegativeLightPower)
   expectError(runFilter(filter), "light power");
 }
 
-TEST(FilterBadInput, TrajectoryTimesMustIncrease)
+TEST(FilterBadInput, TrajectoryTimesMustIncreaseAndNoEarlierResultStays)
 {
   BoxSetup setup = closedBoxSetup(3);
-  setup.trajectory = trajectoryPolyData(setup.positions, { 0, 2, 1 });
   auto filter = fastFilter(setup);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  ASSERT_GT(filter->GetOutput()->GetNumberOfCells(), 0);
+
+  filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT,
+    trajectoryPolyData(setup.positions, { 0, 2, 1 }));
   auto messages = vtkSmartPointer<MessageRecorder>::New();
   messages->watch(filter);
   EXPECT_FALSE(filter->UpdateTimeStep(0));
   EXPECT_NE(messages->allErrors().find("Time must increase strictly"), std::string::npos)
     << messages->allErrors();
+  EXPECT_EQ(filter->GetOutput(0)->GetNumberOfCells(), 0);
+  EXPECT_EQ(filter->GetOutput(1)->GetNumberOfCells(), 0);
 }
 
 TEST(FilterBadInput, TrajectoryWithoutPoints)
