@@ -102,6 +102,25 @@ TEST(FilterBadInput, MissingReflectanceIsGreyWithAWarning)
   EXPECT_FLOAT_EQ(static_cast<float>(rho->GetRange(2)[1]), 0.5f);
 }
 
+TEST(FilterBadInput, OneComponentReflectanceIsGrey)
+{
+  BoxSetup setup = closedBoxSetup(2);
+  vtkNew<vtkDoubleArray> grey;
+  grey->SetNumberOfTuples(setup.scene->GetNumberOfCells());
+  grey->FillValue(0.3);
+  setReflectance(setup.scene, grey);
+  auto filter = fastFilter(setup);
+  const FilterRun run = runFilter(filter);
+  EXPECT_TRUE(run.succeeded) << run.messages->allErrors();
+  vtkDataArray* rho = filter->GetOutput()->GetCellData()->GetArray("Reflectance");
+  ASSERT_NE(rho, nullptr);
+  for (int c = 0; c < 3; ++c)
+  {
+    EXPECT_FLOAT_EQ(static_cast<float>(rho->GetRange(c)[0]), 0.3f);
+    EXPECT_FLOAT_EQ(static_cast<float>(rho->GetRange(c)[1]), 0.3f);
+  }
+}
+
 TEST(FilterBadInput, NaNPoints)
 {
   BoxSetup setup = closedBoxSetup(2);
