@@ -10,4 +10,4 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build "$build" -j 2 --target moving-light-radiosity
 cd "$root"
-exec "$build/Apps/moving-light-radiosity" "$@"
+exec "$build/bin/moving-light-radiosity" "$@"
