@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds in Release, and reproduces the paper's measurements on the
+# Cornell box: output/paper/results.json, CSV tables, plots and the middle-frame pictures.
+# The first run computes the reference solution (a few minutes) and caches it in
+# output/paper/cache; later runs reuse it.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+"$root/Tools/setup-debian.sh"
+build="${MLR_BUILD_DIR:-$root/build}"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build "$build" -j 2
+cd "$root"
+export PYTHONPATH="$build/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}"
+out="${1:-output/paper}"
+xvfb-run -a /usr/bin/python3 Benchmarks/paper_benchmark.py --output "$out"
+/usr/bin/python3 Benchmarks/plot_paper.py "$out/results.json"
