@@ -1,0 +1,174 @@
+"""The moving-light Cornell box in ParaView, from the shipped data to an animation on disk.
+
+    xvfb-run -a pvpython Examples/cornell_box_animation.py [--plugin PATH] [--output DIR] [--paths N]
+
+(without a display server, xvfb-run gives pvpython one; on a desktop, plain pvpython works.)
+
+It does what a ParaView user does by hand: open Data/cornell_box.vtp (Scene),
+cornell_light.vtp (Light) and cornell_trajectory.vtp (Trajectory, 30 positions), apply
+Filters > Radiosity > Moving Light Radiosity, then save
+
+  DIR/cornell.pvd + DIR/cornell/*.vtu   the Elements of every light position (MergeBlocks +
+                                        File > Save Data with "Write Time Steps"), for ParaView,
+                                        VisIt or any VTK reader;
+  DIR/png/frame_0000.png ...            one picture per light position, in colour: each
+                                        element's RGB radiosity, smoothed at the points and
+                                        tone mapped like the command line's pictures.
+
+DIR defaults to output/paraview. The plugin defaults to the one built in build/ (or in
+$MLR_BUILD_DIR); a plugin already loaded through PV_PLUGIN_PATH is used as it is.
+"""
+import argparse
+import glob
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PLUGIN_NAME = "MovingLightRadiosity"
+
+
+def parse_arguments():
+    parser = argparse.ArgumentParser(
+        description="Render the moving-light Cornell box with the ParaView plugin and save "
+                    "it as PNG frames and a .pvd/.vtu series.")
+    parser.add_argument("--plugin", help="MovingLightRadiosity.so to load (default: the one "
+                        "in the build tree, build/ or $MLR_BUILD_DIR)")
+    parser.add_argument("--output", default=os.path.join("output", "paraview"),
+                        help="folder for cornell.pvd, cornell/ and png/ (default: %(default)s)")
+    parser.add_argument("--paths", type=int, default=600000,
+                        help="effective shooting paths per light position; fewer is faster and "
+                             "noisier (default: %(default)s)")
+    parser.add_argument("--patch-size", type=float, default=0.0,
+                        help="patch edge length in metres, 0 for about 3000 patches (default: 0)")
+    parser.add_argument("--size", type=int, default=640,
+                        help="picture width and height in pixels (default: %(default)s)")
+    parser.add_argument("--data", default=os.path.join(ROOT, "Data"),
+                        help="folder with cornell_box.vtp, cornell_light.vtp and "
+                             "cornell_trajectory.vtp (default: the repository's Data/)")
+    args = parser.parse_args()
+    if args.paths < 1:
+        parser.error(f"--paths must be at least 1, not {args.paths}")
+    if args.size < 16:
+        parser.error(f"--size must be at least 16 pixels, not {args.size}")
+    for name in ("cornell_box.vtp", "cornell_light.vtp", "cornell_trajectory.vtp"):
+        if not os.path.isfile(os.path.join(args.data, name)):
+            parser.error(f"no {name} in {args.data}: give the Data/ folder with --data")
+    return args, parser
+
+
+def default_plugin():
+    """The plugin in the build tree: <build>/<libdir>/paraview-5.11/plugins/<Name>/<Name>.so."""
+    build = os.environ.get("MLR_BUILD_DIR", os.path.join(ROOT, "build"))
+    found = sorted(glob.glob(os.path.join(build, "lib*", "**", PLUGIN_NAME, PLUGIN_NAME + ".so"),
+                             recursive=True))
+    return found[0] if found else None
+
+
+args, parser = parse_arguments()
+
+# Only now: importing paraview.simple starts ParaView, which --help need not wait for.
+import paraview.simple as pv  # noqa: E402
+from paraview import servermanager  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+import numpy  # noqa: E402
+
+if not hasattr(pv, PLUGIN_NAME):
+    plugin = args.plugin or default_plugin()
+    if not plugin or not os.path.isfile(plugin):
+        parser.error(f"no plugin {plugin or PLUGIN_NAME + '.so'}: build the project "
+                     f"(cmake --build build) or give --plugin PATH")
+    pv.LoadPlugin(plugin, remote=False)  # adds the filter to paraview.simple
+    if not hasattr(pv, PLUGIN_NAME):
+        sys.exit(f"{plugin} loaded, but it does not provide the {PLUGIN_NAME} filter")
+MovingLightRadiosity = getattr(pv, PLUGIN_NAME)
+
+# --- The pipeline, as built in the GUI ------------------------------------------------------
+scene = pv.XMLPolyDataReader(registrationName="cornell_box.vtp",
+                             FileName=[os.path.join(args.data, "cornell_box.vtp")])
+light = pv.XMLPolyDataReader(registrationName="cornell_light.vtp",
+                             FileName=[os.path.join(args.data, "cornell_light.vtp")])
+trajectory = pv.XMLPolyDataReader(registrationName="cornell_trajectory.vtp",
+                                  FileName=[os.path.join(args.data, "cornell_trajectory.vtp")])
+radiosity = MovingLightRadiosity(registrationName="MovingLightRadiosity", Scene=scene,
+                                 Light=light, Trajectory=trajectory, NumberOfPaths=args.paths,
+                                 PatchSize=args.patch_size)
+
+started = time.time()
+radiosity.UpdatePipeline(time=0.0)
+if radiosity.GetDataInformation().GetNumberOfCells() == 0:
+    sys.exit("the filter produced nothing: see the error above")
+times = list(radiosity.TimestepValues)
+print(f"solved {len(times)} light positions, "
+      f"{radiosity.GetDataInformation().GetNumberOfCells()} elements, "
+      f"{args.paths} paths each, in {time.time() - started:.1f} s")
+
+os.makedirs(args.output, exist_ok=True)
+
+# --- The .pvd/.vtu series: every time step, from the one cached solve -----------------------
+merged = pv.MergeBlocks(registrationName="Elements", Input=radiosity)
+series = os.path.join(args.output, "cornell.pvd")
+pv.SaveData(series, proxy=merged, WriteTimeSteps=1)
+print(f"wrote {series} and {len(times)} .vtu files in {os.path.join(args.output, 'cornell')}")
+
+# --- The pictures -----------------------------------------------------------------------------
+# As the command line renders them: the crease-split mesh carries the radiosity to its points
+# (smooth within a wall, sharp where walls meet, and less Monte Carlo noise), and each RGB
+# channel is tone mapped 1 - exp(-2 B / B99) with B99 the 99th percentile of the luminance
+# over all frames, then gamma 2.2, into an unsigned-char colour shown as is.
+bright = 0.0
+for t in times:
+    radiosity.UpdatePipeline(time=t)
+    rgb = vtk_to_numpy(servermanager.Fetch(radiosity).GetCellData().GetArray("Radiosity"))
+    bright = max(bright, float(numpy.percentile(rgb @ numpy.array([0.2126, 0.7152, 0.0722]), 99)))
+exposure = 2.0 / bright if bright > 0 else 1.0
+
+creases = pv.GenerateSurfaceNormals(Input=radiosity, FeatureAngle=30.0, Splitting=1,
+                                    Consistency=0, ComputeCellNormals=0)
+smooth = pv.CellDatatoPointData(Input=creases, ProcessAllArrays=0,
+                                CellDataArraytoprocess=["Radiosity"])
+# An unsigned-char result is what ParaView shows as colours without a colour map.
+colour = pv.PythonCalculator(
+    registrationName="Colour", Input=smooth, ArrayAssociation="Point Data", ArrayName="Colour",
+    Expression=f"(255.0 * (1.0 - exp(-{exposure!r} * Radiosity)) ** (1 / 2.2) + 0.5).astype('uint8')")
+moving_light = pv.Transform(registrationName="Light", Input=light)
+
+view = pv.CreateRenderView()
+view.ViewSize = [args.size, args.size]
+view.OrientationAxesVisibility = 0
+view.UseColorPaletteForBackground = 0
+view.Background = [0.0, 0.0, 0.0]
+
+room = pv.Show(colour, view)
+pv.ColorBy(room, ("POINTS", "Colour"))
+room.MapScalars = 0  # the colours are the picture: no colour map
+room.Ambient, room.Diffuse = 1.0, 0.0  # radiosity already is the lighting
+lamp = pv.Show(moving_light, view)
+lamp.ColorArrayName = ["POINTS", ""]  # solid colour
+lamp.AmbientColor = lamp.DiffuseColor = [1.0, 1.0, 1.0]
+lamp.Ambient, lamp.Diffuse = 1.0, 0.0
+
+# The Cornell box camera (35 mm lens, 25 mm film): along +z, the front face filling the view.
+bounds = scene.GetDataInformation().GetBounds()
+centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2 for i in range(3)]
+half = max(bounds[1] - bounds[0], bounds[3] - bounds[2]) / 2
+view.CameraViewAngle = 39.3
+view.CameraFocalPoint = centre
+view.CameraPosition = [centre[0], centre[1],
+                       bounds[4] - half / numpy.tan(numpy.radians(39.3 / 2))]
+view.CameraViewUp = [0.0, 1.0, 0.0]
+
+animation = pv.GetAnimationScene()
+animation.UpdateAnimationUsingDataTimeSteps()
+pictures = os.path.join(args.output, "png")
+os.makedirs(pictures, exist_ok=True)
+for index, t in enumerate(times):
+    animation.AnimationTime = t
+    radiosity.UpdatePipeline(time=t)
+    # The light's displacement in this frame, from the filter's field data.
+    translation = radiosity.GetDataInformation().DataInformation.GetFieldDataInformation() \
+        .GetArrayInformation("LightTranslation")
+    moving_light.Transform.Translate = [translation.GetComponentRange(c)[0] for c in range(3)]
+    pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
+                      ImageResolution=[args.size, args.size])
+print(f"wrote {len(times)} pictures in {pictures}")

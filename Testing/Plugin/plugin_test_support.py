@@ -1,0 +1,91 @@
+"""Shared by the plugin's pvbatch/pvpython test scripts: finding and loading the plugin, the
+pipeline built from ParaView sources only, and failure bookkeeping.
+
+The scripts take the plugin from --plugin PATH or the MLR_PLUGIN environment variable (ctest
+sets both from the build tree) and exit non-zero with one line per failed check."""
+import argparse
+import os
+import sys
+
+# A closed unit box centred on the origin (ParaView's Box source: outward normals) lit from
+# inside by a 0.2 x 0.2 plane 0.1 below its top, moving along a diagonal in 10 steps.
+LIGHT_Z = 0.4
+LIGHT_HALF = 0.1
+PATH_START = (-0.3, -0.3, LIGHT_Z)
+PATH_END = (0.3, 0.3, LIGHT_Z)
+POSITIONS = 10
+FLOOR_Z = -0.5
+# Enough paths for the light's footprint to stand out, few enough for a second's solve.
+TEST_PATHS = 20000
+
+
+def parse_arguments(description, extra=None):
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--plugin", default=os.environ.get("MLR_PLUGIN"),
+                        help="MovingLightRadiosity.so to load (default: $MLR_PLUGIN)")
+    if extra:
+        extra(parser)
+    args = parser.parse_args()
+    if not args.plugin:
+        parser.error("give the plugin with --plugin PATH or the MLR_PLUGIN environment variable")
+    if not os.path.isfile(args.plugin):
+        parser.error(f"no plugin at {args.plugin}: build the project first")
+    return args
+
+
+_filter = None
+
+
+def load_plugin(path, namespace):
+    """LoadPlugin into `namespace` (the script's globals), as a user would."""
+    global _filter
+    from paraview.simple import LoadPlugin
+    LoadPlugin(path, remote=False, ns=namespace)
+    if "MovingLightRadiosity" not in namespace:
+        sys.exit(f"LoadPlugin({path!r}) did not define MovingLightRadiosity")
+    _filter = namespace["MovingLightRadiosity"]
+
+
+def light_position(frame):
+    """The light centroid the Line trajectory gives for `frame`."""
+    f = frame / (POSITIONS - 1)
+    return tuple(a + f * (b - a) for a, b in zip(PATH_START, PATH_END))
+
+
+def box_pipeline(**properties):
+    """Box as Scene, a Plane facing down (-z) as Light, a Line with resolution 9 as
+    Trajectory; returns (filter, sources) with the sources by name."""
+    from paraview import simple
+    box = simple.Box()
+    x, y, z = -LIGHT_HALF, -LIGHT_HALF, LIGHT_Z
+    # normal = (Point1 - Origin) x (Point2 - Origin) = (+y) x (+x) = -z: towards the floor.
+    light = simple.Plane(Origin=[x, y, z], Point1=[x, y + 2 * LIGHT_HALF, z],
+                         Point2=[x + 2 * LIGHT_HALF, y, z])
+    trajectory = simple.Line(Point1=list(PATH_START), Point2=list(PATH_END),
+                             Resolution=POSITIONS - 1)
+    properties.setdefault("NumberOfPaths", TEST_PATHS)
+    radiosity = _filter(Scene=box, Light=light, Trajectory=trajectory,
+                        **properties)
+    return radiosity, {"box": box, "light": light, "trajectory": trajectory}
+
+
+class Checks:
+    """Collects failures so that one run reports every broken expectation."""
+
+    def __init__(self, name):
+        self.name = name
+        self.failures = []
+
+    def check(self, condition, message):
+        if not condition:
+            self.failures.append(message)
+        return condition
+
+    def finish(self):
+        if self.failures:
+            print(f"{self.name}: {len(self.failures)} failure(s)", file=sys.stderr)
+            for failure in self.failures:
+                print("  " + failure, file=sys.stderr)
+            sys.exit(1)
+        print(f"{self.name}: OK")
+        sys.stdout.flush()

@@ -1,0 +1,171 @@
+"""The plugin's proxy as ParaView users meet it, checked in pvbatch:
+
+- the menu hint (Filters > Radiosity), the input ports (Scene, Light, optional Trajectory)
+  and the data types they accept, the output port names (Elements, Patches);
+- every property: a label that is also its paraview.simple name, documentation, a domain,
+  the VTK filter's default, the filter's clamping range, advanced or not;
+- what the first Apply shows: TimestepValues and the time keeper with one step per light
+  position, the Elements coloured by cell Radiosity (magnitude), the Patches not shown.
+
+    pvbatch --force-offscreen-rendering pvbatch_proxy.py --plugin MovingLightRadiosity.so
+
+The VTK defaults and clamps come from the Python package (PYTHONPATH=<build>/lib/python3/
+dist-packages), so that the XML cannot drift from vtkMovingLightRadiosity."""
+import plugin_test_support as support
+
+args = support.parse_arguments(__doc__.splitlines()[0])
+
+from paraview import servermanager
+from paraview.simple import *  # noqa: F401,F403 (LoadPlugin adds the filter here)
+
+support.load_plugin(args.plugin, globals())
+checks = support.Checks("Plugin.Proxy")
+check = checks.check
+
+from movinglightradiosity import vtkMovingLightRadiosity  # noqa: E402
+
+radiosity, sources = support.box_pipeline()
+proxy = radiosity.SMProxy
+
+# --- Menu, ports --------------------------------------------------------------------------
+check(proxy.GetXMLGroup() == "filters" and proxy.GetXMLLabel() == "Moving Light Radiosity",
+      f"proxy {proxy.GetXMLGroup()}/{proxy.GetXMLLabel()}, expected filters/Moving Light Radiosity")
+menu = proxy.GetHints().FindNestedElementByName("ShowInMenu") if proxy.GetHints() else None
+check(menu is not None and menu.GetAttribute("category") == "Radiosity",
+      "no <ShowInMenu category=\"Radiosity\"/> hint: the filter would not be in Filters > Radiosity")
+for port, name in enumerate(("Elements", "Patches")):
+    check(proxy.GetOutputPortName(port) == name,
+          f"output port {port} is named {proxy.GetOutputPortName(port)!r}, expected {name!r}")
+
+
+def domains(prop):
+    iterator = prop.NewDomainIterator()
+    iterator.Begin()
+    while not iterator.IsAtEnd():
+        yield iterator.GetDomain()
+        iterator.Next()
+
+
+# What each port accepts, asked the way the GUI's input dialog asks: polygons (Box), a
+# tetrahedral unstructured grid (a point set, not polygons) and an image (neither).
+candidates = {"polydata": Box(), "tetrahedra": Tetrahedralize(Input=Wavelet(WholeExtent=[0, 2] * 3)),
+              "image": Wavelet(WholeExtent=[0, 2] * 3)}
+for candidate in candidates.values():
+    candidate.UpdatePipeline()
+for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False),
+                                                   ("Light", {"polydata"}, False),
+                                                   ("Trajectory", {"polydata", "tetrahedra"}, True))):
+    prop = proxy.GetProperty(name)
+    if not check(prop is not None and prop.IsA("vtkSMInputProperty"), f"no input property {name}"):
+        continue
+    check(prop.GetPortIndex() == port, f"input {name} on port {prop.GetPortIndex()}, expected {port}")
+    check(prop.GetXMLLabel() == name, f"input {name} labelled {prop.GetXMLLabel()!r}")
+    for kind, candidate in candidates.items():
+        prop.RemoveAllUncheckedProxies()
+        prop.AddUncheckedInputConnection(candidate.SMProxy, 0)
+        takes = bool(prop.IsInDomains())
+        check(takes == (kind in accepted),
+              f"input {name} {'accepts' if takes else 'refuses'} {kind}, expected the opposite")
+    prop.RemoveAllUncheckedProxies()
+    hints = prop.GetHints()
+    is_optional = bool(hints and hints.FindNestedElementByName("Optional"))
+    check(is_optional == optional, f"input {name} optional: {is_optional}, expected {optional}")
+    check(bool(prop.GetDocumentation() and prop.GetDocumentation().GetDescription().strip()),
+          f"input {name} has no documentation")
+
+# --- Properties ---------------------------------------------------------------------------
+ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", "MemoryLimit"}
+BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering"}
+EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurvival",
+            "ReuseShooting", "ReuseGathering", "PatchSize", "Seed", "NumberOfThreads",
+            "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit"}
+vtk_defaults = vtkMovingLightRadiosity()
+# The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
+pristine = servermanager.filters.MovingLightRadiosity().SMProxy
+python_names = set(radiosity.ListProperties())
+found = set()
+iterator = proxy.NewPropertyIterator()
+iterator.Begin()
+while not iterator.IsAtEnd():
+    name, prop = iterator.GetKey(), iterator.GetProperty()
+    iterator.Next()
+    if prop.GetInformationOnly() or prop.IsA("vtkSMInputProperty"):
+        continue
+    found.add(name)
+    where = f"property {name}"
+    check(prop.GetXMLLabel() and prop.GetXMLLabel().replace(" ", "") == name,
+          f"{where}: label {prop.GetXMLLabel()!r} does not spell the VTK name (paraview.simple uses it)")
+    check(name in python_names, f"{where}: not in paraview.simple's ListProperties()")
+    doc = prop.GetDocumentation()
+    check(doc is not None and len(doc.GetDescription().split()) >= 8,
+          f"{where}: documentation missing or shorter than a sentence")
+    own_domains = list(domains(prop))
+    check(own_domains, f"{where}: no domain")
+    visibility = prop.GetPanelVisibility()
+    expected_visibility = "advanced" if name in ADVANCED else "default"
+    check(visibility == expected_visibility, f"{where}: panel_visibility {visibility!r}, expected "
+          f"{expected_visibility!r}")
+    if name in BOOLEANS:
+        check(any(d.IsA("vtkSMBooleanDomain") for d in own_domains), f"{where}: not a checkbox")
+
+    getter = getattr(vtk_defaults, "Get" + name, None)
+    if not check(getter is not None, f"{where}: vtkMovingLightRadiosity has no Get{name}"):
+        continue
+    vtk_value = getter()
+    vtk_value = list(vtk_value) if isinstance(vtk_value, tuple) else [vtk_value]
+    default = pristine.GetProperty(name)
+    xml_value = [default.GetElement(i) for i in range(default.GetNumberOfElements())]
+    check([float(v) for v in xml_value] == [float(v) for v in vtk_value],
+          f"{where}: XML default {xml_value}, VTK default {vtk_value}")
+
+    # Where the filter clamps a scalar, the domain must give the same range, else the panel
+    # would accept values the filter silently changes.
+    for domain in own_domains:
+        if prop.GetNumberOfElements() != 1 or not (domain.IsA("vtkSMIntRangeDomain") or
+                                                   domain.IsA("vtkSMDoubleRangeDomain")):
+            continue
+        probe = vtkMovingLightRadiosity()
+        setter = getattr(probe, "Set" + name)
+        if domain.GetMinimumExists(0):
+            low = domain.GetMinimum(0)
+            below = low - 1 if domain.IsA("vtkSMIntRangeDomain") else low - 1e-6 - abs(low)
+            setter(below)
+            got = getattr(probe, "Get" + name)()
+            check(got == low, f"{where}: domain minimum {low}, but the filter turns {below} into {got}")
+        if domain.GetMaximumExists(0):
+            high = domain.GetMaximum(0)
+            setter(high + 1)
+            got = getattr(probe, "Get" + name)()
+            check(got == high, f"{where}: domain maximum {high}, but the filter turns {high + 1} into {got}")
+check(found == EXPECTED, f"properties {sorted(found)}, expected {sorted(EXPECTED)}")
+
+# --- The first Apply ----------------------------------------------------------------------
+radiosity.UpdatePipeline()
+timesteps = list(radiosity.TimestepValues)
+check(timesteps == [float(i) for i in range(support.POSITIONS)],
+      f"TimestepValues {timesteps}, expected 0..{support.POSITIONS - 1}")
+scene = GetAnimationScene()
+scene.UpdateAnimationUsingDataTimeSteps()
+keeper_steps = list(GetTimeKeeper().TimestepValues)
+check(keeper_steps == timesteps, f"the time keeper has {keeper_steps}, expected {timesteps}")
+check(scene.PlayMode == "Snap To TimeSteps", f"animation play mode {scene.PlayMode!r}")
+
+# pqApplyBehavior shows each output port with ShowInPreferredView: do the same.
+from paraview.modules.vtkRemotingViews import vtkSMParaViewPipelineControllerWithRendering
+
+view = CreateRenderView()
+controller = vtkSMParaViewPipelineControllerWithRendering()
+shown = [controller.ShowInPreferredView(proxy, port, view.SMProxy) for port in (0, 1)]
+check(shown[0] is not None, "Apply would not show the Elements output")
+check(shown[1] is None, "Apply would show the Patches output on top of the Elements")
+display = GetDisplayProperties(radiosity, view)
+check(list(display.ColorArrayName) == ["CELLS", "Radiosity"],
+      f"the Elements are coloured by {list(display.ColorArrayName)}, expected cell Radiosity")
+lut = display.LookupTable
+check(lut is not None and lut.VectorMode == "Magnitude",
+      f"Radiosity colour map vector mode {lut.VectorMode if lut else None!r}, expected Magnitude")
+if lut is not None:
+    low, high = lut.RGBPoints[0], lut.RGBPoints[-4]
+    check(0 <= low < high, f"colour map range [{low}, {high}] is not that of a lit scene")
+
+checks.finish()

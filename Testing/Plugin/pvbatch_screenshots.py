@@ -1,0 +1,132 @@
+"""Rendered pictures of the first and the last light position, in pvbatch under an X server
+(xvfb-run): neither is blank, and they differ where the light moved. The camera looks up at
+the floor of the box (seen from outside, Radiosity shows its lit inner side); the pictures
+are compared by pixel statistics around the spots under the light, not with golden images.
+
+    xvfb-run -a pvbatch pvbatch_screenshots.py --plugin MovingLightRadiosity.so [--keep DIR]"""
+import os
+import tempfile
+
+import numpy
+
+import plugin_test_support as support
+
+
+def options(parser):
+    parser.add_argument("--keep", help="also copy the two pictures into this folder")
+
+
+args = support.parse_arguments(__doc__.splitlines()[0], options)
+
+from paraview import servermanager
+from paraview.simple import *  # noqa: F401,F403
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOImage import vtkPNGReader
+
+support.load_plugin(args.plugin, globals())
+checks = support.Checks("Plugin.Screenshots")
+check = checks.check
+
+SIZE = 300
+# Patches of 0.1 (about 600): less noise per element than the default 3000 for the same paths.
+radiosity, sources = support.box_pipeline(PatchSize=0.1)
+last = float(support.POSITIONS - 1)
+
+view = CreateRenderView()
+view.ViewSize = [SIZE, SIZE]
+view.OrientationAxesVisibility = 0
+view.UseColorPaletteForBackground = 0
+view.Background = [0.0, 0.0, 0.0]
+view.CameraPosition = [0.0, 0.0, -3.0]
+view.CameraFocalPoint = [0.0, 0.0, 0.0]
+view.CameraViewUp = [0.0, 1.0, 0.0]
+view.CameraViewAngle = 30.0
+
+display = Show(radiosity, view)
+# Radiosity already is the lighting: show the colour map flat, so a pixel's brightness is the
+# element's radiosity, on one grey scale shared by both pictures. The scale ends at the
+# floor's brightest element: the walls beside the light are far brighter still.
+display.Ambient = 1.0
+display.Diffuse = 0.0
+lut = GetColorTransferFunction("Radiosity")
+lut.ApplyPreset("Grayscale", True)
+highest = 0.0
+for time in (0.0, last):
+    radiosity.UpdatePipeline(time=time)
+    data = servermanager.Fetch(radiosity)
+    magnitude = numpy.linalg.norm(vtk_to_numpy(data.GetCellData().GetArray("Radiosity")), axis=1)
+    points = vtk_to_numpy(data.GetPoints().GetData())
+    triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    floor = numpy.abs(points[triangles][:, :, 2].mean(axis=1) - support.FLOOR_Z) < 1e-6
+    highest = max(highest, float(magnitude[floor].max()))
+lut.AutomaticRescaleRangeMode = "Never"
+lut.RescaleTransferFunction(0.0, highest)
+
+scene = GetAnimationScene()
+scene.UpdateAnimationUsingDataTimeSteps()
+
+
+def luminance(path):
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    image = reader.GetOutput()
+    width, height, _ = image.GetDimensions()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, -1)
+    return pixels[:, :, :3].astype(float).mean(axis=2)  # row 0 is the bottom, as on screen
+
+
+def spot_on_screen(frame):
+    """Display coordinates of the floor point under the light in `frame`."""
+    x, y, _ = support.light_position(frame)
+    renderer = view.GetRenderer()
+    renderer.SetWorldPoint(x, y, support.FLOOR_Z, 1.0)
+    renderer.WorldToDisplay()
+    return numpy.array(renderer.GetDisplayPoint()[:2])
+
+
+def disc_mean(image, centre, radius):
+    rows, columns = numpy.indices(image.shape)
+    inside = (columns - centre[0]) ** 2 + (rows - centre[1]) ** 2 <= radius ** 2
+    return image[inside].mean()
+
+
+pictures = {}
+with tempfile.TemporaryDirectory(prefix="mlr-plugin-screenshots-") as folder:
+    for time in (0.0, last):
+        scene.AnimationTime = time
+        Render(view)
+        path = os.path.join(folder, f"frame_{int(time)}.png")
+        SaveScreenshot(path, view, ImageResolution=[SIZE, SIZE])
+        if check(os.path.isfile(path), f"no screenshot written at time {time}"):
+            pictures[time] = luminance(path)
+            if args.keep:
+                os.makedirs(args.keep, exist_ok=True)
+                os.replace(path, os.path.join(args.keep, os.path.basename(path)))
+    spots = {0.0: spot_on_screen(0), last: spot_on_screen(support.POSITIONS - 1)}
+
+if len(pictures) == 2:
+    # The spot radius on screen: about the light's size seen from the camera.
+    radius = 0.1 * SIZE
+    for time, image in pictures.items():
+        lit = (image > 10).mean()
+        check(lit > 0.3, f"time {time}: only {100 * lit:.0f}% of the picture is lit (blank?)")
+        check(image.std() > 5, f"time {time}: the picture is uniform (standard deviation {image.std():.1f})")
+    first, final = pictures[0.0], pictures[last]
+    at_first = [disc_mean(first, spots[0.0], radius), disc_mean(first, spots[last], radius)]
+    at_final = [disc_mean(final, spots[0.0], radius), disc_mean(final, spots[last], radius)]
+    check(at_first[0] > 1.3 * at_first[1],
+          f"frame 0 is not brighter under its light ({at_first[0]:.1f}) than under the last "
+          f"frame's ({at_first[1]:.1f})")
+    check(at_final[1] > 1.3 * at_final[0],
+          f"the last frame is not brighter under its light ({at_final[1]:.1f}) than under "
+          f"frame 0's ({at_final[0]:.1f})")
+    difference = numpy.abs(final - first)
+    where_moved = min(disc_mean(difference, spots[0.0], radius), disc_mean(difference, spots[last], radius))
+    check(where_moved > 2 * difference.mean(),
+          f"the pictures differ as much everywhere ({difference.mean():.1f}) as where the light "
+          f"moved ({where_moved:.1f})")
+    print(f"brightness under the light at frame 0 / last: frame 0 {at_first[0]:.0f} / "
+          f"{at_first[1]:.0f}, last frame {at_final[0]:.0f} / {at_final[1]:.0f}")
+
+checks.finish()

@@ -1,0 +1,52 @@
+"""Examples/cornell_box_animation.py runs as the README says (xvfb-run -a pvpython ...) on the
+shipped Cornell box, with few paths and small pictures: it writes one lit PNG and one .vtu per
+trajectory position and a .pvd listing their times."""
+import os
+import shutil
+import subprocess
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+POSITIONS = 30  # Data/cornell_trajectory.vtp
+
+
+def test_example_writes_the_animation(tmp_path):
+    xvfb_run = os.environ.get("MLR_XVFB_RUN") or shutil.which("xvfb-run")
+    if not xvfb_run:
+        pytest.skip("xvfb-run is not installed")
+    plugin = os.environ.get("MLR_PLUGIN")
+    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
+    output = tmp_path / "animation"
+    env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
+    run = subprocess.run(
+        [xvfb_run, "-a", os.environ.get("MLR_PVPYTHON", "pvpython"),
+         os.path.join(ROOT, "Examples", "cornell_box_animation.py"), "--plugin", plugin,
+         "--output", str(output), "--paths", "20000", "--size", "128"],
+        capture_output=True, text=True, timeout=300, env=env)
+    report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
+    assert run.returncode == 0, report
+
+    pvd = output / "cornell.pvd"
+    assert pvd.is_file(), report
+    entries = [(float(e.get("timestep")), e.get("file"))
+               for e in ElementTree.parse(pvd).getroot().iter("DataSet")]
+    assert [t for t, _ in entries] == [float(i) for i in range(POSITIONS)], entries
+    assert all((output / f).is_file() and f.endswith(".vtu") for _, f in entries), entries
+
+    pictures = sorted((output / "png").glob("frame_*.png"))
+    assert [p.name for p in pictures] == [f"frame_{i:04d}.png" for i in range(POSITIONS)], pictures
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    for picture in (pictures[0], pictures[-1]):
+        reader = vtkPNGReader()
+        reader.SetFileName(str(picture))
+        reader.Update()
+        pixels = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())[:, :3]
+        lit = (pixels.max(axis=1) > 30).mean()
+        assert lit > 0.5, f"{picture.name}: only {100 * lit:.0f}% of the picture is lit"
+        # The red and the green wall: a colour picture, not a grey or a colour-mapped one.
+        red = ((pixels[:, 0] > 1.5 * pixels[:, 1]) & (pixels[:, 0] > 40)).mean()
+        green = ((pixels[:, 1] > 1.5 * pixels[:, 0]) & (pixels[:, 1] > 40)).mean()
+        assert red > 0.05 and green > 0.05, f"{picture.name}: red {red:.2f}, green {green:.2f} of the picture"
