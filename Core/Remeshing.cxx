@@ -1,13 +1,16 @@
 #include "Remeshing.h"
 
+#include "CancellationPoll.h"
 #include "CgalRemeshing.h"
 #include "Error.h"
 #include "PolygonTriangulation.h"
+#include "Solver.h"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <sstream>
 
@@ -20,6 +23,12 @@ namespace
 constexpr double MaximumPatches = 1 << 26;
 /// Share of the progress taken by CGAL; refining what it refused takes the rest.
 constexpr double CgalShare = 0.95;
+/// Memory estimates, generous: CGAL's repaired soup, surface meshes, AABB trees and maps per
+/// input triangle, and per patch the remeshed surface, the output mesh and the Scene built
+/// from it (points, element triangles, normals, areas, midpoint map). Measured peaks (VmHWM)
+/// are below these on spheres, boxes and the paper room.
+constexpr double BytesPerInputTriangle = 1500;
+constexpr double BytesPerPatch = 1000;
 
 /// Uniform 1:m^2 split of a triangle, m = ceil(longest edge / h). Neighbours split with
 /// different m meet at T-junctions, which are harmless to ray casting.
@@ -176,32 +185,76 @@ struct Triangulation
 };
 
 /// Polygons on the same points as an earlier one, whatever their order: exporters write
-/// two-sided walls twice, and two coincident surfaces cannot both be remeshed.
-std::vector<bool> duplicatePolygons(const PolygonSoup& soup)
+/// two-sided walls twice, and two coincident surfaces cannot both be remeshed. Keys (sorted
+/// distinct corners) are compared only within runs of equal hashes, so that millions of
+/// polygons cost no allocation each.
+std::vector<bool> duplicatePolygons(const PolygonSoup& soup, detail::CancellationPoll& poll)
 {
-  using Key = std::vector<std::array<double, 3>>;
-  std::vector<std::pair<Key, std::size_t>> keys;
+  using Corner = std::array<double, 3>;
+  auto keyOf = [&soup](std::size_t i, std::vector<Corner>& key) {
+    key.clear();
+    for (std::uint32_t v : soup.polygons[i])
+    {
+      const Vec3& p = soup.points[v];
+      key.push_back({ p.x + 0.0, p.y + 0.0, p.z + 0.0 }); // -0 and 0 are the same point
+    }
+    std::sort(key.begin(), key.end());
+    key.erase(std::unique(key.begin(), key.end()), key.end());
+  };
+  std::vector<std::pair<std::uint64_t, std::size_t>> hashes;
+  hashes.reserve(soup.polygons.size());
+  std::vector<Corner> key;
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
+    poll.tick();
     if (soup.polygons[i].size() < 3)
     {
       continue;
     }
-    Key key;
-    for (std::uint32_t v : soup.polygons[i])
+    keyOf(i, key);
+    std::uint64_t hash = 1469598103934665603ULL; // FNV-1a over the key's bytes
+    for (const Corner& c : key)
     {
-      const Vec3& p = soup.points[v];
-      key.push_back({ p.x, p.y, p.z });
+      unsigned char bytes[sizeof(Corner)];
+      std::memcpy(bytes, c.data(), sizeof(Corner));
+      for (unsigned char b : bytes)
+      {
+        hash = (hash ^ b) * 1099511628211ULL;
+      }
     }
-    std::sort(key.begin(), key.end());
-    key.erase(std::unique(key.begin(), key.end()), key.end());
-    keys.emplace_back(std::move(key), i);
+    hashes.emplace_back(hash, i);
   }
-  std::sort(keys.begin(), keys.end());
+  std::sort(hashes.begin(), hashes.end(), [&poll](const auto& a, const auto& b) {
+    poll.tick();
+    return a < b;
+  });
+
   std::vector<bool> duplicate(soup.polygons.size(), false);
-  for (std::size_t k = 1; k < keys.size(); ++k)
+  std::vector<std::vector<Corner>> distinct; // the different keys of one run of equal hashes
+  for (std::size_t begin = 0; begin < hashes.size();)
   {
-    duplicate[keys[k].second] = keys[k].first == keys[k - 1].first;
+    std::size_t end = begin + 1;
+    while (end < hashes.size() && hashes[end].first == hashes[begin].first)
+    {
+      ++end;
+    }
+    if (end - begin > 1)
+    {
+      // In index order: the first polygon of each key is kept, the later ones are duplicates.
+      distinct.clear();
+      for (std::size_t k = begin; k < end; ++k)
+      {
+        poll.tick();
+        keyOf(hashes[k].second, key);
+        const bool seen = std::find(distinct.begin(), distinct.end(), key) != distinct.end();
+        duplicate[hashes[k].second] = seen;
+        if (!seen)
+        {
+          distinct.push_back(key);
+        }
+      }
+    }
+    begin = end;
   }
   return duplicate;
 }
@@ -226,13 +279,15 @@ bool isCollinear(const std::vector<Vec3>& corners)
   return true;
 }
 
-Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32_t>& materialOfPolygon)
+Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32_t>& materialOfPolygon,
+  detail::CancellationPoll& poll)
 {
   Triangulation out;
-  const std::vector<bool> duplicate = duplicatePolygons(soup);
+  const std::vector<bool> duplicate = duplicatePolygons(soup, poll);
   std::vector<Vec3> corners;
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
+    poll.tick();
     const auto& polygon = soup.polygons[i];
     if (polygon.size() < 3 || duplicate[i])
     {
@@ -285,22 +340,58 @@ void addTriangulationWarnings(const Triangulation& t, std::vector<std::string>& 
   }
 }
 
-/// Refuses an h that would cut the scene into more patches than memory allows.
-void checkPatchBudget(const std::vector<Vec3>& points, const detail::TriangleSoup& soup, double h)
+/// Patches that refining the given triangles (all when `which` is null) at h makes.
+double refinedPatchCount(const std::vector<Vec3>& points, const detail::TriangleSoup& soup,
+  const std::vector<std::size_t>* which, double h)
 {
-  double expected = 0;
-  for (const Triangle& t : soup.triangles)
+  double count = 0;
+  const std::size_t n = which ? which->size() : soup.triangles.size();
+  for (std::size_t i = 0; i < n; ++i)
   {
+    const Triangle& t = soup.triangles[which ? (*which)[i] : i];
     const Vec3 &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
     const double longest = std::max({ length(b - a), length(c - b), length(a - c) });
     const double m = std::max(1.0, std::ceil(longest / h - 1e-9));
-    expected += m * m;
+    count += m * m;
   }
+  return count;
+}
+
+/// Patches isotropic remeshing makes of `area` at edge length h.
+double remeshedPatchCount(double area, double h)
+{
+  constexpr double RemeshedPerEquilateral = 1.18; // see edgeLengthForPatchCount
+  return area * RemeshedPerEquilateral / (std::sqrt(3.0) / 4.0 * h * h);
+}
+
+/// Refuses an h that would cut the scene into more patches than memory allows.
+void checkPatchBudget(double expected, double h)
+{
   if (expected > MaximumPatches)
   {
     std::ostringstream s;
     s << "the patch size " << h << " would cut the scene into about " << expected
       << " patches (the maximum is " << MaximumPatches << "): give a larger patch size";
+    throw Error(s.str());
+  }
+}
+
+/// Refuses, before allocating, remeshing `inputTriangles` into about `patches` patches when
+/// the estimate exceeds the memory limit.
+void checkRemeshMemory(double inputTriangles, double patches, double h, const RemeshOptions& options)
+{
+  const double limit = static_cast<double>(
+    options.memoryLimitBytes > 0 ? options.memoryLimitBytes : defaultMemoryLimitBytes());
+  const double estimate = inputTriangles * BytesPerInputTriangle + patches * BytesPerPatch;
+  if (estimate > limit)
+  {
+    std::ostringstream s;
+    s.precision(3);
+    s << "remeshing at patch size " << h << " needs an estimated "
+      << estimate / (1024.0 * 1024.0 * 1024.0) << " GiB (" << inputTriangles
+      << " input triangles into about " << patches << " patches), over the memory limit of "
+      << limit / (1024.0 * 1024.0 * 1024.0)
+      << " GiB: give a larger patch size or a smaller scene, or raise the limit";
     throw Error(s.str());
   }
 }
@@ -349,6 +440,13 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
       settings, [&](double f) { return !progress || progress(CgalShare * f); });
     appendCgalPatches(cgal, materials, result.mesh);
     refined = cgal.refineOnly;
+    if (!refined.empty())
+    {
+      // What CGAL refused is refined: check its size before allocating it.
+      const double count = refinedPatchCount(soup.points, triangles, &refined, h);
+      checkPatchBudget(count + static_cast<double>(result.mesh.triangles.size()), h);
+      checkRemeshMemory(0, count + static_cast<double>(result.mesh.triangles.size()), h, options);
+    }
     result.statistics.regions = cgal.regions;
     result.statistics.fallbackRegions = cgal.fallbackRegions;
     result.statistics.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
@@ -374,6 +472,38 @@ double totalArea(const PatchMesh& mesh)
 }
 }
 
+std::size_t expectedPatchCount(const PolygonSoup& soup, const RemeshOptions& options)
+{
+  if (options.targetEdgeLength == 0)
+  {
+    return options.targetPatchCount;
+  }
+  if (!(options.targetEdgeLength > 0) || !std::isfinite(options.targetEdgeLength))
+  {
+    return 0;
+  }
+  double area = 0;
+  std::vector<Vec3> corners;
+  for (const auto& polygon : soup.polygons)
+  {
+    corners.clear();
+    for (std::uint32_t v : polygon)
+    {
+      if (v < soup.points.size())
+      {
+        corners.push_back(soup.points[v]);
+      }
+    }
+    if (corners.size() == polygon.size() && corners.size() >= 3)
+    {
+      const double a = 0.5 * length(newellNormal(corners));
+      area += std::isfinite(a) ? a : 0.0;
+    }
+  }
+  const double count = remeshedPatchCount(area, options.targetEdgeLength);
+  return count < 1e18 ? static_cast<std::size_t>(count) : static_cast<std::size_t>(1e18);
+}
+
 double edgeLengthForPatchCount(double area, std::size_t patches)
 {
   // Isotropic remeshing keeps edges between 4/5 h and 4/3 h, and its triangles come out
@@ -395,7 +525,8 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
 
   std::vector<std::uint32_t> materialOfPolygon;
   const std::vector<Material> materials = distinctMaterials(soup, materialOfPolygon);
-  const Triangulation triangulation = triangulate(soup, materialOfPolygon);
+  detail::CancellationPoll poll([&progress] { return !progress || progress(0.0); });
+  const Triangulation triangulation = triangulate(soup, materialOfPolygon, poll);
   const detail::TriangleSoup& triangles = triangulation.soup;
   stats.inputTriangles = triangles.triangles.size();
   stats.inputArea = triangulation.area;
@@ -413,7 +544,13 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
     ? options.targetEdgeLength
     : edgeLengthForPatchCount(stats.inputArea, options.targetPatchCount);
   stats.targetEdgeLength = h;
-  checkPatchBudget(soup.points, triangles, h);
+  // Refining makes exactly this many patches; remeshing about the area-based count, unless
+  // CGAL refuses regions, which are then refined (and checked again, see buildPatches).
+  const double refinedCount = refinedPatchCount(soup.points, triangles, nullptr, h);
+  checkPatchBudget(refinedCount, h);
+  checkRemeshMemory(options.useCgal ? static_cast<double>(triangles.triangles.size()) : 0,
+    options.useCgal ? std::min(refinedCount, remeshedPatchCount(stats.inputArea, h)) : refinedCount,
+    h, options);
 
   buildPatches(soup, triangles, materials, h, options, progress, result);
   if (result.mesh.triangles.empty())

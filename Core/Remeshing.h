@@ -42,6 +42,9 @@ struct RemeshOptions
   double sharpEdgeAngle = 30;
   /// Remesh with CGAL; when false every region is only refined (split to size).
   bool useCgal = true;
+  /// Refuse (mlr::Error) a remeshing whose memory estimate exceeds this many bytes, before
+  /// allocating it; 0 means half of the physical memory, as for the solver.
+  std::uint64_t memoryLimitBytes = 0;
 };
 
 struct RemeshStatistics
@@ -85,6 +88,14 @@ using RemeshProgress = std::function<bool(double fraction)>;
  */
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
+
+/**
+ * About how many patches remesh() will make of `soup`, without remeshing it (no CGAL, no
+ * triangulation: polygon areas from their Newell normals): for checking the memory a solve
+ * needs before spending time on remeshing. Invalid polygons count as no area; 0 when the
+ * options are invalid.
+ */
+std::size_t expectedPatchCount(const PolygonSoup& soup, const RemeshOptions& options);
 
 /// The h at which remeshing cuts `area` into about `patches` patches (a little more than the
 /// side of `patches` equilateral triangles covering it).

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <initializer_list>
 #include <sstream>
 
 #include <unistd.h>
@@ -33,15 +35,17 @@ std::string gibibytes(std::uint64_t bytes)
   return s.str();
 }
 
-std::uint64_t defaultMemoryLimit()
+/// a * b, saturating at UINT64_MAX.
+std::uint64_t saturatingProduct(std::uint64_t a, std::uint64_t b)
 {
-  const long pages = sysconf(_SC_PHYS_PAGES);
-  const long pageSize = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || pageSize <= 0)
-  {
-    return 4ULL << 30;
-  }
-  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 2;
+  std::uint64_t product = 0;
+  return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
+}
+
+std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
+{
+  std::uint64_t sum = 0;
+  return __builtin_add_overflow(a, b, &sum) ? UINT64_MAX : sum;
 }
 
 /// A walk longer than this is cut: with reflectance < 1 it is astronomically unlikely,
@@ -583,21 +587,70 @@ void validateOptions(const SolverOptions& options)
   }
 }
 
+std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options)
+{
+  const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
+  const auto times = [](std::initializer_list<std::uint64_t> factors) {
+    std::uint64_t product = 1;
+    for (std::uint64_t f : factors)
+    {
+      product = saturatingProduct(product, f);
+    }
+    return product;
+  };
+  // Results: direct and indirect per element side, shooting radiosity per patch side.
+  const std::uint64_t results = times({ frames,
+    saturatingSum(times({ elements, 2, 2 }), times({ patches, 2 })), sizeof(Rgb) });
+  // The fixed-point accumulators (FixedPointAccumulator::bytes), one copy per worker.
+  const std::uint64_t accumulators =
+    saturatingSum(times({ workers, elements, 2, frames, 1, sizeof(std::int64_t) }),
+      times({ workers, patches, 2, frames, 3, sizeof(std::int64_t) }));
+  const std::uint64_t scratch = times({ workers, frames, 2 * sizeof(Rgb) + sizeof(Vec3) + 16 });
+  // Embree's BVH and buffers, generously.
+  const std::uint64_t tracing = saturatingSum(times({ elements, 256 }), times({ points, 16 }));
+  return saturatingSum(saturatingSum(results, accumulators), saturatingSum(scratch, tracing));
+}
+
 std::uint64_t estimateSolveMemory(
   const Scene& scene, std::size_t frames, const SolverOptions& options)
 {
-  const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
-  const std::uint64_t elements = scene.elementCount();
-  const std::uint64_t patches = scene.patchCount();
-  // Results: direct and indirect per element side, shooting radiosity per patch side.
-  const std::uint64_t results = frames * (elements * 2 * 2 + patches * 2) * sizeof(Rgb);
-  const std::uint64_t accumulators =
-    FixedPointAccumulator<1>::bytes(static_cast<int>(workers), elements, frames) +
-    FixedPointAccumulator<3>::bytes(static_cast<int>(workers), patches, frames);
-  const std::uint64_t scratch = workers * frames * (2 * sizeof(Rgb) + sizeof(Vec3) + 16);
-  // Embree's BVH and buffers, generously.
-  const std::uint64_t tracing = elements * 256 + scene.points().size() * 16;
-  return results + accumulators + scratch + tracing;
+  return estimateSolveMemory(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
+}
+
+std::uint64_t defaultMemoryLimitBytes()
+{
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long pageSize = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || pageSize <= 0)
+  {
+    return 4ULL << 30;
+  }
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 2;
+}
+
+std::uint64_t memoryLimitBytes(const SolverOptions& options)
+{
+  return options.memoryLimitBytes > 0 ? options.memoryLimitBytes : defaultMemoryLimitBytes();
+}
+
+void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
+  std::size_t elements, const SolverOptions& options, bool approximate)
+{
+  const std::uint64_t limit = memoryLimitBytes(options);
+  if (estimate <= limit)
+  {
+    return;
+  }
+  std::ostringstream s;
+  const char* about = approximate ? "about " : "";
+  s << "the solve needs an estimated " << gibibytes(estimate) << " (" << frames << " frames x ("
+    << about << patches << " patches + " << about << elements
+    << " elements) x 2 sides x RGB, plus per-thread buffers), over the memory limit of "
+    << gibibytes(limit)
+    << ": use fewer frames, a larger patch size or fewer threads, or raise the limit";
+  throw Error(s.str());
 }
 
 Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
@@ -608,18 +661,7 @@ Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions
   const std::size_t frames = light.frameCount();
   const int workers = resolveThreadCount(options.threads);
   const std::uint64_t memory = estimateSolveMemory(scene, frames, options);
-  const std::uint64_t limit =
-    options.memoryLimitBytes > 0 ? options.memoryLimitBytes : defaultMemoryLimit();
-  if (memory > limit)
-  {
-    std::ostringstream s;
-    s << "the solve needs an estimated " << gibibytes(memory) << " (" << frames << " frames x ("
-      << scene.patchCount() << " patches + " << scene.elementCount()
-      << " elements) x 2 sides x RGB, plus per-thread buffers), over the memory limit of "
-      << gibibytes(limit)
-      << ": use fewer frames, a larger patch size or fewer threads, or raise the limit";
-    throw Error(s.str());
-  }
+  checkSolveMemory(memory, frames, scene.patchCount(), scene.elementCount(), options);
 
   // Progress: phases weighted by their expected ray counts.
   const double n = static_cast<double>(frames);

@@ -140,6 +140,25 @@ using ProgressCallback = std::function<bool(double fraction)>;
 std::uint64_t estimateSolveMemory(
   const Scene& scene, std::size_t frames, const SolverOptions& options);
 
+/// The same estimate from counts alone, e.g. for a scene not remeshed yet. Saturates at
+/// UINT64_MAX instead of overflowing.
+std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options);
+
+/// Half of the physical memory (4 GiB when it cannot be read): the default memory limit.
+std::uint64_t defaultMemoryLimitBytes();
+
+/// options.memoryLimitBytes, or the default when it is 0.
+std::uint64_t memoryLimitBytes(const SolverOptions& options);
+
+/**
+ * Throws mlr::Error when `estimate` bytes exceed the memory limit of `options`; the message
+ * gives the estimate, the limit and what it is made of (`frames`, `patches`, `elements`;
+ * `approximate` says the counts are expected ones, before remeshing).
+ */
+void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
+  std::size_t elements, const SolverOptions& options, bool approximate = false);
+
 /// Throws mlr::Error naming the first option that is out of range.
 void validateOptions(const SolverOptions& options);
 

@@ -77,6 +77,17 @@ const char* reuseMode(bool shooting, bool gathering)
 }
 }
 
+std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
+{
+  // Element mesh: double points, 3 ids + 1 offset (64-bit) per triangle, Reflectance (3
+  // floats) and PatchId; the patch mesh is a quarter of it. Per frame: Radiosity, Direct,
+  // Indirect, Front and Back (3 floats each) per element, and the patches' Radiosity.
+  const std::uint64_t e = elements, p = points;
+  const std::uint64_t meshes = p * 24 + e * (32 + 12 + 8) + e / 4 * (32 + 12);
+  const std::uint64_t frame = e * 5 * 12 + e / 4 * 12;
+  return meshes + frame;
+}
+
 vtkSmartPointer<vtkPolyData> elementMesh(const Scene& scene)
 {
   auto mesh = triangleMesh(scene.points(), scene.points().size(), scene.elementTriangles());

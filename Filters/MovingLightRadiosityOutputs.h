@@ -18,6 +18,11 @@ class vtkPolyData;
 namespace mlr::vtkoutputs
 {
 
+/// Bytes of the outputs of a scene of `elements` elements on `points` points: the element and
+/// patch meshes kept with the solution, and the arrays of the frame shown (each time request
+/// builds them again).
+std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points);
+
 /// The element triangles with `Reflectance` and `PatchId`: everything of the Elements output
 /// that does not depend on the frame.
 vtkSmartPointer<vtkPolyData> elementMesh(const Scene& scene);

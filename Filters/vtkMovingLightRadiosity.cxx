@@ -24,6 +24,7 @@
 #include "vtkTimeStamp.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <new>
 #include <string>
 #include <vector>
@@ -35,6 +36,11 @@ namespace
 {
 /// Share of the progress bar given to remeshing; the solve takes the rest.
 constexpr double RemeshingShare = 0.05;
+
+std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
+{
+  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
 }
 
 /// The last solve: every frame of the animation, kept until an input or a property changes.
@@ -314,6 +320,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
 
     mlr::RemeshOptions remeshOptions;
     remeshOptions.targetEdgeLength = this->PatchSize;
+    remeshOptions.memoryLimitBytes = options.memoryLimitBytes;
+    // A solve that cannot fit is refused before remeshing, which may take a while: with the
+    // patch count remeshing is expected to give, halved so that an estimate on the high side
+    // never refuses a solve that fits (the exact check follows remeshing).
+    // (Capped at 2^40 patches, far past any limit, so that the sums below cannot overflow.)
+    const std::size_t expectedPatches =
+      std::min<std::size_t>(mlr::expectedPatchCount(soup, remeshOptions) / 2, std::size_t(1) << 40);
+    mlr::checkSolveMemory(
+      saturatingSum(mlr::estimateSolveMemory(expectedPatches, 4 * expectedPatches,
+                      2 * expectedPatches, translations.size(), options),
+        mlr::vtkoutputs::estimateOutputMemory(4 * expectedPatches, 2 * expectedPatches)),
+      translations.size(), expectedPatches, 4 * expectedPatches, options, true);
     const mlr::RemeshResult remeshed =
       mlr::remesh(soup, remeshOptions, progress(0.0, RemeshingShare));
     for (const std::string& warning : remeshed.warnings)
@@ -321,6 +339,10 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       vtkWarningMacro(<< "Scene: " << warning);
     }
     const mlr::Scene scene = mlr::Scene::fromPatchMesh(remeshed.mesh);
+    // The solve checks its own estimate; the outputs built from it come on top.
+    mlr::checkSolveMemory(saturatingSum(mlr::estimateSolveMemory(scene, translations.size(), options),
+                            mlr::vtkoutputs::estimateOutputMemory(scene.elementCount(), scene.points().size())),
+      translations.size(), scene.patchCount(), scene.elementCount(), options);
 
     mlr::Solution solution =
       mlr::solve(scene, light, options, progress(RemeshingShare, 1.0 - RemeshingShare));
