@@ -3,6 +3,7 @@
 #include "Error.h"
 #include "PolygonTriangulation.h"
 #include "Random.h"
+#include "Scene.h"
 
 #include <algorithm>
 #include <sstream>
@@ -36,6 +37,14 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
     {
       throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
     }
+    if (!isWithinCoordinateRange(translations[k]))
+    {
+      std::ostringstream s;
+      s << "light position " << k << " moves the light by (" << translations[k].x << ", "
+        << translations[k].y << ", " << translations[k].z << "): coordinates must stay within +-"
+        << MaximumCoordinate << " (rays are traced in single precision)";
+      throw Error(s.str());
+    }
   }
 
   for (std::size_t i = 0; i < polygons.size(); ++i)
@@ -52,6 +61,14 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
       if (!isFinite(p))
       {
         throw Error(which + " has NaN or infinite coordinates");
+      }
+      if (!isWithinCoordinateRange(p))
+      {
+        std::ostringstream s;
+        s << which << " has a point at (" << p.x << ", " << p.y << ", " << p.z
+          << "): coordinates must stay within +-" << MaximumCoordinate
+          << " (rays are traced in single precision)";
+        throw Error(s.str());
       }
     }
     const Vec3 newell = newellNormal(polygon);

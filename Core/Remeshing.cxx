@@ -119,6 +119,17 @@ void validateSoup(const PolygonSoup& soup)
     throw Error("the scene has " + countOf(nonFinite, "point") +
       " with NaN or infinite coordinates: remove or fix them");
   }
+  for (const Vec3& p : soup.points)
+  {
+    if (!isWithinCoordinateRange(p))
+    {
+      std::ostringstream s;
+      s << "the scene has a point at (" << p.x << ", " << p.y << ", " << p.z
+        << "): coordinates must stay within +-" << MaximumCoordinate
+        << " (rays are traced in single precision); scale the scene down";
+      throw Error(s.str());
+    }
+  }
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
     const Rgb& rho = soup.materials[i].reflectance;
@@ -472,38 +483,6 @@ double totalArea(const PatchMesh& mesh)
 }
 }
 
-std::size_t expectedPatchCount(const PolygonSoup& soup, const RemeshOptions& options)
-{
-  if (options.targetEdgeLength == 0)
-  {
-    return options.targetPatchCount;
-  }
-  if (!(options.targetEdgeLength > 0) || !std::isfinite(options.targetEdgeLength))
-  {
-    return 0;
-  }
-  double area = 0;
-  std::vector<Vec3> corners;
-  for (const auto& polygon : soup.polygons)
-  {
-    corners.clear();
-    for (std::uint32_t v : polygon)
-    {
-      if (v < soup.points.size())
-      {
-        corners.push_back(soup.points[v]);
-      }
-    }
-    if (corners.size() == polygon.size() && corners.size() >= 3)
-    {
-      const double a = 0.5 * length(newellNormal(corners));
-      area += std::isfinite(a) ? a : 0.0;
-    }
-  }
-  const double count = remeshedPatchCount(area, options.targetEdgeLength);
-  return count < 1e18 ? static_cast<std::size_t>(count) : static_cast<std::size_t>(1e18);
-}
-
 double edgeLengthForPatchCount(double area, std::size_t patches)
 {
   // Isotropic remeshing keeps edges between 4/5 h and 4/3 h, and its triangles come out
@@ -548,9 +527,14 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
   // CGAL refuses regions, which are then refined (and checked again, see buildPatches).
   const double refinedCount = refinedPatchCount(soup.points, triangles, nullptr, h);
   checkPatchBudget(refinedCount, h);
-  checkRemeshMemory(options.useCgal ? static_cast<double>(triangles.triangles.size()) : 0,
-    options.useCgal ? std::min(refinedCount, remeshedPatchCount(stats.inputArea, h)) : refinedCount,
-    h, options);
+  const double expected =
+    options.useCgal ? std::min(refinedCount, remeshedPatchCount(stats.inputArea, h)) : refinedCount;
+  checkRemeshMemory(
+    options.useCgal ? static_cast<double>(triangles.triangles.size()) : 0, expected, h, options);
+  if (options.checkExpectedPatches)
+  {
+    options.checkExpectedPatches(static_cast<std::size_t>(std::min(expected, MaximumPatches)));
+  }
 
   buildPatches(soup, triangles, materials, h, options, progress, result);
   if (result.mesh.triangles.empty())

@@ -45,6 +45,10 @@ struct RemeshOptions
   /// Refuse (mlr::Error) a remeshing whose memory estimate exceeds this many bytes, before
   /// allocating it; 0 means half of the physical memory, as for the solver.
   std::uint64_t memoryLimitBytes = 0;
+  /// Called once the polygons are triangulated and duplicates dropped, before CGAL or
+  /// refinement allocate anything, with the number of patches expected; it may throw (e.g.
+  /// mlr::Error when a solve of that many patches would not fit) to stop before the work.
+  std::function<void(std::size_t expectedPatches)> checkExpectedPatches;
 };
 
 struct RemeshStatistics
@@ -88,14 +92,6 @@ using RemeshProgress = std::function<bool(double fraction)>;
  */
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
-
-/**
- * About how many patches remesh() will make of `soup`, without remeshing it (no CGAL, no
- * triangulation: polygon areas from their Newell normals): for checking the memory a solve
- * needs before spending time on remeshing. Invalid polygons count as no area; 0 when the
- * options are invalid.
- */
-std::size_t expectedPatchCount(const PolygonSoup& soup, const RemeshOptions& options);
 
 /// The h at which remeshing cuts `area` into about `patches` patches (a little more than the
 /// side of `patches` equilateral triangles covering it).

@@ -49,6 +49,17 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
       << " points with NaN or infinite coordinates: remove or fix them";
     throw Error(s.str());
   }
+  for (const Vec3& p : mesh.points)
+  {
+    if (!isWithinCoordinateRange(p))
+    {
+      std::ostringstream s;
+      s << "the scene has a point at (" << p.x << ", " << p.y << ", " << p.z
+        << "): coordinates must stay within +-" << MaximumCoordinate
+        << " (rays are traced in single precision); scale the scene down";
+      throw Error(s.str());
+    }
+  }
 
   Scene scene;
   scene.Points = mesh.points;

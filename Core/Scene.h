@@ -5,6 +5,7 @@
 #include "Vec3.h"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -20,6 +21,18 @@ enum class Side : std::uint8_t
 };
 
 using Triangle = std::array<std::uint32_t, 3>;
+
+/// The largest coordinate magnitude accepted in scenes, lights and light positions. Embree
+/// traces rays in single precision and only accepts ray origins within about +-1.8e18; the
+/// offsets that lift rays off surfaces grow with the scene's size.
+constexpr double MaximumCoordinate = 1e15;
+
+/// True when every coordinate of p is finite and within +-MaximumCoordinate.
+inline bool isWithinCoordinateRange(const Vec3& p)
+{
+  return std::abs(p.x) <= MaximumCoordinate && std::abs(p.y) <= MaximumCoordinate &&
+    std::abs(p.z) <= MaximumCoordinate;
+}
 
 /// Patches as given by the caller (or by remeshing): one triangle and one reflectance each.
 struct PatchMesh

@@ -321,17 +321,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     mlr::RemeshOptions remeshOptions;
     remeshOptions.targetEdgeLength = this->PatchSize;
     remeshOptions.memoryLimitBytes = options.memoryLimitBytes;
-    // A solve that cannot fit is refused before remeshing, which may take a while: with the
-    // patch count remeshing is expected to give, halved so that an estimate on the high side
-    // never refuses a solve that fits (the exact check follows remeshing).
-    // (Capped at 2^40 patches, far past any limit, so that the sums below cannot overflow.)
-    const std::size_t expectedPatches =
-      std::min<std::size_t>(mlr::expectedPatchCount(soup, remeshOptions) / 2, std::size_t(1) << 40);
-    mlr::checkSolveMemory(
-      saturatingSum(mlr::estimateSolveMemory(expectedPatches, 4 * expectedPatches,
-                      2 * expectedPatches, translations.size(), options),
-        mlr::vtkoutputs::estimateOutputMemory(4 * expectedPatches, 2 * expectedPatches)),
-      translations.size(), expectedPatches, 4 * expectedPatches, options, true);
+    // A solve that cannot fit is refused before remeshing does the work (CGAL may take a
+    // while): with the patch count remeshing expects once the polygons are triangulated,
+    // halved so that an estimate on the high side never refuses a solve that fits (the exact
+    // check follows remeshing).
+    remeshOptions.checkExpectedPatches = [&](std::size_t expected) {
+      const std::size_t patches = expected / 2;
+      mlr::checkSolveMemory(
+        saturatingSum(mlr::estimateSolveMemory(
+                        patches, 4 * patches, 2 * patches, translations.size(), options),
+          mlr::vtkoutputs::estimateOutputMemory(4 * patches, 2 * patches)),
+        translations.size(), patches, 4 * patches, options, true);
+    };
     const mlr::RemeshResult remeshed =
       mlr::remesh(soup, remeshOptions, progress(0.0, RemeshingShare));
     for (const std::string& warning : remeshed.warnings)
