@@ -1,0 +1,135 @@
+// libFuzzer target: arbitrary bytes -> a scene file as the command line reads it
+// (Apps/InputFiles.cxx: .vtp .vtu .vtk .obj .ply .stl, chosen by the first byte) -> the
+// vtkMovingLightRadiosity filter with a fixed light and a 2-frame trajectory, few paths and a
+// small memory limit.
+//
+// A refused file (mlr::cli::InputError) or a filter error is a normal outcome. Findings are
+// crashes, sanitizer reports in our code, exceptions escaping, hangs and memory over
+// -rss_limit_mb. VTK's readers are not instrumented: a fault inside them shows as a crash
+// (SEGV), not as an ASan report, and InputFiles.cxx must refuse such files before VTK sees them.
+#include "InputFiles.h"
+#include "Messages.h"
+
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkMovingLightRadiosity.h"
+#include "vtkNew.h"
+#include "vtkObject.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkCellArray.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+namespace
+{
+namespace fs = std::filesystem;
+
+[[noreturn]] void finding(const std::string& what)
+{
+  std::fprintf(stderr, "FUZZ FINDING: %s\n", what.c_str());
+  std::abort();
+}
+
+/// What every input shares: a private directory for the file, the light and the trajectory.
+struct Setup
+{
+  fs::path directory;
+  vtkNew<vtkPolyData> light, trajectory;
+
+  Setup()
+  {
+    // Counts VTK's errors for readSurfaceFile, as in the command line; quiet unless asked.
+    mlr::cli::installMessageWindow("fuzz-readers");
+    if (!std::getenv("MLR_FUZZ_VERBOSE"))
+    {
+      vtkObject::GlobalWarningDisplayOff();
+    }
+    char pattern[] = "/tmp/mlr-fuzz-readers-XXXXXX";
+    if (!mkdtemp(pattern))
+    {
+      finding("cannot create a temporary directory");
+    }
+    this->directory = pattern;
+
+    // A 0.2 m square light at z = 1 facing down, moving along x.
+    vtkNew<vtkPoints> corners;
+    corners->InsertNextPoint(-0.1, -0.1, 1);
+    corners->InsertNextPoint(-0.1, 0.1, 1);
+    corners->InsertNextPoint(0.1, 0.1, 1);
+    corners->InsertNextPoint(0.1, -0.1, 1);
+    vtkNew<vtkCellArray> square;
+    const vtkIdType ids[4] = { 0, 1, 2, 3 };
+    square->InsertNextCell(4, ids);
+    this->light->SetPoints(corners);
+    this->light->SetPolys(square);
+    vtkNew<vtkPoints> positions;
+    positions->InsertNextPoint(0, 0, 1);
+    positions->InsertNextPoint(0.5, 0, 1);
+    this->trajectory->SetPoints(positions);
+  }
+
+  ~Setup() { fs::remove_all(this->directory); }
+};
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+  static Setup setup;
+  static const char* const extensions[] = { ".vtp", ".obj", ".ply", ".stl", ".vtu", ".vtk" };
+  if (size == 0)
+  {
+    return 0;
+  }
+  const fs::path path = setup.directory / (std::string("scene") + extensions[data[0] % 6]);
+  {
+    std::ofstream file(path, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
+  }
+
+  vtkSmartPointer<vtkPolyData> scene;
+  try
+  {
+    scene = mlr::cli::readSurfaceFile(path.string(), "scene");
+  }
+  catch (const mlr::cli::InputError&)
+  {
+    return 0;
+  }
+
+  vtkNew<vtkMovingLightRadiosity> filter;
+  filter->SetInputData(vtkMovingLightRadiosity::SCENE_PORT, scene);
+  filter->SetInputData(vtkMovingLightRadiosity::LIGHT_PORT, setup.light);
+  filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT, setup.trajectory);
+  filter->SetNumberOfPaths(300);
+  filter->SetNumberOfThreads(1);
+  filter->SetMemoryLimit(16); // MiB: refused rather than slow
+  // About a hundred patches over the scene's extent, whatever its scale.
+  const double diagonal = scene->GetLength();
+  filter->SetPatchSize(std::isfinite(diagonal) && diagonal > 0 ? diagonal / 8 : 0.0);
+  const bool solved = filter->UpdateTimeStep(0) != 0;
+
+  vtkPolyData* elements = filter->GetOutput(vtkMovingLightRadiosity::ELEMENTS_PORT);
+  if (!solved && elements->GetNumberOfCells() != 0)
+  {
+    finding("a failed update left cells in the output");
+  }
+  if (vtkDataArray* radiosity = elements->GetCellData()->GetArray("Radiosity"))
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const double* range = radiosity->GetRange(c);
+      if (!std::isfinite(range[0]) || !std::isfinite(range[1]) || range[0] < 0)
+      {
+        finding("the filter output radiosity that is negative, NaN or infinite");
+      }
+    }
+  }
+  return 0;
+}

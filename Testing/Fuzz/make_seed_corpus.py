@@ -1,0 +1,184 @@
+#!/usr/bin/python3
+"""Writes the seed corpus of the fuzz targets (Testing/Fuzz/corpus/{solve,readers}/).
+
+solve:   byte strings that FuzzSolve.cxx decodes into small valid scenes (boxes, a triangle,
+         an L-shaped pair of walls) with a light, a trajectory and options; the fuzzer mutates
+         them into everything else.
+readers: a first byte choosing the extension (0 .vtp, 1 .obj, 2 .ply, 3 .stl, 4 .vtu, 5 .vtk,
+         as in FuzzReaders.cxx), then a small file of that format: a box with a cell array
+         Reflectance, in every encoding the writers offer (ASCII, binary, appended, zlib).
+
+Run with Debian's Python (VTK from python3-paraview): /usr/bin/python3 make_seed_corpus.py
+"""
+import os
+import struct
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+# --- solve: the encoding FuzzSolve.cxx decodes --------------------------------------------
+def coordinate(v):
+    kind = round((v + 2.0) * 4.0)
+    assert 0 <= kind <= 16 and abs(kind / 4.0 - 2.0 - v) < 1e-12, v
+    return bytes([kind])
+
+
+def solve_input(points, polygons, light, frames, flags=0, patches=None, edge_index=None,
+                paths=400, gathering=64, survival=64, cancel_after=0, memory=31):
+    out = bytearray([flags, len(points) - 3])
+    for p in points:
+        out += b"".join(coordinate(c) for c in p)
+    out += bytes([len(polygons) - 1])
+    for polygon, grey in polygons:
+        out += bytes([len(polygon)])
+        for v in polygon:
+            out += bytes([0, v])
+        out += bytes([round(grey * 20)])  # kind < 200: grey (kind % 20) / 20
+    out += bytes([len(light) - 1])
+    for z, corners in light:
+        out += coordinate(z) + bytes([len(corners) - 2])
+        for x, y in corners:
+            out += coordinate(x) + coordinate(y)
+    out += bytes([0, 0])  # power 100 in every channel
+    out += bytes([len(frames)])
+    for t in frames:
+        out += b"".join(coordinate(c) for c in t)
+    if patches is not None:
+        out += bytes([0]) + struct.pack("<H", patches)
+    else:
+        out += bytes([200, edge_index])
+    out += bytes([0])  # sharp edge angle 30
+    out += struct.pack("<H", paths) + bytes([gathering, survival, 7, 0, memory, cancel_after])
+    return bytes(out)
+
+
+BOX = [(x, y, z) for z in (-1, 1) for y in (-1, 1) for x in (-1, 1)]
+# Quads of the box [-1,1]^3, normals out (corner index = x + 2y + 4z, bits for +1).
+BOX_FACES = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]]
+LIGHT_DOWN = [(0.75, [(-0.25, -0.25), (-0.25, 0.25), (0.25, 0.25), (0.25, -0.25)])]
+
+
+def solve_seeds():
+    walls = [(face, 0.5 + 0.05 * i) for i, face in enumerate(BOX_FACES)]
+    inward = [(list(reversed(face)), grey) for face, grey in walls]
+    frames = [(0, 0, 0), (0.25, 0.25, 0)]
+    yield "box_cgal", solve_input(BOX, inward, LIGHT_DOWN, frames, patches=120)
+    yield "box_refine_only", solve_input(BOX, inward, LIGHT_DOWN, frames, flags=0x01, edge_index=7)
+    yield "box_outward_classic_one_sided", solve_input(
+        BOX, walls, LIGHT_DOWN, frames, flags=0x02 | 0x04 | 0x08, patches=60)
+    yield "box_cancelled", solve_input(BOX, inward, LIGHT_DOWN, frames, flags=0x40, patches=200,
+                                       cancel_after=5)
+    yield "one_triangle", solve_input([(-1, -1, -1), (1, -1, -1), (-1, 1, -1)],
+                                      [([0, 1, 2], 0.5)], LIGHT_DOWN, [(0, 0, 0)], edge_index=6)
+    l_shape = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1), (-1, 1, 1), (1, 1, 1)]
+    yield "l_shaped_walls", solve_input(l_shape, [([0, 1, 2, 3], 0.7), ([3, 2, 5, 4], 0.3)],
+                                        LIGHT_DOWN, frames + [(0, -0.5, 0)], patches=80)
+    concave = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (0, 0, -1), (-1, 1, -1)]
+    yield "concave_polygon", solve_input(concave, [([0, 1, 2, 3, 4], 0.6)], LIGHT_DOWN,
+                                         frames, edge_index=5, gathering=0)
+
+
+# --- readers: small files in every format and encoding the command line reads -------------
+def box_polydata():
+    from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+    points = vtkPoints()
+    for p in BOX:
+        points.InsertNextPoint(*p)
+    cells = vtkCellArray()
+    for face in BOX_FACES:
+        cells.InsertNextCell(4, face)
+    rho = vtkFloatArray()
+    rho.SetName("Reflectance")
+    rho.SetNumberOfComponents(3)
+    for i in range(len(BOX_FACES)):
+        rho.InsertNextTuple3(0.5, 0.1 * i, 0.3)
+    box = vtkPolyData()
+    box.SetPoints(points)
+    box.SetPolys(cells)
+    box.GetCellData().AddArray(rho)
+    return box
+
+
+def reader_seeds():
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+    from vtkmodules.vtkIOGeometry import vtkOBJWriter, vtkSTLWriter
+    from vtkmodules.vtkIOLegacy import vtkPolyDataWriter, vtkUnstructuredGridWriter
+    from vtkmodules.vtkIOPLY import vtkPLYWriter
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
+    from vtkmodules.vtkFiltersCore import vtkAppendFilter
+
+    box = box_polydata()
+    triangles = vtkTriangleFilter()
+    triangles.SetInputData(box)
+    triangles.Update()
+    grid = vtkAppendFilter()
+    grid.SetInputData(box)
+    grid.Update()
+
+    def written(writer, data, setup=None, extension=".file"):
+        with tempfile.TemporaryDirectory() as directory:
+            path = os.path.join(directory, "file" + extension)
+            writer.SetInputData(data)
+            writer.SetFileName(path)
+            if setup:
+                setup(writer)
+            assert writer.Write()
+            with open(path, "rb") as f:
+                return f.read()
+
+    def xml(mode, compressed):
+        def setup(w):
+            getattr(w, "SetDataModeTo" + mode)()
+            if mode == "Appended":
+                w.EncodeAppendedDataOff()
+            if compressed:
+                w.SetCompressorTypeToZLib()
+            else:
+                w.SetCompressorTypeToNone()
+        return setup
+
+    for mode in ("Ascii", "Binary", "Appended"):
+        for compressed in (False, True):
+            if mode == "Ascii" and compressed:
+                continue
+            name = mode.lower() + ("_zlib" if compressed else "")
+            yield "vtp_" + name, 0, written(vtkXMLPolyDataWriter(), box, xml(mode, compressed))
+            yield "vtu_" + name, 4, written(vtkXMLUnstructuredGridWriter(), grid.GetOutput(),
+                                            xml(mode, compressed))
+    yield "obj", 1, written(vtkOBJWriter(), box)
+    yield "obj_handwritten", 1, (b"# two quads and a triangle\nv 0 0 0\nv 1 0 0\nv 1 1 0\n"
+                                 b"v 0 1 0\nv 0 1 1\nvn 0 0 1\nvt 0 0\n"
+                                 b"f 1 2 3 4\nf 4/1 3/1 5/1\nf -1 -2 -3\nl 1 2\n")
+    for binary in (False, True):
+        suffix = "binary" if binary else "ascii"
+
+        def ply(w, binary=binary):
+            (w.SetFileTypeToBinary if binary else w.SetFileTypeToASCII)()
+        yield "ply_" + suffix, 2, written(vtkPLYWriter(), box, ply, ".ply")
+
+        def stl(w, binary=binary):
+            (w.SetFileTypeToBinary if binary else w.SetFileTypeToASCII)()
+        yield "stl_" + suffix, 3, written(vtkSTLWriter(), triangles.GetOutput(), stl, ".stl")
+
+        def legacy(w, binary=binary):
+            (w.SetFileTypeToBinary if binary else w.SetFileTypeToASCII)()
+        yield "vtk_polydata_" + suffix, 5, written(vtkPolyDataWriter(), box, legacy)
+        yield "vtk_grid_" + suffix, 5, written(vtkUnstructuredGridWriter(), grid.GetOutput(),
+                                               legacy)
+
+
+def main():
+    for target, seeds in (("solve", ((n, b) for n, b in solve_seeds())),
+                          ("readers", ((n, bytes([k]) + b) for n, k, b in reader_seeds()))):
+        directory = os.path.join(HERE, "corpus", target)
+        os.makedirs(directory, exist_ok=True)
+        for name, data in seeds:
+            with open(os.path.join(directory, name), "wb") as f:
+                f.write(data)
+            print(f"corpus/{target}/{name}: {len(data)} bytes")
+
+
+if __name__ == "__main__":
+    main()

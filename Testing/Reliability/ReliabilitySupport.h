@@ -1,0 +1,67 @@
+// Shared by the reliability tests: resident memory, sanitizer detection, the 200,000-triangle
+// input and a canceller that asks to stop at a given time from another thread.
+#pragma once
+
+#include "Remeshing.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <thread>
+
+namespace mlr::reliability
+{
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool UnderAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool UnderAddressSanitizer = true;
+#else
+constexpr bool UnderAddressSanitizer = false;
+#endif
+#else
+constexpr bool UnderAddressSanitizer = false;
+#endif
+
+/// The cancellation latency promised by issue 7; sanitizer builds run several times slower
+/// and get three times as long (their job there is to find memory errors on the way).
+constexpr double CancelLatencyBound = UnderAddressSanitizer ? 1.5 : 0.5;
+
+/// Resident set size of this process, in bytes (/proc/self/statm).
+std::size_t residentBytes();
+
+/// A geodesic sphere of radius 1 with 20 * frequency^2 triangles (200,000 at 100).
+PolygonSoup sphereSoup(int frequency);
+
+/**
+ * Asks to stop at a given time, as a user pressing Abort does: the flag is set from another
+ * thread at `delay` after construction, whatever the solve is doing then. keepGoing() is what
+ * a progress callback returns; latency() is the time from the request to the call of
+ * finished() (or to now).
+ */
+class DelayedCancel
+{
+public:
+  using Clock = std::chrono::steady_clock;
+
+  explicit DelayedCancel(double delaySeconds);
+  ~DelayedCancel();
+  DelayedCancel(const DelayedCancel&) = delete;
+  DelayedCancel& operator=(const DelayedCancel&) = delete;
+
+  bool keepGoing() const { return !this->Requested.load(); }
+  bool requested() const { return this->Requested.load(); }
+  void finished() { this->End = Clock::now(); }
+  /// Seconds from the request to finished(); negative when it was never requested.
+  double latency() const;
+
+private:
+  std::atomic<bool> Requested{ false };
+  std::atomic<bool> Stop{ false };
+  Clock::time_point RequestedAt{};
+  Clock::time_point End{};
+  std::thread Timer;
+};
+
+} // namespace mlr::reliability
