@@ -19,6 +19,7 @@ DIR defaults to output/paraview. The plugin defaults to the one built in build/ 
 $MLR_BUILD_DIR); a plugin already loaded through PV_PLUGIN_PATH is used as it is.
 """
 import argparse
+import ctypes
 import glob
 import os
 import sys
@@ -65,7 +66,29 @@ def default_plugin():
     return found[0] if found else None
 
 
+def hold_x_display():
+    """Keeps one connection to the X server open for the whole run. ParaView connects to X,
+    disconnects and connects again to render; an Xvfb server (xvfb-run) resets when its last
+    client leaves and drops a connection arriving meanwhile, and pvpython then aborts with
+    "bad X server connection" now and then. A client that stays prevents the reset."""
+    if not os.environ.get("DISPLAY"):
+        return None
+    try:
+        xlib = ctypes.CDLL("libX11.so.6")
+    except OSError:
+        return None
+    xlib.XOpenDisplay.restype = ctypes.c_void_p
+    xlib.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    return xlib.XOpenDisplay(None)
+
+
 args, parser = parse_arguments()
+if not os.environ.get("DISPLAY"):
+    # Checked first: Debian's ParaView renders through X only and would abort at the first
+    # picture, after the whole solve.
+    parser.error("no X display (DISPLAY is not set): run it as "
+                 "xvfb-run -a pvpython Examples/cornell_box_animation.py ...")
+x_connection = hold_x_display()
 
 # Only now: importing paraview.simple starts ParaView, which --help need not wait for.
 import paraview.simple as pv  # noqa: E402
