@@ -125,6 +125,9 @@ const std::map<std::string, OptionSpec>& optionSpecs()
       { "S", [](Options& o, const auto& n, const auto& v) { o.seed = parseInteger(n, v); } } },
     { "--threads",
       { "T", [](Options& o, const auto& n, const auto& v) { o.threads = parseInteger(n, v); } } },
+    { "--memory-limit",
+      { "MIB",
+        [](Options& o, const auto& n, const auto& v) { o.memoryLimit = parseInteger(n, v); } } },
     { "--output",
       { "PATH.pvd",
         [](Options& o, const auto& n, const auto& v) {
@@ -302,6 +305,11 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
       filter->GetNumberOfThreadsMaxValue());
     filter->SetNumberOfThreads(static_cast<int>(*o.threads));
   }
+  if (o.memoryLimit)
+  {
+    checkRange<long long>("--memory-limit", *o.memoryLimit, 1, filter->GetMemoryLimitMaxValue());
+    filter->SetMemoryLimit(static_cast<int>(*o.memoryLimit));
+  }
   if (o.from)
   {
     checkRange<long long>("--frames", *o.frames, filter->GetNumberOfPositionsMinValue(),
@@ -347,6 +355,8 @@ Solver:
   --patch-size H        target patch edge length in scene units (default: about 3000 patches)
   --seed S              seed of the random numbers (default 0)
   --threads T           worker threads, 0 for every core (default 0)
+  --memory-limit MIB    refuse, before allocating, a solve (or reading a file) estimated to
+                        need more memory than this (default: half the physical memory)
 Output:
   --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)

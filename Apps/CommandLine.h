@@ -41,6 +41,7 @@ struct Options
   std::optional<double> patchSize;
   std::optional<long long> seed;
   std::optional<long long> threads;
+  std::optional<long long> memoryLimit; ///< MiB
 
   std::string output; ///< PATH.pvd
   std::string stats;  ///< FILE.json, or empty

@@ -222,7 +222,9 @@ vtkSmartPointer<vtkPolyData> readInChildProcess(const std::string& path,
       std::uint64_t pages = 0;
       statm >> pages;
       const std::uint64_t current = pages * static_cast<std::uint64_t>(sysconf(_SC_PAGE_SIZE));
-      const rlimit addressSpace{ current + limit, current + limit };
+      // Readers need some room whatever the limit: at least 256 MiB.
+      const std::uint64_t room = std::max<std::uint64_t>(limit, std::uint64_t(256) << 20);
+      const rlimit addressSpace{ current + room, current + room };
       setrlimit(RLIMIT_AS, &addressSpace);
     }
     int code = Unexpected;

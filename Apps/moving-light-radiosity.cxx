@@ -28,6 +28,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <unistd.h>
@@ -119,6 +120,38 @@ void ensureDisplay(int argc, char** argv)
   throw InputError(std::string("cannot run xvfb-run: ") + std::strerror(errno));
 }
 
+/// Refuses an output file name that is taken by a directory.
+void checkNotADirectory(const fs::path& path, const std::string& what)
+{
+  std::error_code error;
+  if (fs::is_directory(path, error))
+  {
+    throw InputError("the " + what + " '" + path.string() +
+      "' is a directory: give the name of a file to write");
+  }
+}
+
+/// Creates `directory` (rolled back with the transaction) and checks that files can be
+/// written in it, with a file that is removed again.
+void prepareDirectory(OutputTransaction& output, const fs::path& directory)
+{
+  output.createDirectories(directory);
+  const fs::path where = directory.empty() ? fs::path(".") : directory;
+  const fs::path probe = where / (".mlr-write-test-" + std::to_string(getpid()));
+  {
+    std::ofstream file(probe);
+    if (!file || !(file << "probe") || !(file.flush()))
+    {
+      const std::string reason = std::strerror(errno);
+      std::error_code error;
+      fs::remove(probe, error);
+      throw InputError("cannot write in the directory '" + where.string() + "': " + reason);
+    }
+  }
+  std::error_code error;
+  fs::remove(probe, error);
+}
+
 std::vector<double> timeSteps(vtkMovingLightRadiosity* filter)
 {
   vtkInformation* info = filter->GetOutputInformation(vtkMovingLightRadiosity::ELEMENTS_PORT);
@@ -136,6 +169,7 @@ vtkPolyData* frameAt(vtkMovingLightRadiosity* filter, double time)
 {
   if (!filter->UpdateTimeStep(time))
   {
+    throwIfInterrupted(); // the filter's "aborted" error is the interrupt's doing
     throw AlreadyReported();
   }
   return filter->GetOutput(vtkMovingLightRadiosity::ELEMENTS_PORT);
@@ -167,14 +201,17 @@ int run(int argc, char** argv)
   }
 
   // Every input is read and checked before anything is written.
-  const auto scene = options.usesEmbeddedScene() ? readEmbeddedFile("cornell_box.vtp")
-                                                 : readSurfaceFile(options.scene, "scene");
+  const std::uint64_t memoryLimit =
+    options.memoryLimit ? static_cast<std::uint64_t>(*options.memoryLimit) << 20 : 0;
+  const auto scene = options.usesEmbeddedScene()
+    ? readEmbeddedFile("cornell_box.vtp")
+    : readSurfaceFile(options.scene, "scene", memoryLimit);
   const auto light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
-                                           : readSurfaceFile(options.light, "light");
+                                           : readSurfaceFile(options.light, "light", memoryLimit);
   vtkSmartPointer<vtkPolyData> trajectory;
   if (!options.trajectory.empty())
   {
-    trajectory = readSurfaceFile(options.trajectory, "trajectory");
+    trajectory = readSurfaceFile(options.trajectory, "trajectory", memoryLimit);
   }
   else if (!options.from)
   {
@@ -219,6 +256,24 @@ int run(int argc, char** argv)
 
   filter->UpdateInformation();
   const std::vector<double> times = timeSteps(filter);
+
+  // Where the results go is checked before the solve, which may take minutes: output names
+  // taken by directories, directories that cannot be created or written.
+  OutputTransaction output;
+  const fs::path collection = options.output;
+  const SeriesNaming naming(collection, times.size());
+  checkNotADirectory(collection, "output");
+  prepareDirectory(output, naming.directory);
+  if (!options.stats.empty())
+  {
+    checkNotADirectory(options.stats, "statistics file");
+    prepareDirectory(output, fs::path(options.stats).parent_path());
+  }
+  if (!options.png.empty())
+  {
+    prepareDirectory(output, options.png);
+  }
+
   vtkPolyData* first = frameAt(filter, times.front()); // the solve
   // Later updates only copy frames out of the filter's cache: their progress is not the solve's.
   filter->RemoveObserver(solving);
@@ -232,10 +287,6 @@ int run(int argc, char** argv)
   vtkNew<vtkFieldData> statistics;
   statistics->ShallowCopy(first->GetFieldData());
 
-  OutputTransaction output;
-  const fs::path collection = options.output;
-  const SeriesNaming naming(collection, times.size());
-  output.createDirectories(naming.directory);
   std::vector<FrameRecord> records;
   double brightLevel = 0;
   for (std::size_t f = 0; f < times.size(); ++f)
@@ -256,7 +307,6 @@ int run(int argc, char** argv)
   if (!options.png.empty())
   {
     const fs::path pictures = options.png;
-    output.createDirectories(pictures);
     FrameRenderer renderer(light, scene->GetBounds());
     renderer.setBrightLevel(brightLevel);
     for (std::size_t f = 0; f < times.size(); ++f)
@@ -281,7 +331,6 @@ int run(int argc, char** argv)
   if (!options.stats.empty())
   {
     const fs::path statsPath = options.stats;
-    output.createDirectories(statsPath.parent_path());
     writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records);
   }
   throwIfInterrupted();

@@ -210,8 +210,11 @@ PolygonSoup icosphere(int frequency, double radius)
     return index;
   };
   const int n = frequency;
-  for (const auto& [a, b, c] : faces)
+  for (const auto& face : faces)
   {
+    // Named corners, not a structured binding: lambdas capture bindings only from C++20 on
+    // (clang refuses, and the sanitizer and fuzz builds use clang).
+    const int a = face[0], b = face[1], c = face[2];
     auto at = [&](int i, int j) { return point({ { a, n - i - j }, { b, i }, { c, j } }); };
     for (int j = 0; j < n; ++j)
     {
