@@ -1,6 +1,7 @@
 #include "MovingLightRadiosityInputs.h"
 
 #include "Error.h"
+#include "Solver.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
@@ -130,12 +131,36 @@ Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId)
 }
 }
 
-PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings)
+PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
+  std::uint64_t memoryLimitBytes)
 {
   PolygonSoup soup;
   if (!scene || scene->GetNumberOfCells() == 0)
   {
     return soup;
+  }
+  {
+    // Per point 24 bytes; per polygon its index vector (~56 bytes with the allocator's
+    // overhead) and material (24), and 4 bytes per index. Strips become one polygon per
+    // triangle.
+    const double cells = static_cast<double>(scene->GetNumberOfPolys()) +
+      static_cast<double>(scene->GetStrips()->GetNumberOfConnectivityIds());
+    const double ids = static_cast<double>(scene->GetPolys()->GetNumberOfConnectivityIds()) +
+      3.0 * static_cast<double>(scene->GetStrips()->GetNumberOfConnectivityIds());
+    const double estimate = 24.0 * static_cast<double>(scene->GetNumberOfPoints()) + 80.0 * cells + 4.0 * ids;
+    const double limit =
+      static_cast<double>(memoryLimitBytes > 0 ? memoryLimitBytes : defaultMemoryLimitBytes());
+    if (estimate > limit)
+    {
+      std::ostringstream s;
+      s.precision(3);
+      s << "the Scene has " << scene->GetNumberOfCells() << " cells on "
+        << scene->GetNumberOfPoints() << " points: taking them for remeshing needs an estimated "
+        << estimate / (1024.0 * 1024.0 * 1024.0) << " GiB, over the memory limit of "
+        << limit / (1024.0 * 1024.0 * 1024.0)
+        << " GiB: simplify the scene or raise MemoryLimit";
+      throw Error(s.str());
+    }
   }
   const vtkIdType ignored = scene->GetNumberOfVerts() + scene->GetNumberOfLines();
   if (ignored > 0)

@@ -5,6 +5,7 @@
 #include "Remeshing.h"
 #include "Vec3.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,10 @@ namespace mlr::vtkinputs
 /// The Scene's polygons (strips split into triangles) with one material each, read from the
 /// cell array `Reflectance`. Recoverable oddities (ignored vertices and lines, no
 /// `Reflectance`) are appended to `warnings`. An empty soup means there is nothing to light.
-PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings);
+/// Throws mlr::Error, before copying anything, when the copy is estimated to need more than
+/// `memoryLimitBytes` (0: half the physical memory).
+PolygonSoup sceneSoup(
+  vtkPolyData* scene, std::vector<std::string>& warnings, std::uint64_t memoryLimitBytes = 0);
 
 /// The Light's polygons (strips split into triangles), in the light's own frame.
 std::vector<std::vector<Vec3>> lightPolygons(vtkPolyData* light);

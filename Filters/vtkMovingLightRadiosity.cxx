@@ -279,8 +279,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   {
     const mlr::vtkinputs::Trajectory trajectory = trajectoryOf(this, inputVector[TRAJECTORY_PORT]);
     std::vector<std::string> warnings;
-    const mlr::PolygonSoup soup =
-      mlr::vtkinputs::sceneSoup(vtkPolyData::GetData(inputVector[SCENE_PORT], 0), warnings);
+    const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(
+      vtkPolyData::GetData(inputVector[SCENE_PORT], 0), warnings,
+      static_cast<std::uint64_t>(this->MemoryLimit) << 20);
     for (const std::string& warning : warnings)
     {
       vtkWarningMacro(<< warning);

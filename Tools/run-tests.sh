@@ -17,6 +17,8 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
 cmake --build "$build" -j 2
 status=0
 ctest --test-dir "$build" --output-on-failure -j 2 --timeout 900 || status=$?
+echo "Release stage: ${SECONDS} s"
+stage=$SECONDS
 
 if [ "${MLR_SKIP_SANITIZERS:-0}" = 1 ]; then
   exit "$status"
@@ -37,6 +39,8 @@ if CC=clang CXX=clang++ cmake -S "$root" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=
 else
   failed+=("sanitizer build")
 fi
+echo "sanitizer stage: $((SECONDS - stage)) s"
+stage=$SECONDS
 
 # --- Fuzzing: each libFuzzer target for a bounded time --------------------------------------
 # New inputs go to build-fuzz/fuzz-corpus/<target>; crashes, hangs (-timeout) and memory over
@@ -69,6 +73,7 @@ if CC=clang CXX=clang++ cmake -S "$root" -B "$fuzz" -G Ninja -DCMAKE_BUILD_TYPE=
 else
   failed+=("fuzz build")
 fi
+echo "fuzzing stage: $((SECONDS - stage)) s"
 
 if [ ${#failed[@]} -gt 0 ]; then
   printf 'FAILED: %s\n' "${failed[@]}" >&2

@@ -223,6 +223,12 @@ std::vector<Row> rows()
       // "about": refused on the patch count expected before remeshing, not after it.
       Outcome::Error, "(10000 frames x (about", 5,
       [](Case& c) { EXPECT_EQ(c.filter->GetPatchSize(), 0.02); } },
+    { "LargeSceneOverTheMemoryLimitIsRefusedBeforeCopying",
+      [](Case& c) {
+        c.setup.scene = soupPolyData(sphereSoup(100)); // ~20 MB as a soup
+        c.filter->SetMemoryLimit(8);
+      },
+      Outcome::Error, "the Scene has 200000 cells on 100002 points: taking them for remeshing needs an estimated", 2 },
     { "PathsZeroIsClampedToOne", [](Case& c) { c.filter->SetNumberOfPaths(0); },
       Outcome::Result, "", 10,
       [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 1); } },
