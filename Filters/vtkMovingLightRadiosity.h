@@ -213,8 +213,10 @@ public:
 
   ///@{
   /**
-   * Refuse solves estimated to need more memory than this (MiB); 0 means half of the
-   * physical memory. Default 0.
+   * Refuse work estimated to need more memory than this (MiB), before allocating it: taking
+   * the scene for remeshing, remeshing it, and the solve with its outputs (a solve that
+   * cannot fit is refused before remeshing runs, from the patch count expected); 0 means
+   * half of the physical memory. Default 0.
    */
   vtkSetClampMacro(MemoryLimit, int, 0, VTK_INT_MAX);
   vtkGetMacro(MemoryLimit, int);
