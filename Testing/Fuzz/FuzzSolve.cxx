@@ -108,9 +108,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       polygon.emplace_back(x, y, (flags & 0x20) ? in.coordinate() : z);
     }
   }
+  // Mostly a valid power and 1 or 2 frames, so that most inputs reach the solve.
   static const double powers[] = { 100, 1, 0, 1e30, -1, std::nan(""), 1e-300, 3 };
-  const mlr::Rgb power(powers[in.below(8)], 100, powers[in.below(8)]);
-  std::vector<mlr::Vec3> translations(in.below(4)); // 0 to 3 frames
+  auto powerOf = [&in](std::uint8_t b) { return b < 192 ? 100.0 : powers[b % 8]; };
+  const double red = powerOf(in.byte()), blue = powerOf(in.byte());
+  const mlr::Rgb power(red, 100, blue);
+  const std::uint8_t frames = in.byte();
+  std::vector<mlr::Vec3> translations(frames < 8 ? 0 : frames < 16 ? 3 : 1 + frames % 2);
   for (mlr::Vec3& t : translations)
   {
     const double x = in.coordinate(), y = in.coordinate(), z = in.coordinate();

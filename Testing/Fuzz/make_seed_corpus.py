@@ -41,7 +41,7 @@ def solve_input(points, polygons, light, frames, flags=0, patches=None, edge_ind
         for x, y in corners:
             out += coordinate(x) + coordinate(y)
     out += bytes([0, 0])  # power 100 in every channel
-    out += bytes([len(frames)])
+    out += bytes([{0: 0, 1: 16, 2: 17, 3: 8}[len(frames)]])  # frame count, as decoded
     for t in frames:
         out += b"".join(coordinate(c) for c in t)
     if patches is not None:
