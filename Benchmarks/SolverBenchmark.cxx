@@ -94,6 +94,7 @@ struct ModeResult
   bool reuseShooting, reuseGathering;
   SolverStatistics stats;
   double bareSeconds = 0;
+  int repeats = 1;
 };
 }
 
@@ -144,10 +145,21 @@ int main(int argc, char** argv)
       SolverOptions o = options;
       o.reuseShooting = m.reuseShooting;
       o.reuseGathering = m.reuseGathering;
-      m.stats = solve(scene, light, o).statistics;
+      // A solve under a few seconds is at the mercy of the machine's hiccups: take the
+      // median of three (the rays, and the result, are the same every time).
+      std::vector<SolverStatistics> runs = { solve(scene, light, o).statistics };
+      if (runs[0].secondsTotal < 3.0)
+      {
+        runs.push_back(solve(scene, light, o).statistics);
+        runs.push_back(solve(scene, light, o).statistics);
+        std::sort(runs.begin(), runs.end(),
+          [](const SolverStatistics& a, const SolverStatistics& b) { return a.secondsTotal < b.secondsTotal; });
+      }
+      m.stats = runs[runs.size() / 2];
+      m.repeats = static_cast<int>(runs.size());
     }
     const int threads = modes[0].stats.threads;
-    const bench::BareRates bare = bench::measureBareEmbree(scene, light, threads, 2000000);
+    const bench::BareRates bare = bench::measureBareEmbree(scene, light, threads, 4000000);
 
     std::printf("Threads: %d\n\n", threads);
     std::printf("%-16s %9s %9s %9s %12s %12s %12s %10s %9s\n", "mode", "total s", "shoot s",
@@ -179,7 +191,7 @@ int main(int argc, char** argv)
                 "surface rays/s (rtcIntersect1), %.1f M shadow rays/s (rtcOccluded16)\n",
       threads, bare.lightRays / 1e6, bare.surfaceRays / 1e6, bare.shadowRays / 1e6);
     std::printf("'vs bare' = solver seconds (shooting + gathering) / bare Embree seconds for "
-                "the same rays of the same kinds.\n");
+                "the same rays of the same kinds.\nModes under 3 s show the median of 3 runs.\n");
     std::printf("Mean path length l = %.3f (from classic: shooting rays per path = 1 + "
                 "lambda (l - 1))\n",
       classic.meanPathLength);

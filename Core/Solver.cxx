@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <sstream>
 
 #include <unistd.h>
@@ -109,6 +110,12 @@ public:
     // M_k paths start from position k; they add up to N exactly.
     const std::uint64_t n = this->Frames;
     const std::uint64_t N = options.pathsPerFrame;
+    for (const Vec3& t : light.translations())
+    {
+      this->TranslationX.push_back(t.x);
+      this->TranslationY.push_back(t.y);
+      this->TranslationZ.push_back(t.z);
+    }
     this->PathsFromPosition.resize(this->Frames);
     for (std::uint64_t k = 0; k < n; ++k)
     {
@@ -124,6 +131,24 @@ public:
     Solution& out, int worker);
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
+
+  /// True if side s of patch p received shooting power: a later bounce, or a first hit on
+  /// one of its elements.
+  bool patchReceived(std::size_t p, int s) const
+  {
+    if (this->PatchPower.received(p, s))
+    {
+      return true;
+    }
+    for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+    {
+      if (this->ElementShare.received(e, s))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
 
   /// Which position path `path` of a reuse solve starts from.
   std::size_t positionOfPath(std::uint64_t path) const
@@ -142,7 +167,8 @@ public:
 private:
   void scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
     std::size_t firstFrame, std::size_t frameCount, int worker);
-  void prefetchFirstHit(
+  // Always inlined, like the prefetch it calls: GCC would delete the call otherwise.
+  [[gnu::always_inline]] inline void prefetchFirstHit(
     const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker);
 
   const Scene& SceneRef;
@@ -155,11 +181,14 @@ private:
   // power whose first hit lands there. Its colour rho_e Phi is the same for every hit, and
   // a scalar is a third of the memory traffic of RGB in the hottest loop.
   FixedPointAccumulator<1> ElementShare;
-  // The patch solution: reflected power (W), RGB, all bounces.
+  // The patch solution's reflected power (W), RGB, from the second hit of a walk on; the
+  // first hits come from ElementShare.
   FixedPointAccumulator<3> PatchPower;
   std::vector<WorkerCounters> Counters;
   std::vector<WorkerScratch> Scratch;
   std::vector<double> PathsFromPosition;
+  // The light's translations as a structure of arrays, for the vectorised weights.
+  std::vector<double> TranslationX, TranslationY, TranslationZ;
 };
 
 /**
@@ -177,18 +206,17 @@ private:
 void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
   std::size_t firstFrame, std::size_t frameCount, int worker)
 {
+  // The first hit scores only the element's share: the patch's first-hit power is
+  // rho_p Phi times the shares of its four elements, added when shooting ends. That keeps
+  // the RGB patch slots (3n values) out of the one write every path makes.
   const int firstSide = static_cast<int>(firstHit.side);
-  const std::size_t firstPatch = Scene::patchOfElement(firstHit.element);
-  const Rgb& firstRho = this->SceneRef.patchReflectance(firstPatch);
+  const Rgb& firstRho = this->SceneRef.elementReflectance(firstHit.element);
   Rgb colour = firstRho * this->Light.power();
   {
     std::int64_t* elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
-    std::int64_t* patchSlots = this->PatchPower.slots(worker, firstPatch, firstSide);
     for (std::size_t f = 0; f < frameCount; ++f)
     {
-      const double reflected[3] = { colour.r * shares[f], colour.g * shares[f], colour.b * shares[f] };
       this->ElementShare.add(elementSlots, firstFrame + f, &shares[f]);
-      this->PatchPower.add(patchSlots, firstFrame + f, reflected);
     }
     const double lambda = this->Options.firstBounceSurvival;
     if (random.uniform() >= lambda)
@@ -252,13 +280,11 @@ void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const 
 
 /// Called as soon as a walk's first hit is known, so that the weights and shadow rays
 /// computed before scoring hide the cache misses of the slots it will score.
-void SolveRun::prefetchFirstHit(
+inline void SolveRun::prefetchFirstHit(
   const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker)
 {
-  const int side = static_cast<int>(hit.side);
-  this->ElementShare.prefetch(this->ElementShare.slots(worker, hit.element, side), firstFrame, frameCount);
-  this->PatchPower.prefetch(
-    this->PatchPower.slots(worker, Scene::patchOfElement(hit.element), side), firstFrame, frameCount);
+  this->ElementShare.prefetch(
+    this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame, frameCount);
 }
 
 void SolveRun::shootReused(std::uint64_t path, int worker)
@@ -290,17 +316,25 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
 
   // Mixture weights w_j = G(x_j, y) / sum_k M_k G(x_k, y), with real visibility. The pi of
   // G cancels; with d = y - x_j unnormalised, cos_x cos_y / r^2 = (n_x.d)(-n_y.d) / |d|^4.
+  // The loop is branch-free over the positions (structure of arrays) so that it vectorises.
   const Vec3 ny = this->SceneRef.elementSideNormal(hit.element, hit.side);
+  const Vec3 toHit = hit.point - x;
+  double* kernel = scratch.kernel.data();
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    const double dx = toHit.x - this->TranslationX[j];
+    const double dy = toHit.y - this->TranslationY[j];
+    const double dz = toHit.z - this->TranslationZ[j];
+    const double cosX = lightNormal.x * dx + lightNormal.y * dy + lightNormal.z * dz;
+    const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+    kernel[j] = cosX > 0 && cosY > 0 ? g : 0.0;
+  }
   std::size_t shadowCount = 0;
   for (std::size_t j = 0; j < this->Frames; ++j)
   {
-    const Vec3 d = hit.point - (x + this->Light.translation(j));
-    const double cosX = dot(lightNormal, d);
-    const double cosY = -dot(ny, d);
-    const double r2 = lengthSquared(d);
-    const double g = cosX > 0 && cosY > 0 && r2 > 0 ? cosX * cosY / (r2 * r2) : 0.0;
-    scratch.kernel[j] = g;
-    if (g > 0 && j != origin)
+    if (kernel[j] > 0 && j != origin)
     {
       scratch.targets[shadowCount] = x + this->Light.translation(j);
       scratch.targetFrames[shadowCount] = static_cast<std::uint32_t>(j);
@@ -316,7 +350,7 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
     {
       if (!scratch.visible[s])
       {
-        scratch.kernel[scratch.targetFrames[s]] = 0;
+        kernel[scratch.targetFrames[s]] = 0;
       }
     }
   }
@@ -329,9 +363,10 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   {
     return; // grazing to the last bit: the path carries nothing
   }
+  const double inverseMixture = 1.0 / mixture;
   for (std::size_t j = 0; j < this->Frames; ++j)
   {
-    scratch.kernel[j] /= mixture;
+    kernel[j] *= inverseMixture;
   }
   this->scoreAndWalk(random, hit, scratch.kernel.data(), 0, this->Frames, worker);
 }
@@ -386,14 +421,22 @@ void SolveRun::finishShooting(Solution& solution) const
   for (std::size_t p = 0; p < patches; ++p)
   {
     const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
+    const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->Light.power();
     for (int s = 0; s < 2; ++s)
     {
       for (std::size_t f = 0; f < this->Frames; ++f)
       {
         double power[3];
         this->PatchPower.total(p, s, f, power);
+        double share = 0;
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        {
+          double elementShare = 0;
+          this->ElementShare.total(e, s, f, &elementShare);
+          share += elementShare;
+        }
         patch[solution.patchIndex(f, p, static_cast<Side>(s))] =
-          Rgb(power[0], power[1], power[2]) * inverseArea;
+          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * inverseArea;
       }
     }
   }
@@ -413,7 +456,7 @@ std::vector<std::uint32_t> SolveRun::gatheringSides(std::uint64_t& rays, std::ui
   {
     for (int s = 0; s < 2; ++s)
     {
-      if (this->PatchPower.received(p, s))
+      if (this->patchReceived(p, s))
       {
         for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
         {
@@ -447,9 +490,24 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
   const Vec3 normal = this->SceneRef.elementSideNormal(element, side);
   std::fill(sum.begin(), sum.end(), Rgb());
 
+  // A hit's row of patch radiosity is added after the next ray is traced: the row was
+  // prefetched when the hit was found, so the trace hides its cache miss.
   const std::size_t passes = reuse ? 1 : this->Frames;
+  const std::size_t rowLength = reuse ? this->Frames : 1;
   for (std::size_t pass = 0; pass < passes; ++pass)
   {
+    Rgb* into = reuse ? sum.data() : &sum[pass];
+    const Rgb* pending = nullptr;
+    auto addPending = [&] {
+      if (pending)
+      {
+        for (std::size_t f = 0; f < rowLength; ++f)
+        {
+          into[f] += pending[f];
+        }
+        pending = nullptr;
+      }
+    };
     RandomStream random(this->Options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
     for (std::uint64_t r = 0; r < rays; ++r)
     {
@@ -458,7 +516,9 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
       const Vec3 direction = sampleCosineDirection(normal, random);
       ++counters.gatheringRays;
       RayHit hit;
-      if (!this->Tracer.intersect(this->Tracer.liftOff(origin, normal), direction, hit))
+      const bool found = this->Tracer.intersect(this->Tracer.liftOff(origin, normal), direction, hit);
+      addPending();
+      if (!found)
       {
         ++counters.missedRays;
         continue;
@@ -467,20 +527,14 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
       {
         continue;
       }
-      const std::size_t patch = Scene::patchOfElement(hit.element);
-      if (reuse)
+      pending = &shooting.patchRadiosity(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
+      const char* row = reinterpret_cast<const char*>(pending);
+      for (std::size_t byte = 0; byte < rowLength * sizeof(Rgb); byte += 64)
       {
-        const Rgb* b = &shooting.patchRadiosity(0, patch, hit.side);
-        for (std::size_t f = 0; f < this->Frames; ++f)
-        {
-          sum[f] += b[f];
-        }
-      }
-      else
-      {
-        sum[pass] += shooting.patchRadiosity(pass, patch, hit.side);
+        __builtin_prefetch(row + byte);
       }
     }
+    addPending();
   }
   const Rgb scale = this->SceneRef.elementReflectance(element) / static_cast<double>(rays);
   for (std::size_t f = 0; f < this->Frames; ++f)
