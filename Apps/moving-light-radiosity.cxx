@@ -108,8 +108,12 @@ void ensureDisplay(int argc, char** argv)
       std::strerror(errno));
   }
   setenv("MLR_UNDER_XVFB", "1", 1);
+  // xvfb-run -a takes the first free display from 99 on; two runs starting together can both
+  // pick the same one and one of them then aborts. Starting the search at a number drawn
+  // from the process id keeps concurrent runs (parallel tests, batch jobs) apart.
+  std::string firstDisplay = std::to_string(100 + getpid() % 4000);
   std::vector<char*> arguments = { const_cast<char*>("xvfb-run"), const_cast<char*>("-a"),
-    self };
+    const_cast<char*>("-n"), firstDisplay.data(), self };
   for (int i = 1; i < argc; ++i)
   {
     arguments.push_back(argv[i]);
