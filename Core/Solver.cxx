@@ -165,6 +165,8 @@ public:
   }
 
 private:
+  bool emit(RandomStream& random, std::size_t position, int worker, Vec3& x, Vec3& lightNormal,
+    RayHit& hit);
   void scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
     std::size_t firstFrame, std::size_t frameCount, int worker);
   // Always inlined, like the prefetch it calls: GCC would delete the call otherwise.
@@ -287,6 +289,32 @@ inline void SolveRun::prefetchFirstHit(
     this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame, frameCount);
 }
 
+/// Starts a walk from the light at `position`: a uniform point x of the light (own frame)
+/// with its normal, a cosine direction and the first ray. False when the walk ends there: a
+/// miss (the power leaves the scene) or, with one-sided surfaces, a back face.
+bool SolveRun::emit(RandomStream& random, std::size_t position, int worker, Vec3& x,
+  Vec3& lightNormal, RayHit& hit)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
+  const Vec3 direction = sampleCosineDirection(lightNormal, random);
+  const Vec3 start = x + this->Light.translation(position);
+  ++counters.shootingRays;
+  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  {
+    ++counters.missedRays;
+    return false;
+  }
+  ++counters.firstHits;
+  if (!this->Options.twoSided && hit.side == Side::Back)
+  {
+    ++counters.firstHitsOnBack;
+    return false;
+  }
+  return true;
+}
+
 void SolveRun::shootReused(std::uint64_t path, int worker)
 {
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
@@ -295,21 +323,9 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, 0);
 
   Vec3 x, lightNormal;
-  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
-  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
-  const Vec3 direction = sampleCosineDirection(lightNormal, random);
-  const Vec3 start = x + this->Light.translation(origin);
-  ++counters.shootingRays;
   RayHit hit;
-  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  if (!this->emit(random, origin, worker, x, lightNormal, hit))
   {
-    ++counters.missedRays;
-    return;
-  }
-  ++counters.firstHits;
-  if (!this->Options.twoSided && hit.side == Side::Back)
-  {
-    ++counters.firstHitsOnBack;
     return;
   }
   this->prefetchFirstHit(hit, 0, this->Frames, worker);
@@ -373,24 +389,11 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
 
 void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
 {
-  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
   RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, frame + 1);
   Vec3 x, lightNormal;
-  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
-  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
-  const Vec3 direction = sampleCosineDirection(lightNormal, random);
-  const Vec3 start = x + this->Light.translation(static_cast<std::size_t>(frame));
-  ++counters.shootingRays;
   RayHit hit;
-  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  if (!this->emit(random, static_cast<std::size_t>(frame), worker, x, lightNormal, hit))
   {
-    ++counters.missedRays;
-    return;
-  }
-  ++counters.firstHits;
-  if (!this->Options.twoSided && hit.side == Side::Back)
-  {
-    ++counters.firstHitsOnBack;
     return;
   }
   const double share = 1.0 / static_cast<double>(this->Options.pathsPerFrame);

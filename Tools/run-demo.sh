@@ -4,10 +4,7 @@
 # PNG picture per frame in output/png/.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-"$root/Tools/setup-debian.sh"
+"$root/Tools/build.sh" moving-light-radiosity
 build="${MLR_BUILD_DIR:-$root/build}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build "$build" -j 2 --target moving-light-radiosity
 cd "$root"
 exec "$build/bin/moving-light-radiosity" "$@"

@@ -5,11 +5,8 @@
 # output/paper/cache; later runs reuse it.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-"$root/Tools/setup-debian.sh"
+"$root/Tools/build.sh"
 build="${MLR_BUILD_DIR:-$root/build}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build "$build" -j 2
 cd "$root"
 export PYTHONPATH="$build/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}"
 out="${1:-output/paper}"

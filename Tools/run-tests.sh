@@ -10,11 +10,8 @@
 # MLR_SKIP_SANITIZERS=1 runs the Release part only.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-"$root/Tools/setup-debian.sh"
+"$root/Tools/build.sh"
 build="${MLR_BUILD_DIR:-$root/build}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build "$build" -j 2
 status=0
 ctest --test-dir "$build" --output-on-failure -j 2 --timeout 900 || status=$?
 echo "Release stage: ${SECONDS} s"

@@ -1,5 +1,6 @@
 // Every bad input is refused with a message that names what to fix; cancellation stops a
 // solve quickly and never returns a partial result.
+#include "CoreChecks.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
@@ -10,24 +11,10 @@
 #include <limits>
 
 using namespace mlr;
+using mlr::checks::expectError;
 
 namespace
 {
-/// Runs `action`, expects mlr::Error, and checks its message contains `words`.
-template <typename Action>
-void expectError(Action action, const std::string& words)
-{
-  try
-  {
-    action();
-    ADD_FAILURE() << "no error; expected one mentioning \"" << words << "\"";
-  }
-  catch (const Error& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << "message: " << e.what();
-  }
-}
-
 PatchMesh floorMesh()
 {
   PatchMesh mesh;

@@ -1,38 +1,16 @@
 // A closed box absorbs all the light's power: sum_i A_i (1-rho_i)/rho_i B_i = Phi.
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
 #include <gtest/gtest.h>
 
 using namespace mlr;
+using mlr::checks::Balance;
+using mlr::checks::balanceOfFrame;
 
 namespace
 {
-struct Balance
-{
-  Rgb absorbed;     ///< sum_i A_i (1 - rho_i) / rho_i B_i over element sides
-  Rgb radiantPower; ///< sum_i A_i B_i
-};
-
-Balance balanceOfFrame(const Scene& scene, const Solution& solution, std::size_t frame)
-{
-  Balance b;
-  for (std::size_t e = 0; e < scene.elementCount(); ++e)
-  {
-    const Rgb& rho = scene.elementReflectance(e);
-    for (Side side : { Side::Front, Side::Back })
-    {
-      const Rgb B = solution.total(frame, e, side);
-      for (int c = 0; c < 3; ++c)
-      {
-        b.absorbed[c] += scene.elementArea(e) * (1 - rho[c]) / rho[c] * B[c];
-        b.radiantPower[c] += scene.elementArea(e) * B[c];
-      }
-    }
-  }
-  return b;
-}
-
 std::vector<Vec3> boxTrajectory(std::size_t frames)
 {
   return scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.25, 0.3, 0.9 }, { 0.75, 0.7, 0.8 }, frames);

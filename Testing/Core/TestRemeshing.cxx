@@ -1,5 +1,6 @@
 // Remeshing any polygon soup into well-shaped patches of one material each: geometry and
 // materials are kept, fine input is coarsened, and messy input never crashes.
+#include "CoreChecks.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
 #include "Remeshing.h"
@@ -17,6 +18,7 @@
 
 using namespace mlr;
 using namespace mlr::scenes;
+using mlr::checks::expectError;
 
 namespace
 {
@@ -131,20 +133,6 @@ std::vector<int> commonCubeFaces(const PatchMesh& mesh, std::size_t p, double to
     }
   }
   return common;
-}
-
-template <typename Action>
-void expectError(Action action, const std::string& words)
-{
-  try
-  {
-    action();
-    ADD_FAILURE() << "no error; expected one mentioning \"" << words << "\"";
-  }
-  catch (const Error& e)
-  {
-    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << "message: " << e.what();
-  }
 }
 
 RemeshOptions withEdgeLength(double h)
@@ -577,22 +565,10 @@ TEST(Remeshing, RemeshedClosedBoxAbsorbsAllPower)
   const Solution solution = solve(scene, light, solverOptions);
   for (std::size_t f = 0; f < light.frameCount(); ++f)
   {
-    Rgb absorbed;
-    for (std::size_t e = 0; e < scene.elementCount(); ++e)
-    {
-      const Rgb& rho = scene.elementReflectance(e);
-      for (Side side : { Side::Front, Side::Back })
-      {
-        const Rgb B = solution.total(f, e, side);
-        for (int c = 0; c < 3; ++c)
-        {
-          absorbed[c] += scene.elementArea(e) * (1 - rho[c]) / rho[c] * B[c];
-        }
-      }
-    }
+    const checks::Balance b = checks::balanceOfFrame(scene, solution, f);
     for (int c = 0; c < 3; ++c)
     {
-      EXPECT_NEAR(absorbed[c] / power[c], 1.0, 0.01) << "frame " << f << " channel " << c;
+      EXPECT_NEAR(b.absorbed[c] / power[c], 1.0, 0.01) << "frame " << f << " channel " << c;
     }
   }
 }
