@@ -3,7 +3,7 @@
 # the ParaView state: python3-paraview conflicts with python3-vtk9 (pulled in by libvtk9-dev),
 # and find_package(ParaView) only configures with python3-paraview installed.
 # ParaView's CMake package needs MPI's headers (libopenmpi-dev) to configure, and its
-# rendering modules need GLEW's and X11's (libglew-dev, libx11-dev).
+# rendering modules need GLEW's, X11's and OpenGL's (libglew-dev, libx11-dev, libgl-dev).
 # Idempotent: when everything is present it only runs dpkg-query and returns.
 set -euo pipefail
 
@@ -12,7 +12,7 @@ packages=(
   paraview paraview-dev python3-paraview
   libcgal-dev libembree-dev libtbb-dev libgtest-dev libbenchmark-dev
   xvfb python3-numpy python3-pytest python3-matplotlib
-  libopenmpi-dev libglew-dev libx11-dev
+  libopenmpi-dev libglew-dev libx11-dev libgl-dev
   clang libclang-rt-14-dev
 )
 
