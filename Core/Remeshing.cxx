@@ -109,27 +109,7 @@ void validateSoup(const PolygonSoup& soup)
       << " materials: give exactly one material per polygon";
     throw Error(s.str());
   }
-  std::size_t nonFinite = 0;
-  for (const Vec3& p : soup.points)
-  {
-    nonFinite += isFinite(p) ? 0 : 1;
-  }
-  if (nonFinite > 0)
-  {
-    throw Error("the scene has " + countOf(nonFinite, "point") +
-      " with NaN or infinite coordinates: remove or fix them");
-  }
-  for (const Vec3& p : soup.points)
-  {
-    if (!isWithinCoordinateRange(p))
-    {
-      std::ostringstream s;
-      s << "the scene has a point at (" << p.x << ", " << p.y << ", " << p.z
-        << "): coordinates must stay within +-" << MaximumCoordinate
-        << " (rays are traced in single precision); scale the scene down";
-      throw Error(s.str());
-    }
-  }
+  checkScenePoints(soup.points);
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
   {
     const Rgb& rho = soup.materials[i].reflectance;

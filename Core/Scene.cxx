@@ -19,6 +19,31 @@ std::string describe(const Rgb& c)
 }
 }
 
+void checkScenePoints(const std::vector<Vec3>& points)
+{
+  std::size_t nonFinite = 0;
+  for (const Vec3& p : points)
+  {
+    nonFinite += isFinite(p) ? 0 : 1;
+  }
+  if (nonFinite > 0)
+  {
+    throw Error("the scene has " + std::to_string(nonFinite) + (nonFinite == 1 ? " point" : " points") +
+      " with NaN or infinite coordinates: remove or fix them");
+  }
+  for (const Vec3& p : points)
+  {
+    if (!isWithinCoordinateRange(p))
+    {
+      std::ostringstream s;
+      s << "the scene has a point at (" << p.x << ", " << p.y << ", " << p.z
+        << "): coordinates must stay within +-" << MaximumCoordinate
+        << " (rays are traced in single precision); scale the scene down";
+      throw Error(s.str());
+    }
+  }
+}
+
 Scene Scene::fromPatchMesh(const PatchMesh& mesh)
 {
   if (mesh.triangles.empty())
@@ -37,29 +62,7 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
   {
     throw Error("the scene is too large: it must have fewer than 2^28 patches and 2^31 points");
   }
-  std::size_t nonFinite = 0;
-  for (const Vec3& p : mesh.points)
-  {
-    nonFinite += isFinite(p) ? 0 : 1;
-  }
-  if (nonFinite > 0)
-  {
-    std::ostringstream s;
-    s << "the scene has " << nonFinite
-      << " points with NaN or infinite coordinates: remove or fix them";
-    throw Error(s.str());
-  }
-  for (const Vec3& p : mesh.points)
-  {
-    if (!isWithinCoordinateRange(p))
-    {
-      std::ostringstream s;
-      s << "the scene has a point at (" << p.x << ", " << p.y << ", " << p.z
-        << "): coordinates must stay within +-" << MaximumCoordinate
-        << " (rays are traced in single precision); scale the scene down";
-      throw Error(s.str());
-    }
-  }
+  checkScenePoints(mesh.points);
 
   Scene scene;
   scene.Points = mesh.points;

@@ -34,6 +34,10 @@ inline bool isWithinCoordinateRange(const Vec3& p)
     std::abs(p.z) <= MaximumCoordinate;
 }
 
+/// Throws mlr::Error when any point has a NaN or infinite coordinate (saying how many) or
+/// lies beyond +-MaximumCoordinate (saying where).
+void checkScenePoints(const std::vector<Vec3>& points);
+
 /// Patches as given by the caller (or by remeshing): one triangle and one reflectance each.
 struct PatchMesh
 {

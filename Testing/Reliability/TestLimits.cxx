@@ -1,5 +1,6 @@
 // Limits (issue 7): memory estimates refuse work before allocating it, and a solve can be
 // cancelled at any phase, remeshing a 200,000-triangle input included, within 0.5 s.
+#include "CoreChecks.h"
 #include "ReliabilitySupport.h"
 
 #include "Error.h"
@@ -17,6 +18,7 @@
 #include <string>
 
 using namespace mlr;
+using mlr::checks::errorOf;
 using namespace mlr::reliability;
 
 namespace
@@ -28,21 +30,6 @@ double secondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// Runs `action`, expects mlr::Error, and returns its message.
-template <typename Action>
-std::string errorOf(Action action)
-{
-  try
-  {
-    action();
-  }
-  catch (const Error& e)
-  {
-    return e.what();
-  }
-  ADD_FAILURE() << "no mlr::Error";
-  return {};
-}
 
 /// Remeshing, scene and solve of the 200,000-triangle sphere lit from inside, as the filter
 /// runs them; `keepGoing` is polled through both progress callbacks. Returns the phase it

@@ -1,5 +1,6 @@
 // Regression tests for what fuzzing found in Core (issue 7). The inputs that crashed are also
 // replayed as files: Testing/Fuzz/regressions/<target>/ (ctest Fuzz.*.Replay).
+#include "CoreChecks.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
 #include "MovingLight.h"
@@ -12,23 +13,10 @@
 #include <string>
 
 using namespace mlr;
+using mlr::checks::errorOf;
 
 namespace
 {
-template <typename Action>
-std::string errorOf(Action action)
-{
-  try
-  {
-    action();
-  }
-  catch (const Error& e)
-  {
-    return e.what();
-  }
-  ADD_FAILURE() << "no mlr::Error";
-  return {};
-}
 
 constexpr const char* OutOfRange = "coordinates must stay within +-1e+15";
 }

@@ -27,6 +27,22 @@ void expectError(Action action, const std::string& words)
   }
 }
 
+/// Runs `action`, expects mlr::Error, and returns its message.
+template <typename Action>
+std::string errorOf(Action action)
+{
+  try
+  {
+    action();
+  }
+  catch (const Error& e)
+  {
+    return e.what();
+  }
+  ADD_FAILURE() << "no mlr::Error";
+  return {};
+}
+
 /// The power balance of one frame, over both sides of every element.
 struct Balance
 {
