@@ -6,42 +6,25 @@ ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
 """
 import json
 import os
+import sys
 import shutil
-import subprocess
 import xml.etree.ElementTree as ElementTree
 
 import pytest
 
-from vtkmodules.vtkCommonCore import vtkFloatArray
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from cli_support import FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
+
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkCommonCore import vtkPoints, vtkDoubleArray
 from vtkmodules.vtkIOImage import vtkPNGReader
-from vtkmodules.vtkIOXML import (vtkXMLPolyDataReader, vtkXMLPolyDataWriter,
-                                 vtkXMLUnstructuredGridReader)
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
 from paraview.modules.vtkPVVTKExtensionsIOCore import vtkPVDReader
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-CLI = os.path.abspath(os.environ.get("MLR_CLI", os.path.join(
-    HERE, os.pardir, os.pardir, "build", "bin", "moving-light-radiosity")))
-DATA = os.path.abspath(os.environ.get("MLR_DATA_DIR",
-                                     os.path.join(HERE, os.pardir, os.pardir, "Data")))
-SCENE = os.path.join(DATA, "cornell_box.vtp")
-LIGHT = os.path.join(DATA, "cornell_light.vtp")
-FAST = ["--paths", "20000", "--patch-size", "0.08"]
 PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40"]
 ARRAYS = ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "RadiosityFront",
           "RadiosityBack", "Reflectance", "PatchId")
-
-
-def run(args, cwd, env=None):
-    return subprocess.run([CLI] + args, cwd=cwd, capture_output=True, text=True, timeout=300,
-                          env=env)
-
-
-def all_files(directory):
-    return sorted(os.path.relpath(os.path.join(root, name), directory)
-                  for root, _, names in os.walk(directory) for name in names)
 
 
 def read_grid(path):
@@ -53,13 +36,6 @@ def read_grid(path):
 
 def field(data, name):
     return data.GetFieldData().GetArray(name).GetValue(0)
-
-
-def write_polydata(data, path):
-    writer = vtkXMLPolyDataWriter()
-    writer.SetInputData(data)
-    writer.SetFileName(str(path))
-    assert writer.Write()
 
 
 def read_scene():

@@ -7,6 +7,7 @@ ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Reliability
 """
 import os
+import sys
 import signal
 import subprocess
 import time
@@ -16,49 +17,21 @@ from typing import Callable, Optional
 
 import pytest
 
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
+
 from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
-from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints
+from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-from vtkmodules.vtkIOXML import (vtkXMLPolyDataReader, vtkXMLPolyDataWriter,
-                                 vtkXMLUnstructuredGridReader)
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
 
 import numpy
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-CLI = os.path.abspath(os.environ.get("MLR_CLI", os.path.join(
-    HERE, os.pardir, os.pardir, "build", "bin", "moving-light-radiosity")))
-DATA = os.path.abspath(os.environ.get("MLR_DATA_DIR",
-                                     os.path.join(HERE, os.pardir, os.pardir, "Data")))
-SCENE = os.path.join(DATA, "cornell_box.vtp")
-LIGHT = os.path.join(DATA, "cornell_light.vtp")
-FAST = ["--paths", "20000", "--patch-size", "0.08"]
 PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40", "--frames", "2"]
 OUTPUT = ["--output", "out/series.pvd"]
 
 
-def run(args, cwd, timeout=300):
-    return subprocess.run([CLI] + args, cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout)
-
-
-def all_files(directory):
-    return sorted(os.path.relpath(os.path.join(root, name), directory)
-                  for root, _, names in os.walk(directory) for name in names)
-
-
 # --- Inputs ------------------------------------------------------------------------------
-def write_polydata(data, path, compressed=False):
-    writer = vtkXMLPolyDataWriter()
-    writer.SetInputData(data)
-    writer.SetFileName(str(path))
-    if compressed:
-        writer.SetDataModeToAppended()
-        writer.SetCompressorTypeToZLib()
-    else:
-        writer.SetCompressorTypeToNone()
-    assert writer.Write()
-
-
 def read_box():
     reader = vtkXMLPolyDataReader()
     reader.SetFileName(SCENE)
@@ -72,7 +45,7 @@ def box_with_reflectance(rgb):
     def make(directory):
         box = read_box()
         box.GetCellData().GetArray("Reflectance").SetTuple3(3, *rgb)
-        write_polydata(box, directory / "scene.vtp")
+        write_polydata(box, directory / "scene.vtp", compressed=False)
     return make
 
 
@@ -80,7 +53,7 @@ def box_with_point(point):
     def make(directory):
         box = read_box()
         box.GetPoints().SetPoint(2, *point)
-        write_polydata(box, directory / "scene.vtp")
+        write_polydata(box, directory / "scene.vtp", compressed=False)
     return make
 
 
@@ -123,7 +96,7 @@ def binary_ply(directory):
 
 
 def scene_vtp(directory):
-    write_polydata(read_box(), directory / "scene.vtp")
+    write_polydata(read_box(), directory / "scene.vtp", compressed=False)
 
 
 def copy_as(name, source):
@@ -158,7 +131,7 @@ def trajectory(points):
         for p in points:
             vtk_points.InsertNextPoint(*p)
         data.SetPoints(vtk_points)
-        write_polydata(data, directory / "path.vtp")
+        write_polydata(data, directory / "path.vtp", compressed=False)
     return make
 
 
