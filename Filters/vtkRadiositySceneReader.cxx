@@ -1,0 +1,174 @@
+#include "vtkRadiositySceneReader.h"
+
+#include "RadiositySceneFormats.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkMath.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStringArray.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <new>
+#include <string>
+
+vtkStandardNewMacro(vtkRadiositySceneReader);
+
+namespace
+{
+std::string lowerExtension(const char* fileName)
+{
+  std::string extension = std::filesystem::path(fileName ? fileName : "").extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+vtkSmartPointer<vtkStringArray> stringField(const char* name, const std::string& value)
+{
+  auto array = vtkSmartPointer<vtkStringArray>::New();
+  array->SetName(name);
+  array->InsertNextValue(value);
+  return array;
+}
+}
+
+//------------------------------------------------------------------------------
+vtkRadiositySceneReader::vtkRadiositySceneReader()
+{
+  this->SetNumberOfInputPorts(0);
+}
+
+//------------------------------------------------------------------------------
+vtkRadiositySceneReader::~vtkRadiositySceneReader()
+{
+  this->SetFileName(nullptr);
+}
+
+//------------------------------------------------------------------------------
+int vtkRadiositySceneReader::CanReadFile(const char* fileName)
+{
+  const std::string extension = lowerExtension(fileName);
+  return extension == ".obj" || extension == ".gltf" || extension == ".glb" || extension == ".ply";
+}
+
+//------------------------------------------------------------------------------
+int vtkRadiositySceneReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkPolyData* output = vtkPolyData::GetData(outputVector);
+  output->Initialize();
+  if (!this->FileName || !*this->FileName)
+  {
+    vtkErrorMacro(<< "no FileName: give an .obj, .gltf, .glb or .ply scene file");
+    return 0;
+  }
+  const std::string path = this->FileName;
+  const std::string extension = lowerExtension(this->FileName);
+
+  namespace sf = mlr::scenefile;
+  const sf::Warn warn = [this](const std::string& message) { vtkWarningMacro(<< message); };
+  const sf::Progress progress = [this](double fraction) {
+    this->UpdateProgress(0.9 * fraction);
+    return !this->CheckAbort();
+  };
+  sf::Scene scene;
+  try
+  {
+    if (extension == ".obj")
+    {
+      scene = sf::readObj(path, warn, progress);
+    }
+    else if (extension == ".gltf" || extension == ".glb")
+    {
+      scene = sf::readGltf(path, warn, progress);
+    }
+    else if (extension == ".ply")
+    {
+      scene = sf::readPly(path, warn, progress);
+    }
+    else
+    {
+      vtkErrorMacro(<< "the scene file '" << path << "' has the extension '" << extension
+                    << "', which this reader does not read: give an .obj (with its .mtl), "
+                       ".gltf, .glb or .ply file");
+      return 0;
+    }
+  }
+  catch (const sf::FileError& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return 0;
+  }
+  catch (const sf::Aborted&)
+  {
+    vtkErrorMacro(<< "reading '" << path << "' was aborted");
+    return 0;
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro(<< "out of memory reading the scene file '" << path << "'");
+    return 0;
+  }
+
+  const vtkIdType cells = scene.polygons->GetNumberOfCells();
+  vtkNew<vtkDoubleArray> reflectance;
+  reflectance->SetName("Reflectance");
+  reflectance->SetNumberOfComponents(3);
+  reflectance->SetNumberOfTuples(cells);
+  vtkNew<vtkDoubleArray> emission;
+  emission->SetName("Emission");
+  emission->SetNumberOfComponents(3);
+  emission->SetNumberOfTuples(cells);
+  vtkNew<vtkIntArray> materialId;
+  materialId->SetName("MaterialId");
+  materialId->SetNumberOfTuples(cells);
+  for (vtkIdType cell = 0; cell < cells; ++cell)
+  {
+    const int id = scene.materialOfCell[static_cast<std::size_t>(cell)];
+    const sf::Material& material = scene.materials[static_cast<std::size_t>(id)];
+    const auto& rho = scene.cellReflectance.empty()
+      ? material.reflectance
+      : scene.cellReflectance[static_cast<std::size_t>(cell)];
+    reflectance->SetTuple3(cell, rho[0], rho[1], rho[2]);
+    // Radiance L of a diffuse emitter leaves as exitance pi x L.
+    emission->SetTuple3(cell, vtkMath::Pi() * material.radiance[0],
+      vtkMath::Pi() * material.radiance[1], vtkMath::Pi() * material.radiance[2]);
+    materialId->SetValue(cell, id);
+  }
+  vtkNew<vtkStringArray> names;
+  names->SetName("MaterialNames");
+  for (const auto& material : scene.materials)
+  {
+    names->InsertNextValue(material.name);
+  }
+
+  output->SetPoints(scene.points);
+  output->SetPolys(scene.polygons);
+  output->GetCellData()->AddArray(reflectance);
+  output->GetCellData()->AddArray(emission);
+  output->GetCellData()->AddArray(materialId);
+  output->GetCellData()->SetActiveScalars("Reflectance");
+  output->GetFieldData()->AddArray(names);
+  output->GetFieldData()->AddArray(stringField("EmissionUnits", "W/m^2"));
+  output->GetFieldData()->AddArray(stringField("SceneFormat", scene.format));
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkRadiositySceneReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+}

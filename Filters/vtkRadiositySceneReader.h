@@ -1,0 +1,97 @@
+/**
+ * @class   vtkRadiositySceneReader
+ * @brief   reads a scene with its materials (OBJ + MTL, glTF 2.0, PLY) for vtkMovingLightRadiosity
+ *
+ * vtkRadiositySceneReader reads the polygons of a scene file and gives every cell the diffuse
+ * reflectance and the emission of its material, in the arrays vtkMovingLightRadiosity and the
+ * command line read:
+ *
+ * - cell array `Reflectance` (double, 3 components, RGB, each in [0, 0.99]);
+ * - cell array `Emission` (double, 3 components, W/m^2): the radiant exitance of the cell,
+ *   pi times the material's emitted radiance, so that a material emits
+ *   pi x radiance x area watts per colour channel; 0 for materials that do not emit;
+ * - cell array `MaterialId` (int) and field data `MaterialNames` (vtkStringArray, indexed by
+ *   MaterialId);
+ * - field data `EmissionUnits` ("W/m^2") and `SceneFormat` ("OBJ", "glTF" or "PLY").
+ *
+ * Formats, chosen by the file's extension (case-insensitive):
+ * - `.obj`: Wavefront OBJ faces, with the materials of the MTL files its `mtllib` lines name
+ *   (relative to the OBJ's folder). `Kd` is the reflectance, `Ke` the emitted radiance in
+ *   W/(m^2 sr), as path tracers read it (the Cornell box's `Ke 17 12 4` light emits
+ *   pi x (17, 12, 4) W/m^2). Faces before any `usemtl` have the material `none`. Texture maps
+ *   (`map_Kd`) are not read: Kd alone gives the reflectance. Points and lines are skipped with
+ *   a warning. A missing MTL file, or a material it does not define, is grey 0.5 and does not
+ *   emit, with a warning naming the file or the material.
+ * - `.gltf`, `.glb`: glTF 2.0 through VTK's vtkGLTFDocumentLoader, the default scene with its
+ *   node transforms (glTF lengths are metres), its skins and animations in the rest pose.
+ *   Triangles, strips and fans are read; points and lines are skipped with a warning, and a
+ *   file with no triangles is an error. `baseColorFactor` (RGB) times the mean linear colour of
+ *   the base colour texture is the reflectance; `COLOR_0` multiplies it per cell (mean over the
+ *   cell's vertices). `emissiveFactor` times `KHR_materials_emissive_strength` (1 without it)
+ *   times the mean of the emissive texture is the emitted radiance in W/(m^2 sr), read like
+ *   OBJ's Ke: emissiveFactor (1, 1, 1) with strength 17 emits as Ke 17 17 17. Primitives
+ *   without a material have glTF's default material, `default` (white, clamped).
+ * - `.ply`: faces with per-face `red`/`green`/`blue` (or per-vertex ones, averaged over each
+ *   face's vertices; `diffuse_red`/... too): 8-bit values are divided by 255, 16-bit ones by
+ *   65535, floats are taken as they are. No emission; one material named after the file.
+ *
+ * A reflectance of 1 or more (modelling tools often export Kd 1 1 1) is clamped to 0.99 with a
+ * warning naming the material. Lengths are kept as the file has them.
+ *
+ * VTK 9.2's own vtkOBJReader and vtkPLYReader are not used: the first gives the first faces
+ * after a `usemtl` the material NO_MATERIAL and crashes on indices the file does not define,
+ * the second truncates float colours to 0 and crashes on some malformed headers. Their formats
+ * are read here instead, checking every index. glTF files are checked (buffer, accessor and
+ * node indices and sizes) before vtkGLTFDocumentLoader reads them.
+ *
+ * Bad input (a missing, unreadable or malformed file, an unknown extension, a file without
+ * faces or triangles) gives an error naming the file and what is wrong, and an empty output.
+ * Progress is reported through UpdateProgress; AbortExecute stops the reading with an empty
+ * output.
+ *
+ * @sa
+ * vtkMovingLightRadiosity
+ */
+
+#ifndef vtkRadiositySceneReader_h
+#define vtkRadiositySceneReader_h
+
+#include "MovingLightRadiosityFiltersModule.h" // For export macro
+#include "vtkPolyDataAlgorithm.h"
+
+class MOVINGLIGHTRADIOSITYFILTERS_EXPORT vtkRadiositySceneReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkRadiositySceneReader* New();
+  vtkTypeMacro(vtkRadiositySceneReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * The scene file: .obj (with its .mtl files), .gltf, .glb or .ply. Default: none (an error
+   * on update).
+   */
+  vtkSetFilePathMacro(FileName);
+  vtkGetFilePathMacro(FileName);
+  ///@}
+
+  /**
+   * Whether the extension of `fileName` is one this reader reads (.obj, .gltf, .glb, .ply).
+   * The file itself is not opened.
+   */
+  static int CanReadFile(const char* fileName);
+
+protected:
+  vtkRadiositySceneReader();
+  ~vtkRadiositySceneReader() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+private:
+  vtkRadiositySceneReader(const vtkRadiositySceneReader&) = delete;
+  void operator=(const vtkRadiositySceneReader&) = delete;
+
+  char* FileName = nullptr;
+};
+
+#endif
