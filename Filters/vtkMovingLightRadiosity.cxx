@@ -24,6 +24,7 @@
 #include "vtkTimeStamp.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <new>
 #include <string>
@@ -52,6 +53,15 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<double> Times;
   std::vector<mlr::Vec3> LightPositions;
   mlr::Vec3 LightCentroid;
+  // Display (issue 17): the light as given, for the Light output, and what the colours of
+  // every frame need.
+  std::vector<std::vector<mlr::Vec3>> LightPolygons;
+  mlr::Rgb LightPower;
+  mlr::vtkoutputs::SmoothShading Shading;
+  double AutoExposure = 0;
+  /// Taken when the properties were last found to match the solve: Exposure moves it on, as
+  /// a new exposure needs no new solve (see SetExposure).
+  vtkTimeStamp PropertiesTime;
   /// Null when the scene had nothing to light: the outputs are then empty.
   vtkSmartPointer<vtkPolyData> Elements;
   vtkSmartPointer<vtkPolyData> Patches;
@@ -94,13 +104,34 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->NumberOfPositions = 10;
   this->MemoryLimit = 0;
   this->SolveCount = 0;
+  this->Exposure = 0.0;
 
   this->SetNumberOfInputPorts(3);
-  this->SetNumberOfOutputPorts(2);
+  this->SetNumberOfOutputPorts(3);
 }
 
 //------------------------------------------------------------------------------
 vtkMovingLightRadiosity::~vtkMovingLightRadiosity() = default;
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetExposure(double exposure)
+{
+  exposure = std::clamp(exposure, -20.0, 20.0);
+  if (exposure == this->Exposure)
+  {
+    return;
+  }
+  // The outputs must be built again, but from the cached solve: when the properties matched
+  // the solve before this change, they still do after it.
+  vtkInternals& cache = *this->Internals;
+  const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
+  this->Exposure = exposure;
+  this->Modified();
+  if (current)
+  {
+    cache.PropertiesTime.Modified();
+  }
+}
 
 //------------------------------------------------------------------------------
 int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* info)
@@ -209,7 +240,7 @@ int vtkMovingLightRadiosity::RequestData(
     this->AbortExecute = 0;
     cache.Aborted = false;
   }
-  bool current = cache.HasResult && this->GetMTime() <= cache.SolveTime.GetMTime();
+  bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
   for (int port = 0; current && port < this->GetNumberOfInputPorts(); ++port)
   {
     vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
@@ -220,7 +251,7 @@ int vtkMovingLightRadiosity::RequestData(
     return 0;
   }
 
-  // Both outputs show the frame asked for on the port whose update runs this request, so that
+  // All the outputs show the frame asked for on the port whose update runs this request, so that
   // UpdateTimeStep(t) followed by GetOutput(PATCHES_PORT) gives the patches of time t too.
   const int fromPort = request->Has(vtkExecutive::FROM_OUTPUT_PORT())
     ? std::max(request->Get(vtkExecutive::FROM_OUTPUT_PORT()), 0)
@@ -236,23 +267,35 @@ int vtkMovingLightRadiosity::RequestData(
     vtkPolyData* output = vtkPolyData::GetData(outputVector, port);
     if (cache.Elements)
     {
+      const mlr::Vec3& position = cache.LightPositions[frame];
       if (port == ELEMENTS_PORT)
       {
         output->ShallowCopy(cache.Elements);
         mlr::vtkoutputs::addElementRadiosity(
           cache.Solution, frame, cache.TwoSided, output->GetCellData());
+        mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, frame,
+          std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
+          output->GetCellData());
       }
-      else
+      else if (port == PATCHES_PORT)
       {
         output->ShallowCopy(cache.Patches);
         mlr::vtkoutputs::addPatchRadiosity(
           cache.Solution, cache.PatchLitSides, frame, output->GetCellData());
       }
+      else
+      {
+        // The light only translates for now: identity rotation.
+        mlr::vtkoutputs::LightTransform transform;
+        transform.translation = position - cache.LightCentroid;
+        output->ShallowCopy(
+          mlr::vtkoutputs::posedLight(cache.LightPolygons, transform, cache.LightPower));
+      }
       vtkNew<vtkFieldData> fieldData;
       fieldData->ShallowCopy(cache.Statistics);
-      const mlr::Vec3& position = cache.LightPositions[frame];
       mlr::vtkoutputs::addFrameFieldData(
         fieldData, frame, position, position - cache.LightCentroid, this->SolveCount);
+      mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
       output->SetFieldData(fieldData);
     }
     output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
@@ -266,6 +309,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   vtkInternals& cache = *this->Internals;
   cache.Clear();
   cache.SolveTime.Modified();
+  cache.PropertiesTime.Modified();
 
   // Core reports progress on this thread, so the abort flag can be polled right here.
   auto progress = [this](double base, double share) {
@@ -306,6 +350,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     const mlr::MovingLight light(polygons, power, translations);
     cache.LightPositions = trajectory.positions;
     cache.LightCentroid = centroid;
+    cache.LightPolygons = polygons;
+    cache.LightPower = power;
 
     mlr::SolverOptions options;
     options.pathsPerFrame = static_cast<std::uint64_t>(this->NumberOfPaths);
@@ -354,7 +400,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       vtkWarningMacro(<< warning);
     }
 
-    cache.Elements = mlr::vtkoutputs::elementMesh(scene);
+    cache.Shading = mlr::vtkoutputs::smoothShading(scene, solution);
+    cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
+    cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
     cache.Patches = mlr::vtkoutputs::patchMesh(scene, remeshed.mesh.points.size());
     cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, options);
     cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
@@ -411,6 +459,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
+  os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
      << "\n";
 }

@@ -25,19 +25,27 @@
  *   `Radiosity`, `DirectRadiosity`, `IndirectRadiosity` (3 components, W/m^2, of the
  *   element's lit side: the side that received more power over the whole animation, so
  *   that a room made of outward-facing polygons still shows its lit walls), `RadiosityFront`
- *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`. Its field data holds
- *   the solver statistics (paths, rays by kind, seconds by phase, patches, elements, frames,
- *   reuse modes, predicted speed-up), the frame shown (`FrameIndex`), where the light is in
- *   it (`LightPosition`, its centroid, and `LightTranslation`, from the Light input) and
- *   `SolveCount`.
+ *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
+ *   display colour of `Radiosity` (see Exposure). For smooth shading its points are split
+ *   along creases (lit-side normals more than 30 degrees apart), between materials and
+ *   between the lit sides of thin walls, and carry `Radiosity` (area-weighted mean of the
+ *   cells around the point), `Color` (its display colour) and `ScenePointId` (the remeshed
+ *   scene's point it was split from, the numbering of the Patches output). `Color` is the
+ *   active scalars of points and cells. Its field data holds the solver statistics (paths,
+ *   rays by kind, seconds by phase, patches, elements, frames, reuse modes, predicted
+ *   speed-up), the frame shown (`FrameIndex`), where the light is in it (`LightPosition`, its
+ *   centroid, and `LightTranslation`, from the Light input), `SolveCount`, and the exposure
+ *   (`AutoExposure`, `Exposure`, `ExposureScale`).
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
+ * - port 2, Light: the light's polygons where they are in the frame shown, with the cell
+ *   array `Power` (RGB, W: each polygon's share of LightPower, by area).
  *
  * Time: the outputs have one time step per light position (TIME_STEPS, TIME_RANGE). The
  * first update solves every frame at once and keeps the result; requests for other times
- * are served from it without solving again, until an input or a property changes. A time
- * between two steps shows the step at or below it. Both outputs show the time requested on
- * the port being updated. The filter's time is not passed upstream: the inputs are used as
+ * are served from it without solving again, until an input or a property other than
+ * Exposure changes. A time between two steps shows the step at or below it. All the outputs
+ * show the time requested on the port being updated. The filter's time is not passed upstream: the inputs are used as
  * they are.
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
@@ -81,7 +89,8 @@ public:
   enum OutputPorts
   {
     ELEMENTS_PORT = 0,
-    PATCHES_PORT = 1
+    PATCHES_PORT = 1,
+    LIGHT_OUTPUT_PORT = 2
   };
 
   ///@{
@@ -222,6 +231,22 @@ public:
   vtkGetMacro(MemoryLimit, int);
   ///@}
 
+  // ---------------------------------------------------------------- Display (issue 17)
+  ///@{
+  /**
+   * Exposure of the display colours, in EV (stops), on top of the automatic exposure: the
+   * `Color` arrays show Radiosity x 2^(AutoExposure + Exposure), tone mapped with the ACES
+   * filmic curve (Narkowicz's fit) and sRGB-encoded. AutoExposure is computed once per solve
+   * over every frame and element (it maps the 99th percentile of the lit-side luminance to
+   * 2, a bright grey), so that all frames share one exposure. +1 doubles the value before
+   * the tone map. Changing it only recolours: it never solves again. From -20 to 20;
+   * default 0.
+   */
+  void SetExposure(double exposure);
+  vtkGetMacro(Exposure, double);
+  ///@}
+  // --------------------------------------------------------------- end of Display block
+
   /**
    * Number of solves performed so far by this filter (new times do not solve again).
    */
@@ -254,6 +279,7 @@ protected:
   int NumberOfPositions;
   int MemoryLimit;
   vtkIdType SolveCount;
+  double Exposure;
 
 private:
   vtkMovingLightRadiosity(const vtkMovingLightRadiosity&) = delete;
