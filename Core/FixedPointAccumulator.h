@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -39,8 +40,16 @@ template <int Channels>
 class FixedPointAccumulator
 {
 public:
+  /// One quantum for every channel.
   FixedPointAccumulator(
     int workers, std::size_t records, std::size_t frames, double quantum, FrameLayout layout)
+    : FixedPointAccumulator(workers, records, frames, filled(quantum), layout)
+  {
+  }
+
+  /// One quantum per channel: a channel much weaker than the others keeps its precision.
+  FixedPointAccumulator(int workers, std::size_t records, std::size_t frames,
+    const std::array<double, Channels>& quantum, FrameLayout layout)
     : Frames(frames)
     , Stride(records * 2 * frames * Channels)
     , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
@@ -50,6 +59,10 @@ public:
     , Size(static_cast<std::size_t>(workers) * Stride)
     , Values(allocateZeroed(Size))
   {
+    for (int c = 0; c < Channels; ++c)
+    {
+      this->InverseQuantum[c] = 1.0 / this->Quantum[c];
+    }
   }
 
   /// The slots of (record, side) at frame 0 for one worker; add() steps to other frames.
@@ -63,11 +76,10 @@ public:
   void add(std::int64_t* recordSlots, std::size_t frame, const double* values) const
   {
     std::int64_t* s = recordSlots + frame * this->FrameStride;
-    const double scale = 1.0 / this->Quantum;
     for (int c = 0; c < Channels; ++c)
     {
       // Values are >= 0, so truncating x + 0.5 rounds to nearest.
-      s[c] += static_cast<std::int64_t>(values[c] * scale + 0.5);
+      s[c] += static_cast<std::int64_t>(values[c] * this->InverseQuantum[c] + 0.5);
     }
   }
 
@@ -107,7 +119,7 @@ public:
     }
     for (int c = 0; c < Channels; ++c)
     {
-      out[c] = static_cast<double>(sum[c]) * this->Quantum;
+      out[c] = static_cast<double>(sum[c]) * this->Quantum[c];
     }
   }
 
@@ -144,6 +156,13 @@ private:
       frame * this->FrameStride;
   }
 
+  static std::array<double, Channels> filled(double value)
+  {
+    std::array<double, Channels> a;
+    a.fill(value);
+    return a;
+  }
+
   struct Free
   {
     void operator()(std::int64_t* p) const { std::free(p); }
@@ -174,7 +193,8 @@ private:
   std::size_t RecordStride;
   std::size_t SideStride;
   std::size_t FrameStride;
-  double Quantum;
+  std::array<double, Channels> Quantum;
+  std::array<double, Channels> InverseQuantum;
   std::size_t Size;
   std::unique_ptr<std::int64_t[], Free> Values;
 };

@@ -13,8 +13,71 @@ namespace mlr
 
 MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const Rgb& power,
   const std::vector<Vec3>& translations)
+  : MovingLight(polygons, power, std::vector<LightPose>{ LightPose() })
+{
+  if (translations.empty())
+  {
+    throw Error("the light has zero frames: give at least one light position");
+  }
+  std::vector<LightPose> poses(translations.size());
+  for (std::size_t k = 0; k < translations.size(); ++k)
+  {
+    poses[k].position = this->Centroid + translations[k];
+    if (!isFinite(translations[k]))
+    {
+      throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
+    }
+  }
+  this->setPoses(poses);
+}
+
+void MovingLight::setPoses(const std::vector<LightPose>& poses)
+{
+  if (poses.empty())
+  {
+    throw Error("the light has zero frames: give at least one light position");
+  }
+  this->Rotates = false;
+  for (std::size_t k = 0; k < poses.size(); ++k)
+  {
+    const LightPose& pose = poses[k];
+    if (!isFinite(pose.position))
+    {
+      throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
+    }
+    if (!isWithinCoordinateRange(pose.position))
+    {
+      std::ostringstream s;
+      s << "light position " << k << " is at (" << pose.position.x << ", " << pose.position.y
+        << ", " << pose.position.z << "): coordinates must stay within +-" << MaximumCoordinate
+        << " (rays are traced in single precision)";
+      throw Error(s.str());
+    }
+    if (!pose.power.isFinite() || pose.power.minComponent() < 0)
+    {
+      std::ostringstream s;
+      s << "the power factor of light position " << k << " is (" << pose.power.r << ", "
+        << pose.power.g << ", " << pose.power.b << "): it must be finite and >= 0 (0 turns the "
+        << "light off)";
+      throw Error(s.str());
+    }
+    const Rotation& r = pose.rotation;
+    const double orthogonality = std::max({ std::abs(dot(r.row0, r.row0) - 1),
+      std::abs(dot(r.row1, r.row1) - 1), std::abs(dot(r.row2, r.row2) - 1),
+      std::abs(dot(r.row0, r.row1)), std::abs(dot(r.row0, r.row2)), std::abs(dot(r.row1, r.row2)) });
+    if (!r.isFinite() || !(orthogonality < 1e-6) || !(dot(cross(r.row0, r.row1), r.row2) > 0))
+    {
+      throw Error("the orientation of light position " + std::to_string(k) +
+        " is not a rotation (NaN, scaled, sheared or mirrored)");
+    }
+    this->Rotates = this->Rotates || !r.isIdentity();
+  }
+  this->Poses = poses;
+}
+
+MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const Rgb& power,
+  const std::vector<LightPose>& poses)
   : Power(power)
-  , Translations(translations)
 {
   if (polygons.empty())
   {
@@ -27,26 +90,6 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
       << ") must be finite and not negative";
     throw Error(s.str());
   }
-  if (translations.empty())
-  {
-    throw Error("the light has zero frames: give at least one light position");
-  }
-  for (std::size_t k = 0; k < translations.size(); ++k)
-  {
-    if (!isFinite(translations[k]))
-    {
-      throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
-    }
-    if (!isWithinCoordinateRange(translations[k]))
-    {
-      std::ostringstream s;
-      s << "light position " << k << " moves the light by (" << translations[k].x << ", "
-        << translations[k].y << ", " << translations[k].z << "): coordinates must stay within +-"
-        << MaximumCoordinate << " (rays are traced in single precision)";
-      throw Error(s.str());
-    }
-  }
-
   for (std::size_t i = 0; i < polygons.size(); ++i)
   {
     const std::vector<Vec3>& polygon = polygons[i];
@@ -115,6 +158,7 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
     throw Error("the light has zero area: give a polygon that encloses some area");
   }
   this->Centroid = this->Centroid / this->Area;
+  this->setPoses(poses);
 }
 
 void MovingLight::samplePoint(double u0, double u1, double u2, Vec3& point, Vec3& normal) const

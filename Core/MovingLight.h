@@ -1,7 +1,8 @@
-// The moving light: diffuse emitting polygons translated to one position per frame.
+// The moving light: diffuse emitting polygons posed (moved, turned, dimmed) in every frame.
 #pragma once
 
 #include "Rgb.h"
+#include "Rotation.h"
 #include "Vec3.h"
 
 #include <cstddef>
@@ -18,15 +19,31 @@ struct LightTriangle
   double area = 0;
 };
 
+/// Where a light is in one frame: a rigid motion about its area centroid c and a power factor.
+struct LightPose
+{
+  /// The light's area centroid in this frame.
+  Vec3 position;
+  /// The turn about the centroid, relative to the light as given: x -> R (x - c) + position.
+  Rotation rotation;
+  /// A factor on the light's power in this frame, per channel; 0 is a light that is off.
+  Rgb power{ 1, 1, 1 };
+};
+
 /**
  * A planar polygonal light (one or more simple polygons, convex or concave) with total power
- * Phi (RGB, W), emitting diffusely from the front side of each polygon, and the translation
- * t_k that places it in frame k. Power is spread uniformly over the area (exitance Phi/A_L).
- * The light does not occlude. The constructor throws mlr::Error naming what is wrong.
+ * Phi (RGB, W), emitting diffusely from the front side of each polygon, posed in every frame:
+ * frame k maps a point x of the light as given to R_k (x - c) + p_k and its normal n to
+ * R_k n, and emits s_k Phi. Power is spread uniformly over the area (exitance Phi/A_L). The
+ * light does not occlude. A light with one pose does not move: it lights every frame alike.
+ * The constructors throw mlr::Error naming what is wrong.
  */
 class MovingLight
 {
 public:
+  MovingLight(const std::vector<std::vector<Vec3>>& polygons, const Rgb& power,
+    const std::vector<LightPose>& poses);
+  /// A light that only translates: frame k moves it by translations[k], at full power.
   MovingLight(const std::vector<std::vector<Vec3>>& polygons, const Rgb& power,
     const std::vector<Vec3>& translations);
 
@@ -36,9 +53,21 @@ public:
   const Vec3& centroid() const { return this->Centroid; }
   const std::vector<LightTriangle>& triangles() const { return this->Triangles; }
 
-  std::size_t frameCount() const { return this->Translations.size(); }
-  const Vec3& translation(std::size_t frame) const { return this->Translations[frame]; }
-  const std::vector<Vec3>& translations() const { return this->Translations; }
+  std::size_t frameCount() const { return this->Poses.size(); }
+  const LightPose& pose(std::size_t frame) const { return this->Poses[frame]; }
+  const std::vector<LightPose>& poses() const { return this->Poses; }
+  /// How far frame `frame` moves the centroid: p_k - c.
+  Vec3 translation(std::size_t frame) const { return this->Poses[frame].position - this->Centroid; }
+  /// True when some frame turns the light.
+  bool rotates() const { return this->Rotates; }
+
+  /// A point of the light as given, placed in frame `frame`.
+  Vec3 place(std::size_t frame, const Vec3& x) const
+  {
+    return this->Poses[frame].rotation.apply(x - this->Centroid) + this->Poses[frame].position;
+  }
+  /// A direction of the light as given (a normal), turned as in frame `frame`.
+  Vec3 turn(std::size_t frame, const Vec3& n) const { return this->Poses[frame].rotation.apply(n); }
 
   /// A uniformly distributed point on the light (own frame) and the normal there.
   void samplePoint(double u0, double u1, double u2, Vec3& point, Vec3& normal) const;
@@ -49,7 +78,10 @@ private:
   Vec3 Centroid;
   std::vector<LightTriangle> Triangles;
   std::vector<double> CumulativeArea;
-  std::vector<Vec3> Translations;
+  std::vector<LightPose> Poses;
+  bool Rotates = false;
+
+  void setPoses(const std::vector<LightPose>& poses);
 };
 
 } // namespace mlr

@@ -4,6 +4,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -71,12 +72,17 @@ RayTracer::RayTracer(const Scene& scene)
 {
   RTCDevice device = sharedDevice();
   lastEmbreeError.clear();
-  // Offsets must exceed float rounding at the scene's coordinates, and stay far below
+  // Offsets must exceed float rounding at the (centred) coordinates, and stay far below
   // any feature size.
   const Vec3 lo = scene.boundsMin(), hi = scene.boundsMax();
-  const double magnitude = std::max({ std::abs(lo.x), std::abs(lo.y), std::abs(lo.z),
-    std::abs(hi.x), std::abs(hi.y), std::abs(hi.z) });
+  this->Centre = (lo + hi) * 0.5;
+  const Vec3 half = (hi - lo) * 0.5;
+  const double magnitude = std::max({ std::abs(half.x), std::abs(half.y), std::abs(half.z) });
   this->Offset = std::max(1e-5 * scene.diagonal(), 64 * 6e-8 * magnitude);
+  if (!(this->Offset > 0))
+  {
+    this->Offset = 1e-9 * std::max(1.0, length(this->Centre)); // a single degenerate point
+  }
 
   this->Impl->Scene = rtcNewScene(device);
   rtcSetSceneFlags(this->Impl->Scene, RTC_SCENE_FLAG_ROBUST);
@@ -96,9 +102,10 @@ RayTracer::RayTracer(const Scene& scene)
   }
   for (std::size_t i = 0; i < points.size(); ++i)
   {
-    vertices[3 * i + 0] = static_cast<float>(points[i].x);
-    vertices[3 * i + 1] = static_cast<float>(points[i].y);
-    vertices[3 * i + 2] = static_cast<float>(points[i].z);
+    const Vec3 p = points[i] - this->Centre;
+    vertices[3 * i + 0] = static_cast<float>(p.x);
+    vertices[3 * i + 1] = static_cast<float>(p.y);
+    vertices[3 * i + 2] = static_cast<float>(p.z);
   }
   const auto& triangles = scene.elementTriangles();
   for (std::size_t e = 0; e < triangles.size(); ++e)
@@ -122,9 +129,10 @@ bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit query;
-  query.ray.org_x = static_cast<float>(origin.x);
-  query.ray.org_y = static_cast<float>(origin.y);
-  query.ray.org_z = static_cast<float>(origin.z);
+  const Vec3 o = origin - this->Centre;
+  query.ray.org_x = static_cast<float>(o.x);
+  query.ray.org_y = static_cast<float>(o.y);
+  query.ray.org_z = static_cast<float>(o.z);
   query.ray.dir_x = static_cast<float>(direction.x);
   query.ray.dir_y = static_cast<float>(direction.y);
   query.ray.dir_z = static_cast<float>(direction.z);
@@ -152,8 +160,13 @@ bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit
   return true;
 }
 
-void RayTracer::visibleFrom(
-  const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const
+namespace
+{
+/// Traces `count` occlusion rays from one origin in 16-wide packets. ray(i, dx, dy, dz, tfar)
+/// sets lane i's direction and far end.
+template <typename RayOf>
+void occludedPackets(RTCScene scene, const Vec3& origin, std::size_t count, std::uint8_t* visible,
+  const RayOf& rayOf)
 {
   constexpr std::size_t width = 16;
   RTCIntersectContext context;
@@ -161,24 +174,15 @@ void RayTracer::visibleFrom(
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   alignas(64) RTCRay16 packet;
   alignas(64) int valid[width];
-  // Stop a fixed fraction short of the target, because the light may sit just in front of a
-  // surface. 2^-16 of a segment is at most the surface offset (segments are shorter than the
-  // scene's diagonal, the offset is 1e-5 of it) and far above float rounding at t = 1; it
-  // spares every lane a square root and a division.
-  constexpr float shortOfTarget = 1.0f - 0x1.0p-16f;
-  const float minimumSquared = static_cast<float>(this->Offset * this->Offset);
   for (std::size_t first = 0; first < count; first += width)
   {
     const std::size_t lanes = std::min(width, count - first);
-    // Branch-free lane set-up: idle lanes repeat the last target and are switched off in
-    // `valid`.
+    // Branch-free lane set-up: idle lanes repeat the last ray and are switched off in `valid`.
     for (std::size_t i = 0; i < width; ++i)
     {
-      const Vec3& target = targets[first + std::min(i, lanes - 1)];
-      const float dx = static_cast<float>(target.x - origin.x);
-      const float dy = static_cast<float>(target.y - origin.y);
-      const float dz = static_cast<float>(target.z - origin.z);
-      valid[i] = i < lanes && dx * dx + dy * dy + dz * dz > minimumSquared ? -1 : 0;
+      float dx, dy, dz, tfar;
+      const bool use = rayOf(first + std::min(i, lanes - 1), dx, dy, dz, tfar);
+      valid[i] = i < lanes && use ? -1 : 0;
       packet.org_x[i] = static_cast<float>(origin.x);
       packet.org_y[i] = static_cast<float>(origin.y);
       packet.org_z[i] = static_cast<float>(origin.z);
@@ -186,20 +190,52 @@ void RayTracer::visibleFrom(
       packet.dir_y[i] = dy;
       packet.dir_z[i] = dz;
       packet.tnear[i] = 0.0f;
-      packet.tfar[i] = shortOfTarget;
+      packet.tfar[i] = tfar;
       packet.time[i] = 0.0f;
       packet.mask[i] = 0xFFFFFFFFu;
       packet.id[i] = static_cast<unsigned>(i);
       packet.flags[i] = 0;
     }
-    rtcOccluded16(valid, this->Impl->Scene, &context, &packet);
+    rtcOccluded16(valid, scene, &context, &packet);
     for (std::size_t i = 0; i < lanes; ++i)
     {
-      // Embree sets tfar to -inf for an occluded ray; a target closer than the offset
-      // has nothing in between.
+      // Embree sets tfar to -inf for an occluded ray; a switched-off lane (a target closer
+      // than the offset) has nothing in between.
       visible[first + i] = !valid[i] || packet.tfar[i] >= 0.0f ? 1 : 0;
     }
   }
+}
+}
+
+void RayTracer::visibleFrom(
+  const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const
+{
+  // The targets are lifted off their surfaces, as the rays that start there are: the whole
+  // segment up to t = 1 is tested, with nothing to stop short of.
+  const Vec3 o = origin - this->Centre;
+  const float minimumSquared = static_cast<float>(this->Offset * this->Offset);
+  occludedPackets(this->Impl->Scene, o, count, visible,
+    [&](std::size_t i, float& dx, float& dy, float& dz, float& tfar) {
+      dx = static_cast<float>(targets[i].x - origin.x);
+      dy = static_cast<float>(targets[i].y - origin.y);
+      dz = static_cast<float>(targets[i].z - origin.z);
+      tfar = 1.0f;
+      return dx * dx + dy * dy + dz * dz > minimumSquared;
+    });
+}
+
+void RayTracer::visibleAlong(
+  const Vec3& origin, const Vec3* directions, std::size_t count, std::uint8_t* visible) const
+{
+  const Vec3 o = origin - this->Centre;
+  occludedPackets(this->Impl->Scene, o, count, visible,
+    [&](std::size_t i, float& dx, float& dy, float& dz, float& tfar) {
+      dx = static_cast<float>(directions[i].x);
+      dy = static_cast<float>(directions[i].y);
+      dz = static_cast<float>(directions[i].z);
+      tfar = std::numeric_limits<float>::infinity();
+      return true;
+    });
 }
 
 } // namespace mlr

@@ -43,12 +43,20 @@ public:
   /**
    * Visibility of the segments origin -> targets[i] (endpoints excluded), for `count`
    * targets, written to visible[i]. Coherent segments from one origin go through Embree's
-   * 16-wide packet query, not one call per segment.
+   * 16-wide packet query, not one call per segment. Callers pass points lifted off their
+   * surfaces (liftOff), the same points rays start from, so that a segment is blocked exactly
+   * when a ray between its ends would be.
    */
   void visibleFrom(
     const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const;
 
-  /// The distance rays leaving a surface start above it, so that they do not hit it again.
+  /// Visibility to infinity from `origin` along each of `count` directions, as visibleFrom.
+  void visibleAlong(
+    const Vec3& origin, const Vec3* directions, std::size_t count, std::uint8_t* visible) const;
+
+  /// The distance rays leaving a surface start above it, so that they do not hit it again:
+  /// 1e-5 of the scene's diagonal, whatever the scene's distance from the origin (rays are
+  /// traced in coordinates relative to the scene's centre).
   double surfaceOffset() const { return this->Offset; }
 
   /// The point `offset` above p on the side whose normal is n.
@@ -59,6 +67,9 @@ private:
   const Scene& SceneRef;
   std::unique_ptr<Embree> Impl;
   double Offset = 0;
+  /// Embree holds single-precision coordinates relative to this point, the scene's centre:
+  /// a room 10 km from the origin traces as accurately as one at the origin.
+  Vec3 Centre;
 };
 
 } // namespace mlr

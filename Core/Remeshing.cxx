@@ -32,7 +32,7 @@ constexpr double BytesPerPatch = 1000;
 
 /// Uniform 1:m^2 split of a triangle, m = ceil(longest edge / h). Neighbours split with
 /// different m meet at T-junctions, which are harmless to ray casting.
-void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const Rgb& rho,
+void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const Material& material,
   PatchMesh& out)
 {
   const double longest = std::max({ length(b - a), length(c - b), length(a - c) });
@@ -56,11 +56,13 @@ void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const
     for (int j = 0; j < m - i; ++j)
     {
       out.triangles.push_back({ at(i, j), at(i, j + 1), at(i + 1, j) });
-      out.reflectance.push_back(rho);
+      out.reflectance.push_back(material.reflectance);
+      out.emission.push_back(material.emission);
       if (j + 1 < m - i)
       {
         out.triangles.push_back({ at(i, j + 1), at(i + 1, j + 1), at(i + 1, j) });
-        out.reflectance.push_back(rho);
+        out.reflectance.push_back(material.reflectance);
+        out.emission.push_back(material.emission);
       }
     }
   }
@@ -122,6 +124,14 @@ void validateSoup(const PolygonSoup& soup)
           << "): every channel must be >= 0 and < 1";
         throw Error(s.str());
       }
+    }
+    const Rgb& emission = soup.materials[i].emission;
+    if (!emission.isFinite() || emission.minComponent() < 0)
+    {
+      std::ostringstream s;
+      s << "polygon " << i << " has emission (" << emission.r << ", " << emission.g << ", "
+        << emission.b << ") W/m^2: every channel must be finite and >= 0";
+      throw Error(s.str());
     }
     for (std::uint32_t v : soup.polygons[i])
     {
@@ -396,7 +406,7 @@ void refineOnly(const std::vector<Vec3>& points, const detail::TriangleSoup& sou
   {
     const Triangle& t = soup.triangles[which[i]];
     refineTriangle(points[t[0]], points[t[1]], points[t[2]], h,
-      materials[soup.material[which[i]]].reflectance, out);
+      materials[soup.material[which[i]]], out);
     if (i % 4096 == 0)
     {
       checkProgress(progress, from + (1 - from) * double(i) / double(which.size()));
@@ -414,6 +424,7 @@ void appendCgalPatches(
     const Triangle& t = cgal.triangles[i];
     out.triangles.push_back({ base + t[0], base + t[1], base + t[2] });
     out.reflectance.push_back(materials[cgal.material[i]].reflectance);
+    out.emission.push_back(materials[cgal.material[i]].emission);
   }
 }
 /// Remeshes with CGAL (unless told not to) and refines what it refused, or everything.

@@ -18,8 +18,13 @@ namespace mlr
 struct Material
 {
   Rgb reflectance{ 0.5, 0.5, 0.5 };
+  /// Radiant exitance emitted from the front side (W/m^2, RGB); zero for most surfaces.
+  Rgb emission{ 0, 0, 0 };
 
-  bool operator==(const Material& o) const { return this->reflectance == o.reflectance; }
+  bool operator==(const Material& o) const
+  {
+    return this->reflectance == o.reflectance && this->emission == o.emission;
+  }
   bool operator!=(const Material& o) const { return !(*this == o); }
 };
 

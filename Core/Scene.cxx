@@ -57,6 +57,13 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
       << " reflectances: give exactly one reflectance per patch";
     throw Error(s.str());
   }
+  if (!mesh.emission.empty() && mesh.emission.size() != mesh.triangles.size())
+  {
+    std::ostringstream s;
+    s << "the scene has " << mesh.triangles.size() << " patches but " << mesh.emission.size()
+      << " emissions: give one emission per patch, or none";
+    throw Error(s.str());
+  }
   if (mesh.points.size() >= std::numeric_limits<std::uint32_t>::max() / 2 ||
     mesh.triangles.size() >= (std::size_t(1) << 28))
   {
@@ -68,6 +75,21 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
   scene.Points = mesh.points;
   scene.PatchTriangles = mesh.triangles;
   scene.Reflectance = mesh.reflectance;
+  bool emits = false;
+  for (std::size_t p = 0; p < mesh.emission.size(); ++p)
+  {
+    const Rgb& e = mesh.emission[p];
+    if (!e.isFinite() || e.minComponent() < 0)
+    {
+      throw Error("patch " + std::to_string(p) + " has emission " + describe(e) +
+        " W/m^2: every channel must be finite and >= 0");
+    }
+    emits = emits || e.maxComponent() > 0;
+  }
+  if (emits)
+  {
+    scene.Emission = mesh.emission; // kept only when something emits
+  }
   const std::size_t patches = mesh.triangles.size();
   scene.PatchNormals.resize(patches);
   scene.PatchAreas.resize(patches);

@@ -44,6 +44,9 @@ struct PatchMesh
   std::vector<Vec3> points;
   std::vector<Triangle> triangles;
   std::vector<Rgb> reflectance; ///< one per triangle, every channel in [0, 1)
+  /// Radiant exitance (W/m^2, RGB) emitted from each triangle's front side: one per triangle,
+  /// or empty when nothing in the scene emits.
+  std::vector<Rgb> emission;
 };
 
 /**
@@ -82,6 +85,15 @@ public:
     return this->Reflectance[patchOfElement(e)];
   }
 
+  /// Self-emission (W/m^2, front side only): zero unless the scene's material emits.
+  Rgb patchEmission(std::size_t p) const
+  {
+    return this->Emission.empty() ? Rgb() : this->Emission[p];
+  }
+  Rgb elementEmission(std::size_t e) const { return this->patchEmission(patchOfElement(e)); }
+  /// True when some patch emits light of its own.
+  bool hasEmission() const { return !this->Emission.empty(); }
+
   /// The unit normal on the given side of element e.
   Vec3 elementSideNormal(std::size_t e, Side side) const
   {
@@ -102,6 +114,7 @@ private:
   std::vector<double> PatchAreas;
   std::vector<double> ElementAreas;
   std::vector<Rgb> Reflectance;
+  std::vector<Rgb> Emission; ///< empty when nothing emits
   double TotalArea = 0;
   Vec3 BoundsMin, BoundsMax;
 };

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include <unistd.h>
@@ -49,15 +50,24 @@ std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
   return __builtin_add_overflow(a, b, &sum) ? UINT64_MAX : sum;
 }
 
-/// A walk longer than this is cut: with reflectance < 1 it is astronomically unlikely,
-/// and the cut bounds the time between two cancellation checks.
-constexpr int MaximumBounces = 100000;
+/// A walk longer than this is cut, which bounds the time between two cancellation checks.
+/// Roulette survives with the largest reflectance channel rho_max < 1, so a walk reaches
+/// this length with probability rho_max^(2^24): the power the cut loses is below 1e-7 of the
+/// walk's for every rho_max <= 1 - 1e-6 (TestEnergyBalance checks rho = 0.999).
+constexpr int MaximumBounces = 1 << 24;
 
 /// Shooting paths per task: small enough that cancellation is noticed within
 /// milliseconds, large enough that scheduling costs nothing.
 constexpr std::uint64_t ReusedPathsPerTask = 256;
 constexpr std::uint64_t ClassicPathsPerTask = 2048;
 constexpr std::size_t GatheringSidesPerTask = 32;
+constexpr std::size_t ReachabilityPatchesPerTask = 64;
+
+/// Probe walks from each light (spread over its positions) that find the sides it lights
+/// first; a fixed number, so that reachability does not depend on N or the seed.
+constexpr std::uint64_t ReachabilityProbesPerLight = 16384;
+/// The fixed seed of the reachability probes.
+constexpr std::uint64_t ReachabilitySeed = 0x5eed;
 
 struct alignas(64) WorkerCounters
 {
@@ -79,23 +89,94 @@ struct WorkerScratch
   std::vector<Rgb> gathered;
 };
 
-/// Everything one solve shares between its phases and workers.
-class SolveRun
+/**
+ * One light the solver shoots from, seen through one interface: an area light (a moving or
+ * static lamp, or a group of the scene's emissive patches of one emission) or a directional
+ * light. It has `positions` poses; one pose is a static light, added to every frame.
+ */
+struct Source
+{
+  enum class Kind
+  {
+    Area,
+    Directional,
+  };
+  Kind kind = Kind::Area;
+  const MovingLight* area = nullptr;
+  const DirectionalLight* directional = nullptr;
+  std::size_t positions = 1;
+  /// The power a whole path set carries before weights: Phi for an area light, E times the
+  /// disc's area for a directional one.
+  Rgb power;
+  /// Per position, a factor on the power (0: that position is off and casts no path).
+  std::vector<Rgb> factors;
+  /// Directional lights: paths start on a disc of this radius, centred on the scene's
+  /// bounding sphere and pushed out of it along the direction towards the light.
+  Vec3 sphereCentre;
+  double sphereRadius = 0;
+  /// The scene's emissive patches rather than a lamp: they occlude, and they are in the
+  /// scene's own geometry.
+  bool sceneEmitter = false;
+
+  bool isStatic() const { return this->positions == 1; }
+  bool isActive(std::size_t position) const { return this->factors[position].maxComponent() > 0; }
+
+  /// A path's start at `position`: the point (lifted off the light), the direction, and for
+  /// area lights the point and normal in the light's own frame (the weights need them).
+  void emit(std::size_t position, RandomStream& random, double offset, Vec3& start,
+    Vec3& direction, Vec3& ownPoint, Vec3& ownNormal) const
+  {
+    if (this->kind == Kind::Area)
+    {
+      const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+      this->area->samplePoint(u0, u1, u2, ownPoint, ownNormal);
+      const Vec3 normal = this->area->turn(position, ownNormal);
+      direction = sampleCosineDirection(normal, random);
+      start = this->area->place(position, ownPoint) + normal * offset;
+      return;
+    }
+    const Vec3& s = this->directional->direction(position);
+    Vec3 t, b;
+    orthonormalBasis(s, t, b);
+    // A uniform point of the disc by rejection, as sampleCosineDirection does.
+    double u, v;
+    do
+    {
+      u = 2.0 * random.uniform() - 1.0;
+      v = 2.0 * random.uniform() - 1.0;
+    } while (u * u + v * v >= 1.0);
+    const double radius = this->sphereRadius;
+    start = this->sphereCentre + s * (radius + 2 * offset) + (t * u + b * v) * radius;
+    direction = -s;
+    ownPoint = start;
+    ownNormal = direction;
+  }
+};
+
+/// The rounding quantum of a fixed-point channel whose largest value per path is `scale`:
+/// one per channel, so that a channel 10^6 weaker than the others keeps its precision.
+double quantumFor(double scale)
+{
+  return scale > 0 && std::isfinite(scale) ? scale * 0x1.0p-40 : 1.0;
+}
+
+/// The shooting of one Source into its own accumulators, added to the solution at the end.
+class ShootingRun
 {
 public:
-  SolveRun(const Scene& scene, const MovingLight& light, const SolverOptions& options,
+  ShootingRun(const Scene& scene, const Source& source, const SolverOptions& options,
     const RayTracer& tracer, int workers)
     : SceneRef(scene)
-    , Light(light)
+    , SourceRef(source)
     , Options(options)
     , Tracer(tracer)
-    , Frames(light.frameCount())
-    , Workers(workers)
-    , ElementShare(workers, scene.elementCount(), light.frameCount(), 0x1.0p-50,
-        options.reuseShooting ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
-    , PatchPower(workers, scene.patchCount(), light.frameCount(),
-        (light.power().maxComponent() > 0 ? light.power().maxComponent() : 1.0) * 0x1.0p-40,
-        options.reuseShooting ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+    , Frames(source.positions)
+    , Reuse(options.reuseShooting && source.positions > 1)
+    , ElementShare(workers, scene.elementCount(), source.positions, 0x1.0p-50,
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+    , PatchPower(workers, scene.patchCount(), source.positions,
+        { quantumFor(source.power.r), quantumFor(source.power.g), quantumFor(source.power.b) },
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
     , Counters(static_cast<std::size_t>(workers))
     , Scratch(static_cast<std::size_t>(workers))
   {
@@ -105,63 +186,72 @@ public:
       s.targets.resize(this->Frames);
       s.targetFrames.resize(this->Frames);
       s.visible.resize(this->Frames);
-      s.gathered.resize(this->Frames);
     }
-    // M_k paths start from position k; they add up to N exactly.
-    const std::uint64_t n = this->Frames;
+    for (std::size_t k = 0; k < this->Frames; ++k)
+    {
+      if (source.isActive(k))
+      {
+        this->ActivePositions.push_back(k);
+      }
+    }
+    // M_k paths start from active position k; they add up to N exactly. Positions that are
+    // off cast nothing: their frames are zero, and every active frame j still has M_j > 0 in
+    // its weights' denominator, so no light is lost.
+    const std::uint64_t active = this->ActivePositions.size();
     const std::uint64_t N = options.pathsPerFrame;
-    for (const Vec3& t : light.translations())
+    this->PathsFromPosition.assign(this->Frames, 0.0);
+    for (std::uint64_t a = 0; a < active; ++a)
     {
-      this->TranslationX.push_back(t.x);
-      this->TranslationY.push_back(t.y);
-      this->TranslationZ.push_back(t.z);
+      this->PathsFromPosition[this->ActivePositions[a]] =
+        static_cast<double>(N / active + (a < N % active ? 1 : 0));
     }
-    this->PathsFromPosition.resize(this->Frames);
-    for (std::uint64_t k = 0; k < n; ++k)
+    // The poses as a structure of arrays, for the vectorised weights: x_j = R_j x + o_j and
+    // n_j = R_j n for an area light, s_j for a directional one.
+    this->Pose.assign(12, std::vector<double>(this->Frames, 0.0));
+    for (std::size_t j = 0; j < this->Frames; ++j)
     {
-      this->PathsFromPosition[k] = static_cast<double>(N / n + (k < N % n ? 1 : 0));
+      if (source.kind == Source::Kind::Area)
+      {
+        const LightPose& pose = source.area->pose(j);
+        const Rotation& r = pose.rotation;
+        const Vec3 o = pose.position - r.apply(source.area->centroid());
+        const double values[12] = { r.row0.x, r.row0.y, r.row0.z, r.row1.x, r.row1.y, r.row1.z,
+          r.row2.x, r.row2.y, r.row2.z, o.x, o.y, o.z };
+        for (int i = 0; i < 12; ++i)
+        {
+          this->Pose[i][j] = values[i];
+        }
+      }
+      else
+      {
+        const Vec3& s = source.directional->direction(j);
+        this->Pose[0][j] = s.x;
+        this->Pose[1][j] = s.y;
+        this->Pose[2][j] = s.z;
+      }
     }
   }
 
+  bool reuses() const { return this->Reuse; }
+  const std::vector<std::size_t>& activePositions() const { return this->ActivePositions; }
+
   void shootReused(std::uint64_t path, int worker);
-  void shootClassic(std::uint64_t frame, std::uint64_t path, int worker);
-  void finishShooting(Solution& solution) const;
-  std::vector<std::uint32_t> gatheringSides(std::uint64_t& rays, std::uint64_t total) const;
-  void gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse, const Solution& solution,
-    Solution& out, int worker);
+  void shootClassic(std::size_t position, std::uint64_t path, int worker);
+  /// Adds this source's radiosity to `solution`: frame f gets position f, or the one
+  /// position of a static source, times that position's power factor.
+  void addTo(Solution& solution) const;
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
 
-  /// True if side s of patch p received shooting power: a later bounce, or a first hit on
-  /// one of its elements.
-  bool patchReceived(std::size_t p, int s) const
-  {
-    if (this->PatchPower.received(p, s))
-    {
-      return true;
-    }
-    for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
-    {
-      if (this->ElementShare.received(e, s))
-      {
-        return true;
-      }
-    }
-    return false;
-  }
-
-  /// Which position path `path` of a reuse solve starts from.
+  /// Which active position path `path` of a reuse solve starts from.
   std::size_t positionOfPath(std::uint64_t path) const
   {
-    const std::uint64_t n = this->Frames;
+    const std::uint64_t n = this->ActivePositions.size();
     const std::uint64_t base = this->Options.pathsPerFrame / n;
     const std::uint64_t extra = this->Options.pathsPerFrame % n;
     const std::uint64_t firstBlock = extra * (base + 1);
-    if (path < firstBlock)
-    {
-      return static_cast<std::size_t>(path / (base + 1));
-    }
-    return static_cast<std::size_t>(extra + (path - firstBlock) / base);
+    const std::uint64_t index = path < firstBlock ? path / (base + 1) : extra + (path - firstBlock) / base;
+    return this->ActivePositions[static_cast<std::size_t>(index)];
   }
 
 private:
@@ -172,14 +262,17 @@ private:
   // Always inlined, like the prefetch it calls: GCC would delete the call otherwise.
   [[gnu::always_inline]] inline void prefetchFirstHit(
     const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker);
+  std::size_t areaKernel(const Vec3& x, const Vec3& n, const RayHit& hit, std::size_t origin,
+    WorkerScratch& scratch) const;
+  std::size_t directionalKernel(const RayHit& hit, std::size_t origin, WorkerScratch& scratch) const;
 
   const Scene& SceneRef;
-  const MovingLight& Light;
+  const Source& SourceRef;
   const SolverOptions& Options;
   const RayTracer& Tracer;
   std::size_t Frames;
-  int Workers;
-  // Direct light needs one scalar per element side and frame: the share of the light's
+  bool Reuse;
+  // Direct light needs one scalar per element side and frame: the share of the source's
   // power whose first hit lands there. Its colour rho_e Phi is the same for every hit, and
   // a scalar is a third of the memory traffic of RGB in the hottest loop.
   FixedPointAccumulator<1> ElementShare;
@@ -188,24 +281,24 @@ private:
   FixedPointAccumulator<3> PatchPower;
   std::vector<WorkerCounters> Counters;
   std::vector<WorkerScratch> Scratch;
+  std::vector<std::size_t> ActivePositions;
   std::vector<double> PathsFromPosition;
-  // The light's translations as a structure of arrays, for the vectorised weights.
-  std::vector<double> TranslationX, TranslationY, TranslationZ;
+  std::vector<std::vector<double>> Pose;
 };
 
 /**
  * Scores a walk's first hit on the element (direct) and patch, then follows it: continue
  * with probability lambda, and at every later hit score the patch and play Russian
- * roulette with the maximum reflectance channel. shares[f] is the fraction of the light's
+ * roulette with the maximum reflectance channel. shares[f] is the fraction of the source's
  * power the walk carries to its first hit in frame firstFrame + f: 1/N for a classic path,
- * G(x_j,y) / sum_k M_k G(x_k,y) for a reused one. A walk's power in frame f is then
+ * G_j(y) / sum_k M_k G_k(y) for a reused one. A walk's power in frame f is then
  * colour * shares[f], with one RGB colour for all frames: the frames differ only by scalar
- * weights.
+ * weights (and the power factors, applied when the sums become radiosity).
  *
  * METHOD.md writes step 3 as P <- P / lambda; the power that leaves the first hit is the
  * reflected power, so we carry rho * P / lambda (the energy balance test checks this).
  */
-void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
+void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
   std::size_t firstFrame, std::size_t frameCount, int worker)
 {
   // The first hit scores only the element's share: the patch's first-hit power is
@@ -213,7 +306,7 @@ void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const 
   // the RGB patch slots (3n values) out of the one write every path makes.
   const int firstSide = static_cast<int>(firstHit.side);
   const Rgb& firstRho = this->SceneRef.elementReflectance(firstHit.element);
-  Rgb colour = firstRho * this->Light.power();
+  Rgb colour = firstRho * this->SourceRef.power;
   {
     std::int64_t* elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
     for (std::size_t f = 0; f < frameCount; ++f)
@@ -282,26 +375,24 @@ void SolveRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const 
 
 /// Called as soon as a walk's first hit is known, so that the weights and shadow rays
 /// computed before scoring hide the cache misses of the slots it will score.
-inline void SolveRun::prefetchFirstHit(
+inline void ShootingRun::prefetchFirstHit(
   const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker)
 {
   this->ElementShare.prefetch(
     this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame, frameCount);
 }
 
-/// Starts a walk from the light at `position`: a uniform point x of the light (own frame)
-/// with its normal, a cosine direction and the first ray. False when the walk ends there: a
+/// Starts a walk from the source at `position` and traces its first ray. x and lightNormal
+/// are the start in the light's own frame (area lights). False when the walk ends there: a
 /// miss (the power leaves the scene) or, with one-sided surfaces, a back face.
-bool SolveRun::emit(RandomStream& random, std::size_t position, int worker, Vec3& x,
+bool ShootingRun::emit(RandomStream& random, std::size_t position, int worker, Vec3& x,
   Vec3& lightNormal, RayHit& hit)
 {
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
-  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
-  this->Light.samplePoint(u0, u1, u2, x, lightNormal);
-  const Vec3 direction = sampleCosineDirection(lightNormal, random);
-  const Vec3 start = x + this->Light.translation(position);
+  Vec3 start, direction;
+  this->SourceRef.emit(position, random, this->Tracer.surfaceOffset(), start, direction, x, lightNormal);
   ++counters.shootingRays;
-  if (!this->Tracer.intersect(this->Tracer.liftOff(start, lightNormal), direction, hit))
+  if (!this->Tracer.intersect(start, direction, hit))
   {
     ++counters.missedRays;
     return false;
@@ -315,7 +406,96 @@ bool SolveRun::emit(RandomStream& random, std::size_t position, int worker, Vec3
   return true;
 }
 
-void SolveRun::shootReused(std::uint64_t path, int worker)
+/**
+ * The unoccluded kernel of an area light at every position, into scratch.kernel, and the
+ * positions whose visibility is still unknown, into scratch.targets (lifted emission points)
+ * and scratch.targetFrames. G_j = (n_j.d)(-n_y.d) / |d|^4 with d = y - x_j: the pi of G
+ * cancels in the weights. The loop is branch-free over the positions (structure of arrays)
+ * so that it vectorises.
+ */
+std::size_t ShootingRun::areaKernel(const Vec3& x, const Vec3& n, const RayHit& hit,
+  std::size_t origin, WorkerScratch& scratch) const
+{
+  const Vec3 ny = this->SceneRef.elementSideNormal(hit.element, hit.side);
+  const Vec3& y = hit.point;
+  double* kernel = scratch.kernel.data();
+  const double* pose[12];
+  for (int i = 0; i < 12; ++i)
+  {
+    pose[i] = this->Pose[static_cast<std::size_t>(i)].data();
+  }
+  const double* active = this->PathsFromPosition.data();
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    const double xj = pose[0][j] * x.x + pose[1][j] * x.y + pose[2][j] * x.z + pose[9][j];
+    const double yj = pose[3][j] * x.x + pose[4][j] * x.y + pose[5][j] * x.z + pose[10][j];
+    const double zj = pose[6][j] * x.x + pose[7][j] * x.y + pose[8][j] * x.z + pose[11][j];
+    const double nx = pose[0][j] * n.x + pose[1][j] * n.y + pose[2][j] * n.z;
+    const double nyj = pose[3][j] * n.x + pose[4][j] * n.y + pose[5][j] * n.z;
+    const double nz = pose[6][j] * n.x + pose[7][j] * n.y + pose[8][j] * n.z;
+    const double dx = y.x - xj, dy = y.y - yj, dz = y.z - zj;
+    const double cosX = nx * dx + nyj * dy + nz * dz;
+    const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+    // Positions that are off cast no path and light nothing: their weight is never needed.
+    kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
+  }
+  const double offset = this->Tracer.surfaceOffset();
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    if (kernel[j] > 0 && j != origin)
+    {
+      const Vec3 normal = this->SourceRef.area->turn(j, n);
+      scratch.targets[count] = this->SourceRef.area->place(j, x) + normal * offset;
+      scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+      ++count;
+    }
+  }
+  if (count > 0)
+  {
+    this->Tracer.visibleFrom(this->Tracer.liftOff(y, ny), scratch.targets.data(), count,
+      scratch.visible.data());
+  }
+  return count;
+}
+
+/// The same for a directional light: G_j = max(0, n_y.s_j), visibility towards s_j to
+/// infinity (the disc is outside the scene's bounding sphere).
+std::size_t ShootingRun::directionalKernel(
+  const RayHit& hit, std::size_t origin, WorkerScratch& scratch) const
+{
+  const Vec3 ny = this->SceneRef.elementSideNormal(hit.element, hit.side);
+  double* kernel = scratch.kernel.data();
+  const double* sx = this->Pose[0].data();
+  const double* sy = this->Pose[1].data();
+  const double* sz = this->Pose[2].data();
+  const double* active = this->PathsFromPosition.data();
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    const double c = ny.x * sx[j] + ny.y * sy[j] + ny.z * sz[j];
+    kernel[j] = c > 0 && active[j] > 0 ? c : 0.0;
+  }
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    if (kernel[j] > 0 && j != origin)
+    {
+      scratch.targets[count] = Vec3(sx[j], sy[j], sz[j]);
+      scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+      ++count;
+    }
+  }
+  if (count > 0)
+  {
+    this->Tracer.visibleAlong(this->Tracer.liftOff(hit.point, ny), scratch.targets.data(), count,
+      scratch.visible.data());
+  }
+  return count;
+}
+
+void ShootingRun::shootReused(std::uint64_t path, int worker)
 {
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
   WorkerScratch& scratch = this->Scratch[static_cast<std::size_t>(worker)];
@@ -330,50 +510,24 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   }
   this->prefetchFirstHit(hit, 0, this->Frames, worker);
 
-  // Mixture weights w_j = G(x_j, y) / sum_k M_k G(x_k, y), with real visibility. The pi of
-  // G cancels; with d = y - x_j unnormalised, cos_x cos_y / r^2 = (n_x.d)(-n_y.d) / |d|^4.
-  // The loop is branch-free over the positions (structure of arrays) so that it vectorises.
-  const Vec3 ny = this->SceneRef.elementSideNormal(hit.element, hit.side);
-  const Vec3 toHit = hit.point - x;
+  // Mixture weights w_j = G_j(y) / sum_k M_k G_k(y), with real visibility: one shadow ray
+  // per other position whose unoccluded kernel is not zero (the origin's is known).
+  const std::size_t shadowCount = this->SourceRef.kind == Source::Kind::Area
+    ? this->areaKernel(x, lightNormal, hit, origin, scratch)
+    : this->directionalKernel(hit, origin, scratch);
   double* kernel = scratch.kernel.data();
-  for (std::size_t j = 0; j < this->Frames; ++j)
+  counters.shadowRays += shadowCount;
+  for (std::size_t s = 0; s < shadowCount; ++s)
   {
-    const double dx = toHit.x - this->TranslationX[j];
-    const double dy = toHit.y - this->TranslationY[j];
-    const double dz = toHit.z - this->TranslationZ[j];
-    const double cosX = lightNormal.x * dx + lightNormal.y * dy + lightNormal.z * dz;
-    const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
-    kernel[j] = cosX > 0 && cosY > 0 ? g : 0.0;
-  }
-  std::size_t shadowCount = 0;
-  for (std::size_t j = 0; j < this->Frames; ++j)
-  {
-    if (kernel[j] > 0 && j != origin)
+    if (!scratch.visible[s])
     {
-      scratch.targets[shadowCount] = x + this->Light.translation(j);
-      scratch.targetFrames[shadowCount] = static_cast<std::uint32_t>(j);
-      ++shadowCount;
-    }
-  }
-  if (shadowCount > 0)
-  {
-    this->Tracer.visibleFrom(
-      this->Tracer.liftOff(hit.point, ny), scratch.targets.data(), shadowCount, scratch.visible.data());
-    counters.shadowRays += shadowCount;
-    for (std::size_t s = 0; s < shadowCount; ++s)
-    {
-      if (!scratch.visible[s])
-      {
-        kernel[scratch.targetFrames[s]] = 0;
-      }
+      kernel[scratch.targetFrames[s]] = 0;
     }
   }
   double mixture = 0;
   for (std::size_t j = 0; j < this->Frames; ++j)
   {
-    mixture += this->PathsFromPosition[j] * scratch.kernel[j];
+    mixture += this->PathsFromPosition[j] * kernel[j];
   }
   if (!(mixture > 0))
   {
@@ -384,82 +538,247 @@ void SolveRun::shootReused(std::uint64_t path, int worker)
   {
     kernel[j] *= inverseMixture;
   }
-  this->scoreAndWalk(random, hit, scratch.kernel.data(), 0, this->Frames, worker);
+  this->scoreAndWalk(random, hit, kernel, 0, this->Frames, worker);
 }
 
-void SolveRun::shootClassic(std::uint64_t frame, std::uint64_t path, int worker)
+void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int worker)
 {
-  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, frame + 1);
+  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, position + 1);
   Vec3 x, lightNormal;
   RayHit hit;
-  if (!this->emit(random, static_cast<std::size_t>(frame), worker, x, lightNormal, hit))
+  if (!this->emit(random, position, worker, x, lightNormal, hit))
   {
     return;
   }
   const double share = 1.0 / static_cast<double>(this->Options.pathsPerFrame);
-  this->scoreAndWalk(random, hit, &share, static_cast<std::size_t>(frame), 1, worker);
+  this->scoreAndWalk(random, hit, &share, position, 1, worker);
 }
 
-/// Turns the accumulated power into radiosity (W/m^2) in the solution.
-void SolveRun::finishShooting(Solution& solution) const
+void ShootingRun::addTo(Solution& solution) const
 {
   const std::size_t elements = this->SceneRef.elementCount();
   const std::size_t patches = this->SceneRef.patchCount();
+  const std::size_t frames = solution.frameCount();
   std::vector<Rgb>& direct = solution.directData();
   std::vector<Rgb>& patch = solution.patchData();
+  const std::vector<Rgb>& factors = this->SourceRef.factors;
+  auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
   for (std::size_t e = 0; e < elements; ++e)
   {
     const Rgb exitance =
-      this->SceneRef.elementReflectance(e) * this->Light.power() / this->SceneRef.elementArea(e);
+      this->SceneRef.elementReflectance(e) * this->SourceRef.power / this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
-      for (std::size_t f = 0; f < this->Frames; ++f)
+      for (std::size_t f = 0; f < frames; ++f)
       {
         double share = 0;
-        this->ElementShare.total(e, s, f, &share);
-        direct[solution.elementIndex(f, e, static_cast<Side>(s))] = exitance * share;
+        this->ElementShare.total(e, s, positionOf(f), &share);
+        if (share != 0)
+        {
+          direct[solution.elementIndex(f, e, static_cast<Side>(s))] +=
+            exitance * factors[positionOf(f)] * share;
+        }
       }
     }
   }
   for (std::size_t p = 0; p < patches; ++p)
   {
     const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
-    const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->Light.power();
+    const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->SourceRef.power;
     for (int s = 0; s < 2; ++s)
     {
-      for (std::size_t f = 0; f < this->Frames; ++f)
+      for (std::size_t f = 0; f < frames; ++f)
       {
+        const std::size_t k = positionOf(f);
         double power[3];
-        this->PatchPower.total(p, s, f, power);
+        this->PatchPower.total(p, s, k, power);
         double share = 0;
         for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
         {
           double elementShare = 0;
-          this->ElementShare.total(e, s, f, &elementShare);
+          this->ElementShare.total(e, s, k, &elementShare);
           share += elementShare;
         }
-        patch[solution.patchIndex(f, p, static_cast<Side>(s))] =
-          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * inverseArea;
+        patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
+          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * factors[k] * inverseArea;
       }
     }
   }
 }
 
 /**
- * The element sides that gather: those whose patch side received shooting power (the
- * inside of a closed block never does). Returns them as element * 2 + side, in element
- * order, and sets `rays` to the rays each casts so that together they cast about `total`
- * (at least one each: equal counts keep every side's estimate equally accurate).
+ * Which patch sides light can reach, from geometry alone (the same for any N, seed and
+ * thread count). Seeds: the sides that probe walks from every light's positions hit first.
+ * Then a side is reachable when one of ReachabilityProbesPerSide cosine rays from it reaches
+ * a reachable side, or one from a reachable side reaches it (light paths are reversible).
+ * The inside of a closed block is never reached; a side that random shooting happened to
+ * miss still is.
  */
-std::vector<std::uint32_t> SolveRun::gatheringSides(std::uint64_t& rays, std::uint64_t total) const
+std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tracer,
+  const std::vector<Source>& sources, const SolverOptions& options, int workers,
+  const std::function<bool(double)>& keepGoing, std::uint64_t& rays)
+{
+  const std::size_t patches = scene.patchCount();
+  const std::size_t sides = 2 * patches;
+  const bool twoSided = options.twoSided;
+  constexpr std::uint32_t None = std::numeric_limits<std::uint32_t>::max();
+  auto sideOf = [&](const RayHit& hit) -> std::uint32_t {
+    if (!twoSided && hit.side == Side::Back)
+    {
+      return None;
+    }
+    return static_cast<std::uint32_t>(Scene::patchOfElement(hit.element) * 2 + static_cast<std::size_t>(hit.side));
+  };
+
+  // Seeds, one slot per probe so that the result does not depend on scheduling.
+  std::vector<std::uint32_t> seeds;
+  for (std::size_t l = 0; l < sources.size(); ++l)
+  {
+    const Source& source = sources[l];
+    std::vector<std::size_t> active;
+    for (std::size_t k = 0; k < source.positions; ++k)
+    {
+      if (source.isActive(k))
+      {
+        active.push_back(k);
+      }
+    }
+    if (active.empty())
+    {
+      continue;
+    }
+    const std::uint64_t perPosition =
+      std::max<std::uint64_t>(64, ReachabilityProbesPerLight / active.size());
+    const std::uint64_t total = perPosition * active.size();
+    const std::size_t first = seeds.size();
+    seeds.resize(first + total, None);
+    const std::uint64_t perTask = 1024;
+    parallelFor((total + perTask - 1) / perTask, workers,
+      [&](std::size_t task, int) {
+        for (std::uint64_t i = task * perTask; i < std::min(total, (task + 1) * perTask); ++i)
+        {
+          RandomStream random(ReachabilitySeed + l, StreamPurpose::Reachability, i, 0);
+          Vec3 start, direction, x, n;
+          source.emit(active[i / perPosition], random, tracer.surfaceOffset(), start, direction, x, n);
+          RayHit hit;
+          if (tracer.intersect(start, direction, hit))
+          {
+            seeds[first + i] = sideOf(hit);
+          }
+        }
+      },
+      [&](std::size_t) { return keepGoing(0.0); });
+    rays += total;
+  }
+
+  // Probes from every side.
+  constexpr std::size_t K = ReachabilityProbesPerSide;
+  std::vector<std::uint32_t> probe(sides * K, None);
+  const auto& points = scene.points();
+  const std::size_t tasks = (patches + ReachabilityPatchesPerTask - 1) / ReachabilityPatchesPerTask;
+  parallelFor(tasks, workers,
+    [&](std::size_t task, int) {
+      for (std::size_t p = task * ReachabilityPatchesPerTask;
+           p < std::min(patches, (task + 1) * ReachabilityPatchesPerTask); ++p)
+      {
+        const Triangle& t = scene.patchTriangles()[p];
+        for (int s = 0; s < (twoSided ? 2 : 1); ++s)
+        {
+          const Vec3 normal = s == 0 ? scene.patchNormal(p) : -scene.patchNormal(p);
+          const std::size_t side = 2 * p + static_cast<std::size_t>(s);
+          RandomStream random(ReachabilitySeed, StreamPurpose::Reachability, side, 1);
+          for (std::size_t r = 0; r < K; ++r)
+          {
+            const double u1 = random.uniform(), u2 = random.uniform();
+            const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
+            const Vec3 direction = sampleCosineDirection(normal, random);
+            RayHit hit;
+            if (tracer.intersect(tracer.liftOff(origin, normal), direction, hit))
+            {
+              probe[side * K + r] = sideOf(hit);
+            }
+          }
+        }
+      }
+    },
+    [&](std::size_t done) { return keepGoing(static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1))); });
+  rays += patches * (twoSided ? 2 : 1) * K;
+
+  // Reverse edges (compressed rows), then a breadth-first search from the seeds over both.
+  std::vector<std::uint32_t> reverseStart(sides + 1, 0);
+  for (std::uint32_t to : probe)
+  {
+    if (to != None)
+    {
+      ++reverseStart[to + 1];
+    }
+  }
+  for (std::size_t i = 0; i < sides; ++i)
+  {
+    reverseStart[i + 1] += reverseStart[i];
+  }
+  std::vector<std::uint32_t> reverse(reverseStart[sides]);
+  {
+    std::vector<std::uint32_t> fill(reverseStart.begin(), reverseStart.end() - 1);
+    for (std::size_t from = 0; from < sides; ++from)
+    {
+      for (std::size_t r = 0; r < K; ++r)
+      {
+        const std::uint32_t to = probe[from * K + r];
+        if (to != None)
+        {
+          reverse[fill[to]++] = static_cast<std::uint32_t>(from);
+        }
+      }
+    }
+  }
+  std::vector<std::uint8_t> reached(sides, 0);
+  std::vector<std::uint32_t> queue;
+  auto visit = [&](std::uint32_t side) {
+    if (side != None && !reached[side])
+    {
+      reached[side] = 1;
+      queue.push_back(side);
+    }
+  };
+  for (std::uint32_t s : seeds)
+  {
+    visit(s);
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head)
+  {
+    const std::uint32_t side = queue[head];
+    for (std::size_t r = 0; r < K; ++r)
+    {
+      visit(probe[side * K + r]);
+    }
+    for (std::uint32_t i = reverseStart[side]; i < reverseStart[side + 1]; ++i)
+    {
+      visit(reverse[i]);
+    }
+  }
+  return reached;
+}
+
+/**
+ * The element sides that gather: those of reachable patch sides whose reflectance is not
+ * zero (a black element reflects nothing it gathers). Returns them as element * 2 + side,
+ * in element order, and sets `rays` to the rays each casts so that together they cast about
+ * `total` (at least one each: equal counts keep every side's estimate equally accurate).
+ */
+std::vector<std::uint32_t> gatheringSides(const Scene& scene,
+  const std::vector<std::uint8_t>& reachable, std::uint64_t& rays, std::uint64_t total)
 {
   std::vector<std::uint32_t> sides;
-  const std::size_t patches = this->SceneRef.patchCount();
-  for (std::size_t p = 0; p < patches; ++p)
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
   {
+    if (!(scene.patchReflectance(p).maxComponent() > 0))
+    {
+      continue;
+    }
     for (int s = 0; s < 2; ++s)
     {
-      if (this->patchReceived(p, s))
+      if (reachable[2 * p + static_cast<std::size_t>(s)])
       {
         for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
         {
@@ -481,22 +800,23 @@ std::vector<std::uint32_t> SolveRun::gatheringSides(std::uint64_t& rays, std::ui
  * on it; each ray that reaches a patch side adds that side's shooting radiosity. With reuse
  * one set of rays serves every frame; otherwise each frame casts its own.
  */
-void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
-  const Solution& shooting, Solution& out, int worker)
+void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
+  std::uint32_t elementSide, std::uint64_t rays, Solution& solution, std::vector<Rgb>& sum,
+  WorkerCounters& counters)
 {
-  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
-  std::vector<Rgb>& sum = this->Scratch[static_cast<std::size_t>(worker)].gathered;
+  const std::size_t frames = solution.frameCount();
+  const bool reuse = options.reuseGathering;
   const std::size_t element = elementSide / 2;
   const Side side = static_cast<Side>(elementSide % 2);
-  const Triangle& t = this->SceneRef.elementTriangles()[element];
-  const auto& points = this->SceneRef.points();
-  const Vec3 normal = this->SceneRef.elementSideNormal(element, side);
-  std::fill(sum.begin(), sum.end(), Rgb());
+  const Triangle& t = scene.elementTriangles()[element];
+  const auto& points = scene.points();
+  const Vec3 normal = scene.elementSideNormal(element, side);
+  sum.assign(frames, Rgb());
 
   // A hit's row of patch radiosity is added after the next ray is traced: the row was
   // prefetched when the hit was found, so the trace hides its cache miss.
-  const std::size_t passes = reuse ? 1 : this->Frames;
-  const std::size_t rowLength = reuse ? this->Frames : 1;
+  const std::size_t passes = reuse ? 1 : frames;
+  const std::size_t rowLength = reuse ? frames : 1;
   for (std::size_t pass = 0; pass < passes; ++pass)
   {
     Rgb* into = reuse ? sum.data() : &sum[pass];
@@ -511,7 +831,7 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
         pending = nullptr;
       }
     };
-    RandomStream random(this->Options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
+    RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
     for (std::uint64_t r = 0; r < rays; ++r)
     {
       const double u1 = random.uniform(), u2 = random.uniform();
@@ -519,18 +839,18 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
       const Vec3 direction = sampleCosineDirection(normal, random);
       ++counters.gatheringRays;
       RayHit hit;
-      const bool found = this->Tracer.intersect(this->Tracer.liftOff(origin, normal), direction, hit);
+      const bool found = tracer.intersect(tracer.liftOff(origin, normal), direction, hit);
       addPending();
       if (!found)
       {
         ++counters.missedRays;
         continue;
       }
-      if (!this->Options.twoSided && hit.side == Side::Back)
+      if (!options.twoSided && hit.side == Side::Back)
       {
         continue;
       }
-      pending = &shooting.patchRadiosity(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
+      pending = &solution.patchRadiosity(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
       const char* row = reinterpret_cast<const char*>(pending);
       for (std::size_t byte = 0; byte < rowLength * sizeof(Rgb); byte += 64)
       {
@@ -539,10 +859,10 @@ void SolveRun::gather(std::uint32_t elementSide, std::uint64_t rays, bool reuse,
     }
     addPending();
   }
-  const Rgb scale = this->SceneRef.elementReflectance(element) / static_cast<double>(rays);
-  for (std::size_t f = 0; f < this->Frames; ++f)
+  const Rgb scale = scene.elementReflectance(element) / static_cast<double>(rays);
+  for (std::size_t f = 0; f < frames; ++f)
   {
-    out.indirectData()[out.elementIndex(f, element, side)] = scale * sum[f];
+    solution.indirectData()[solution.elementIndex(f, element, side)] = scale * sum[f];
   }
 }
 
@@ -621,10 +941,13 @@ void validateOptions(const SolverOptions& options)
       ", is over the maximum of " + std::to_string(MaximumPathsPerFrame) +
       ": such a solve would not finish");
   }
-  if (!(options.firstBounceSurvival > 0.0 && options.firstBounceSurvival <= 1.0))
+  if (!(options.firstBounceSurvival >= MinimumFirstBounceSurvival &&
+        options.firstBounceSurvival <= 1.0))
   {
     throw Error("the first-bounce survival probability lambda is " +
-      std::to_string(options.firstBounceSurvival) + ": it must be in (0, 1] (0.25 is typical)");
+      std::to_string(options.firstBounceSurvival) +
+      ": it must be in [0.001, 1] (0.25 is typical; a surviving walk carries 1/lambda of its "
+      "power, and below 0.001 the fixed-point sums could overflow)");
   }
   if (!(options.gatheringRatio >= 0.0) || !std::isfinite(options.gatheringRatio))
   {
@@ -666,7 +989,11 @@ std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std
   const std::uint64_t scratch = times({ workers, frames, 2 * sizeof(Rgb) + sizeof(Vec3) + 16 });
   // Embree's BVH and buffers, generously.
   const std::uint64_t tracing = saturatingSum(times({ elements, 256 }), times({ points, 16 }));
-  return saturatingSum(saturatingSum(results, accumulators), saturatingSum(scratch, tracing));
+  // Reachability: the probes' hits and their reverse edges.
+  const std::uint64_t reachability =
+    times({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });
+  return saturatingSum(saturatingSum(results, accumulators),
+    saturatingSum(saturatingSum(scratch, tracing), reachability));
 }
 
 std::uint64_t estimateSolveMemory(
@@ -710,26 +1037,191 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
   throw Error(s.str());
 }
 
+std::size_t frameCount(const LightRig& rig, bool sceneEmits)
+{
+  std::size_t frames = 0;
+  std::string first;
+  auto take = [&](std::size_t n, const std::string& what) {
+    if (n <= 1)
+    {
+      return;
+    }
+    if (frames == 0)
+    {
+      frames = n;
+      first = what;
+    }
+    else if (n != frames)
+    {
+      throw Error(what + " has " + std::to_string(n) + " positions but " + first + " has " +
+        std::to_string(frames) + ": every moving light needs one position per frame");
+    }
+  };
+  for (std::size_t i = 0; i < rig.areaLights.size(); ++i)
+  {
+    take(rig.areaLights[i].frameCount(), "light " + std::to_string(i));
+  }
+  for (std::size_t i = 0; i < rig.directionalLights.size(); ++i)
+  {
+    take(rig.directionalLights[i].frameCount(), "directional light " + std::to_string(i));
+  }
+  if (rig.areaLights.empty() && rig.directionalLights.empty() && !sceneEmits)
+  {
+    throw Error("nothing emits light: give a light, a directional light or scene surfaces with "
+                "emission");
+  }
+  return std::max<std::size_t>(frames, 1);
+}
+
+namespace
+{
+/// The scene's emissive patches as static area lights, one per distinct emission (an area
+/// light has one colour). They are part of the geometry too, so they occlude.
+std::vector<MovingLight> sceneEmitters(const Scene& scene)
+{
+  std::vector<MovingLight> lights;
+  if (!scene.hasEmission())
+  {
+    return lights;
+  }
+  std::vector<Rgb> emissions;
+  std::vector<std::vector<std::vector<Vec3>>> polygons;
+  std::vector<double> areas;
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    const Rgb e = scene.patchEmission(p);
+    if (!(e.maxComponent() > 0))
+    {
+      continue;
+    }
+    std::size_t group = std::find(emissions.begin(), emissions.end(), e) - emissions.begin();
+    if (group == emissions.size())
+    {
+      emissions.push_back(e);
+      polygons.emplace_back();
+      areas.push_back(0);
+    }
+    const Triangle& t = scene.patchTriangles()[p];
+    const auto& points = scene.points();
+    polygons[group].push_back({ points[t[0]], points[t[1]], points[t[2]] });
+    areas[group] += scene.patchArea(p);
+  }
+  for (std::size_t g = 0; g < emissions.size(); ++g)
+  {
+    lights.emplace_back(polygons[g], emissions[g] * areas[g], std::vector<LightPose>{ LightPose() });
+    // The pose above is at the origin; a static light's only pose must leave it in place.
+    LightPose stay;
+    stay.position = lights.back().centroid();
+    lights.back() = MovingLight(polygons[g], emissions[g] * areas[g], std::vector<LightPose>{ stay });
+  }
+  return lights;
+}
+
+std::vector<Source> sourcesOf(const Scene& scene, const LightRig& rig,
+  const std::vector<MovingLight>& emitters)
+{
+  std::vector<Source> sources;
+  auto addArea = [&](const MovingLight& light, bool sceneEmitter) {
+    Source s;
+    s.kind = Source::Kind::Area;
+    s.area = &light;
+    s.positions = light.frameCount();
+    s.power = light.power();
+    s.sceneEmitter = sceneEmitter;
+    for (const LightPose& pose : light.poses())
+    {
+      s.factors.push_back(pose.power);
+    }
+    sources.push_back(s);
+  };
+  for (const MovingLight& light : rig.areaLights)
+  {
+    addArea(light, false);
+  }
+  for (const MovingLight& light : emitters)
+  {
+    addArea(light, true);
+  }
+  const Vec3 centre = (scene.boundsMin() + scene.boundsMax()) * 0.5;
+  const double radius = std::max(0.5 * scene.diagonal(), 1e-9 * std::max(1.0, length(centre)));
+  for (const DirectionalLight& light : rig.directionalLights)
+  {
+    Source s;
+    s.kind = Source::Kind::Directional;
+    s.directional = &light;
+    s.positions = light.frameCount();
+    s.sphereCentre = centre;
+    s.sphereRadius = radius;
+    s.power = light.irradiance() * (M_PI * radius * radius);
+    for (std::size_t k = 0; k < light.frameCount(); ++k)
+    {
+      s.factors.push_back(light.powerFactor(k));
+    }
+    sources.push_back(s);
+  }
+  return sources;
+}
+}
+
 Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
+  const ProgressCallback& progress)
+{
+  LightRig rig;
+  rig.areaLights.push_back(light);
+  return solve(scene, rig, options, progress);
+}
+
+Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   const ProgressCallback& progress)
 {
   const auto start = Clock::now();
   validateOptions(options);
-  const std::size_t frames = light.frameCount();
+  const std::size_t frames = frameCount(rig, scene.hasEmission());
   const int workers = resolveThreadCount(options.threads);
   const std::uint64_t memory = estimateSolveMemory(scene, frames, options);
   checkSolveMemory(memory, frames, scene.patchCount(), scene.elementCount(), options);
 
+  const std::vector<MovingLight> emitters = sceneEmitters(scene);
+  const std::vector<Source> sources = sourcesOf(scene, rig, emitters);
+  for (std::size_t i = 0; i < sources.size(); ++i)
+  {
+    const Source& source = sources[i];
+    std::size_t active = 0;
+    for (std::size_t k = 0; k < source.positions; ++k)
+    {
+      active += source.isActive(k) ? 1 : 0;
+    }
+    if (options.reuseShooting && source.positions > 1 && options.pathsPerFrame < active)
+    {
+      // With M_k = 0 for some position k, the mixture has holes where only k lights: light
+      // would be lost, and the weights would be unbounded.
+      throw Error("reusing shooting paths needs at least one path per light position: " +
+        std::to_string(options.pathsPerFrame) + " paths per frame is fewer than the " +
+        std::to_string(active) + " light positions that emit; give at least " +
+        std::to_string(active) + " paths per frame, or turn shooting reuse off");
+    }
+  }
+
   // Progress: phases weighted by their expected ray counts.
-  const double n = static_cast<double>(frames);
   const double N = static_cast<double>(options.pathsPerFrame);
   const double lambda = options.firstBounceSurvival;
-  const double shootingCost = options.reuseShooting ? N * (1 + 1.5 * lambda + 0.2 * (n - 1))
-                                                    : n * N * (1 + 1.5 * lambda);
+  std::vector<double> shootingCost;
+  double totalCost = 0;
+  for (const Source& source : sources)
+  {
+    const double n = static_cast<double>(source.positions);
+    const bool reuse = options.reuseShooting && source.positions > 1;
+    shootingCost.push_back(reuse ? N * (1 + 1.5 * lambda + 0.2 * (n - 1)) : n * N * (1 + 1.5 * lambda));
+    totalCost += shootingCost.back();
+  }
+  const double reachabilityCost =
+    static_cast<double>(scene.patchCount() * 2 * ReachabilityProbesPerSide);
   const double gatheringCost =
-    options.gatheringRatio * N * (options.reuseGathering ? 1.0 : n);
-  const double shootingShare = shootingCost / (shootingCost + gatheringCost);
-  auto phaseTick = [&](double base, double share, std::size_t total) {
+    options.gatheringRatio * N * (options.reuseGathering ? 1.0 : static_cast<double>(frames));
+  totalCost += reachabilityCost + gatheringCost;
+  double progressBase = 0;
+  auto phaseTick = [&](double share, std::size_t total) {
+    const double base = progressBase;
     return [&progress, base, share, total](std::size_t done) {
       return !progress ||
         progress(base + share * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)));
@@ -741,67 +1233,115 @@ Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions
   }
 
   RayTracer tracer(scene);
-  SolveRun run(scene, light, options, tracer, workers);
   Solution solution(frames, scene.elementCount(), scene.patchCount());
+  if (scene.hasEmission())
+  {
+    solution.emissionData().resize(scene.elementCount());
+    for (std::size_t e = 0; e < scene.elementCount(); ++e)
+    {
+      solution.emissionData()[e] = scene.elementEmission(e);
+    }
+  }
   SolverStatistics& stats = solution.statistics;
   stats.secondsSetup = secondsSince(start);
 
-  // Shooting.
+  // Shooting, one source at a time: each has its own accumulators, added to the solution.
   const auto shootingStart = Clock::now();
-  if (options.reuseShooting)
+  std::uint64_t firstHits = 0, backAbsorbed = 0;
+  for (std::size_t i = 0; i < sources.size(); ++i)
   {
+    const Source& source = sources[i];
+    ShootingRun run(scene, source, options, tracer, workers);
+    const double share = shootingCost[i] / totalCost;
     const std::uint64_t paths = options.pathsPerFrame;
-    const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
-    parallelFor(tasks, workers,
-      [&](std::size_t task, int worker) {
-        const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
-        for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
-        {
-          run.shootReused(p, worker);
-        }
-      },
-      phaseTick(0.0, shootingShare, tasks));
-    stats.pathsCast = paths;
+    std::uint64_t cast = 0;
+    if (run.activePositions().empty())
+    {
+      // Off in every frame: nothing to add.
+    }
+    else if (run.reuses())
+    {
+      const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
+      parallelFor(tasks, workers,
+        [&](std::size_t task, int worker) {
+          const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
+          for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
+          {
+            run.shootReused(p, worker);
+          }
+        },
+        phaseTick(share, tasks));
+      cast = paths;
+    }
+    else
+    {
+      const std::vector<std::size_t>& positions = run.activePositions();
+      const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
+      const std::uint64_t tasks = tasksPerFrame * positions.size();
+      parallelFor(tasks, workers,
+        [&](std::size_t task, int worker) {
+          const std::size_t position = positions[task / tasksPerFrame];
+          const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
+          const std::uint64_t end = std::min<std::uint64_t>(paths, first + ClassicPathsPerTask);
+          for (std::uint64_t p = first; p < end; ++p)
+          {
+            run.shootClassic(position, p, worker);
+          }
+        },
+        phaseTick(share, tasks));
+      cast = paths * positions.size();
+    }
+    progressBase += share;
+    run.addTo(solution);
+    stats.pathsCast += cast;
+    stats.staticPathsCast += source.isStatic() ? cast : 0;
+    for (const WorkerCounters& c : run.counters())
+    {
+      stats.shootingRays += c.shootingRays;
+      stats.shadowRays += c.shadowRays;
+      stats.gatheringRays += c.gatheringRays;
+      stats.missedRays += c.missedRays;
+      firstHits += c.firstHits;
+      backAbsorbed += c.firstHitsOnBack;
+    }
   }
-  else
-  {
-    const std::uint64_t paths = options.pathsPerFrame;
-    const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
-    const std::uint64_t tasks = tasksPerFrame * frames;
-    parallelFor(tasks, workers,
-      [&](std::size_t task, int worker) {
-        const std::uint64_t frame = task / tasksPerFrame;
-        const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
-        const std::uint64_t end = std::min<std::uint64_t>(paths, first + ClassicPathsPerTask);
-        for (std::uint64_t p = first; p < end; ++p)
-        {
-          run.shootClassic(frame, p, worker);
-        }
-      },
-      phaseTick(0.0, shootingShare, tasks));
-    stats.pathsCast = paths * frames;
-  }
-  run.finishShooting(solution);
+  stats.sources = sources.size();
   stats.secondsShooting = secondsSince(shootingStart);
 
-  // Final gathering.
+  // Final gathering, once, on the sum of every source's patch solution.
   const auto gatheringStart = Clock::now();
   if (options.gatheringRatio > 0)
   {
+    const double share = reachabilityCost / totalCost;
+    const double base = progressBase;
+    const std::vector<std::uint8_t> reachable = reachableSides(scene, tracer, sources, options,
+      workers,
+      [&](double fraction) { return !progress || progress(base + share * fraction); },
+      stats.reachabilityRays);
+    progressBase += share;
+    stats.reachableSides = static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
     std::uint64_t raysPerSide = 0;
     const auto total = static_cast<std::uint64_t>(std::llround(options.gatheringRatio * N));
-    const std::vector<std::uint32_t> sides = run.gatheringSides(raysPerSide, total);
+    const std::vector<std::uint32_t> sides = gatheringSides(scene, reachable, raysPerSide, total);
     stats.gatheringSides = sides.size();
+    std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
+    std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
     const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
     parallelFor(tasks, workers,
       [&](std::size_t task, int worker) {
         const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
         for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
         {
-          run.gather(sides[i], raysPerSide, options.reuseGathering, solution, solution, worker);
+          gather(scene, tracer, options, sides[i], raysPerSide, solution,
+            sums[static_cast<std::size_t>(worker)], counters[static_cast<std::size_t>(worker)]);
         }
       },
-      phaseTick(shootingShare, 1.0 - shootingShare, tasks));
+      phaseTick(1.0 - progressBase, tasks));
+    for (const WorkerCounters& c : counters)
+    {
+      stats.gatheringRays += c.gatheringRays;
+      stats.missedRays += c.missedRays;
+    }
   }
   else
   {
@@ -810,16 +1350,6 @@ Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions
   stats.secondsGathering = secondsSince(gatheringStart);
   chooseLitSides(scene, solution);
 
-  std::uint64_t firstHits = 0, backAbsorbed = 0;
-  for (const WorkerCounters& c : run.counters())
-  {
-    stats.shootingRays += c.shootingRays;
-    stats.shadowRays += c.shadowRays;
-    stats.gatheringRays += c.gatheringRays;
-    stats.missedRays += c.missedRays;
-    firstHits += c.firstHits;
-    backAbsorbed += c.firstHitsOnBack;
-  }
   stats.frames = frames;
   stats.patches = scene.patchCount();
   stats.elements = scene.elementCount();
@@ -838,7 +1368,7 @@ Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions
   {
     solution.warnings.push_back(
       "no light reached the scene: the light may face away from it (it emits along its "
-      "normal) or lie outside it; the result is all zero");
+      "normal), lie outside it, or be off in every frame; the result is all zero");
   }
   else if (!options.twoSided && backAbsorbed * 2 > firstHits)
   {

@@ -2,6 +2,7 @@
 // of both across all light positions (Sbert & Castro; see shared/docs/METHOD.md).
 #pragma once
 
+#include "DirectionalLight.h"
 #include "MovingLight.h"
 #include "Rgb.h"
 #include "Scene.h"
@@ -21,7 +22,9 @@ struct SolverOptions
   std::uint64_t pathsPerFrame = 600000;
   /// k: gathering rays per frame = k * N, shared over the element sides that gather.
   double gatheringRatio = 1.0;
-  /// lambda: probability that a path continues after its first hit, in (0, 1].
+  /// lambda: probability that a path continues after its first hit, in [0.001, 1]. A walk
+  /// that survives carries 1/lambda of its power; the bound keeps the fixed-point sums (2^23
+  /// times the light's power per slot) far from overflow.
   double firstBounceSurvival = 0.25;
   /// Cast M = N/n paths from each position and weight them for every frame.
   bool reuseShooting = true;
@@ -40,6 +43,29 @@ struct SolverOptions
 /// The largest pathsPerFrame accepted: past it a solve would run for months.
 constexpr std::uint64_t MaximumPathsPerFrame = 100000000000ULL;
 
+/// The smallest lambda accepted (SolverOptions::firstBounceSurvival).
+constexpr double MinimumFirstBounceSurvival = 0.001;
+
+/// Probe rays cast from every patch side to decide which sides light can reach.
+constexpr int ReachabilityProbesPerSide = 32;
+
+/**
+ * Everything that emits in an animation besides the scene's own emissive surfaces (which
+ * Scene::patchEmission gives). Lights with one pose or direction are static: solved once and
+ * added to every frame. All moving lights must have the same number of poses: the frames.
+ * Transport is linear, so every light is shot on its own and the results add up; gathering
+ * then runs once on the sum.
+ */
+struct LightRig
+{
+  std::vector<MovingLight> areaLights;
+  std::vector<DirectionalLight> directionalLights;
+};
+
+/// The number of frames of a rig: the pose count of its moving lights, or 1 when nothing
+/// moves. Throws mlr::Error when moving lights disagree or nothing can emit.
+std::size_t frameCount(const LightRig& rig, bool sceneEmits);
+
 struct SolverStatistics
 {
   std::uint64_t frames = 0;
@@ -52,6 +78,10 @@ struct SolverStatistics
   std::uint64_t gatheringRays = 0;  ///< nearest-hit rays of the final gathering
   std::uint64_t missedRays = 0;     ///< nearest-hit rays that hit nothing
   std::uint64_t gatheringSides = 0; ///< element sides that gathered
+  std::uint64_t reachabilityRays = 0; ///< probes that decided which sides light can reach
+  std::uint64_t reachableSides = 0;   ///< patch sides light can reach (the others stay dark)
+  std::uint64_t sources = 0;          ///< lights shot: moving, static, directional, emitters
+  std::uint64_t staticPathsCast = 0;  ///< of pathsCast, from sources solved once for all frames
   /// l of the paper: mean number of hits of a path without the lambda cut, from
   /// shootingRays / pathsCast = 1 + lambda (l - 1).
   double meanPathLength = 0;
@@ -74,9 +104,10 @@ double predictedSpeedup(std::size_t frames, double gatheringRatio, double lambda
 /**
  * Radiosity (W/m^2) of every element and patch side, for every frame.
  *
- * B_total = B_direct + B_indirect for elements (no self-emission: only the light emits).
- * B_direct comes from the shooting walks' first hits; B_indirect from final gathering of
- * the patches' shooting solution. Both sides are kept; litSide() picks the one to show.
+ * B_total = E + B_direct + B_indirect for elements, E the self-emission of the front side.
+ * B_direct comes from the shooting walks' first hits (from every light and emitter);
+ * B_indirect from final gathering of the patches' shooting solution. Both sides are kept;
+ * litSide() picks the one to show.
  */
 class Solution
 {
@@ -96,10 +127,15 @@ public:
   {
     return this->Indirect[this->elementIndex(frame, element, side)];
   }
+  /// Self-emission (W/m^2): the scene's emission on the front side, zero on the back.
+  Rgb emitted(std::size_t element, Side side) const
+  {
+    return side == Side::Front && !this->Emission.empty() ? this->Emission[element] : Rgb();
+  }
   Rgb total(std::size_t frame, std::size_t element, Side side) const
   {
     const std::size_t i = this->elementIndex(frame, element, side);
-    return this->Direct[i] + this->Indirect[i];
+    return this->emitted(element, side) + this->Direct[i] + this->Indirect[i];
   }
   /// The patch-level shooting solution (all bounces), which gathering reads.
   const Rgb& patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
@@ -126,10 +162,12 @@ public:
   std::vector<Rgb>& indirectData() { return this->Indirect; }
   std::vector<Rgb>& patchData() { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
+  /// One per element, or empty when nothing emits.
+  std::vector<Rgb>& emissionData() { return this->Emission; }
 
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
-  std::vector<Rgb> Direct, Indirect, Patch;
+  std::vector<Rgb> Direct, Indirect, Patch, Emission;
   std::vector<Side> LitSide;
 };
 
@@ -163,10 +201,15 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
 void validateOptions(const SolverOptions& options);
 
 /**
- * Solves every frame of the animation. Throws mlr::Error on bad options or a memory estimate
- * over the limit (checked before allocating), and mlr::Cancelled when the progress callback
- * asks to stop (within a few milliseconds: tasks are small).
+ * Solves every frame of the animation lit by `rig` and the scene's emissive surfaces.
+ * Throws mlr::Error on bad options or a memory estimate over the limit (checked before
+ * allocating), and mlr::Cancelled when the progress callback asks to stop (within a few
+ * milliseconds: tasks are small).
  */
+Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress = {});
+
+/// The same for one area light (and the scene's emitters).
 Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
   const ProgressCallback& progress = {});
 

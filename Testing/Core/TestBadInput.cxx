@@ -81,7 +81,7 @@ TEST(BadInput, DegenerateLight)
   const auto square = scenes::squareLightFacingDown({ 0, 0, 0 }, 1);
   expectError([&] { MovingLight(square, Rgb(1, -1, 1), frames); }, "light power");
   expectError([&] { MovingLight(square, Rgb(1, notANumber, 1), frames); }, "light power");
-  expectError([&] { MovingLight(square, Rgb(1), {}); }, "zero frames");
+  expectError([&] { MovingLight(square, Rgb(1), std::vector<Vec3>{}); }, "zero frames");
   expectError([&] { MovingLight(square, Rgb(1), { Vec3(0, infinity, 0) }); }, "light position 0");
 }
 

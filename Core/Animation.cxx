@@ -1,0 +1,100 @@
+#include "Animation.h"
+
+#include "Error.h"
+
+#include <sstream>
+
+namespace mlr
+{
+
+namespace
+{
+/// Share of the progress given to remeshing; the solve takes the rest.
+constexpr double RemeshingShare = 0.05;
+
+std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
+{
+  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+std::uint64_t outputBytes(const AnimationOptions& options, std::size_t elements, std::size_t points)
+{
+  const auto product = [](std::uint64_t a, std::uint64_t b) {
+    std::uint64_t p = 0;
+    return __builtin_mul_overflow(a, b, &p) ? UINT64_MAX : p;
+  };
+  return saturatingSum(product(options.outputBytesPerElement, elements),
+    product(options.outputBytesPerPoint, points));
+}
+}
+
+void checkMemory(std::uint64_t bytes, std::uint64_t limitBytes, const std::string& what,
+  const std::string& advice)
+{
+  const std::uint64_t limit = limitBytes > 0 ? limitBytes : defaultMemoryLimitBytes();
+  if (bytes <= limit)
+  {
+    return;
+  }
+  std::ostringstream s;
+  s.precision(3);
+  s << what << " needs an estimated " << static_cast<double>(bytes) / (1 << 30)
+    << " GiB, over the memory limit of " << static_cast<double>(limit) / (1 << 30)
+    << " GiB: " << advice << ", or raise the limit";
+  throw Error(s.str());
+}
+
+Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
+  const AnimationOptions& options, const ProgressCallback& progress)
+{
+  validateOptions(options.solver);
+  bool soupEmits = false;
+  for (const Material& m : soup.materials)
+  {
+    soupEmits = soupEmits || m.emission.maxComponent() > 0;
+  }
+  const std::size_t frames = frameCount(lights, soupEmits);
+
+  RemeshOptions remeshing = options.remeshing;
+  remeshing.memoryLimitBytes = options.solver.memoryLimitBytes;
+  // A solve that cannot fit is refused before remeshing does the work (CGAL may take a
+  // while), with the patch count remeshing expects once the polygons are triangulated,
+  // halved so that an estimate on the high side never refuses a solve that fits (the exact
+  // check follows remeshing).
+  remeshing.checkExpectedPatches = [&](std::size_t expected) {
+    const std::size_t patches = expected / 2;
+    checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
+                                     options.solver),
+                       outputBytes(options, 4 * patches, 2 * patches)),
+      frames, patches, 4 * patches, options.solver, true);
+  };
+  ProgressCallback remeshProgress;
+  if (progress)
+  {
+    remeshProgress = [&](double f) { return progress(RemeshingShare * f); };
+  }
+  RemeshResult remeshed = remesh(soup, remeshing, remeshProgress);
+
+  Animation animation;
+  animation.warnings = std::move(remeshed.warnings);
+  animation.remeshing = remeshed.statistics;
+  animation.scene = Scene::fromPatchMesh(remeshed.mesh);
+  animation.patches = std::move(remeshed.mesh);
+  const Scene& scene = animation.scene;
+  checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver),
+                     outputBytes(options, scene.elementCount(), scene.points().size())),
+    frames, scene.patchCount(), scene.elementCount(), options.solver);
+
+  ProgressCallback solveProgress;
+  if (progress)
+  {
+    solveProgress = [&](double f) { return progress(RemeshingShare + (1 - RemeshingShare) * f); };
+  }
+  animation.solution = solve(scene, lights, options.solver, solveProgress);
+  animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
+  animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
+    animation.solution.warnings.end());
+  return animation;
+}
+
+} // namespace mlr

@@ -1,0 +1,53 @@
+// Core's one entry point for an animation: scene polygons with materials and a light rig in,
+// per-frame radiosity of every element out.
+#pragma once
+
+#include "Remeshing.h"
+#include "Scene.h"
+#include "Solver.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mlr
+{
+
+struct AnimationOptions
+{
+  RemeshOptions remeshing;
+  SolverOptions solver;
+  /// What the caller will allocate for its outputs, per element and per point of the element
+  /// mesh: counted in the one memory check, before remeshing and again before solving.
+  std::uint64_t outputBytesPerElement = 0;
+  std::uint64_t outputBytesPerPoint = 0;
+};
+
+/// A solved animation: the patches, the scene built from them and every frame's radiosity.
+struct Animation
+{
+  PatchMesh patches;
+  Scene scene;
+  Solution solution;
+  RemeshStatistics remeshing;
+  /// Recoverable oddities from remeshing and solving, for the caller to show.
+  std::vector<std::string> warnings;
+};
+
+/**
+ * Remeshes `soup` (its materials' reflectance and emission) and solves every frame lit by
+ * `lights` and the scene's emissive surfaces. One memory policy covers the whole run: the
+ * limit of options.solver.memoryLimitBytes (0: half the physical memory) is checked before
+ * remeshing allocates (from the patch count it expects) and again before solving, with the
+ * caller's outputs included. Throws mlr::Error naming what to fix and mlr::Cancelled.
+ * Progress: remeshing takes the first 5%, solving the rest.
+ */
+Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
+  const AnimationOptions& options, const ProgressCallback& progress = {});
+
+/// Throws mlr::Error when `bytes` exceed the memory limit (0: the default), saying what they
+/// are for and what to reduce.
+void checkMemory(std::uint64_t bytes, std::uint64_t limitBytes, const std::string& what,
+  const std::string& advice);
+
+} // namespace mlr
