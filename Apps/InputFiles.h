@@ -1,10 +1,12 @@
-// Reading the scene, light and trajectory files, or the Cornell box compiled into the program.
+// Reading the scene, light and trajectory files (through the guarded reading of
+// GuardedRead/), or the Cornell box compiled into the program.
 #pragma once
+
+#include "GuardedRead.h"
 
 #include "vtkSmartPointer.h"
 
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 
 class vtkPolyData;
@@ -13,22 +15,14 @@ namespace mlr::cli
 {
 
 /// An input that cannot be used: the message names the file and the problem.
-class InputError : public std::runtime_error
-{
-public:
-  using std::runtime_error::runtime_error;
-};
+using InputError = mlr::guarded::InputError;
 
 /**
- * Reads a .vtp .vtu .vtk .obj .ply or .stl file as polygons (the surface of volumetric data),
- * keeping its cell arrays. `role` ("scene", "light", ...) names it in messages. Throws
- * InputError when the file is missing, unreadable or has no points.
- *
- * VTK's readers are not hardened against damaged files (fuzzing crashed several of them), so
- * the file is first checked (FileChecks.h) and then read in a child process, whose address
- * space is limited to `memoryLimitBytes` (0: half the physical memory) more than it starts
- * with; a child that crashes or runs out of memory costs only that file, with a message. The
- * child hands its result back as VTK XML in memory.
+ * Reads a .vtp .vtu .vtk .obj .ply or .stl file as polygons with mlr::guarded::readSurfaceFile:
+ * checked first, then read in a child process whose address space may grow by
+ * `memoryLimitBytes` (0: half the physical memory) and whose time is limited to 5 s of CPU
+ * time plus 1 s per MiB of file (4 times that of wall-clock time). `role` ("scene", "light",
+ * ...) names it in messages. Throws InputError.
  */
 vtkSmartPointer<vtkPolyData> readSurfaceFile(
   const std::string& path, const std::string& role, std::uint64_t memoryLimitBytes = 0);

@@ -1,14 +1,16 @@
-// libFuzzer target: arbitrary bytes -> a scene file as the command line reads it
-// (Apps/InputFiles.cxx: .vtp .vtu .vtk .obj .ply .stl, chosen by the first byte) -> the
-// vtkMovingLightRadiosity filter with a fixed light and a 2-frame trajectory, few paths and a
-// small memory limit.
+// libFuzzer target: arbitrary bytes -> a scene file read as the command line reads it, through
+// the guarded reading (Apps/GuardedRead: .vtp .obj .ply .stl .vtu .vtk, chosen by the first
+// byte modulo 6, in that order) -> the vtkMovingLightRadiosity filter with a fixed light and a
+// 2-frame trajectory, few paths and a small memory limit.
 //
-// A refused file (mlr::cli::InputError) or a filter error is a normal outcome. Findings are
-// crashes, sanitizer reports in our code, exceptions escaping, hangs and memory over
-// -rss_limit_mb. VTK's readers are not instrumented: a fault inside them shows as a crash
-// (SEGV), not as an ASan report, and InputFiles.cxx must refuse such files before VTK sees them.
-#include "InputFiles.h"
-#include "Messages.h"
+// A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
+// out of time in its child process) or a filter error is a normal outcome. Findings are crashes,
+// sanitizer reports in our code, exceptions escaping, hangs and memory over -rss_limit_mb.
+// VTK's readers are not instrumented: a fault inside them shows as a crash of the reading
+// process, and GuardedRead must turn it into a refusal. The reader's time limit here (1 s of
+// CPU time, 4 s in all, plus 1 s per MiB) stays well under the fuzzer's -timeout, so that a
+// reader that loops is refused, not reported as a hang: the replay in ctest must end.
+#include "GuardedRead.h"
 
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -18,6 +20,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkCellArray.h"
+#include "vtkLogger.h"
 
 #include <cmath>
 #include <cstdio>
@@ -45,11 +48,11 @@ struct Setup
 
   Setup()
   {
-    // Counts VTK's errors for readSurfaceFile, as in the command line; quiet unless asked.
-    mlr::cli::installMessageWindow("fuzz-readers");
+    // Quiet unless asked (GuardedRead counts VTK's errors either way).
     if (!std::getenv("MLR_FUZZ_VERBOSE"))
     {
       vtkObject::GlobalWarningDisplayOff();
+      vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
     }
     char pattern[] = "/tmp/mlr-fuzz-readers-XXXXXX";
     if (!mkdtemp(pattern))
@@ -96,9 +99,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   vtkSmartPointer<vtkPolyData> scene;
   try
   {
-    scene = mlr::cli::readSurfaceFile(path.string(), "scene");
+    mlr::guarded::ReadLimits limits;
+    limits.time.baseSeconds = 1;
+    scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits);
   }
-  catch (const mlr::cli::InputError&)
+  catch (const mlr::guarded::InputError&)
   {
     return 0;
   }

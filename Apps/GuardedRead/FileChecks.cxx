@@ -1,6 +1,6 @@
 #include "FileChecks.h"
 
-#include "InputFiles.h"
+#include "GuardedRead.h"
 
 #include <algorithm>
 #include <cctype>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-namespace mlr::cli
+namespace mlr::guarded
 {
 
 namespace
@@ -365,4 +365,4 @@ void checkPlyFile(const std::string& path, const std::string& what)
   }
 }
 
-} // namespace mlr::cli
+} // namespace mlr::guarded

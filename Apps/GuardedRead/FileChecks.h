@@ -6,7 +6,7 @@
 
 #include <string>
 
-namespace mlr::cli
+namespace mlr::guarded
 {
 
 /**
@@ -31,4 +31,4 @@ void checkStlFile(const std::string& path, const std::string& what);
  */
 void checkPlyFile(const std::string& path, const std::string& what);
 
-} // namespace mlr::cli
+} // namespace mlr::guarded
