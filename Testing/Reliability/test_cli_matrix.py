@@ -1,11 +1,14 @@
 """The bad-input matrix of issue 7 for the command line moving-light-radiosity: one row per kind
 of bad input, file or option. Every row asserts the exit status, the message and that no
 output file (nor a partial one) is left behind; rows that succeed assert what was written.
-The filter's rows are in TestFilterMatrix.cxx.
+The filter's rows are in TestFilterMatrix.cxx. No row may leave a process behind: this process
+adopts the orphans of the command line (PR_SET_CHILD_SUBREAPER), so that a reading process that
+outlived the command line would show up as its child.
 
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Reliability
 """
+import ctypes
 import os
 import sys
 import signal
@@ -26,6 +29,9 @@ from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
 
 import numpy
+
+HANG_REGRESSION = os.path.join(os.path.dirname(__file__), os.pardir, "Fuzz", "regressions",
+                               "readers", "vtk_legacy_reader_loops_forever")
 
 PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40", "--frames", "2"]
 OUTPUT = ["--output", "out/series.pvd"]
@@ -135,6 +141,14 @@ def trajectory(points):
     return make
 
 
+def fuzz_input(name, path):
+    """A fuzz regression of mlr-fuzz-readers as a file: its first byte only chose the extension."""
+    def make(directory):
+        with open(path, "rb") as regression:
+            (directory / name).write_bytes(regression.read()[1:])
+    return make
+
+
 def each(*makers):
     def make(directory):
         for m in makers:
@@ -187,6 +201,11 @@ ROWS = [
         "is a binary STL file whose header counts"),
     Row("stl_named_obj", each(binary_stl, copy_as("scene.obj", "scene.stl")),
         scene_args("scene.obj"), 1, "scene.obj"),
+    # VTK 9.2's legacy reader loops for ever on it: the CPU-time limit of the reading process
+    # (5 s for a small file; 20 s of wall-clock time) refuses it.
+    Row("legacy_vtk_reader_loops_forever", fuzz_input("scene.vtk", HANG_REGRESSION),
+        scene_args("scene.vtk"), 1,
+        "VTK's .vtk reader did not finish reading the scene file 'scene.vtk' within", seconds=40),
     Row("only_lines_and_points", text("scene.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2 3\np 1\n"),
         scene_args("scene.obj"), 1, "no polygons or triangle strips to light"),
     Row("one_triangle", text("scene.obj", "v 0 0 0\nv 0 0 0.6\nv 0.6 0 0\nf 1 2 3\n"),
@@ -241,6 +260,55 @@ ROWS = [
 ]
 
 
+# --- Processes ---------------------------------------------------------------------------
+PR_SET_CHILD_SUBREAPER = 36
+
+
+@pytest.fixture(autouse=True, scope="module")
+def adopt_orphans():
+    libc = ctypes.CDLL(None, use_errno=True)
+    assert libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0, os.strerror(ctypes.get_errno())
+    yield
+    libc.prctl(PR_SET_CHILD_SUBREAPER, 0, 0, 0, 0)
+
+
+def processes_left(seconds=0.0):
+    """The command lines of this process's children: after a run, processes the command line
+    left behind. Waits up to `seconds` for them to end (a process killed by its parent's death
+    ends a moment after it); the dead are reaped."""
+    deadline = time.monotonic() + seconds
+    while True:
+        try:
+            while os.waitpid(-1, os.WNOHANG)[0] != 0:
+                pass
+        except ChildProcessError:
+            return []
+        if time.monotonic() >= deadline:
+            break
+        time.sleep(0.05)
+    left = []
+    for pid in children_of(os.getpid()):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as cmdline:
+                left.append(cmdline.read().replace(b"\0", b" ").decode(errors="replace"))
+        except OSError:
+            continue  # ended meanwhile
+    return left
+
+
+def children_of(parent):
+    children = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/stat") as stat:
+                # pid (comm) state ppid ...: comm may hold spaces and parentheses
+                if int(stat.read().rsplit(")", 1)[1].split()[1]) == parent:
+                    children.append(int(pid))
+        except (OSError, IndexError, ValueError):
+            continue  # ended meanwhile
+    return children
+
+
 def all_radiosity_zero(directory):
     for name in os.listdir(directory):
         if name.endswith(".vtu"):
@@ -265,6 +333,7 @@ def test_row(tmp_path, row):
     assert row.message in output, result.stderr
     assert seconds < row.seconds
     assert "returned failure" not in result.stderr  # no pipeline dumps
+    assert processes_left() == []
     written = [f for f in all_files(tmp_path) if f not in inputs]
     assert not [f for f in written if ".partial" in f or ".mlr-write-test" in f], written
     if row.status == 0:
@@ -341,6 +410,37 @@ def test_interrupt_mid_solve_writes_nothing(tmp_path, sig):
     assert process.returncode == 1, stderr
     assert "interrupted: nothing was written" in stderr
     assert all_files(tmp_path) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL],
+                         ids=["SIGINT", "SIGTERM", "SIGKILL"])
+def test_ending_the_program_while_it_reads_leaves_no_process(tmp_path, sig):
+    """Ended while its reading process loops in VTK's legacy reader: an interrupt stops the
+    reading at once; SIGKILL cannot be caught, and the reading process dies with the program."""
+    fuzz_input("scene.vtk", HANG_REGRESSION)(tmp_path)
+    process = subprocess.Popen(
+        [CLI] + scene_args("scene.vtk") + ["--output", "out/series.pvd"],
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for _ in range(200):  # up to 10 s for the reading process to start
+        if children_of(process.pid):
+            break
+        time.sleep(0.05)
+    assert children_of(process.pid), "no reading process"
+    process.send_signal(sig)
+    process.wait(timeout=30)
+    # The reading process has used well under its 5 s of CPU time: if it ends within 2 s, its
+    # parent's death ended it, not its own limit.
+    left = processes_left(seconds=2)
+    for pid in children_of(os.getpid()):
+        os.kill(pid, signal.SIGKILL)
+    assert left == []
+    stdout, stderr = process.communicate(timeout=30)
+    if sig == signal.SIGKILL:
+        assert process.returncode == -signal.SIGKILL
+    else:
+        assert process.returncode == 1, stderr
+        assert "interrupted while reading the scene file 'scene.vtk': nothing was written" in stderr
+    assert all_files(tmp_path) == ["scene.vtk"]
 
 
 def test_failed_run_keeps_the_previous_series(tmp_path):
