@@ -237,7 +237,7 @@ bool parseMtlColour(const std::string& rest, std::array<double, 3>& rgb)
 }
 
 /// The materials of an MTL file by name; the first definition of a name wins.
-std::map<std::string, MtlMaterial> readMtl(const std::string& path, const Warn& warn)
+std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::string& objPath, const Warn& warn)
 {
   std::ifstream in = openFile(path, "material library");
   std::map<std::string, MtlMaterial> materials;
@@ -248,7 +248,8 @@ std::map<std::string, MtlMaterial> readMtl(const std::string& path, const Warn& 
   while (lines.next(line))
   {
     splitKeyword(line, keyword, rest);
-    const std::string where = "the material library " + named(path) + ", line " + std::to_string(lines.number());
+    const std::string where = "the material library " + named(path) + " of the OBJ file " + named(objPath) +
+      ", line " + std::to_string(lines.number());
     if (keyword == "newmtl")
     {
       if (rest.empty())
@@ -489,7 +490,7 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
         std::to_string(lineNumber) + ") does not exist: its materials are grey 0.5 and do not emit");
       continue;
     }
-    for (auto& [name, material] : readMtl(file, warn))
+    for (auto& [name, material] : readMtl(file, path, warn))
     {
       library.emplace(name, material);
     }
@@ -1199,6 +1200,20 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
   const Json root = readGltfJson(path, glb, binBytes);
   GltfChecks checks(root, path);
   checks.run(glb, binBytes);
+  std::size_t surfaces = 0, others = 0;
+  for (const auto& mesh : checks.array("meshes"))
+  {
+    for (const auto& primitive : mesh["primitives"])
+    {
+      (checks.integer(primitive, "mode", "a primitive", 4) >= 4 ? surfaces : others) += 1;
+    }
+  }
+  if (surfaces == 0)
+  {
+    throw FileError("the glTF file " + named(path) + " has no triangles" +
+      (others > 0 ? " (only points or lines: " + std::to_string(others) + " primitives)" : std::string()) +
+      ": there is no surface to light");
+  }
   poll(0.1);
 
   vtkNew<vtkGLTFDocumentLoader> loader;

@@ -1,0 +1,556 @@
+// vtkRadiositySceneReader (issue 13): materials from OBJ+MTL, glTF and PLY files written here,
+// the same reflectances from every format, and bad input with an error naming the file.
+#include "FilterTestSupport.h"
+
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkPolyData.h"
+#include "vtkRadiositySceneReader.h"
+#include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace mlr::testing;
+
+namespace
+{
+namespace fs = std::filesystem;
+constexpr double Pi = 3.14159265358979323846;
+
+/// A fresh folder for one test's files.
+fs::path testFolder(const std::string& name)
+{
+  const fs::path folder = fs::temp_directory_path() / ("mlr-scene-reader-" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+void writeFile(const fs::path& path, const std::string& text)
+{
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+struct ReadResult
+{
+  bool succeeded = false;
+  vtkSmartPointer<vtkPolyData> output;
+  vtkSmartPointer<MessageRecorder> messages;
+  std::string errors() const { return this->messages->allErrors(); }
+  std::string warnings() const { return this->messages->allWarnings(); }
+};
+
+ReadResult readScene(const fs::path& path)
+{
+  ReadResult result;
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  reader->SetFileName(path.string().c_str());
+  result.messages = vtkSmartPointer<MessageRecorder>::New();
+  result.messages->watch(reader);
+  result.succeeded = reader->GetExecutive()->Update() != 0;
+  result.output = reader->GetOutput();
+  return result;
+}
+
+std::array<double, 3> tuple3(vtkPolyData* mesh, const char* name, vtkIdType cell)
+{
+  vtkDataArray* array = mesh->GetCellData()->GetArray(name);
+  std::array<double, 3> value{ { NAN, NAN, NAN } };
+  if (array && array->GetNumberOfComponents() == 3 && cell < array->GetNumberOfTuples())
+  {
+    array->GetTuple(cell, value.data());
+  }
+  return value;
+}
+
+std::vector<std::string> materialNames(vtkPolyData* mesh)
+{
+  std::vector<std::string> names;
+  auto* array = vtkStringArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray("MaterialNames"));
+  for (vtkIdType i = 0; array && i < array->GetNumberOfValues(); ++i)
+  {
+    names.push_back(array->GetValue(i));
+  }
+  return names;
+}
+
+std::string stringField(vtkPolyData* mesh, const char* name)
+{
+  auto* array = vtkStringArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(name));
+  return array && array->GetNumberOfValues() == 1 ? array->GetValue(0) : std::string();
+}
+
+int materialId(vtkPolyData* mesh, vtkIdType cell)
+{
+  vtkDataArray* array = mesh->GetCellData()->GetArray("MaterialId");
+  return array ? static_cast<int>(array->GetComponent(cell, 0)) : -1;
+}
+
+void expectRgbNear(const std::array<double, 3>& actual, double r, double g, double b,
+  double tolerance, const std::string& context = "")
+{
+  SCOPED_TRACE(context);
+  EXPECT_NEAR(actual[0], r, tolerance);
+  EXPECT_NEAR(actual[1], g, tolerance);
+  EXPECT_NEAR(actual[2], b, tolerance);
+}
+
+// --- The two-material scene every format describes ------------------------------------------
+// A white floor (z = 0) and a red wall (x = 0), one unit square each, two triangles each.
+const double White[3] = { 0.725, 0.71, 0.68 };
+const double Red[3] = { 0.63, 0.065, 0.05 };
+const float Corners[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, // floor
+  { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 1 }, { 0, 0, 1 } };                          // wall
+const std::uint16_t Triangles[4][3] = { { 0, 1, 2 }, { 0, 2, 3 }, { 4, 5, 6 }, { 4, 6, 7 } };
+
+void expectTwoMaterialScene(vtkPolyData* mesh, double tolerance)
+{
+  ASSERT_EQ(mesh->GetNumberOfCells(), 4);
+  for (vtkIdType cell = 0; cell < 4; ++cell)
+  {
+    const double* kd = cell < 2 ? White : Red;
+    expectRgbNear(tuple3(mesh, "Reflectance", cell), kd[0], kd[1], kd[2], tolerance,
+      "cell " + std::to_string(cell));
+    expectRgbNear(tuple3(mesh, "Emission", cell), 0, 0, 0, 0);
+  }
+}
+
+std::string base64(const std::string& bytes)
+{
+  static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string text;
+  for (std::size_t i = 0; i < bytes.size(); i += 3)
+  {
+    std::uint32_t chunk = static_cast<std::uint8_t>(bytes[i]) << 16;
+    chunk |= i + 1 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 1]) << 8 : 0;
+    chunk |= i + 2 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 2]) : 0;
+    text += alphabet[(chunk >> 18) & 63];
+    text += alphabet[(chunk >> 12) & 63];
+    text += i + 1 < bytes.size() ? alphabet[(chunk >> 6) & 63] : '=';
+    text += i + 2 < bytes.size() ? alphabet[chunk & 63] : '=';
+  }
+  return text;
+}
+
+/// The buffer of the glTF scene: 8 float positions, then 12 uint16 indices.
+std::string gltfBuffer()
+{
+  std::string bytes(sizeof(Corners) + sizeof(Triangles), '\0');
+  std::memcpy(bytes.data(), Corners, sizeof(Corners));
+  std::memcpy(bytes.data() + sizeof(Corners), Triangles, sizeof(Triangles));
+  return bytes;
+}
+
+/// The glTF JSON of the two-material scene: one mesh, a primitive per material, under a node
+/// translated by `translation`. `bufferUri` empty: the .glb BIN chunk.
+std::string gltfJson(const std::string& bufferUri, const std::string& extra = "",
+  const std::string& translation = "[0, 0, 0]", int mode = 4)
+{
+  const std::string uri = bufferUri.empty() ? "" : R"("uri": ")" + bufferUri + R"(", )";
+  return R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"translation": )" + translation + R"(, "children": [1]}, {"mesh": 0}],
+  "meshes": [{"primitives": [
+    {"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": )" + std::to_string(mode) + R"(},
+    {"attributes": {"POSITION": 0}, "indices": 2, "material": 1, "mode": )" + std::to_string(mode) + R"(}]}],
+  "materials": [
+    {"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}},
+    {"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}}],
+  "buffers": [{)" + uri + R"("byteLength": 120}],
+  "bufferViews": [
+    {"buffer": 0, "byteOffset": 0, "byteLength": 96},
+    {"buffer": 0, "byteOffset": 96, "byteLength": 24}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+     "min": [0, 0, 0], "max": [1, 1, 1]},
+    {"bufferView": 1, "byteOffset": 0, "componentType": 5123, "count": 6, "type": "SCALAR"},
+    {"bufferView": 1, "byteOffset": 12, "componentType": 5123, "count": 6, "type": "SCALAR"}])" +
+    extra + "\n}\n";
+}
+
+std::string dataUri(const std::string& bytes)
+{
+  return "data:application/octet-stream;base64," + base64(bytes);
+}
+
+void put32(std::string& out, std::uint32_t value)
+{
+  for (int i = 0; i < 4; ++i)
+  {
+    out += static_cast<char>((value >> (8 * i)) & 0xff);
+  }
+}
+
+std::string glbFile(std::string json, std::string bin)
+{
+  while (json.size() % 4)
+  {
+    json += ' ';
+  }
+  while (bin.size() % 4)
+  {
+    bin += '\0';
+  }
+  std::string out = "glTF";
+  put32(out, 2);
+  put32(out, static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
+  put32(out, static_cast<std::uint32_t>(json.size()));
+  out += "JSON" + json;
+  put32(out, static_cast<std::uint32_t>(bin.size()));
+  out += std::string("BIN\0", 4) + bin;
+  return out;
+}
+
+std::string twoMaterialObj(const std::string& mtllib)
+{
+  std::string text = mtllib.empty() ? "" : "mtllib " + mtllib + "\n";
+  for (const auto& corner : Corners)
+  {
+    text += "v " + std::to_string(corner[0]) + " " + std::to_string(corner[1]) + " " +
+      std::to_string(corner[2]) + "\n";
+  }
+  return text + "usemtl white\nf 1 2 3\nf 1 3 4\nusemtl red\nf 5 6 7\nf 5 7 8\n";
+}
+} // namespace
+
+// --- OBJ + MTL --------------------------------------------------------------------------------
+
+TEST(SceneReader, ObjMaterialsGiveReflectanceEmissionAndIds)
+{
+  const fs::path folder = testFolder("obj");
+  writeFile(folder / "room.mtl", R"(# two reflectors, a lamp and a glowing panel
+newmtl white
+Kd 0.725 0.71 0.68
+Ka 0 0 0
+newmtl red
+Kd 0.63 0.065 0.05
+newmtl light
+Kd 0.78 0.78 0.78
+Ke 17 12 4
+newmtl glow
+Kd 0.2
+Ke 0.5 0.25 0.125
+)");
+  // The first face after each usemtl has no texture or normal indices (VTK 9.2's vtkOBJReader
+  // gives those NO_MATERIAL); others use v/vt/vn, v//vn, negative indices and a continuation.
+  writeFile(folder / "room.obj", R"(mtllib room.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vt 0 0
+vn 0 0 1
+usemtl white
+f 1 2 3
+f 1/1/1 3/1/1 4/1/1
+usemtl red
+f 1 4 \
+  3
+v 0.4 0.4 0.99
+v 0.6 0.4 0.99
+v 0.6 0.6 0.99
+v 0.4 0.6 0.99
+usemtl light
+f -1 -2 -3 -4
+usemtl glow
+f 1//1 2//1 3//1
+usemtl white
+f 4 3 2
+)");
+  const ReadResult result = readScene(folder / "room.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.errors(), "");
+  EXPECT_EQ(result.warnings(), "");
+  vtkPolyData* mesh = result.output;
+  ASSERT_EQ(mesh->GetNumberOfPoints(), 8);
+  ASSERT_EQ(mesh->GetNumberOfCells(), 6);
+  EXPECT_EQ(mesh->GetCell(3)->GetNumberOfPoints(), 4);
+  EXPECT_EQ(materialNames(mesh), (std::vector<std::string>{ "white", "red", "light", "glow" }));
+  const int expectedIds[6] = { 0, 0, 1, 2, 3, 0 };
+  for (vtkIdType cell = 0; cell < 6; ++cell)
+  {
+    EXPECT_EQ(materialId(mesh, cell), expectedIds[cell]) << "cell " << cell;
+  }
+  expectRgbNear(tuple3(mesh, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(mesh, "Reflectance", 1), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(mesh, "Reflectance", 2), 0.63, 0.065, 0.05, 1e-12);
+  expectRgbNear(tuple3(mesh, "Reflectance", 3), 0.78, 0.78, 0.78, 1e-12);
+  expectRgbNear(tuple3(mesh, "Reflectance", 4), 0.2, 0.2, 0.2, 1e-12);
+  expectRgbNear(tuple3(mesh, "Reflectance", 5), 0.725, 0.71, 0.68, 1e-12);
+  // Ke is radiance: the exitance is pi x Ke, so the lamp emits pi x Ke x area watts.
+  for (vtkIdType cell : { 0, 1, 2, 5 })
+  {
+    expectRgbNear(tuple3(mesh, "Emission", cell), 0, 0, 0, 0, "cell " + std::to_string(cell));
+  }
+  expectRgbNear(tuple3(mesh, "Emission", 3), 17 * Pi, 12 * Pi, 4 * Pi, 1e-9);
+  expectRgbNear(tuple3(mesh, "Emission", 4), 0.5 * Pi, 0.25 * Pi, 0.125 * Pi, 1e-12);
+  const double lampArea = triangleArea(mesh, 3); // 0.2 m square: 0.04 m^2 (first triangle: half)
+  EXPECT_NEAR(lampArea, 0.02, 1e-9);
+  EXPECT_EQ(stringField(mesh, "EmissionUnits"), "W/m^2");
+  EXPECT_EQ(stringField(mesh, "SceneFormat"), "OBJ");
+}
+
+TEST(SceneReader, ReflectanceOfOneIsClampedWithAWarningNamingTheMaterial)
+{
+  const fs::path folder = testFolder("clamp");
+  writeFile(folder / "scene.mtl", "newmtl paper\nKd 1 1 1\nnewmtl red\nKd 0.63 0.065 0.05\n");
+  writeFile(folder / "scene.obj",
+    "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paper\nf 1 2 3\nusemtl red\nf 1 3 2\n");
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.99, 0.99, 0.99, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 1), 0.63, 0.065, 0.05, 1e-12);
+  ASSERT_EQ(result.messages->warnings.size(), 1u) << result.warnings();
+  EXPECT_NE(result.warnings().find("'paper'"), std::string::npos) << result.warnings();
+  EXPECT_NE(result.warnings().find("clamped to 0.99"), std::string::npos) << result.warnings();
+}
+
+TEST(SceneReader, MissingMtlFallsBackToGreyWithAWarningNamingTheFile)
+{
+  const fs::path folder = testFolder("missing-mtl");
+  writeFile(folder / "scene.obj", twoMaterialObj("absent.mtl"));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.errors(), "");
+  EXPECT_NE(result.warnings().find((folder / "absent.mtl").string()), std::string::npos)
+    << result.warnings();
+  EXPECT_NE(result.warnings().find("grey 0.5"), std::string::npos) << result.warnings();
+  ASSERT_EQ(result.output->GetNumberOfCells(), 4);
+  for (vtkIdType cell = 0; cell < 4; ++cell)
+  {
+    expectRgbNear(tuple3(result.output, "Reflectance", cell), 0.5, 0.5, 0.5, 0);
+  }
+  EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "red" }));
+}
+
+TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
+{
+  const fs::path folder = testFolder("undefined-material");
+  writeFile(folder / "scene.mtl", "newmtl white\nKd 0.725 0.71 0.68\n");
+  writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_NE(result.warnings().find("'red'"), std::string::npos) << result.warnings();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 0);
+}
+
+// --- The same scene in every format -----------------------------------------------------------
+
+TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
+{
+  const fs::path folder = testFolder("formats");
+  writeFile(folder / "scene.mtl",
+    "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
+  writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
+  writeFile(folder / "scene.gltf", gltfJson(dataUri(gltfBuffer())));
+  writeFile(folder / "scene.glb", glbFile(gltfJson(""), gltfBuffer()));
+
+  // PLY, ASCII with float face colours (exact) and binary with 8-bit vertex colours.
+  std::string ascii = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+                      "property float red\nproperty float green\nproperty float blue\nend_header\n";
+  for (const auto& corner : Corners)
+  {
+    ascii += std::to_string(corner[0]) + " " + std::to_string(corner[1]) + " " + std::to_string(corner[2]) + "\n";
+  }
+  for (int f = 0; f < 4; ++f)
+  {
+    const double* kd = f < 2 ? White : Red;
+    ascii += "3 " + std::to_string(Triangles[f][0]) + " " + std::to_string(Triangles[f][1]) + " " +
+      std::to_string(Triangles[f][2]) + " " + std::to_string(kd[0]) + " " + std::to_string(kd[1]) +
+      " " + std::to_string(kd[2]) + "\n";
+  }
+  writeFile(folder / "faces.ply", ascii);
+  std::string binary = "ply\nformat binary_little_endian 1.0\ncomment per-vertex colours\n"
+                       "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                       "element face 4\nproperty list uchar uint vertex_indices\nend_header\n";
+  for (int v = 0; v < 8; ++v)
+  {
+    binary.append(reinterpret_cast<const char*>(Corners[v]), 12);
+    const double* kd = v < 4 ? White : Red;
+    for (int c = 0; c < 3; ++c)
+    {
+      binary += static_cast<char>(static_cast<int>(std::lround(kd[c] * 255)));
+    }
+  }
+  for (const auto& triangle : Triangles)
+  {
+    binary += static_cast<char>(3);
+    for (std::uint16_t index : triangle)
+    {
+      const std::uint32_t wide = index;
+      binary.append(reinterpret_cast<const char*>(&wide), 4);
+    }
+  }
+  writeFile(folder / "vertices.ply", binary);
+
+  const ReadResult obj = readScene(folder / "scene.obj");
+  ASSERT_TRUE(obj.succeeded) << obj.errors();
+  expectTwoMaterialScene(obj.output, 1e-6);
+  for (const char* name : { "scene.gltf", "scene.glb", "faces.ply", "vertices.ply" })
+  {
+    SCOPED_TRACE(name);
+    const ReadResult other = readScene(folder / name);
+    ASSERT_TRUE(other.succeeded) << other.errors();
+    EXPECT_EQ(other.errors(), "");
+    EXPECT_EQ(other.warnings(), "");
+    // 8-bit colours are the reflectance to within half a step.
+    expectTwoMaterialScene(other.output, std::string(name) == "vertices.ply" ? 0.5 / 255 : 1e-6);
+    for (vtkIdType cell = 0; cell < 4; ++cell)
+    {
+      expectRgbNear(tuple3(other.output, "Reflectance", cell),
+        tuple3(obj.output, "Reflectance", cell)[0], tuple3(obj.output, "Reflectance", cell)[1],
+        tuple3(obj.output, "Reflectance", cell)[2], 0.5 / 255);
+    }
+  }
+  const ReadResult gltf = readScene(folder / "scene.gltf");
+  EXPECT_EQ(materialNames(gltf.output), (std::vector<std::string>{ "white", "red" }));
+  EXPECT_EQ(materialId(gltf.output, 0), 0);
+  EXPECT_EQ(materialId(gltf.output, 3), 1);
+  EXPECT_EQ(stringField(gltf.output, "SceneFormat"), "glTF");
+  EXPECT_EQ(stringField(readScene(folder / "faces.ply").output, "SceneFormat"), "PLY");
+  EXPECT_EQ(materialNames(readScene(folder / "faces.ply").output), (std::vector<std::string>{ "faces" }));
+}
+
+TEST(SceneReader, GltfNodeTransformsAndEmission)
+{
+  const fs::path folder = testFolder("gltf-emission");
+  // The red material emits (1, 0.5, 0.25) x strength 4 as radiance, like Ke 4 2 1.
+  std::string json = gltfJson(dataUri(gltfBuffer()), "", "[1, 2, 3]");
+  const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
+  json.replace(json.find(red), red.size(),
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]},
+        "emissiveFactor": [1, 0.5, 0.25],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})");
+  json.replace(json.find(R"("scene": 0,)"), 11,
+    R"("scene": 0, "extensionsUsed": ["KHR_materials_emissive_strength"],)");
+  writeFile(folder / "lamp.gltf", json);
+  const ReadResult result = readScene(folder / "lamp.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.warnings(), "");
+  vtkPolyData* mesh = result.output;
+  ASSERT_EQ(mesh->GetNumberOfCells(), 4);
+  expectRgbNear(tuple3(mesh, "Emission", 0), 0, 0, 0, 0);
+  expectRgbNear(tuple3(mesh, "Emission", 2), 4 * Pi, 2 * Pi, 1 * Pi, 1e-6);
+  double bounds[6];
+  mesh->GetBounds(bounds);
+  EXPECT_NEAR(bounds[0], 1, 1e-6);
+  EXPECT_NEAR(bounds[1], 2, 1e-6);
+  EXPECT_NEAR(bounds[2], 2, 1e-6);
+  EXPECT_NEAR(bounds[5], 4, 1e-6);
+}
+
+// --- Bad input: an error naming the file and what is wrong, an empty output -------------------
+
+struct BadFile
+{
+  const char* name;
+  std::string content;
+  const char* expected; ///< a piece of the error
+};
+
+TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
+{
+  const fs::path folder = testFolder("bad");
+  const std::string buffer = gltfBuffer();
+  std::string lines = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 1);
+  std::string points = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 0);
+  std::string outside = gltfJson(dataUri(buffer));
+  outside.replace(outside.find(R"("count": 8)"), 10, R"("count": 9)");
+  std::string cycle = gltfJson(dataUri(buffer));
+  cycle.replace(cycle.find(R"({"mesh": 0})"), 11, R"({"mesh": 0, "children": [0]})");
+  std::string glb = glbFile(gltfJson(""), buffer);
+  const std::vector<BadFile> files = {
+    { "lines.gltf", lines, "only points or lines" },
+    { "points.gltf", points, "only points or lines" },
+    { "broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [", "is not valid JSON" },
+    { "outside.gltf", outside, "accessors[0]" },
+    { "cycle.gltf", cycle, "cycle through node" },
+    { "truncated.glb", glb.substr(0, glb.size() - 10), "truncated or damaged" },
+    { "empty.gltf", R"({"asset": {"version": "2.0"}})", "no triangles" },
+    { "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4: a face names vertex 4" },
+    { "negative.obj", "v 0 0 0\nf -1 -2 -3\n", "names vertex -2" },
+    { "word.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "'x' is not a vertex reference" },
+    { "nan.obj", "v 0 nan 0\n", "line 1: 'v 0 nan 0' is not a vertex" },
+    { "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", "has no faces" },
+    { "badkd.obj", "mtllib badkd.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
+      "'Kd red' is not a colour" },
+    { "notply.ply", "solid cube\n", "does not start with 'ply'" },
+    { "novertex.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n3 0 1 2\n",
+      "no element 'vertex'" },
+    { "short.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n",
+      "truncated" },
+    { "faceindex.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
+      "names vertex 7" },
+    { "scene.stl", "solid x\nendsolid x\n", "extension '.stl'" },
+  };
+  writeFile(folder / "badkd.mtl", "newmtl m\nKd red\n");
+  for (const BadFile& file : files)
+  {
+    SCOPED_TRACE(file.name);
+    writeFile(folder / file.name, file.content);
+    const ReadResult result = readScene(folder / file.name);
+    EXPECT_FALSE(result.succeeded);
+    ASSERT_FALSE(result.messages->errors.empty());
+    EXPECT_NE(result.errors().find((folder / file.name).string()), std::string::npos) << result.errors();
+    EXPECT_NE(result.errors().find(file.expected), std::string::npos) << result.errors();
+    EXPECT_EQ(result.output->GetNumberOfCells(), 0);
+    EXPECT_EQ(result.output->GetNumberOfPoints(), 0);
+  }
+}
+
+TEST(SceneReader, MissingFileAndNoFileNameAreErrors)
+{
+  const fs::path folder = testFolder("missing");
+  const ReadResult missing = readScene(folder / "nowhere.obj");
+  EXPECT_FALSE(missing.succeeded);
+  EXPECT_NE(missing.errors().find("nowhere.obj' does not exist"), std::string::npos) << missing.errors();
+
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(reader);
+  EXPECT_EQ(reader->GetExecutive()->Update(), 0);
+  EXPECT_NE(messages->allErrors().find("no FileName"), std::string::npos) << messages->allErrors();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+
+  EXPECT_TRUE(vtkRadiositySceneReader::CanReadFile("a/B.OBJ"));
+  EXPECT_TRUE(vtkRadiositySceneReader::CanReadFile("scene.glb"));
+  EXPECT_FALSE(vtkRadiositySceneReader::CanReadFile("scene.stl"));
+}
+
+TEST(SceneReader, ABadFileAfterAGoodOneLeavesNoStaleOutput)
+{
+  const fs::path folder = testFolder("stale");
+  writeFile(folder / "good.obj", twoMaterialObj(""));
+  writeFile(folder / "bad.obj", "v 0 0 0\nf 1 2 3\n");
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(reader);
+  reader->SetFileName((folder / "good.obj").string().c_str());
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 4);
+  EXPECT_NE(messages->allWarnings().find("no material library"), std::string::npos);
+  reader->SetFileName((folder / "bad.obj").string().c_str());
+  reader->Update();
+  EXPECT_FALSE(messages->errors.empty());
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+}
