@@ -11,9 +11,11 @@ Filters > Radiosity > Moving Light Radiosity, then save
   DIR/cornell.pvd + DIR/cornell/*.vtu   the Elements of every light position (MergeBlocks +
                                         File > Save Data with "Write Time Steps"), for ParaView,
                                         VisIt or any VTK reader;
-  DIR/png/frame_0000.png ...            one picture per light position, in colour: each
-                                        element's RGB radiosity, smoothed at the points and
-                                        tone mapped like the command line's pictures.
+  DIR/png/frame_0000.png ...            one picture per light position, as Apply shows it:
+                                        the Elements in their display colours (point array
+                                        Color: the radiosity smoothed at the points, exposed
+                                        once for the whole animation, ACES filmic tone map,
+                                        sRGB) and the Light output, the lamp, in yellow.
 
 DIR defaults to output/paraview. The plugin defaults to the one built in build/ (or in
 $MLR_BUILD_DIR); a plugin already loaded through PV_PLUGIN_PATH is used as it is.
@@ -21,6 +23,7 @@ $MLR_BUILD_DIR); a plugin already loaded through PV_PLUGIN_PATH is used as it is
 import argparse
 import ctypes
 import glob
+import math
 import os
 import sys
 import time
@@ -92,9 +95,6 @@ x_connection = hold_x_display()
 
 # Only now: importing paraview.simple starts ParaView, which --help need not wait for.
 import paraview.simple as pv  # noqa: E402
-from paraview import servermanager  # noqa: E402
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
-import numpy  # noqa: E402
 
 if not hasattr(pv, PLUGIN_NAME):
     plugin = args.plugin or default_plugin()
@@ -135,41 +135,15 @@ pv.SaveData(series, proxy=merged, WriteTimeSteps=1)
 print(f"wrote {series} and {len(times)} .vtu files in {os.path.join(args.output, 'cornell')}")
 
 # --- The pictures -----------------------------------------------------------------------------
-# As the command line renders them: the crease-split mesh carries the radiosity to its points
-# (smooth within a wall, sharp where walls meet, and less Monte Carlo noise), and each RGB
-# channel is tone mapped 1 - exp(-2 B / B99) with B99 the 99th percentile of the luminance
-# over all frames, then gamma 2.2, into an unsigned-char colour shown as is.
-bright = 0.0
-for t in times:
-    radiosity.UpdatePipeline(time=t)
-    rgb = vtk_to_numpy(servermanager.Fetch(radiosity).GetCellData().GetArray("Radiosity"))
-    bright = max(bright, float(numpy.percentile(rgb @ numpy.array([0.2126, 0.7152, 0.0722]), 99)))
-exposure = 2.0 / bright if bright > 0 else 1.0
-
-creases = pv.GenerateSurfaceNormals(Input=radiosity, FeatureAngle=30.0, Splitting=1,
-                                    Consistency=0, ComputeCellNormals=0)
-smooth = pv.CellDatatoPointData(Input=creases, ProcessAllArrays=0,
-                                CellDataArraytoprocess=["Radiosity"])
-# An unsigned-char result is what ParaView shows as colours without a colour map.
-colour = pv.PythonCalculator(
-    registrationName="Colour", Input=smooth, ArrayAssociation="Point Data", ArrayName="Colour",
-    Expression=f"(255.0 * (1.0 - exp(-{exposure!r} * Radiosity)) ** (1 / 2.2) + 0.5).astype('uint8')")
-moving_light = pv.Transform(registrationName="Light", Input=light)
-
+# Shown as Apply shows them: the filter's Elements in true colours (its point array Color, Map
+# Scalars off, unlit) and its Light output, the lamp where it is in each frame, in yellow.
 view = pv.CreateRenderView()
 view.ViewSize = [args.size, args.size]
 view.OrientationAxesVisibility = 0
 view.UseColorPaletteForBackground = 0
 view.Background = [0.0, 0.0, 0.0]
-
-room = pv.Show(colour, view)
-pv.ColorBy(room, ("POINTS", "Colour"))
-room.MapScalars = 0  # the colours are the picture: no colour map
-room.Ambient, room.Diffuse = 1.0, 0.0  # radiosity already is the lighting
-lamp = pv.Show(moving_light, view)
-lamp.ColorArrayName = ["POINTS", ""]  # solid colour
-lamp.AmbientColor = lamp.DiffuseColor = [1.0, 1.0, 1.0]
-lamp.Ambient, lamp.Diffuse = 1.0, 0.0
+room = pv.Show(radiosity, view)
+lamp = pv.Show(pv.OutputPort(radiosity, 2), view)
 
 # The Cornell box camera (35 mm lens, 25 mm film): along +z, the front face filling the view.
 bounds = scene.GetDataInformation().GetBounds()
@@ -178,7 +152,7 @@ half = max(bounds[1] - bounds[0], bounds[3] - bounds[2]) / 2
 view.CameraViewAngle = 39.3
 view.CameraFocalPoint = centre
 view.CameraPosition = [centre[0], centre[1],
-                       bounds[4] - half / numpy.tan(numpy.radians(39.3 / 2))]
+                       bounds[4] - half / math.tan(math.radians(39.3 / 2))]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 
 animation = pv.GetAnimationScene()
@@ -187,11 +161,6 @@ pictures = os.path.join(args.output, "png")
 os.makedirs(pictures, exist_ok=True)
 for index, t in enumerate(times):
     animation.AnimationTime = t
-    radiosity.UpdatePipeline(time=t)
-    # The light's displacement in this frame, from the filter's field data.
-    translation = radiosity.GetDataInformation().DataInformation.GetFieldDataInformation() \
-        .GetArrayInformation("LightTranslation")
-    moving_light.Transform.Translate = [translation.GetComponentRange(c)[0] for c in range(3)]
     pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
                       ImageResolution=[args.size, args.size])
 print(f"wrote {len(times)} pictures in {pictures}")

@@ -78,9 +78,9 @@ std::array<unsigned char, 3> displayColor(const Rgb& radiosity, double exposureS
 /// steps of 1/64 EV; 0 when nothing is lit.
 double autoExposure(const Solution& solution);
 
-/// The exposed value the 99th percentile maps to: acesFilmic(2) = 0.92, bright but short of
-/// white, so that the hot spot under the light keeps some gradation.
-constexpr double AutoExposureTarget = 2.0;
+/// The exposed value the 99th percentile maps to: acesFilmic(1) = 0.80 (sRGB 231 of 255),
+/// bright but short of white, so that brighter spots (under the light) keep some gradation.
+constexpr double AutoExposureTarget = 1.0;
 
 /**
  * The element mesh prepared for smooth shading: each scene point is split into one point

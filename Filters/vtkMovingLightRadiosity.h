@@ -9,20 +9,37 @@
  *
  * Inputs:
  * - port 0, Scene (required): polygons and triangle strips; vertices and lines are ignored
- *   with a warning. The cell array `Reflectance` gives each cell's reflectance (3 components,
- *   RGB, or 1 component, grey; every value >= 0 and < 1). Without it the scene is grey 0.5
- *   and a warning says so. The scene is remeshed into patches of about PatchSize.
- * - port 1, Light (required): one or more planar polygons emitting diffusely along their
- *   normals (right-hand rule) with total power LightPower. Its area centroid is the light's
- *   reference point. The light does not cast shadows.
- * - port 2, Trajectory (optional): the points, in order, are the positions of the light's
- *   centroid, one per frame. An optional point array `Time` (1 component, increasing) gives
- *   the frame times, else they are 0, 1, ..., n-1. Without this input the light moves in a
- *   straight line from PathStart to PathEnd in NumberOfPositions frames.
+ *   with a warning. The cell array named by ReflectanceArrayName (default `Reflectance`)
+ *   gives each cell's reflectance (3 components, RGB, or 1 component, grey; every value >= 0
+ *   and < 1). Without it the scene is grey 0.5 and a warning says so. The cell array named by
+ *   EmissionArrayName (default `Emission`; 3 or 1 components, W/m^2, >= 0) makes those cells
+ *   static emitters that also reflect: they emit from their front side in every frame. The
+ *   scene is remeshed into patches of about PatchSize.
+ * - port 1, Light (required when LightType is Area and nothing in the Scene emits): one or
+ *   more planar polygons emitting diffusely along their normals (right-hand rule). The
+ *   integer cell array `LightId` groups them into several lights (one light without it); the
+ *   cell array `LightPower` (3 components, W) gives each light its power, else each gets the
+ *   LightPower property. A light's area centroid is its reference point. Lights do not cast
+ *   shadows.
+ * - port 2, Trajectory (optional): with one light, the points, in order, are the positions
+ *   of the light's centroid, one per frame; with several, one polyline per light in LightId
+ *   order (a polyline of one point is a light that does not move; moving lights must have one
+ *   point per frame). Optional point arrays: `Time` (1 component, increasing: the frame times,
+ *   else 0, 1, ..., n-1); `Normal` (3 components: the light's emission direction in that
+ *   frame; it is turned about its centroid by the smallest rotation that takes its own mean
+ *   normal there); `Orientation` (4 components, quaternion w, x, y, z: the full rotation about
+ *   the centroid relative to the light as given, normalised with a warning when not unit; it
+ *   wins over `Normal`); `Power` (1 or 3 components: a factor >= 0 on the light's power in
+ *   that frame, 0 is off). With LightType Directional the points are the directions towards
+ *   the light (the sun), one per frame, of any length but 0; `Power` scales SunIrradiance
+ *   (clouds, night); `SunAzimuth` and `SunElevation` (degrees), if present, are passed to the
+ *   outputs' field data. Without this input the light moves in a straight line from
+ *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does).
  *
  * Outputs:
  * - port 0, Elements: the element mesh (triangles, four per patch) with the cell arrays
- *   `Radiosity`, `DirectRadiosity`, `IndirectRadiosity` (3 components, W/m^2, of the
+ *   `Radiosity` (= `EmittedRadiosity` + `DirectRadiosity` + `IndirectRadiosity`),
+ *   `DirectRadiosity`, `IndirectRadiosity`, `EmittedRadiosity` (3 components, W/m^2, of the
  *   element's lit side: the side that received more power over the whole animation, so
  *   that a room made of outward-facing polygons still shows its lit walls), `RadiosityFront`
  *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
@@ -69,6 +86,7 @@
 #include "vtkPolyDataAlgorithm.h"
 
 #include <memory> // For std::unique_ptr
+#include <string> // For std::string
 
 class MOVINGLIGHTRADIOSITYFILTERS_EXPORT vtkMovingLightRadiosity : public vtkPolyDataAlgorithm
 {
@@ -220,6 +238,63 @@ public:
   vtkGetMacro(NumberOfPositions, int);
   ///@}
 
+  /// The kinds of light (LightType).
+  enum LightTypes
+  {
+    AREA_LIGHT = 0,
+    DIRECTIONAL_LIGHT = 1
+  };
+
+  ///@{
+  /**
+   * Area: the Light input's polygons, moved along the Trajectory. Directional: a light at
+   * infinity (the sun) whose direction in each frame is a Trajectory point; the Light input is
+   * not needed and SunIrradiance replaces LightPower. Default Area.
+   */
+  vtkSetClampMacro(LightType, int, AREA_LIGHT, DIRECTIONAL_LIGHT);
+  vtkGetMacro(LightType, int);
+  void SetLightTypeToArea() { this->SetLightType(AREA_LIGHT); }
+  void SetLightTypeToDirectional() { this->SetLightType(DIRECTIONAL_LIGHT); }
+  ///@}
+
+  ///@{
+  /**
+   * Irradiance of the directional light on a surface facing it, W/m^2 (before the
+   * Trajectory's Power factor). Default 1000 (the sun at noon on a clear day).
+   */
+  vtkSetClampMacro(SunIrradiance, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(SunIrradiance, double);
+  ///@}
+
+  ///@{
+  /**
+   * Aim every area light at AimPoint in every frame: its emission direction is turned to
+   * point from its centroid to AimPoint (a Trajectory's Orientation still wins). Default off.
+   */
+  vtkSetMacro(AimAtPoint, vtkTypeBool);
+  vtkGetMacro(AimAtPoint, vtkTypeBool);
+  vtkBooleanMacro(AimAtPoint, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * The point lights face when AimAtPoint is on, in scene units. Default 0, 0, 0.
+   */
+  vtkSetVector3Macro(AimPoint, double);
+  vtkGetVector3Macro(AimPoint, double);
+  ///@}
+
+  ///@{
+  /**
+   * Names of the Scene's cell arrays of reflectance and emission. Defaults "Reflectance" and
+   * "Emission".
+   */
+  vtkSetStdStringFromCharMacro(ReflectanceArrayName);
+  vtkGetCharFromStdStringMacro(ReflectanceArrayName);
+  vtkSetStdStringFromCharMacro(EmissionArrayName);
+  vtkGetCharFromStdStringMacro(EmissionArrayName);
+  ///@}
+
   ///@{
   /**
    * Refuse work estimated to need more memory than this (MiB), before allocating it: taking
@@ -238,7 +313,8 @@ public:
    * `Color` arrays show Radiosity x 2^(AutoExposure + Exposure), tone mapped with the ACES
    * filmic curve (Narkowicz's fit) and sRGB-encoded. AutoExposure is computed once per solve
    * over every frame and element (it maps the 99th percentile of the lit-side luminance to
-   * 2, a bright grey), so that all frames share one exposure. +1 doubles the value before
+   * 1, which the tone map shows as a bright grey, 80%), so that all frames share one
+   * exposure. +1 doubles the value before
    * the tone map. Changing it only recolours: it never solves again. From -20 to 20;
    * default 0.
    */
@@ -278,6 +354,12 @@ protected:
   double PathEnd[3];
   int NumberOfPositions;
   int MemoryLimit;
+  int LightType;
+  double SunIrradiance;
+  vtkTypeBool AimAtPoint;
+  double AimPoint[3];
+  std::string ReflectanceArrayName;
+  std::string EmissionArrayName;
   vtkIdType SolveCount;
   double Exposure;
 
