@@ -6,6 +6,9 @@
 #include "vtkFieldData.h"
 #include "vtkMovingLightRadiosity.h"
 #include "vtkStringArray.h"
+#include "vtkType.h"
+
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -39,43 +42,23 @@ std::string seconds(double s)
   return out.str();
 }
 
-std::string jsonString(const std::string& text)
-{
-  std::ostringstream out;
-  out << '"';
-  for (unsigned char c : text)
-  {
-    if (c == '"' || c == '\\')
-    {
-      out << '\\' << c;
-    }
-    else if (c < 0x20)
-    {
-      out << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-    }
-    else
-    {
-      out << c;
-    }
-  }
-  out << '"';
-  return out.str();
-}
-
-std::string jsonNumber(double x)
+/// A number, or null for NaN and infinities (JSON has none); integers stay integers.
+nlohmann::ordered_json jsonNumber(double x, bool integral = false)
 {
   if (!std::isfinite(x))
   {
-    return "null";
+    return nullptr;
   }
-  std::ostringstream out;
-  out << std::setprecision(12) << x;
-  return out.str();
+  if (integral)
+  {
+    return static_cast<long long>(x);
+  }
+  return x;
 }
 
-std::string jsonTriple(const double* v)
+nlohmann::ordered_json jsonTriple(const double* v)
 {
-  return "[" + jsonNumber(v[0]) + ", " + jsonNumber(v[1]) + ", " + jsonNumber(v[2]) + "]";
+  return { jsonNumber(v[0]), jsonNumber(v[1]), jsonNumber(v[2]) };
 }
 }
 
@@ -103,34 +86,30 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   const std::vector<FrameRecord>& frames)
 {
   const std::string builtIn = "built-in Cornell box";
-  std::ofstream out(path);
-  out << "{\n";
-  out << "  \"scene\": " << jsonString(options.scene.empty() ? builtIn : options.scene) << ",\n";
-  out << "  \"light\": " << jsonString(options.light.empty() ? builtIn : options.light) << ",\n";
-  out << "  \"trajectory\": "
-      << jsonString(!options.trajectory.empty()
-             ? options.trajectory
-             : (options.from ? "straight line" : (options.scene.empty() ? builtIn : "")))
-      << ",\n";
-  out << "  \"output\": " << jsonString(options.output) << ",\n";
-  out << "  \"settings\": {\n"
-      << "    \"lightPower\": " << jsonTriple(filter->GetLightPower()) << ",\n"
-      << "    \"paths\": " << filter->GetNumberOfPaths() << ",\n"
-      << "    \"gatherRatio\": " << jsonNumber(filter->GetGatheringRatio()) << ",\n"
-      << "    \"survival\": " << jsonNumber(filter->GetFirstBounceSurvival()) << ",\n"
-      << "    \"reuseShooting\": " << (filter->GetReuseShooting() ? "true" : "false") << ",\n"
-      << "    \"reuseGathering\": " << (filter->GetReuseGathering() ? "true" : "false") << ",\n"
-      << "    \"patchSize\": " << jsonNumber(filter->GetPatchSize()) << ",\n"
-      << "    \"seed\": " << filter->GetSeed() << ",\n"
-      << "    \"threads\": " << filter->GetNumberOfThreads() << ",\n"
-      << "    \"twoSided\": " << (filter->GetTwoSided() ? "true" : "false") << "\n"
-      << "  },\n";
+  nlohmann::ordered_json json;
+  json["scene"] = options.scene.empty() ? builtIn : options.scene;
+  json["light"] = options.light.empty() ? builtIn : options.light;
+  json["trajectory"] = !options.trajectory.empty()
+    ? options.trajectory
+    : (options.from ? "straight line" : (options.scene.empty() ? builtIn : ""));
+  json["output"] = options.output;
+  json["settings"] = {
+    { "lightPower", jsonTriple(filter->GetLightPower()) },
+    { "paths", filter->GetNumberOfPaths() },
+    { "gatherRatio", jsonNumber(filter->GetGatheringRatio()) },
+    { "survival", jsonNumber(filter->GetFirstBounceSurvival()) },
+    { "reuseShooting", filter->GetReuseShooting() != 0 },
+    { "reuseGathering", filter->GetReuseGathering() != 0 },
+    { "patchSize", jsonNumber(filter->GetPatchSize()) },
+    { "seed", filter->GetSeed() },
+    { "threads", filter->GetNumberOfThreads() },
+    { "twoSided", filter->GetTwoSided() != 0 },
+  };
 
   // Every statistic the filter reports, except those that describe one frame.
   static const std::set<std::string> perFrame = { "FrameIndex", "LightPosition",
     "LightTranslation", "SolveCount", "TimeValue" };
-  out << "  \"statistics\": {";
-  const char* separator = "\n";
+  nlohmann::ordered_json values = nlohmann::ordered_json::object();
   for (int i = 0; statistics && i < statistics->GetNumberOfArrays(); ++i)
   {
     vtkAbstractArray* array = statistics->GetAbstractArray(i);
@@ -139,37 +118,35 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     {
       continue;
     }
-    out << separator << "    " << jsonString(array->GetName()) << ": ";
+    nlohmann::ordered_json& value = values[array->GetName()];
     if (auto* strings = vtkStringArray::SafeDownCast(array))
     {
-      out << jsonString(strings->GetValue(0));
+      value = strings->GetValue(0);
     }
     else if (auto* numbers = vtkDataArray::SafeDownCast(array))
     {
-      out << jsonNumber(numbers->GetComponent(0, 0));
+      const int type = numbers->GetDataType();
+      value = jsonNumber(numbers->GetComponent(0, 0), type != VTK_FLOAT && type != VTK_DOUBLE);
     }
-    else
-    {
-      out << "null";
-    }
-    separator = ",\n";
   }
-  out << "\n  },\n";
+  json["statistics"] = values;
 
-  out << "  \"frames\": [";
-  separator = "\n";
+  nlohmann::ordered_json records = nlohmann::ordered_json::array();
   for (const FrameRecord& frame : frames)
   {
-    out << separator << "    {\"time\": " << jsonNumber(frame.time)
-        << ", \"file\": " << jsonString(frame.file);
+    nlohmann::ordered_json record = { { "time", jsonNumber(frame.time) }, { "file", frame.file } };
     if (!frame.picture.empty())
     {
-      out << ", \"picture\": " << jsonString(frame.picture);
+      record["picture"] = frame.picture;
     }
-    out << ", \"lightPosition\": " << jsonTriple(frame.lightPosition.data()) << "}";
-    separator = ",\n";
+    record["lightPosition"] = jsonTriple(frame.lightPosition.data());
+    records.push_back(record);
   }
-  out << "\n  ]\n}\n";
+  json["frames"] = records;
+
+  std::ofstream out(path);
+  // File names need not be UTF-8: bytes that are not are replaced, not an exception.
+  out << json.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
   out.close();
   if (!out)
   {
