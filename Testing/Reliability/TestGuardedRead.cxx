@@ -4,7 +4,6 @@
 //
 // Each test runs in its own process (gtest_discover_tests), so "no child left" is checked with
 // waitpid(-1): ECHILD means this process has no child at all, running or unreaped.
-#include "FileChecks.h"
 #include "GuardedRead.h"
 
 #include "vtkCellArray.h"
