@@ -458,7 +458,12 @@ ChildOutcome runGuarded(const std::function<int()>& work, std::uint64_t memoryBy
       // SIGKILL at the hard limit, a second after the soft one, if SIGXCPU was caught.
       const bool overTime = outcome.signal == SIGXCPU ||
         (outcome.signal == SIGKILL && outcome.cpuSeconds >= std::ceil(cpuSeconds));
-      outcome.end = overTime ? ChildOutcome::End::CpuTime : ChildOutcome::End::Crashed;
+      // Ctrl-C reaches the whole process group: the child may end of it before this thread
+      // takes its own copy (raised for the caller when the mask was restored).
+      const bool interrupted = outcome.signal == SIGINT || outcome.signal == SIGTERM;
+      outcome.end = overTime ? ChildOutcome::End::CpuTime
+        : interrupted        ? ChildOutcome::End::Interrupted
+                             : ChildOutcome::End::Crashed;
     }
   }
   return outcome;

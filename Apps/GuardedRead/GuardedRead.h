@@ -96,7 +96,7 @@ struct ChildOutcome
     Crashed,     ///< killed by `signal`
     CpuTime,     ///< over its CPU time
     WallTime,    ///< over its wall-clock time, and killed
-    Interrupted, ///< the caller got SIGINT or SIGTERM, and the child was killed
+    Interrupted, ///< SIGINT or SIGTERM reached the caller (the child was killed) or the child
   };
   End end = End::Exited;
   int code = 0;

@@ -412,21 +412,27 @@ def test_interrupt_mid_solve_writes_nothing(tmp_path, sig):
     assert all_files(tmp_path) == []
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL],
-                         ids=["SIGINT", "SIGTERM", "SIGKILL"])
-def test_ending_the_program_while_it_reads_leaves_no_process(tmp_path, sig):
-    """Ended while its reading process loops in VTK's legacy reader: an interrupt stops the
-    reading at once; SIGKILL cannot be caught, and the reading process dies with the program."""
+@pytest.mark.parametrize("sig,group", [(signal.SIGINT, False), (signal.SIGINT, True),
+                                       (signal.SIGTERM, False), (signal.SIGKILL, False)],
+                         ids=["SIGINT", "Ctrl-C", "SIGTERM", "SIGKILL"])
+def test_ending_the_program_while_it_reads_leaves_no_process(tmp_path, sig, group):
+    """Ended while its reading process loops in VTK's legacy reader: an interrupt (to the
+    program, or to its whole process group as Ctrl-C sends it) stops the reading at once;
+    SIGKILL cannot be caught, and the reading process dies with the program."""
     fuzz_input("scene.vtk", HANG_REGRESSION)(tmp_path)
     process = subprocess.Popen(
         [CLI] + scene_args("scene.vtk") + ["--output", "out/series.pvd"],
-        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
     for _ in range(200):  # up to 10 s for the reading process to start
         if children_of(process.pid):
             break
         time.sleep(0.05)
     assert children_of(process.pid), "no reading process"
-    process.send_signal(sig)
+    if group:
+        os.killpg(process.pid, sig)
+    else:
+        process.send_signal(sig)
     process.wait(timeout=30)
     # The reading process has used well under its 5 s of CPU time: if it ends within 2 s, its
     # parent's death ended it, not its own limit.
