@@ -4,14 +4,13 @@
 #include "vtkCellArrayIterator.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
-#include "vtkGLTFDocumentLoader.h"
 #include "vtkImageData.h"
-#include "vtkMatrix4x4.h"
+#include "vtkImageReader2.h"
+#include "vtkJPEGReader.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
+#include "vtkPNGReader.h"
 #include "vtkPoints.h"
-#include "vtkPolyData.h"
-#include "vtkTriangleStrip.h"
 
 #include "vtk_nlohmannjson.h"
 #include VTK_NLOHMANN_JSON(json.hpp)
@@ -569,12 +568,12 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
 
 namespace
 {
-/// Records what vtkGLTFDocumentLoader reports, so that its messages reach the user through the
-/// reader, with the file named.
-class LoaderMessages : public vtkCommand
+/// Records what VTK's image readers report, so that a texture they cannot decode becomes one
+/// warning naming the material instead of errors without context.
+class ReaderMessages : public vtkCommand
 {
 public:
-  static LoaderMessages* New() { return new LoaderMessages; }
+  static ReaderMessages* New() { return new ReaderMessages; }
   void Execute(vtkObject*, unsigned long event, void* data) override
   {
     std::string text = data ? static_cast<const char*>(data) : "";
@@ -584,10 +583,12 @@ public:
     {
       text = text.substr(close + 3);
     }
-    text = trim(text);
-    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings).push_back(text);
+    if (event == vtkCommand::ErrorEvent)
+    {
+      this->Errors.push_back(trim(text));
+    }
   }
-  std::vector<std::string> Errors, Warnings;
+  std::vector<std::string> Errors;
 };
 
 std::int64_t componentBytes(std::int64_t componentType)
@@ -616,9 +617,9 @@ std::int64_t typeComponents(const std::string& type)
   return found == components.end() ? 0 : found->second;
 }
 
-/// Checks of the JSON that keep vtkGLTFDocumentLoader (VTK 9.2) inside its arrays and buffers:
-/// it reads accessors without comparing them with their buffers, follows node children without
-/// looking for cycles, and indexes its vectors with the file's numbers.
+/// Checks of the JSON that keep the reading below inside its arrays and buffers: every index
+/// names an entry the file has, every accessor fits in its buffer view and buffer, the node
+/// hierarchy is a forest.
 class GltfChecks
 {
 public:
@@ -686,7 +687,26 @@ public:
 
   void run(bool glb, std::int64_t binBytes)
   {
-    const std::string nodesName = "nodes";
+    const auto asset = this->Root.find("asset");
+    const std::string version = asset != this->Root.end() && asset->is_object() && asset->contains("version") &&
+        (*asset)["version"].is_string()
+      ? (*asset)["version"].get<std::string>()
+      : std::string();
+    if (version.rfind("2.", 0) != 0)
+    {
+      this->fail(version.empty() ? "it has no asset.version: it is not a glTF 2.0 file"
+                                 : "it is glTF version " + printable(version) + ", not 2.x");
+    }
+    // Extensions a reader must understand: those of materials only change what is not read
+    // here (or the emission strength, which is read); geometry compression is not supported.
+    for (const auto& required : this->array("extensionsRequired"))
+    {
+      const std::string name = required.is_string() ? required.get<std::string>() : std::string("?");
+      if (name.rfind("KHR_materials_", 0) != 0 && name != "KHR_texture_transform")
+      {
+        this->fail("it requires the extension " + printable(name) + ", which this reader does not support");
+      }
+    }
     // Buffers and their views.
     const Json& buffers = this->array("buffers");
     for (std::size_t i = 0; i < buffers.size(); ++i)
@@ -1040,8 +1060,9 @@ std::uint32_t littleEndian32(const unsigned char* bytes)
     (static_cast<std::uint32_t>(bytes[2]) << 16) | (static_cast<std::uint32_t>(bytes[3]) << 24);
 }
 
-/// The JSON of a .gltf file, or of a .glb file's first chunk (and its BIN chunk's size).
-Json readGltfJson(const std::string& path, bool glb, std::int64_t& binBytes)
+/// The JSON of a .gltf file, or of a .glb file's first chunk (and its BIN chunk in `bin`;
+/// binBytes is its size, -1 without one).
+Json readGltfJson(const std::string& path, bool glb, std::string& bin, std::int64_t& binBytes)
 {
   std::ifstream in = openFile(path, "glTF file");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -1086,6 +1107,7 @@ Json readGltfJson(const std::string& path, bool glb, std::int64_t& binBytes)
       if (text.compare(at + 4, 4, std::string("BIN\0", 4)) == 0 && binBytes < 0)
       {
         binBytes = static_cast<std::int64_t>(chunk);
+        bin = text.substr(at + 8, chunk);
       }
       at += 8 + chunk;
     }
@@ -1112,92 +1134,431 @@ double srgbToLinear(double value)
   return value <= 0.04045 ? value / 12.92 : std::pow((value + 0.055) / 1.055, 2.4);
 }
 
-/// The mean linear colour of texture `texture` (sRGB-encoded, as base colour and emissive
-/// textures are); (1, 1, 1) with a warning when VTK gave no image for it.
-std::array<double, 3> textureMean(const vtkGLTFDocumentLoader::Model& model, int texture,
-  const std::string& what, const Warn& warn)
+/// Decodes standard base64 (the payload of a data: URI); false on a character outside it.
+bool decodeBase64(const std::string& text, std::string& bytes)
 {
-  vtkImageData* image = nullptr;
-  if (texture >= 0 && texture < static_cast<int>(model.Textures.size()))
+  bytes.clear();
+  std::uint32_t chunk = 0;
+  int bits = 0;
+  for (char c : text)
   {
-    const int source = model.Textures[static_cast<std::size_t>(texture)].Source;
-    if (source >= 0 && source < static_cast<int>(model.Images.size()))
+    int value = -1;
+    if (c >= 'A' && c <= 'Z')
     {
-      image = model.Images[static_cast<std::size_t>(source)].ImageData;
+      value = c - 'A';
+    }
+    else if (c >= 'a' && c <= 'z')
+    {
+      value = c - 'a' + 26;
+    }
+    else if (c >= '0' && c <= '9')
+    {
+      value = c - '0' + 52;
+    }
+    else if (c == '+' || c == '-')
+    {
+      value = 62;
+    }
+    else if (c == '/' || c == '_')
+    {
+      value = 63;
+    }
+    else if (c == '=' || std::isspace(static_cast<unsigned char>(c)))
+    {
+      continue;
+    }
+    if (value < 0)
+    {
+      return false;
+    }
+    chunk = (chunk << 6) | static_cast<std::uint32_t>(value);
+    bits += 6;
+    if (bits >= 8)
+    {
+      bits -= 8;
+      bytes += static_cast<char>((chunk >> bits) & 0xff);
     }
   }
-  vtkDataArray* texels = image ? image->GetPointData()->GetScalars() : nullptr;
-  if (!texels || texels->GetNumberOfTuples() == 0 || texels->GetNumberOfComponents() < 1)
+  return true;
+}
+
+/// A relative URI of a glTF resource as a path: %XX escapes decoded.
+std::string uriPath(const std::string& uri)
+{
+  std::string path;
+  for (std::size_t i = 0; i < uri.size(); ++i)
   {
-    warn(what + ": its texture could not be read, so its factor alone is used");
-    return { { 1, 1, 1 } };
-  }
-  const int components = texels->GetNumberOfComponents();
-  const double scale = texels->GetDataTypeMax() > 1 ? texels->GetDataTypeMax() : 1.0;
-  // A table for 8-bit texels, the usual case.
-  std::array<double, 256> table{};
-  for (int i = 0; i < 256; ++i)
-  {
-    table[static_cast<std::size_t>(i)] = srgbToLinear(i / 255.0);
-  }
-  const bool eightBit = scale == 255.0;
-  std::array<double, 3> sum{ { 0, 0, 0 } };
-  const vtkIdType count = texels->GetNumberOfTuples();
-  for (vtkIdType t = 0; t < count; ++t)
-  {
-    for (int c = 0; c < 3; ++c)
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+      std::isxdigit(static_cast<unsigned char>(uri[i + 2])))
     {
-      // Grey (and grey + alpha) images hold one colour component.
-      const double raw = texels->GetComponent(t, components >= 3 ? c : 0);
-      sum[static_cast<std::size_t>(c)] += eightBit
-        ? table[static_cast<std::size_t>(std::clamp(raw, 0.0, 255.0))]
-        : srgbToLinear(std::clamp(raw / scale, 0.0, 1.0));
+      path += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    }
+    else
+    {
+      path += uri[i];
     }
   }
-  for (double& s : sum)
-  {
-    s /= static_cast<double>(count);
-  }
-  return sum;
+  return path;
 }
 
-double emissiveStrength(const Json& root, int material)
+/// A glTF document whose indices and sizes GltfChecks has checked: buffers loaded, accessors
+/// read as numbers.
+class GltfDocument
 {
-  if (material < 0)
+public:
+  GltfDocument(const Json& root, const std::string& path, std::string bin)
+    : Root(root)
+    , Path(path)
+    , Folder(std::filesystem::path(path).parent_path())
   {
-    return 1.0;
+    const Json& buffers = root.contains("buffers") ? root["buffers"] : Json::array();
+    for (std::size_t i = 0; i < buffers.size(); ++i)
+    {
+      const std::size_t length = buffers[i]["byteLength"].get<std::size_t>();
+      std::string bytes;
+      if (!buffers[i].contains("uri"))
+      {
+        bytes = bin; // GltfChecks: only buffer 0 of a .glb, and the BIN chunk holds byteLength
+      }
+      else
+      {
+        bytes = this->resource(buffers[i]["uri"].get<std::string>(), "buffers[" + std::to_string(i) + "]");
+      }
+      if (bytes.size() < length)
+      {
+        this->fail("buffers[" + std::to_string(i) + "] holds " + std::to_string(bytes.size()) +
+          " bytes, less than its byteLength " + std::to_string(length));
+      }
+      this->Buffers.push_back(std::move(bytes));
+    }
   }
-  const Json& entry = root["materials"][static_cast<std::size_t>(material)];
-  const auto extensions = entry.find("extensions");
-  if (extensions == entry.end() || !extensions->is_object())
+
+  [[noreturn]] void fail(const std::string& problem) const
   {
-    return 1.0;
+    throw FileError("the glTF file " + named(this->Path) + ": " + problem);
   }
-  const auto strength = extensions->find("KHR_materials_emissive_strength");
-  if (strength == extensions->end() || !strength->is_object())
+
+  /// The bytes of a data: URI or of a file beside the glTF file.
+  std::string resource(const std::string& uri, const std::string& what) const
   {
-    return 1.0;
+    if (uri.rfind("data:", 0) == 0)
+    {
+      const auto comma = uri.find(',');
+      std::string bytes;
+      if (comma == std::string::npos || uri.substr(0, comma).find(";base64") == std::string::npos ||
+        !decodeBase64(uri.substr(comma + 1), bytes))
+      {
+        this->fail(what + " has a data: URI that is not base64");
+      }
+      return bytes;
+    }
+    const std::filesystem::path file = this->Folder / uriPath(uri);
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(file, error))
+    {
+      this->fail(what + " names the file " + named(file.string()) + ", which does not exist");
+    }
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad())
+    {
+      this->fail(what + ": the file " + named(file.string()) + " could not be read");
+    }
+    return bytes;
   }
-  const auto value = strength->find("emissiveStrength");
-  if (value == strength->end() || !value->is_number() || !std::isfinite(value->get<double>()) ||
-    value->get<double>() < 0)
+
+  /// The bytes of a buffer view (checked to fit in its buffer).
+  std::string view(std::size_t index) const
   {
-    return -1.0;
+    const Json& view = this->Root["bufferViews"][index];
+    return this->Buffers[view["buffer"].get<std::size_t>()].substr(
+      view.value("byteOffset", std::size_t(0)), view["byteLength"].get<std::size_t>());
   }
-  return value->get<double>();
+
+  /// Accessor `index` as numbers, `components` per element; normalized integers in [0, 1].
+  std::vector<double> accessor(std::size_t index, std::size_t& components) const
+  {
+    const Json& accessor = this->Root["accessors"][index];
+    const Json& view = this->Root["bufferViews"][accessor["bufferView"].get<std::size_t>()];
+    const std::int64_t type = accessor["componentType"].get<std::int64_t>();
+    const std::size_t bytes = static_cast<std::size_t>(componentBytes(type));
+    components = static_cast<std::size_t>(typeComponents(accessor["type"].get<std::string>()));
+    const std::size_t count = accessor["count"].get<std::size_t>();
+    const std::size_t stride = std::max<std::size_t>(view.value("byteStride", std::size_t(0)), bytes * components);
+    const std::string& buffer = this->Buffers[view["buffer"].get<std::size_t>()];
+    const std::size_t start = view.value("byteOffset", std::size_t(0)) + accessor.value("byteOffset", std::size_t(0));
+    const bool normalized = accessor.value("normalized", false);
+    std::vector<double> values(count * components);
+    for (std::size_t e = 0; e < count; ++e)
+    {
+      for (std::size_t c = 0; c < components; ++c)
+      {
+        const char* at = buffer.data() + start + e * stride + c * bytes;
+        double value = 0;
+        switch (type)
+        {
+          case 5120:
+          {
+            std::int8_t v;
+            std::memcpy(&v, at, 1);
+            value = normalized ? std::max(v / 127.0, -1.0) : v;
+            break;
+          }
+          case 5121:
+          {
+            std::uint8_t v;
+            std::memcpy(&v, at, 1);
+            value = normalized ? v / 255.0 : v;
+            break;
+          }
+          case 5122:
+          {
+            std::int16_t v;
+            std::memcpy(&v, at, 2);
+            value = normalized ? std::max(v / 32767.0, -1.0) : v;
+            break;
+          }
+          case 5123:
+          {
+            std::uint16_t v;
+            std::memcpy(&v, at, 2);
+            value = normalized ? v / 65535.0 : v;
+            break;
+          }
+          case 5125:
+          {
+            std::uint32_t v;
+            std::memcpy(&v, at, 4);
+            value = v;
+            break;
+          }
+          default:
+          {
+            float v;
+            std::memcpy(&v, at, 4);
+            value = v;
+          }
+        }
+        values[e * components + c] = value;
+      }
+    }
+    return values;
+  }
+
+  /// The mean linear colour of texture `texture` (sRGB-encoded, as base colour and emissive
+  /// textures are); (1, 1, 1) with a warning when its image cannot be decoded.
+  std::array<double, 3> textureMean(std::size_t texture, const std::string& what, const Warn& warn) const
+  {
+    const Json& entry = this->Root["textures"][texture];
+    std::string problem;
+    vtkSmartPointer<vtkImageData> image;
+    if (!entry.contains("source"))
+    {
+      problem = "its texture has no image";
+    }
+    else
+    {
+      const Json& source = this->Root["images"][entry["source"].get<std::size_t>()];
+      std::string bytes, mime = source.value("mimeType", std::string());
+      if (source.contains("bufferView"))
+      {
+        bytes = this->view(source["bufferView"].get<std::size_t>());
+      }
+      else
+      {
+        const std::string uri = source["uri"].get<std::string>();
+        bytes = this->resource(uri, what + "'s image");
+        if (uri.rfind("data:image/", 0) == 0)
+        {
+          mime = uri.substr(5, uri.find(';') - 5);
+        }
+      }
+      const bool png = bytes.size() >= 8 && bytes.compare(1, 3, "PNG") == 0;
+      const bool jpeg = bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xff &&
+        static_cast<unsigned char>(bytes[1]) == 0xd8;
+      vtkSmartPointer<vtkImageReader2> reader;
+      if (png)
+      {
+        reader = vtkSmartPointer<vtkPNGReader>::New();
+      }
+      else if (jpeg)
+      {
+        reader = vtkSmartPointer<vtkJPEGReader>::New();
+      }
+      if (!reader)
+      {
+        problem = "its image is neither PNG nor JPEG";
+      }
+      else
+      {
+        vtkNew<ReaderMessages> messages;
+        reader->AddObserver(vtkCommand::ErrorEvent, messages);
+        reader->AddObserver(vtkCommand::WarningEvent, messages);
+        reader->SetMemoryBuffer(bytes.data());
+        reader->SetMemoryBufferLength(static_cast<vtkIdType>(bytes.size()));
+        reader->Update();
+        image = reader->GetOutput();
+        if (!messages->Errors.empty())
+        {
+          problem = "its image could not be decoded (" + messages->Errors.front() + ")";
+          image = nullptr;
+        }
+      }
+    }
+    vtkDataArray* texels = image ? image->GetPointData()->GetScalars() : nullptr;
+    if (problem.empty() && (!texels || texels->GetNumberOfTuples() == 0))
+    {
+      problem = "its image is empty";
+    }
+    if (!problem.empty())
+    {
+      warn(what + ": " + problem + ", so its factor alone is used");
+      return { { 1, 1, 1 } };
+    }
+    const int components = texels->GetNumberOfComponents();
+    const double scale = texels->GetDataTypeMax() > 1 ? texels->GetDataTypeMax() : 1.0;
+    std::array<double, 256> table{};
+    for (std::size_t i = 0; i < 256; ++i)
+    {
+      table[i] = srgbToLinear(static_cast<double>(i) / 255.0);
+    }
+    const bool eightBit = scale == 255.0;
+    std::array<double, 3> sum{ { 0, 0, 0 } };
+    const vtkIdType count = texels->GetNumberOfTuples();
+    for (vtkIdType t = 0; t < count; ++t)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        // Grey (and grey + alpha) images hold one colour component.
+        const double raw = texels->GetComponent(t, components >= 3 ? c : 0);
+        sum[static_cast<std::size_t>(c)] += eightBit
+          ? table[static_cast<std::size_t>(std::clamp(raw, 0.0, 255.0))]
+          : srgbToLinear(std::clamp(raw / scale, 0.0, 1.0));
+      }
+    }
+    for (double& s : sum)
+    {
+      s /= static_cast<double>(count);
+    }
+    return sum;
+  }
+
+  /// The local transform of node `index`: its matrix, or translation x rotation x scale.
+  std::array<double, 16> localTransform(std::size_t index) const
+  {
+    const Json& node = this->Root["nodes"][index];
+    const std::string where = "nodes[" + std::to_string(index) + "]";
+    auto numbers = [&](const char* key, std::size_t size, std::vector<double> fallback) {
+      const auto found = node.find(key);
+      if (found == node.end())
+      {
+        return fallback;
+      }
+      if (!found->is_array() || found->size() != size)
+      {
+        this->fail(where + "." + key + " is not " + std::to_string(size) + " numbers");
+      }
+      std::vector<double> values;
+      for (const auto& value : *found)
+      {
+        if (!value.is_number() || !std::isfinite(value.get<double>()))
+        {
+          this->fail(where + "." + key + " is not " + std::to_string(size) + " finite numbers");
+        }
+        values.push_back(value.get<double>());
+      }
+      return values;
+    };
+    std::array<double, 16> m{}; // row-major
+    if (node.contains("matrix"))
+    {
+      const auto columnMajor = numbers("matrix", 16, {});
+      for (std::size_t r = 0; r < 4; ++r)
+      {
+        for (std::size_t c = 0; c < 4; ++c)
+        {
+          m[4 * r + c] = columnMajor[4 * c + r];
+        }
+      }
+      return m;
+    }
+    const auto t = numbers("translation", 3, { 0, 0, 0 });
+    const auto q = numbers("rotation", 4, { 0, 0, 0, 1 });
+    const auto s = numbers("scale", 3, { 1, 1, 1 });
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (norm == 0)
+    {
+      this->fail(where + ".rotation is a zero quaternion");
+    }
+    const double x = q[0] / norm, y = q[1] / norm, z = q[2] / norm, w = q[3] / norm;
+    const double r[3][3] = { { 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w) },
+      { 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w) },
+      { 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y) } };
+    for (std::size_t i = 0; i < 3; ++i)
+    {
+      for (std::size_t j = 0; j < 3; ++j)
+      {
+        m[4 * i + j] = r[i][j] * s[j];
+      }
+      m[4 * i + 3] = t[i];
+    }
+    m[15] = 1;
+    return m;
+  }
+
+private:
+  const Json& Root;
+  std::string Path;
+  std::filesystem::path Folder;
+  std::vector<std::string> Buffers;
+};
+
+std::array<double, 16> multiply(const std::array<double, 16>& a, const std::array<double, 16>& b)
+{
+  std::array<double, 16> m{};
+  for (std::size_t r = 0; r < 4; ++r)
+  {
+    for (std::size_t c = 0; c < 4; ++c)
+    {
+      for (std::size_t k = 0; k < 4; ++k)
+      {
+        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
+      }
+    }
+  }
+  return m;
 }
-} // namespace
 
-Scene readGltf(const std::string& path, const Warn& warn, const Progress& progress)
+/// A colour factor of a material: `size` numbers (glTF keeps them in [0, 1]; emission
+/// strength scales emissiveFactor).
+std::array<double, 3> colourFactor(const Json& holder, const char* key, std::size_t size,
+  double fallback, const std::string& what, const std::function<void(const std::string&)>& fail)
 {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const bool glb = extension == ".glb";
-  ProgressPoll poll(progress, 0.0, 1.0);
-
-  std::int64_t binBytes = -1;
-  const Json root = readGltfJson(path, glb, binBytes);
+  std::array<double, 3> rgb{ { fallback, fallback, fallback } };
+  const auto found = holder.find(key);
+  if (found == holder.end())
+  {
+    return rgb;
+  }
+  if (!found->is_array() || found->size() != size)
+  {
+    fail(what + "." + key + " is not " + std::to_string(size) + " numbers");
+  }
+  for (std::size_t c = 0; c < 3; ++c)
+  {
+    const Json& value = (*found)[c];
+    if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0)
+    {
+      fail(what + "." + key + " must hold numbers, 0 or more");
+    }
+    rgb[c] = value.get<double>();
+  }
+  return rgb;
+}
+Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std::string bin,
+  std::int64_t binBytes, const Warn& warn, ProgressPoll& poll)
+{
   GltfChecks checks(root, path);
   checks.run(glb, binBytes);
   std::size_t surfaces = 0, others = 0;
@@ -1215,48 +1576,8 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
       ": there is no surface to light");
   }
   poll(0.1);
-
-  vtkNew<vtkGLTFDocumentLoader> loader;
-  vtkNew<LoaderMessages> messages;
-  loader->AddObserver(vtkCommand::ErrorEvent, messages);
-  loader->AddObserver(vtkCommand::WarningEvent, messages);
-  auto failIfErrors = [&](bool ok, const std::string& stage) {
-    if (!ok || !messages->Errors.empty())
-    {
-      std::string text = "the glTF file " + named(path) + " could not be " + stage;
-      for (const auto& error : messages->Errors)
-      {
-        text += (&error == &messages->Errors.front() ? ": " : "; ") + error;
-      }
-      throw FileError(text);
-    }
-  };
-  failIfErrors(loader->LoadModelMetaDataFromFile(path), "read");
-  std::vector<char> glbBuffer;
-  if (glb && binBytes >= 0)
-  {
-    failIfErrors(loader->LoadFileBuffer(path, glbBuffer), "read (its BIN chunk)");
-  }
-  failIfErrors(loader->LoadModelData(glbBuffer), "read (its buffers and images)");
-  poll(0.6);
-  failIfErrors(loader->BuildModelVTKGeometry(), "converted");
-  for (const auto& warning : messages->Warnings)
-  {
-    if (warning.find("KHR_materials_emissive_strength") == std::string::npos)
-    {
-      warn("the glTF file " + named(path) + ": " + warning);
-    }
-  }
-  const auto model = loader->GetInternalModel();
-  // The loader drops entries it cannot read: the file's indices would then point elsewhere.
-  if (model->Meshes.size() != checks.array("meshes").size() ||
-    model->Nodes.size() != checks.array("nodes").size() ||
-    model->Materials.size() != checks.array("materials").size() ||
-    model->Textures.size() != checks.array("textures").size() ||
-    model->Images.size() != checks.array("images").size())
-  {
-    throw FileError("the glTF file " + named(path) + " has meshes, nodes, materials, textures or images VTK could not read");
-  }
+  const GltfDocument document(root, path, std::move(bin));
+  poll(0.3);
 
   // The nodes to draw: the default scene's (or the first scene's), else every root node.
   std::vector<std::int64_t> roots;
@@ -1264,12 +1585,9 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
   if (!scenes.empty())
   {
     const std::size_t scene = static_cast<std::size_t>(std::max<std::int64_t>(0, checks.integer(root, "scene", "the file", 0)));
-    if (scenes[scene].contains("nodes"))
+    for (const auto& node : scenes[scene].value("nodes", Json::array()))
     {
-      for (const auto& node : scenes[scene]["nodes"])
-      {
-        roots.push_back(node.get<std::int64_t>());
-      }
+      roots.push_back(node.get<std::int64_t>());
     }
   }
   else
@@ -1288,125 +1606,148 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
   scene.points = vtkSmartPointer<vtkPoints>::New();
   scene.points->SetDataTypeToDouble();
   scene.polygons = vtkSmartPointer<vtkCellArray>::New();
-  std::map<int, int> materialIds; // glTF material (-1: the default) -> output material
+  std::map<std::int64_t, int> materialIds; // glTF material (-1: the default) -> output material
+  std::vector<std::int64_t> materialOrder;
   std::vector<std::array<double, 3>> vertexColourOfCell;
-  std::vector<bool> cellHasColour;
   bool anyColour = false;
   std::size_t skippedPrimitives = 0;
-  vtkNew<vtkCellArray> triangles;
+  const Json& nodes = checks.array("nodes");
+  const Json& meshes = checks.array("meshes");
 
-  // Depth first, with the transform down to each node.
-  std::vector<std::pair<std::int64_t, vtkSmartPointer<vtkMatrix4x4>>> stack;
+  // Depth first, with the transform down to each node (the hierarchy is a checked forest).
+  std::array<double, 16> identity{};
+  identity[0] = identity[5] = identity[10] = identity[15] = 1;
+  std::vector<std::pair<std::size_t, std::array<double, 16>>> stack;
   for (auto it = roots.rbegin(); it != roots.rend(); ++it)
   {
-    stack.emplace_back(*it, vtkSmartPointer<vtkMatrix4x4>::New());
+    stack.emplace_back(static_cast<std::size_t>(*it), identity);
   }
   while (!stack.empty())
   {
-    auto [nodeIndex, parentMatrix] = stack.back();
+    const auto [nodeIndex, parent] = stack.back();
     stack.pop_back();
-    const auto& node = model->Nodes[static_cast<std::size_t>(nodeIndex)];
-    auto matrix = vtkSmartPointer<vtkMatrix4x4>::New();
-    if (node.Transform)
+    const Json& node = nodes[nodeIndex];
+    const std::array<double, 16> matrix = multiply(parent, document.localTransform(nodeIndex));
+    const Json children = node.value("children", Json::array());
+    for (auto child = children.rbegin(); child != children.rend(); ++child)
     {
-      vtkMatrix4x4::Multiply4x4(parentMatrix, node.Transform, matrix);
+      stack.emplace_back(child->get<std::size_t>(), matrix);
     }
-    else
-    {
-      matrix->DeepCopy(parentMatrix);
-    }
-    for (auto child = node.Children.rbegin(); child != node.Children.rend(); ++child)
-    {
-      stack.emplace_back(*child, matrix);
-    }
-    if (node.Mesh < 0)
+    if (!node.contains("mesh"))
     {
       continue;
     }
-    for (const auto& primitive : model->Meshes[static_cast<std::size_t>(node.Mesh)].Primitives)
+    const std::size_t meshIndex = node["mesh"].get<std::size_t>();
+    for (const Json& primitive : meshes[meshIndex]["primitives"])
     {
-      vtkPolyData* geometry = primitive.Geometry;
-      if (primitive.Mode < 4 || !geometry || !geometry->GetPoints())
+      const std::int64_t mode = primitive.value("mode", std::int64_t(4));
+      if (mode < 4)
       {
         ++skippedPrimitives;
         continue;
       }
-      triangles->Reset();
-      vtkIdType count = 0;
-      const vtkIdType* ids = nullptr;
-      const vtkIdType pointCount = geometry->GetNumberOfPoints();
-      auto inRange = [&]() {
-        return std::all_of(ids, ids + count, [&](vtkIdType id) { return id >= 0 && id < pointCount; });
-      };
-      for (vtkCellArray* cells : { geometry->GetPolys(), geometry->GetStrips() })
+      const Json& attributes = primitive["attributes"];
+      std::size_t components = 0;
+      const std::vector<double> positions = document.accessor(attributes["POSITION"].get<std::size_t>(), components);
+      const std::size_t vertexCount = positions.size() / 3;
+      std::vector<std::size_t> indices;
+      if (primitive.contains("indices"))
       {
-        auto iterator = vtkSmartPointer<vtkCellArrayIterator>::Take(cells->NewIterator());
-        for (iterator->GoToFirstCell(); !iterator->IsDoneWithTraversal(); iterator->GoToNextCell())
+        for (double index : document.accessor(primitive["indices"].get<std::size_t>(), components))
         {
-          iterator->GetCurrentCell(count, ids);
-          if (!inRange())
+          if (index >= static_cast<double>(vertexCount))
           {
-            throw FileError("the glTF file " + named(path) + ": a primitive of mesh " +
-              std::to_string(node.Mesh) + " names a vertex its POSITION accessor does not have");
+            document.fail("a primitive of meshes[" + std::to_string(meshIndex) + "] names vertex " +
+              std::to_string(static_cast<std::uint64_t>(index)) + " but its POSITION has " +
+              std::to_string(vertexCount));
           }
-          if (cells == geometry->GetStrips())
-          {
-            if (count >= 3)
-            {
-              vtkTriangleStrip::DecomposeStrip(static_cast<int>(count), ids, triangles);
-            }
-          }
-          else if (count >= 3)
-          {
-            triangles->InsertNextCell(count, ids);
-          }
+          indices.push_back(static_cast<std::size_t>(index));
         }
       }
-      const auto found = materialIds.find(primitive.Material);
-      const int material = found != materialIds.end()
-        ? found->second
-        : (materialIds[primitive.Material] = static_cast<int>(materialIds.size()));
-      vtkDataArray* colours = geometry->GetPointData()->GetArray("COLOR_0");
+      else
+      {
+        for (std::size_t i = 0; i < vertexCount; ++i)
+        {
+          indices.push_back(i);
+        }
+      }
+      std::vector<std::array<std::size_t, 3>> triangles;
+      for (std::size_t i = 0; i + 2 < indices.size(); i += mode == 4 ? 3 : 1)
+      {
+        if (mode == 4)
+        {
+          triangles.push_back({ { indices[i], indices[i + 1], indices[i + 2] } });
+        }
+        else if (mode == 5) // strip: every other triangle turns the other way
+        {
+          triangles.push_back(i % 2 == 0 ? std::array<std::size_t, 3>{ { indices[i], indices[i + 1], indices[i + 2] } }
+                                         : std::array<std::size_t, 3>{ { indices[i + 1], indices[i], indices[i + 2] } });
+        }
+        else // fan
+        {
+          triangles.push_back({ { indices[0], indices[i + 1], indices[i + 2] } });
+        }
+      }
+      const std::int64_t gltfMaterial = primitive.value("material", std::int64_t(-1));
+      const auto found = materialIds.find(gltfMaterial);
+      int material = 0;
+      if (found != materialIds.end())
+      {
+        material = found->second;
+      }
+      else
+      {
+        material = static_cast<int>(materialOrder.size());
+        materialIds[gltfMaterial] = material;
+        materialOrder.push_back(gltfMaterial);
+      }
+      std::vector<double> colours;
+      std::size_t colourComponents = 0;
+      if (attributes.contains("COLOR_0"))
+      {
+        colours = document.accessor(attributes["COLOR_0"].get<std::size_t>(), colourComponents);
+        if (colourComponents < 3 || colours.size() / colourComponents != vertexCount)
+        {
+          document.fail("a primitive of meshes[" + std::to_string(meshIndex) +
+            "] has a COLOR_0 that is not one RGB or RGBA colour per vertex");
+        }
+      }
       const vtkIdType offset = scene.points->GetNumberOfPoints();
-      double point[4];
-      for (vtkIdType i = 0; i < pointCount; ++i)
+      for (std::size_t v = 0; v < vertexCount; ++v)
       {
-        geometry->GetPoint(i, point);
-        point[3] = 1.0;
-        matrix->MultiplyPoint(point, point);
-        scene.points->InsertNextPoint(point[0] / (point[3] != 0 ? point[3] : 1.0),
-          point[1] / (point[3] != 0 ? point[3] : 1.0), point[2] / (point[3] != 0 ? point[3] : 1.0));
+        double p[3];
+        for (std::size_t r = 0; r < 3; ++r)
+        {
+          p[r] = matrix[4 * r] * positions[3 * v] + matrix[4 * r + 1] * positions[3 * v + 1] +
+            matrix[4 * r + 2] * positions[3 * v + 2] + matrix[4 * r + 3];
+        }
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+        {
+          document.fail("meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
+        }
+        scene.points->InsertNextPoint(p);
       }
-      std::vector<vtkIdType> shifted;
-      auto iterator = vtkSmartPointer<vtkCellArrayIterator>::Take(triangles->NewIterator());
-      for (iterator->GoToFirstCell(); !iterator->IsDoneWithTraversal(); iterator->GoToNextCell())
+      for (const auto& triangle : triangles)
       {
-        iterator->GetCurrentCell(count, ids);
-        shifted.assign(ids, ids + count);
-        std::array<double, 3> mean{ { 1, 1, 1 } };
-        if (colours && colours->GetNumberOfComponents() >= 3 && colours->GetNumberOfTuples() == pointCount)
-        {
-          mean = { { 0, 0, 0 } };
-          for (vtkIdType id : shifted)
-          {
-            for (int c = 0; c < 3; ++c)
-            {
-              mean[static_cast<std::size_t>(c)] += colours->GetComponent(id, c) / static_cast<double>(count);
-            }
-          }
-          anyColour = true;
-        }
-        for (vtkIdType& id : shifted)
-        {
-          id += offset;
-        }
-        scene.polygons->InsertNextCell(count, shifted.data());
+        const vtkIdType ids[3] = { offset + static_cast<vtkIdType>(triangle[0]),
+          offset + static_cast<vtkIdType>(triangle[1]), offset + static_cast<vtkIdType>(triangle[2]) };
+        scene.polygons->InsertNextCell(3, ids);
         scene.materialOfCell.push_back(material);
+        std::array<double, 3> mean{ { 1, 1, 1 } };
+        if (!colours.empty())
+        {
+          anyColour = true;
+          for (std::size_t c = 0; c < 3; ++c)
+          {
+            mean[c] = (colours[triangle[0] * colourComponents + c] + colours[triangle[1] * colourComponents + c] +
+                        colours[triangle[2] * colourComponents + c]) / 3.0;
+          }
+        }
         vertexColourOfCell.push_back(mean);
       }
     }
+    poll(0.3 + 0.5 * static_cast<double>(scene.polygons->GetNumberOfCells() > 0));
   }
-  poll(0.9);
   if (scene.polygons->GetNumberOfCells() == 0)
   {
     throw FileError("the glTF file " + named(path) + " has no triangles in its scene" +
@@ -1418,73 +1759,80 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
     warn("the glTF file " + named(path) + " has " + std::to_string(skippedPrimitives) +
       " primitives of points or lines: they are skipped, only triangles are surfaces");
   }
-  if (!model->Skins.empty() || !model->Animations.empty())
+  if (root.contains("skins") || root.contains("animations") || root.contains("extensionsRequired"))
   {
-    warn("the glTF file " + named(path) + " has skins or animations: the meshes are read in their rest pose");
+    // Morph targets, skins and animations move vertices; the rest pose is what is read.
+    if (!checks.array("skins").empty() || !checks.array("animations").empty())
+    {
+      warn("the glTF file " + named(path) + " has skins or animations: the meshes are read in their rest pose");
+    }
   }
 
   // Materials, in order of first use; names unique (glTF names are optional and may repeat).
-  scene.materials.resize(materialIds.size());
+  const Json& materials = checks.array("materials");
   std::set<std::string> names;
-  for (const auto& [gltfIndex, id] : materialIds)
+  auto failMaterial = [&](const std::string& problem) { document.fail(problem); };
+  for (const std::int64_t gltfIndex : materialOrder)
   {
-    (void)id;
-    Material& material = scene.materials[static_cast<std::size_t>(materialIds[gltfIndex])];
+    Material material;
     if (gltfIndex < 0)
     {
       material.name = "default";
       material.reflectance = checkedReflectance({ { 1, 1, 1 } },
         "the glTF default material (of primitives without a material) in " + named(path), warn);
-      continue;
     }
-    const auto& source = model->Materials[static_cast<std::size_t>(gltfIndex)];
-    material.name = source.Name.empty() ? "material_" + std::to_string(gltfIndex) : source.Name;
-    const std::string what = "the glTF material " + named(material.name) + " of " + named(path);
-    std::array<double, 3> base{ { 1, 1, 1 } };
-    const auto& factor = source.PbrMetallicRoughness.BaseColorFactor;
-    for (std::size_t c = 0; c < 3 && c < factor.size(); ++c)
+    else
     {
-      base[c] = factor[c];
-    }
-    if (source.PbrMetallicRoughness.BaseColorTexture.Index >= 0)
-    {
-      const auto mean = textureMean(*model, source.PbrMetallicRoughness.BaseColorTexture.Index, what, warn);
-      for (std::size_t c = 0; c < 3; ++c)
+      const Json& source = materials[static_cast<std::size_t>(gltfIndex)];
+      const std::string where = "materials[" + std::to_string(gltfIndex) + "]";
+      const auto name = source.find("name");
+      material.name = name != source.end() && name->is_string() && !name->get<std::string>().empty()
+        ? name->get<std::string>()
+        : "material_" + std::to_string(gltfIndex);
+      const std::string what = "the glTF material " + named(material.name) + " of " + named(path);
+      const Json pbr = source.value("pbrMetallicRoughness", Json::object());
+      std::array<double, 3> base = colourFactor(pbr, "baseColorFactor", 4, 1.0, where + ".pbrMetallicRoughness", failMaterial);
+      if (pbr.contains("baseColorTexture"))
       {
-        base[c] *= mean[c];
+        const auto mean = document.textureMean(pbr["baseColorTexture"]["index"].get<std::size_t>(), what, warn);
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+          base[c] *= mean[c];
+        }
+      }
+      material.reflectance = checkedReflectance(base, what, warn);
+      double strength = 1.0;
+      const Json extension = source.value("extensions", Json::object()).value("KHR_materials_emissive_strength", Json::object());
+      if (extension.contains("emissiveStrength"))
+      {
+        const Json& value = extension["emissiveStrength"];
+        if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0)
+        {
+          document.fail(where + ".extensions.KHR_materials_emissive_strength.emissiveStrength must be a number, 0 or more");
+        }
+        strength = value.get<double>();
+      }
+      material.radiance = colourFactor(source, "emissiveFactor", 3, 0.0, where, failMaterial);
+      for (double& value : material.radiance)
+      {
+        value *= strength;
+      }
+      if (source.contains("emissiveTexture") && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
+      {
+        const auto mean = document.textureMean(source["emissiveTexture"]["index"].get<std::size_t>(), what, warn);
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+          material.radiance[c] *= mean[c];
+        }
       }
     }
-    material.reflectance = checkedReflectance(base, what, warn);
-    const double strength = emissiveStrength(root, gltfIndex);
-    if (strength < 0)
-    {
-      throw FileError(what + ": KHR_materials_emissive_strength.emissiveStrength must be a number, 0 or more");
-    }
-    for (std::size_t c = 0; c < 3 && c < source.EmissiveFactor.size(); ++c)
-    {
-      material.radiance[c] = source.EmissiveFactor[c] * strength;
-      if (!std::isfinite(material.radiance[c]) || material.radiance[c] < 0)
-      {
-        throw FileError(what + ": emissiveFactor must hold numbers, 0 or more");
-      }
-    }
-    if (source.EmissiveTexture.Index >= 0 && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
-    {
-      const auto mean = textureMean(*model, source.EmissiveTexture.Index, what, warn);
-      for (std::size_t c = 0; c < 3; ++c)
-      {
-        material.radiance[c] *= mean[c];
-      }
-    }
-  }
-  for (Material& material : scene.materials)
-  {
     std::string unique = material.name;
     for (int n = 2; !names.insert(unique).second; ++n)
     {
       unique = material.name + "_" + std::to_string(n);
     }
     material.name = unique;
+    scene.materials.push_back(material);
   }
   if (anyColour)
   {
@@ -1506,7 +1854,32 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
         " reflectance components of cells coloured by COLOR_0 are clamped to 0.99");
     }
   }
+  poll(1.0);
   return scene;
+}
+
+} // namespace
+
+Scene readGltf(const std::string& path, const Warn& warn, const Progress& progress)
+{
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const bool glb = extension == ".glb";
+  ProgressPoll poll(progress, 0.0, 1.0);
+
+  std::string bin;
+  std::int64_t binBytes = -1;
+  const Json root = readGltfJson(path, glb, bin, binBytes);
+  try
+  {
+    return readGltfDocument(root, path, glb, std::move(bin), binBytes, warn, poll);
+  }
+  catch (const Json::exception& e)
+  {
+    // A member of an unexpected JSON type that the checks above did not look at.
+    throw FileError("the glTF file " + named(path) + " is malformed: " + e.what());
+  }
 }
 
 // =========================================================================================

@@ -74,10 +74,10 @@ std::array<double, 3> checkedReflectance(
 /// with a warning. FileError when the file cannot be read, is malformed, or has no faces.
 Scene readObj(const std::string& path, const Warn& warn, const Progress& progress);
 
-/// glTF 2.0, .gltf (JSON, buffers embedded as data: URIs or in files beside it) or .glb,
-/// through VTK's vtkGLTFDocumentLoader after checks that keep it inside its buffers. The
-/// default scene's meshes with their node transforms, in metres; triangles, strips and fans
-/// (points and lines are skipped with a warning). Material: baseColorFactor times the mean of
+/// glTF 2.0, .gltf (JSON, buffers embedded as data: URIs or in files beside it) or .glb, with
+/// every index and accessor checked against the file before use. The default scene's meshes
+/// with their node transforms, in metres; triangles, strips and fans (points and lines are
+/// skipped with a warning). Material: baseColorFactor times the mean of
 /// its base colour texture (linear) is the reflectance, emissiveFactor times
 /// KHR_materials_emissive_strength times the mean of its emissive texture the radiance.
 /// COLOR_0 multiplies the reflectance per cell (mean over the cell's vertices). FileError

@@ -68,6 +68,13 @@ int vtkRadiositySceneReader::RequestData(
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
   output->Initialize();
+  if (this->Aborted)
+  {
+    // The flag that stopped the last update would stop this one at once (see
+    // vtkAlgorithm::CheckAbort): an update after an abort reads again.
+    this->AbortExecute = 0;
+    this->Aborted = false;
+  }
   if (!this->FileName || !*this->FileName)
   {
     vtkErrorMacro(<< "no FileName: give an .obj, .gltf, .glb or .ply scene file");
@@ -112,12 +119,18 @@ int vtkRadiositySceneReader::RequestData(
   }
   catch (const sf::Aborted&)
   {
+    this->Aborted = true;
     vtkErrorMacro(<< "reading '" << path << "' was aborted");
     return 0;
   }
   catch (const std::bad_alloc&)
   {
     vtkErrorMacro(<< "out of memory reading the scene file '" << path << "'");
+    return 0;
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< "the scene file '" << path << "' could not be read: " << e.what());
     return 0;
   }
 
@@ -171,4 +184,5 @@ void vtkRadiositySceneReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "Aborted: " << (this->Aborted ? "yes" : "no") << "\n";
 }

@@ -22,8 +22,10 @@
  *   (`map_Kd`) are not read: Kd alone gives the reflectance. Points and lines are skipped with
  *   a warning. A missing MTL file, or a material it does not define, is grey 0.5 and does not
  *   emit, with a warning naming the file or the material.
- * - `.gltf`, `.glb`: glTF 2.0 through VTK's vtkGLTFDocumentLoader, the default scene with its
- *   node transforms (glTF lengths are metres), its skins and animations in the rest pose.
+ * - `.gltf`, `.glb`: glTF 2.0 (buffers embedded, in a .glb BIN chunk or in files beside it),
+ *   the default scene with its node transforms (glTF lengths are metres), skins and animations
+ *   in the rest pose. Files that require geometry extensions (Draco, quantization, meshopt)
+ *   are refused.
  *   Triangles, strips and fans are read; points and lines are skipped with a warning, and a
  *   file with no triangles is an error. `baseColorFactor` (RGB) times the mean linear colour of
  *   the base colour texture is the reflectance; `COLOR_0` multiplies it per cell (mean over the
@@ -38,11 +40,13 @@
  * A reflectance of 1 or more (modelling tools often export Kd 1 1 1) is clamped to 0.99 with a
  * warning naming the material. Lengths are kept as the file has them.
  *
- * VTK 9.2's own vtkOBJReader and vtkPLYReader are not used: the first gives the first faces
- * after a `usemtl` the material NO_MATERIAL and crashes on indices the file does not define,
- * the second truncates float colours to 0 and crashes on some malformed headers. Their formats
- * are read here instead, checking every index. glTF files are checked (buffer, accessor and
- * node indices and sizes) before vtkGLTFDocumentLoader reads them.
+ * VTK 9.2's own readers are not used for geometry: vtkOBJReader gives the first faces after a
+ * `usemtl` the material NO_MATERIAL and crashes on indices the file does not define,
+ * vtkPLYReader truncates float colours to 0 and crashes on some malformed headers, and
+ * vtkGLTFDocumentLoader aborts (a failed assertion in Debian's build) on a material without
+ * pbrMetallicRoughness, which glTF allows, and reads accessors past their buffers. The formats
+ * are read here instead (glTF's JSON with VTK's nlohmann::json, textures with vtkPNGReader and
+ * vtkJPEGReader), checking every index and size before using it.
  *
  * Bad input (a missing, unreadable or malformed file, an unknown extension, a file without
  * faces or triangles) gives an error naming the file and what is wrong, and an empty output.
@@ -92,6 +96,8 @@ private:
   void operator=(const vtkRadiositySceneReader&) = delete;
 
   char* FileName = nullptr;
+  /// The last update stopped on AbortExecute, which this VTK does not clear by itself.
+  bool Aborted = false;
 };
 
 #endif

@@ -6,6 +6,10 @@
 #include "vtkDataArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
+#include "vtkImageData.h"
+#include "vtkPNGWriter.h"
+#include "vtkPointData.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkPolyData.h"
 #include "vtkRadiositySceneReader.h"
 #include "vtkSmartPointer.h"
@@ -455,6 +459,97 @@ TEST(SceneReader, GltfNodeTransformsAndEmission)
   EXPECT_NEAR(bounds[1], 2, 1e-6);
   EXPECT_NEAR(bounds[2], 2, 1e-6);
   EXPECT_NEAR(bounds[5], 4, 1e-6);
+}
+
+/// A PNG of 2 x 2 texels, each (r, g, b) of `texels`.
+std::string pngImage(const std::array<std::array<int, 3>, 4>& texels)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(2, 2, 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto* scalars = vtkUnsignedCharArray::SafeDownCast(image->GetPointData()->GetScalars());
+  for (vtkIdType t = 0; t < 4; ++t)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      scalars->SetTypedComponent(t, c, static_cast<unsigned char>(texels[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)]));
+    }
+  }
+  auto writer = vtkSmartPointer<vtkPNGWriter>::New();
+  writer->SetInputData(image);
+  writer->WriteToMemoryOn();
+  writer->Write();
+  vtkUnsignedCharArray* bytes = writer->GetResult();
+  return std::string(reinterpret_cast<const char*>(bytes->GetPointer(0)), static_cast<std::size_t>(bytes->GetNumberOfValues()));
+}
+
+double srgbToLinear(double value)
+{
+  return value <= 0.04045 ? value / 12.92 : std::pow((value + 0.055) / 1.055, 2.4);
+}
+
+TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
+{
+  const fs::path folder = testFolder("gltf-texture");
+  // Half the texels white, half black in red and blue; green 128 everywhere (sRGB, so 0.2159
+  // in linear light). The factor multiplies the mean.
+  const std::string png = pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
+  writeFile(folder / "wood.png", png);
+  std::string json = gltfJson(dataUri(gltfBuffer()),
+    R"(,
+  "textures": [{"source": 0}, {"source": 1}],
+  "images": [{"uri": "data:image/png;base64,)" + base64(png) + R"("}, {"uri": "wood.png"}])");
+  const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
+  json.replace(json.find(white), white.size(),
+    R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 1, 0.6, 1], "baseColorTexture": {"index": 0}}})");
+  const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
+  json.replace(json.find(red), red.size(),
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})");
+  writeFile(folder / "textured.gltf", json);
+  const ReadResult result = readScene(folder / "textured.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.warnings(), "");
+  const double green = srgbToLinear(128 / 255.0);
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, green, 0.6 * 0.5, 1e-9, "data: URI texture");
+  expectRgbNear(tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-9, "texture file beside the glTF");
+}
+
+TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
+{
+  const fs::path folder = testFolder("gltf-modes");
+  // VTK 9.2's vtkGLTFDocumentLoader aborts on a material without pbrMetallicRoughness; glTF's
+  // default for it is white, which is clamped with a warning. Strips and fans make triangles.
+  std::string json = gltfJson(dataUri(gltfBuffer()));
+  const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
+  json.replace(json.find(white), white.size(), R"({"name": "lamp", "emissiveFactor": [1, 1, 1]})");
+  json.replace(json.find(R"("indices": 1, "material": 0, "mode": 4)"), 38, R"("indices": 1, "material": 0, "mode": 5)");
+  json.replace(json.find(R"("indices": 2, "material": 1, "mode": 4)"), 38, R"("indices": 2, "material": 1, "mode": 6)");
+  writeFile(folder / "modes.gltf", json);
+  const ReadResult result = readScene(folder / "modes.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  // Indices 0 1 2 0 2 3: a strip gives 4 triangles, a fan (4 5 6 4 6 7) 4 too.
+  EXPECT_EQ(result.output->GetNumberOfCells(), 8);
+  EXPECT_NE(result.warnings().find("'lamp'"), std::string::npos) << result.warnings();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.99, 0.99, 0.99, 0);
+  expectRgbNear(tuple3(result.output, "Emission", 0), Pi, Pi, Pi, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 7), 0.63, 0.065, 0.05, 1e-6);
+}
+
+TEST(SceneReader, AbortGivesAnEmptyOutputAndTheNextUpdateReads)
+{
+  const fs::path folder = testFolder("abort");
+  writeFile(folder / "scene.obj", twoMaterialObj(""));
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  reader->SetFileName((folder / "scene.obj").string().c_str());
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(reader);
+  reader->SetAbortExecute(1);
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+  EXPECT_NE(messages->allErrors().find("aborted"), std::string::npos) << messages->allErrors();
+  reader->Modified();
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 4);
 }
 
 // --- Bad input: an error naming the file and what is wrong, an empty output -------------------
