@@ -1,6 +1,6 @@
-// Isotropic remeshing with CGAL. The only translation unit of the project that includes CGAL:
-// its headers take ~45 s and 1.6 GB to compile, and its -frounding-math must not reach the
-// solver.
+// Contact splitting and isotropic remeshing with CGAL. The only translation unit of the
+// project that includes CGAL: its headers take ~45 s and 1.6 GB to compile, and its
+// -frounding-math must not reach the solver.
 #include "CgalRemeshing.h"
 
 #include "CancellationPoll.h"
@@ -11,12 +11,14 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/boost/graph/helpers.h>
 
 #include <boost/property_map/property_map.hpp>
@@ -59,13 +61,17 @@ constexpr std::size_t MaximumRegionWarnings = 10;
 
 constexpr double Pi = 3.14159265358979323846;
 
-/// The triangles CGAL works on, after repair and orientation, with where each came from.
+/// The triangles CGAL works on, after repair, orientation and splitting along contacts,
+/// with where each came from.
 struct RepairedSoup
 {
   std::vector<Point> points;
   std::vector<CgalTriangle> triangles;
   std::vector<std::size_t> input; ///< index into TriangleSoup::triangles
   std::vector<bool> flipped;      ///< orient_polygon_soup reversed it
+  /// Edges (point indices, smaller first, sorted) on lines where surfaces touch or cross:
+  /// constraints for remeshing, so that no patch straddles a contact.
+  std::vector<std::pair<std::size_t, std::size_t>> contactEdges;
 };
 
 /// Connected faces of one material and one orientation with respect to the input, bounded
@@ -76,7 +82,7 @@ struct Region
   std::uint32_t material = 0;
   bool flipped = false;
   double inputArea = 0;
-  std::vector<std::size_t> inputTriangles;
+  std::vector<std::size_t> triangles; ///< indices into RepairedSoup::triangles
 };
 
 /// What a remeshing outcome is short of to be kept; empty when it is fine.
@@ -113,7 +119,7 @@ std::string describeRegion(const Region& region, const std::vector<Material>& ma
 {
   std::ostringstream s;
   s << "region " << region.id << " (reflectance " << describe(materials[region.material].reflectance)
-    << ", " << countOf(region.inputTriangles.size(), "input triangle") << ")";
+    << ", " << countOf(region.triangles.size(), "input triangle") << ")";
   return s.str();
 }
 
@@ -158,6 +164,7 @@ struct PolledPointMap
 
 void keepTriangles(RepairedSoup& soup, const std::vector<bool>& keep)
 {
+  const bool oriented = soup.flipped.size() == soup.triangles.size();
   std::size_t kept = 0;
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
@@ -165,11 +172,19 @@ void keepTriangles(RepairedSoup& soup, const std::vector<bool>& keep)
     {
       soup.triangles[kept] = soup.triangles[i];
       soup.input[kept] = soup.input[i];
+      if (oriented)
+      {
+        soup.flipped[kept] = soup.flipped[i];
+      }
       ++kept;
     }
   }
   soup.triangles.resize(kept);
   soup.input.resize(kept);
+  if (oriented)
+  {
+    soup.flipped.resize(kept);
+  }
 }
 
 /// Drops triangles whose corners merged or are exactly collinear (exact predicate).
@@ -227,16 +242,17 @@ bool sameCyclicOrder(const CgalTriangle& a, const CgalTriangle& b, const std::ve
 }
 
 /// orient_polygon_soup() may reverse triangles and duplicates points where the surface is
-/// not a manifold; it keeps the triangles' order and the existing points.
+/// not a manifold; it keeps the triangles' order and the existing points. A reversal adds to
+/// any earlier one.
 std::size_t orientSoup(RepairedSoup& soup)
 {
   const std::vector<CgalTriangle> before = soup.triangles;
   const std::size_t pointsBefore = soup.points.size();
   PMP::orient_polygon_soup(soup.points, soup.triangles);
-  soup.flipped.resize(soup.triangles.size());
+  soup.flipped.resize(soup.triangles.size(), false);
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
-    soup.flipped[i] = !sameCyclicOrder(before[i], soup.triangles[i], soup.points);
+    soup.flipped[i] = soup.flipped[i] != !sameCyclicOrder(before[i], soup.triangles[i], soup.points);
   }
   return soup.points.size() - pointsBefore;
 }
@@ -282,6 +298,497 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
   return soup;
 }
 
+using TriangleList = std::vector<Kernel::Triangle_3>;
+using TreePrimitive = CGAL::AABB_triangle_primitive<Kernel, TriangleList::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TreePrimitive>>;
+
+// ---------------------------------------------------------------------------------------
+// Contact lines. Where a surface touches or crosses another (a block standing on a floor, a
+// panel through a wall), a patch on both sides of the line would average the lit side with
+// the shadowed one, and light would leak across it. The soup is split along these lines
+// first (CGAL's autorefinement: exact predicates, intersection points rounded once), and the
+// lines become remeshing constraints.
+
+constexpr std::size_t NoOrigin = std::numeric_limits<std::size_t>::max();
+
+/// Where autorefinement is in the soup, shared by the visitor's copies.
+struct SplitTracking
+{
+  Mesh::Property_map<FaceIndex, std::size_t> origin;
+  std::size_t splitting = NoOrigin;
+  CancellationPoll* poll = nullptr;
+};
+
+/// Gives the pieces of a split face the origin of that face, and lets autorefinement be
+/// cancelled at its steps (its vertex points are polled too).
+struct SplitVisitor : PMP::Corefinement::Default_visitor<Mesh>
+{
+  SplitTracking* tracking = nullptr;
+
+  void before_subface_creations(FaceIndex f, Mesh&)
+  {
+    this->tracking->splitting = this->tracking->origin[f];
+    this->tracking->poll->tick();
+  }
+  void after_subface_created(FaceIndex f, Mesh&)
+  {
+    this->tracking->origin[f] = this->tracking->splitting;
+  }
+  void progress_filtering_intersections(double) const { this->tracking->poll->tick(); }
+  void triangulating_faces_step() const { this->tracking->poll->tick(); }
+  void intersection_of_coplanar_faces_step() const { this->tracking->poll->tick(); }
+};
+
+/// Connected surfaces of the soup (triangles sharing a point), which of them are closed, and
+/// each triangle's edges: what the contact search and the covered faces need, without building a
+/// mesh of the whole soup.
+struct Surfaces
+{
+  std::vector<std::size_t> of; ///< surface of each triangle
+  std::size_t count = 0;
+  std::vector<bool> closed;    ///< every edge shared by two triangles
+  /// (smaller point, larger point, triangle) for every triangle edge, sorted.
+  std::vector<std::array<std::size_t, 3>> edges;
+};
+
+Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
+{
+  // Union-find over points.
+  std::vector<std::size_t> parent(soup.points.size());
+  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  auto root = [&parent](std::size_t p) {
+    while (parent[p] != p)
+    {
+      parent[p] = parent[parent[p]];
+      p = parent[p];
+    }
+    return p;
+  };
+  for (const CgalTriangle& t : soup.triangles)
+  {
+    poll.tick();
+    for (int k = 1; k < 3; ++k)
+    {
+      const std::size_t a = root(t[0]), b = root(t[static_cast<std::size_t>(k)]);
+      parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  Surfaces s;
+  std::vector<std::size_t> index(soup.points.size(), NoOrigin);
+  s.of.resize(soup.triangles.size());
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    std::size_t& surface = index[root(soup.triangles[i][0])];
+    if (surface == NoOrigin)
+    {
+      surface = s.count++;
+    }
+    s.of[i] = surface;
+  }
+  s.closed.assign(s.count, true);
+  s.edges.reserve(3 * soup.triangles.size());
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    const CgalTriangle& t = soup.triangles[i];
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      const std::size_t a = t[k], b = t[(k + 1) % 3];
+      s.edges.push_back({ std::min(a, b), std::max(a, b), i });
+    }
+  }
+  std::sort(s.edges.begin(), s.edges.end(), [&poll](const auto& a, const auto& b) {
+    poll.tick();
+    return a < b;
+  });
+  for (std::size_t i = 0; i < s.edges.size();)
+  {
+    std::size_t j = i + 1;
+    while (j < s.edges.size() && s.edges[j][0] == s.edges[i][0] && s.edges[j][1] == s.edges[i][1])
+    {
+      ++j;
+    }
+    if (j - i != 2)
+    {
+      s.closed[s.of[s.edges[i][2]]] = false;
+    }
+    i = j;
+  }
+  return s;
+}
+
+using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
+
+/// Triangles that touch or cross a triangle of another surface: boxes first
+/// (box_intersection_d), then CGAL's exact triangle-triangle predicate.
+std::vector<bool> touchingTriangles(const RepairedSoup& soup, const Surfaces& surfaces, CancellationPoll& poll)
+{
+  std::vector<TriangleBox> boxes;
+  boxes.reserve(soup.triangles.size());
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    const CgalTriangle& t = soup.triangles[i];
+    boxes.emplace_back(soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox(), i);
+  }
+  std::vector<bool> touching(soup.triangles.size(), false);
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const TriangleBox& a, const TriangleBox& b) {
+    poll.tick();
+    const std::size_t i = a.info(), j = b.info();
+    if (surfaces.of[i] == surfaces.of[j] || (touching[i] && touching[j]))
+    {
+      return;
+    }
+    const CgalTriangle &s = soup.triangles[i], &t = soup.triangles[j];
+    if (CGAL::do_intersect(Kernel::Triangle_3(soup.points[s[0]], soup.points[s[1]], soup.points[s[2]]),
+          Kernel::Triangle_3(soup.points[t[0]], soup.points[t[1]], soup.points[t[2]])))
+    {
+      touching[i] = touching[j] = true;
+    }
+  });
+  return touching;
+}
+
+/// A connected closed surface: an open surface lying on it face to face (the floor under a
+/// block) is covered, never seen. Its distance tree is built when first needed.
+struct ClosedSurface
+{
+  std::vector<std::size_t> triangles; ///< of the soup before splitting
+  CGAL::Bbox_3 box;
+  double tolerance = 0; ///< distance under which a point lies on the surface
+  TriangleList faces;
+  std::unique_ptr<Tree> tree;
+};
+
+std::vector<ClosedSurface> findClosedSurfaces(const RepairedSoup& soup, const Surfaces& surfaces)
+{
+  std::vector<ClosedSurface> closed(surfaces.count);
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    const std::size_t s = surfaces.of[i];
+    if (surfaces.closed[s])
+    {
+      const CgalTriangle& t = soup.triangles[i];
+      const CGAL::Bbox_3 box = soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox();
+      closed[s].box = closed[s].triangles.empty() ? box : closed[s].box + box;
+      closed[s].triangles.push_back(i);
+    }
+  }
+  for (ClosedSurface& c : closed)
+  {
+    const CGAL::Bbox_3& b = c.box;
+    const double diagonal = std::sqrt(CGAL::square(b.xmax() - b.xmin()) + CGAL::square(b.ymax() - b.ymin()) +
+      CGAL::square(b.zmax() - b.zmin()));
+    // Contact points are rounded once to doubles: far above that, far below any real gap.
+    c.tolerance = 1e-9 * diagonal;
+  }
+  return closed;
+}
+
+const Tree& distanceTree(ClosedSurface& closed, const RepairedSoup& soup)
+{
+  if (!closed.tree)
+  {
+    for (std::size_t i : closed.triangles)
+    {
+      const CgalTriangle& t = soup.triangles[i];
+      closed.faces.emplace_back(soup.points[t[0]], soup.points[t[1]], soup.points[t[2]]);
+    }
+    closed.tree = std::make_unique<Tree>(closed.faces.begin(), closed.faces.end());
+    closed.tree->accelerate_distance_queries();
+  }
+  return *closed.tree;
+}
+
+/**
+ * Marks the triangles of `split` (whose surfaces are `surfaceOf`) that lie face to face on a
+ * closed surface of another surface (the floor under a block), once triangles have been split
+ * along the contacts so that each lies wholly on or off it. The closed surfaces themselves are
+ * kept whole, so that they stay closed; where two closed surfaces touch face to face, both
+ * contact faces go, leaving one closed surface around both. Triangles inside a closed surface
+ * but not on it are kept: with two-sided surfaces a closed box may be a room as well as a
+ * solid, and only the light's position could tell.
+ */
+std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<std::size_t>& surfaceOf,
+  const RepairedSoup& original, std::vector<ClosedSurface>& closed, CancellationPoll& poll)
+{
+  std::vector<bool> covered(split.triangles.size(), false);
+  std::vector<TriangleBox> closedBoxes;
+  for (std::size_t s = 0; s < closed.size(); ++s)
+  {
+    if (!closed[s].triangles.empty())
+    {
+      const double t = closed[s].tolerance;
+      const CGAL::Bbox_3& b = closed[s].box;
+      closedBoxes.emplace_back(
+        CGAL::Bbox_3(b.xmin() - t, b.ymin() - t, b.zmin() - t, b.xmax() + t, b.ymax() + t, b.zmax() + t), s);
+    }
+  }
+  if (closedBoxes.empty())
+  {
+    return covered;
+  }
+  std::vector<TriangleBox> centroids;
+  std::vector<Point> centroidOf(split.triangles.size());
+  for (std::size_t i = 0; i < split.triangles.size(); ++i)
+  {
+    const CgalTriangle& t = split.triangles[i];
+    centroidOf[i] = CGAL::centroid(split.points[t[0]], split.points[t[1]], split.points[t[2]]);
+    centroids.emplace_back(centroidOf[i].bbox(), i);
+  }
+  CGAL::box_intersection_d(centroids.begin(), centroids.end(), closedBoxes.begin(), closedBoxes.end(),
+    [&](const TriangleBox& triangle, const TriangleBox& closedBox) {
+      poll.tick();
+      const std::size_t i = triangle.info();
+      ClosedSurface& surface = closed[closedBox.info()];
+      if (surfaceOf[i] != closedBox.info() && !covered[i])
+      {
+        covered[i] = distanceTree(surface, original).squared_distance(centroidOf[i]) <= CGAL::square(surface.tolerance);
+      }
+    });
+  return covered;
+}
+
+/// A limit the caller set was exceeded: not derived from std::exception, so that guarded()
+/// does not take it for a CGAL failure.
+struct OverLimit
+{
+  std::string message;
+};
+
+/// The triangles CGAL's autorefinement works on: those touching another surface, and their
+/// neighbours across an edge, so that an intersection point on a shared edge splits both
+/// triangles of that edge and no T-junction is left behind.
+std::vector<std::size_t> refinementSet(const Surfaces& surfaces, const std::vector<bool>& touching)
+{
+  std::vector<bool> in = touching;
+  for (std::size_t e = 0; e < surfaces.edges.size();)
+  {
+    std::size_t end = e + 1;
+    while (end < surfaces.edges.size() && surfaces.edges[end][0] == surfaces.edges[e][0] &&
+      surfaces.edges[end][1] == surfaces.edges[e][1])
+    {
+      ++end;
+    }
+    bool any = false;
+    for (std::size_t k = e; k < end; ++k)
+    {
+      any = any || touching[surfaces.edges[k][2]];
+    }
+    for (std::size_t k = e; any && k < end; ++k)
+    {
+      in[surfaces.edges[k][2]] = true;
+    }
+    e = end;
+  }
+  std::vector<std::size_t> set;
+  for (std::size_t i = 0; i < in.size(); ++i)
+  {
+    if (in[i])
+    {
+      set.push_back(i);
+    }
+  }
+  return set;
+}
+
+/**
+ * Splits the soup along the lines where triangles of different surfaces touch or cross, and
+ * drops the pieces lying face to face on closed surfaces. Only the triangles near a contact go through
+ * CGAL's autorefinement (it takes seconds on 200,000 triangles); the rest are kept as they
+ * are. Leaves the soup unchanged when nothing touches. CGAL may throw: the caller guards this.
+ */
+void splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, CgalRemeshOutput& out,
+  CancellationPoll& poll)
+{
+  const Surfaces surfaces = findSurfaces(soup, poll);
+  const std::vector<bool> touching = touchingTriangles(soup, surfaces, poll);
+  const std::vector<std::size_t> set = refinementSet(surfaces, touching);
+  std::vector<bool> inSet(soup.triangles.size(), false);
+  for (std::size_t i : set)
+  {
+    inSet[i] = true;
+  }
+
+  // The set as a mesh of its own; its first vertices are soup points.
+  std::vector<std::size_t> localIndex(soup.points.size(), NoOrigin);
+  std::vector<std::size_t> globalPoint;
+  std::vector<Point> localPoints;
+  std::vector<CgalTriangle> localTriangles;
+  for (std::size_t i : set)
+  {
+    CgalTriangle local;
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      const std::size_t p = soup.triangles[i][k];
+      if (localIndex[p] == NoOrigin)
+      {
+        localIndex[p] = localPoints.size();
+        localPoints.push_back(soup.points[p]);
+        globalPoint.push_back(p);
+      }
+      local[k] = localIndex[p];
+    }
+    localTriangles.push_back(local);
+  }
+  if (!PMP::is_polygon_soup_a_polygon_mesh(localTriangles))
+  {
+    throw Error("the triangles around the contacts do not form a manifold surface");
+  }
+  Mesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(localPoints, localTriangles, mesh);
+  if (mesh.number_of_faces() != set.size() || mesh.number_of_vertices() != localPoints.size())
+  {
+    throw Error("the surface mesh lost triangles when it was built from the soup");
+  }
+  SplitTracking tracking;
+  tracking.origin = mesh.add_property_map<FaceIndex, std::size_t>("f:origin", NoOrigin).first;
+  tracking.poll = &poll;
+  for (std::size_t f = 0; f < set.size(); ++f)
+  {
+    tracking.origin[FaceIndex(static_cast<Mesh::size_type>(f))] = set[f];
+  }
+  auto contact = mesh.add_property_map<EdgeIndex, bool>("e:contact", false).first;
+  if (!set.empty())
+  {
+    SplitVisitor visitor;
+    visitor.tracking = &tracking;
+    PMP::experimental::autorefine(mesh,
+      CGAL::parameters::vertex_point_map(PolledPointMap{ &mesh, &poll })
+        .edge_is_constrained_map(contact)
+        .visitor(visitor));
+    poll.check();
+  }
+  const std::size_t triangleCount = soup.triangles.size() - set.size() + mesh.number_of_faces();
+  if (settings.checkTriangleCount && triangleCount != soup.triangles.size())
+  {
+    try
+    {
+      settings.checkTriangleCount(triangleCount);
+    }
+    catch (const Error& e)
+    {
+      throw OverLimit{ e.what() };
+    }
+  }
+
+  // The split soup: the soup's points, then the new ones. Autorefinement may create several
+  // vertices at one intersection point of one surface (where edges of two surfaces cross):
+  // they are merged within each surface, never across surfaces.
+  RepairedSoup split;
+  split.points = soup.points;
+  std::vector<std::size_t> pointOf(mesh.num_vertices(), NoOrigin);
+  std::vector<std::size_t> surfaceOfVertex(mesh.num_vertices(), NoOrigin);
+  for (FaceIndex f : mesh.faces())
+  {
+    const std::size_t o = tracking.origin[f];
+    if (o >= soup.triangles.size())
+    {
+      throw Error("autorefinement made a face of unknown origin");
+    }
+    for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+    {
+      surfaceOfVertex[v] = surfaces.of[o];
+    }
+  }
+  std::vector<VertexIndex> added;
+  for (VertexIndex v : mesh.vertices())
+  {
+    if (static_cast<std::size_t>(v) < globalPoint.size())
+    {
+      pointOf[v] = globalPoint[v];
+    }
+    else if (surfaceOfVertex[v] != NoOrigin)
+    {
+      added.push_back(v);
+    }
+  }
+  std::sort(added.begin(), added.end(), [&](VertexIndex a, VertexIndex b) {
+    return surfaceOfVertex[a] != surfaceOfVertex[b] ? surfaceOfVertex[a] < surfaceOfVertex[b]
+                                                    : mesh.point(a) < mesh.point(b);
+  });
+  for (std::size_t i = 0; i < added.size(); ++i)
+  {
+    const VertexIndex v = added[i];
+    if (i == 0 || surfaceOfVertex[v] != surfaceOfVertex[added[i - 1]] || mesh.point(v) != mesh.point(added[i - 1]))
+    {
+      split.points.push_back(mesh.point(v));
+    }
+    pointOf[v] = split.points.size() - 1;
+  }
+
+  std::vector<std::size_t> surfaceOf;
+  auto keep = [&](const CgalTriangle& t, std::size_t origin) {
+    split.triangles.push_back(t);
+    split.input.push_back(soup.input[origin]);
+    split.flipped.push_back(soup.flipped[origin]);
+    surfaceOf.push_back(surfaces.of[origin]);
+  };
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    if (!inSet[i])
+    {
+      keep(soup.triangles[i], i);
+    }
+  }
+  std::vector<std::size_t> pieces(soup.triangles.size(), 0);
+  for (FaceIndex f : mesh.faces())
+  {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    const CgalTriangle t = { pointOf[mesh.source(h)], pointOf[mesh.target(h)], pointOf[mesh.target(mesh.next(h))] };
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0] &&
+      !CGAL::collinear(split.points[t[0]], split.points[t[1]], split.points[t[2]]))
+    {
+      keep(t, tracking.origin[f]);
+      ++pieces[tracking.origin[f]];
+    }
+  }
+  for (EdgeIndex e : mesh.edges())
+  {
+    const std::size_t a = pointOf[mesh.vertex(e, 0)], b = pointOf[mesh.vertex(e, 1)];
+    if (contact[e] && a != b)
+    {
+      split.contactEdges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(split.contactEdges.begin(), split.contactEdges.end());
+  split.contactEdges.erase(std::unique(split.contactEdges.begin(), split.contactEdges.end()), split.contactEdges.end());
+
+  std::vector<ClosedSurface> closed = findClosedSurfaces(soup, surfaces);
+  const std::vector<bool> covered = coveredTriangles(split, surfaceOf, soup, closed, poll);
+  std::vector<bool> keepTriangle(split.triangles.size());
+  for (std::size_t i = 0; i < split.triangles.size(); ++i)
+  {
+    keepTriangle[i] = !covered[i];
+    if (covered[i])
+    {
+      const CgalTriangle& t = split.triangles[i];
+      ++out.coveredTriangles;
+      out.coveredArea += triangleArea(split.points[t[0]], split.points[t[1]], split.points[t[2]]);
+    }
+  }
+  if (out.coveredTriangles == 0 && split.contactEdges.empty() && mesh.number_of_faces() == set.size())
+  {
+    return; // nothing touches, nothing is covered: keep the soup as it is
+  }
+  keepTriangles(split, keepTriangle);
+  out.contactEdges = split.contactEdges.size();
+  out.contactSplitTriangles = static_cast<std::size_t>(
+    std::count_if(pieces.begin(), pieces.end(), [](std::size_t n) { return n > 1; }));
+  if (split.triangles.empty())
+  {
+    throw Error("every face lies on a closed surface");
+  }
+  // Dropping covered faces can leave surfaces that meet at one point only.
+  if (!PMP::is_polygon_soup_a_polygon_mesh(split.triangles))
+  {
+    out.splitPoints += orientSoup(split);
+    if (!PMP::is_polygon_soup_a_polygon_mesh(split.triangles))
+    {
+      throw Error("the split triangles do not form a manifold surface");
+    }
+  }
+  soup = std::move(split);
+}
+
 // ---------------------------------------------------------------------------------------
 // Components: each connected surface is remeshed in a mesh of its own, so that a failure
 // costs only that surface.
@@ -305,13 +812,14 @@ std::vector<std::vector<std::size_t>> connectedComponents(const RepairedSoup& so
   return components;
 }
 
-/// The component's triangles as a mesh of their own; face i is soup triangle faces[i].
+/// The component's triangles as a mesh of their own; face i is soup triangle faces[i], and
+/// vertex v is soup point used[v].
 Mesh buildComponentMesh(const RepairedSoup& soup, const std::vector<std::size_t>& faces,
-  std::vector<std::size_t>& localIndex)
+  std::vector<std::size_t>& localIndex, std::vector<std::size_t>& used)
 {
   constexpr std::size_t None = std::numeric_limits<std::size_t>::max();
   std::vector<Point> points;
-  std::vector<std::size_t> used;
+  used.clear();
   std::vector<CgalTriangle> triangles;
   triangles.reserve(faces.size());
   for (std::size_t f : faces)
@@ -350,15 +858,18 @@ struct ComponentLayout
   std::vector<Region> regions;
 };
 
-/// Sharp edges, edges between materials or orientations, and the mesh border.
+/// Sharp edges, edges between materials or orientations, contact lines and the mesh border.
 Mesh::Property_map<EdgeIndex, bool> markConstrainedEdges(Mesh& mesh, const RepairedSoup& soup,
-  const TriangleSoup& input, const std::vector<std::size_t>& faces, double sharpEdgeAngle)
+  const TriangleSoup& input, const std::vector<std::size_t>& faces,
+  const std::vector<std::size_t>& pointOfVertex, double sharpEdgeAngle)
 {
   auto constrained = mesh.add_property_map<EdgeIndex, bool>("e:constrained", false).first;
   PMP::detect_sharp_edges(mesh, sharpEdgeAngle, constrained);
   for (EdgeIndex e : mesh.edges())
   {
-    if (mesh.is_border(e))
+    const std::size_t p = pointOfVertex[mesh.vertex(e, 0)], q = pointOfVertex[mesh.vertex(e, 1)];
+    if (mesh.is_border(e) ||
+      std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(), std::make_pair(std::min(p, q), std::max(p, q))))
     {
       constrained[e] = true;
       continue;
@@ -409,10 +920,11 @@ Mesh::Property_map<VertexIndex, bool> markCorners(
 }
 
 ComponentLayout layOutComponent(Mesh& mesh, const RepairedSoup& soup, const TriangleSoup& input,
-  const std::vector<std::size_t>& faces, double sharpEdgeAngle, std::size_t firstRegionId)
+  const std::vector<std::size_t>& faces, const std::vector<std::size_t>& pointOfVertex,
+  double sharpEdgeAngle, std::size_t firstRegionId)
 {
   ComponentLayout layout;
-  layout.constrained = markConstrainedEdges(mesh, soup, input, faces, sharpEdgeAngle);
+  layout.constrained = markConstrainedEdges(mesh, soup, input, faces, pointOfVertex, sharpEdgeAngle);
   layout.corner = markCorners(mesh, layout.constrained);
   layout.region = mesh.add_property_map<FaceIndex, std::size_t>("f:region", 0).first;
   const std::size_t count = PMP::connected_components(
@@ -426,7 +938,7 @@ ComponentLayout layOutComponent(Mesh& mesh, const RepairedSoup& soup, const Tria
     region.flipped = soup.flipped[s];
     const CgalTriangle& t = soup.triangles[s];
     region.inputArea += triangleArea(soup.points[t[0]], soup.points[t[1]], soup.points[t[2]]);
-    region.inputTriangles.push_back(soup.input[s]);
+    region.triangles.push_back(s);
   }
   for (std::size_t r = 0; r < count; ++r)
   {
@@ -438,9 +950,6 @@ ComponentLayout layOutComponent(Mesh& mesh, const RepairedSoup& soup, const Tria
 // ---------------------------------------------------------------------------------------
 // Remeshing.
 
-using TriangleList = std::vector<Kernel::Triangle_3>;
-using TreePrimitive = CGAL::AABB_triangle_primitive<Kernel, TriangleList::const_iterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TreePrimitive>>;
 
 /**
  * Projects moved vertices onto the input triangles of their own region, as CGAL does by
@@ -585,12 +1094,27 @@ void emitRegions(const Mesh& mesh, const ComponentLayout& layout,
   }
 }
 
-/// Collects the refused regions' input triangles and says why, up to a few warnings.
-void refuseRegion(const Region& region, const std::string& why,
-  const std::vector<Material>& materials, CgalRemeshOutput& out)
+/// Collects the refused regions' triangles, oriented like their input, and says why, up to a
+/// few warnings.
+void refuseRegion(const Region& region, const RepairedSoup& soup, const TriangleSoup& input,
+  const std::string& why, const std::vector<Material>& materials, CgalRemeshOutput& out)
 {
   ++out.fallbackRegions;
-  out.refineOnly.insert(out.refineOnly.end(), region.inputTriangles.begin(), region.inputTriangles.end());
+  for (std::size_t s : region.triangles)
+  {
+    CgalTriangle t = soup.triangles[s];
+    if (soup.flipped[s])
+    {
+      std::swap(t[1], t[2]);
+    }
+    const auto first = static_cast<std::uint32_t>(out.refinePoints.size());
+    for (std::size_t k : t)
+    {
+      out.refinePoints.push_back(toVec3(soup.points[k]));
+    }
+    out.refineOnly.triangles.push_back({ first, first + 1, first + 2 });
+    out.refineOnly.material.push_back(input.material[soup.input[s]]);
+  }
   if (out.fallbackRegions <= MaximumRegionWarnings)
   {
     out.warnings.push_back(describeRegion(region, materials) + " was only refined, not remeshed: " + why);
@@ -633,11 +1157,8 @@ void refuseComponent(const RepairedSoup& soup, const TriangleSoup& input,
   Region whole;
   whole.id = out.regions++;
   whole.material = input.material[soup.input[faces.front()]];
-  for (std::size_t f : faces)
-  {
-    whole.inputTriangles.push_back(soup.input[f]);
-  }
-  refuseRegion(whole, why, materials, out);
+  whole.triangles = faces;
+  refuseRegion(whole, soup, input, why, materials, out);
 }
 
 /// Remeshes one component; what CGAL refuses goes to out.refineOnly with a warning.
@@ -650,11 +1171,12 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
 {
   Mesh mesh;
   ComponentLayout layout;
+  std::vector<std::size_t> pointOfVertex;
   bool valid = false;
   std::string failure;
   const bool built = guarded(
     [&] {
-      mesh = buildComponentMesh(soup, faces, localIndex);
+      mesh = buildComponentMesh(soup, faces, localIndex, pointOfVertex);
       valid = CGAL::is_valid_polygon_mesh(mesh) && CGAL::is_triangle_mesh(mesh);
     },
     failure);
@@ -664,7 +1186,10 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   }
   poll.check();
   if (!built || !valid ||
-    !guarded([&] { layout = layOutComponent(mesh, soup, input, faces, settings.sharpEdgeAngle, out.regions); },
+    !guarded(
+      [&] {
+        layout = layOutComponent(mesh, soup, input, faces, pointOfVertex, settings.sharpEdgeAngle, out.regions);
+      },
       failure))
   {
     refuseComponent(soup, input, materials, faces, failure, out);
@@ -697,7 +1222,7 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   {
     if (!refusals[r].empty())
     {
-      refuseRegion(layout.regions[r], refusals[r], materials, out);
+      refuseRegion(layout.regions[r], soup, input, refusals[r], materials, out);
     }
   }
 }
@@ -737,6 +1262,7 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
   RepairedSoup soup;
   std::vector<std::vector<std::size_t>> components;
   constexpr double RepairShare = 0.05;
+  constexpr double SplitShare = 0.05;
   double reported = 0;
   CancellationPoll poll([&] { return !progress || progress(reported); });
   try
@@ -756,21 +1282,56 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
   catch (const std::exception& e)
   {
     out = CgalRemeshOutput{};
-    out.refineOnly.resize(input.triangles.size());
-    std::iota(out.refineOnly.begin(), out.refineOnly.end(), std::size_t(0));
+    out.refinePoints = points;
+    out.refineOnly = input;
     out.warnings.push_back(std::string("CGAL could not repair the surface (") + e.what() +
       "): all " + countOf(input.triangles.size(), "triangle") + " were only refined, not remeshed");
     return out;
   }
-  checkProgress(progress, RepairShare);
+  reported = RepairShare;
+  checkProgress(progress, reported);
+
+  if (settings.splitAtContacts)
+  {
+    RepairedSoup split = soup;
+    CgalRemeshOutput counts;
+    std::string failure;
+    bool ok = false;
+    try
+    {
+      ok = guarded([&] { splitAtContacts(split, settings, counts, poll); }, failure);
+    }
+    catch (const OverLimit& e)
+    {
+      throw Error(e.message);
+    }
+    std::vector<std::vector<std::size_t>> splitComponents;
+    ok = ok && guarded([&] { splitComponents = connectedComponents(split); }, failure);
+    if (ok)
+    {
+      soup = std::move(split);
+      components = std::move(splitComponents);
+      out.contactSplitTriangles = counts.contactSplitTriangles;
+      out.contactEdges = counts.contactEdges;
+      out.coveredTriangles = counts.coveredTriangles;
+      out.coveredArea = counts.coveredArea;
+      out.splitPoints += counts.splitPoints;
+    }
+    else
+    {
+      out.warnings.push_back("surfaces were not split where they touch or cross (" + failure +
+        "): patches may straddle contact lines, where light and shadow then leak");
+    }
+  }
+  reported = RepairShare + SplitShare;
+  checkProgress(progress, reported);
 
   // Progress in proportion to the faces remeshed, checked after every pass, in steps of at
   // least 0.1% so that thousands of tiny components do not flood the caller.
   const double total = static_cast<double>(std::max<std::size_t>(1, soup.triangles.size()));
   double done = 0;
-  reported = RepairShare;
   auto report = [&](double componentFraction) {
-    const double fraction = RepairShare + (1 - RepairShare) * componentFraction;
+    const double fraction = RepairShare + SplitShare + (1 - RepairShare - SplitShare) * componentFraction;
     if (fraction - reported >= 0.001)
     {
       reported = fraction;

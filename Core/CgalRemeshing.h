@@ -21,18 +21,26 @@ struct TriangleSoup
   std::vector<std::uint32_t> material;
 };
 
-/// Patches CGAL produced, plus the input triangles it refused (to be refined only).
+/// Patches CGAL produced, plus the triangles it refused (to be refined only).
 struct CgalRemeshOutput
 {
   std::vector<Vec3> points;
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> material; ///< index of the distinct material, per triangle
-  std::vector<std::size_t> refineOnly; ///< indices into TriangleSoup::triangles
+  /// The refused triangles, oriented like their input polygons, and their points. They are
+  /// pieces of input triangles once these were split along contact lines, so they can no
+  /// longer be indices into the input.
+  std::vector<Vec3> refinePoints;
+  TriangleSoup refineOnly;
   std::size_t regions = 0;
   std::size_t fallbackRegions = 0;
   std::size_t degenerateTriangles = 0;
   std::size_t duplicateTriangles = 0;
   std::size_t splitPoints = 0;
+  std::size_t contactSplitTriangles = 0; ///< repaired triangles cut along contact lines
+  std::size_t contactEdges = 0;          ///< edges of the contact lines, once split
+  std::size_t coveredTriangles = 0;      ///< pieces dropped, face to face on a closed surface
+  double coveredArea = 0;
   std::vector<std::string> warnings;
 };
 
@@ -43,11 +51,20 @@ struct CgalRemeshSettings
   /// Faces whose remeshed region area differs from the input by more than this fraction
   /// are refined only.
   double areaTolerance = 0.005;
+  /// Split surfaces where they touch or cross each other, and drop what lies face to face on
+  /// a closed surface (see remesh() in Remeshing.h).
+  bool splitAtContacts = true;
+  /// Called with the triangle count once surfaces are split along their contacts, before
+  /// anything is allocated for it; may throw mlr::Error (over the memory limit).
+  std::function<void(std::size_t triangles)> checkTriangleCount;
 };
 
 /**
- * Repairs, orients and isotropically remeshes the triangles region by region. Never lets a
- * CGAL exception escape: what CGAL refuses is listed in refineOnly with a warning.
+ * Repairs and orients the triangles, splits them along the lines where surfaces touch or
+ * cross, drops the pieces lying face to face on closed surfaces, and isotropically remeshes region by region
+ * with the contact lines as constraints. Never lets a CGAL exception escape: what CGAL
+ * refuses is listed in refineOnly with a warning (if splitting fails, the surfaces are
+ * remeshed unsplit, with a warning).
  * Throws mlr::Cancelled when `progress` returns false, mlr::Error when memory runs out.
  */
 CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleSoup& soup,

@@ -432,35 +432,42 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
   const std::vector<Material>& materials, double h, const RemeshOptions& options,
   const RemeshProgress& progress, RemeshResult& result)
 {
-  std::vector<std::size_t> refined;
   if (options.useCgal)
   {
     detail::CgalRemeshSettings settings;
     settings.targetEdgeLength = h;
     settings.sharpEdgeAngle = options.sharpEdgeAngle;
+    settings.splitAtContacts = options.splitAtContacts;
+    settings.checkTriangleCount = [&](std::size_t split) {
+      checkRemeshMemory(static_cast<double>(split), remeshedPatchCount(result.statistics.inputArea, h), h, options);
+    };
     const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
       settings, [&](double f) { return !progress || progress(CgalShare * f); });
     appendCgalPatches(cgal, materials, result.mesh);
-    refined = cgal.refineOnly;
+    std::vector<std::size_t> refined(cgal.refineOnly.triangles.size());
+    std::iota(refined.begin(), refined.end(), std::size_t(0));
     if (!refined.empty())
     {
       // What CGAL refused is refined: check its size before allocating it.
-      const double count = refinedPatchCount(soup.points, triangles, &refined, h);
+      const double count = refinedPatchCount(cgal.refinePoints, cgal.refineOnly, nullptr, h);
       checkPatchBudget(count + static_cast<double>(result.mesh.triangles.size()), h);
       checkRemeshMemory(0, count + static_cast<double>(result.mesh.triangles.size()), h, options);
     }
     result.statistics.regions = cgal.regions;
     result.statistics.fallbackRegions = cgal.fallbackRegions;
     result.statistics.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
+    result.statistics.contactSplitTriangles = cgal.contactSplitTriangles;
+    result.statistics.coveredTriangles = cgal.coveredTriangles;
+    result.statistics.coveredArea = cgal.coveredArea;
     result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
+    refineOnly(cgal.refinePoints, cgal.refineOnly, refined, materials, h, progress, CgalShare, result.mesh);
   }
   else
   {
-    refined.resize(triangles.triangles.size());
-    std::iota(refined.begin(), refined.end(), std::size_t(0));
+    std::vector<std::size_t> all(triangles.triangles.size());
+    std::iota(all.begin(), all.end(), std::size_t(0));
+    refineOnly(soup.points, triangles, all, materials, h, progress, 0.0, result.mesh);
   }
-  refineOnly(soup.points, triangles, refined, materials, h, progress,
-    options.useCgal ? CgalShare : 0.0, result.mesh);
 }
 
 double totalArea(const PatchMesh& mesh)

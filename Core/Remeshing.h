@@ -47,6 +47,10 @@ struct RemeshOptions
   double sharpEdgeAngle = 30;
   /// Remesh with CGAL; when false every region is only refined (split to size).
   bool useCgal = true;
+  /// Split surfaces along the lines where they touch or cross (a block standing on a floor,
+  /// a panel through a wall) and drop what lies face to face on a closed surface, so that no
+  /// patch straddles a contact (CGAL only).
+  bool splitAtContacts = true;
   /// Refuse (mlr::Error) a remeshing whose memory estimate exceeds this many bytes, before
   /// allocating it; 0 means half of the physical memory, as for the solver.
   std::uint64_t memoryLimitBytes = 0;
@@ -65,6 +69,12 @@ struct RemeshStatistics
   /// Connected faces of one material and orientation, bounded by sharp edges (CGAL only).
   std::size_t regions = 0;
   std::size_t fallbackRegions = 0; ///< regions CGAL refused, refined only (with a warning)
+  /// Triangles (after repair) cut along the lines where other surfaces touch or cross them.
+  std::size_t contactSplitTriangles = 0;
+  /// Pieces dropped because they lie face to face on a closed surface (the floor under a
+  /// block), and their area: outputArea is about inputArea - coveredArea.
+  std::size_t coveredTriangles = 0;
+  double coveredArea = 0;
   std::size_t patches = 0;
   double targetEdgeLength = 0; ///< the h actually used
   double inputArea = 0;  ///< of the triangulated polygons that were kept
@@ -90,10 +100,28 @@ using RemeshProgress = std::function<bool(double fraction)>;
  *
  * With CGAL, polygons are triangulated, duplicate points merged, degenerate and duplicate
  * triangles removed, and the soup oriented (points are split where it is not a manifold).
- * Each region is then isotropically remeshed with its border, sharp edges and corners kept,
- * its vertices projected onto its own input triangles. Every patch keeps the orientation of
- * the polygon it lies on. A region whose remeshing fails or changes its area by more than
- * 0.5% keeps its input triangles, only refined.
+ *
+ * Contact lines (splitAtContacts): surfaces are then split where they touch or cross one
+ * another (CGAL's autorefinement, exact predicates), so that a floor is cut along the
+ * footprint of a block standing on it and a wall along the line where a panel passes
+ * through it; these lines are kept as constraints by the remeshing below, so no patch, and
+ * no element, straddles a contact and averages light with shadow there. Pieces that lie face
+ * to face on a closed surface (the floor under a closed block) are dropped: one side faces
+ * into the closed surface and receives no light, the other coincides with the closed
+ * surface's own face, and rays would hit both at the same distance. The closed surface is
+ * kept whole, so it stays closed; where two closed surfaces touch face to face (stacked
+ * boxes) both contact faces go and one closed surface remains around both. What lies inside a
+ * closed surface without touching it is kept: surfaces are two-sided, so a closed box may be
+ * a room as well as a solid block, and only the light's position could tell (the floor inside
+ * an open box, without a bottom face, is also kept, as a region of its own). A polygon lying
+ * on a closed object's face (a label on a box) is therefore dropped, the object's material
+ * showing there. If CGAL fails to split, the surfaces are remeshed unsplit, with a warning.
+ *
+ * Each region is then isotropically remeshed with its border, sharp edges, contact lines
+ * and corners kept, its vertices projected onto its own input triangles. Every patch keeps
+ * the orientation of the polygon it lies on. A region whose remeshing fails or changes its
+ * area by more than 0.5% keeps its input triangles (cut along the contact lines), only
+ * refined.
  */
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});

@@ -241,4 +241,28 @@ PolygonSoup paperRoomOfQuads()
   return room;
 }
 
+PolygonSoup blockOnFloor(double floorSize, const Vec3& blockLo, const Vec3& blockHi,
+  const Rgb& floor, const Rgb& block, bool openBottom)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { floorSize, 0, 0 }, { floorSize, floorSize, 0 }, { 0, floorSize, 0 } }, floor);
+  append(soup, boxOfQuads(blockLo, blockHi, { block }, false, openBottom));
+  return soup;
+}
+
+PolygonSoup panelThroughWall(double thickness)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 1 }, { 0, 0, 1 } }, Rgb(0.5));
+  if (thickness > 0)
+  {
+    append(soup, boxOfQuads({ -0.3, 0.5 - thickness / 2, 0.2 }, { 0.3, 0.5 + thickness / 2, 0.8 }, { Rgb(0.3) }));
+  }
+  else
+  {
+    addPolygon(soup, { { -0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.8 }, { -0.3, 0.5, 0.8 } }, Rgb(0.3));
+  }
+  return soup;
+}
+
 } // namespace mlr::scenes

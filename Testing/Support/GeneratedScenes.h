@@ -67,4 +67,15 @@ PolygonSoup icosphere(int frequency, double radius = 1.0);
 /// The paper-scale room of paperScaleRoom() as 16 big quads, before any remeshing.
 PolygonSoup paperRoomOfQuads();
 
+/// Contact lines: a floor [0, floorSize]^2 at z = 0 facing up, given as one quad that passes
+/// under a block [blockLo, blockHi] standing on it (blockLo.z = 0), the block a closed box with
+/// normals out, or open at its bottom with `openBottom`. Polygons: the floor, then the block's.
+PolygonSoup blockOnFloor(double floorSize, const Vec3& blockLo, const Vec3& blockHi,
+  const Rgb& floor, const Rgb& block, bool openBottom = false);
+
+/// Contact lines: a wall x = 0, y and z in [0, 1], facing +x, and a panel through it: the quad
+/// y = 0.5, x in [-0.3, 0.3], z in [0.2, 0.8] when `thickness` is 0, else a closed box of that
+/// thickness around it (normals out). The wall is the first polygon.
+PolygonSoup panelThroughWall(double thickness = 0);
+
 } // namespace mlr::scenes
