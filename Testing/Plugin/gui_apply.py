@@ -31,14 +31,16 @@ support._filter = globals()["MovingLightRadiosity"]
 radiosity, sources = support.box_pipeline()
 view = GetActiveViewOrCreate("RenderView")
 controller = vtkSMParaViewPipelineControllerWithRendering()
-shown = [controller.ShowInPreferredView(radiosity.SMProxy, port, view.SMProxy) for port in (0, 1)]
+shown = [controller.ShowInPreferredView(radiosity.SMProxy, port, view.SMProxy) for port in (0, 1, 2)]
 check(shown[0] is not None, "Apply shows no Elements")
 check(shown[1] is None, "Apply shows the Patches on top of the Elements")
+check(shown[2] is not None, "Apply shows no Light")
 display = GetDisplayProperties(radiosity, view)
-check(list(display.ColorArrayName) == ["CELLS", "Radiosity"],
-      f"the Elements are coloured by {list(display.ColorArrayName)}, expected cell Radiosity")
-check(display.LookupTable is not None and display.LookupTable.VectorMode == "Magnitude",
-      "the Radiosity colour map does not show the magnitude")
+check(list(display.ColorArrayName) == ["POINTS", "Color"],
+      f"the Elements are coloured by {list(display.ColorArrayName)}, expected point Color")
+check(display.MapScalars == 0, "the Elements' Color goes through a colour map (Map Scalars on)")
+lamp = GetDisplayProperties(OutputPort(radiosity, 2), view)
+check(lamp.ColorArrayName[1] == "", f"the Light is coloured by {list(lamp.ColorArrayName)}")
 Render(view)
 
 scene = GetAnimationScene()
@@ -51,4 +53,9 @@ frame = radiosity.GetDataInformation().DataInformation.GetFieldDataInformation()
     .GetArrayInformation("FrameIndex")
 check(frame is not None and frame.GetComponentRange(0)[0] == support.POSITIONS - 1,
       f"after Last Frame the view shows frame {frame.GetComponentRange(0) if frame else None}")
+bounds = OutputPort(radiosity, 2).GetDataInformation().GetBounds()
+centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2 for i in range(3)]
+expected = support.light_position(support.POSITIONS - 1)
+check(all(abs(a - b) < 1e-6 for a, b in zip(centre, expected)),
+      f"after Last Frame the Light is centred on {centre}, expected {expected}")
 report_and_quit()

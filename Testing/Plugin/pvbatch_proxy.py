@@ -1,11 +1,14 @@
 """The plugin's proxy as ParaView users meet it, checked in pvbatch:
 
 - the menu hint (Filters > Radiosity), the input ports (Scene, Light, optional Trajectory)
-  and the data types they accept, the output port names (Elements, Patches);
+  and the data types they accept, the output port names (Elements, Patches, Light);
 - every property: a label that is also its paraview.simple name, documentation, a domain,
   the VTK filter's default, the filter's clamping range, advanced or not;
+- every property's documentation names its unit (or says it has none) and its effect on
+  the cost of a solve;
 - what the first Apply shows: TimestepValues and the time keeper with one step per light
-  position, the Elements coloured by cell Radiosity (magnitude), the Patches not shown.
+  position, the Elements in the true colours of point Color (Map Scalars off), the Patches
+  not shown, the Light shown (pvbatch_display.py checks the display in detail).
 
     pvbatch --force-offscreen-rendering pvbatch_proxy.py --plugin MovingLightRadiosity.so
 
@@ -33,7 +36,7 @@ check(proxy.GetXMLGroup() == "filters" and proxy.GetXMLLabel() == "Moving Light 
 menu = proxy.GetHints().FindNestedElementByName("ShowInMenu") if proxy.GetHints() else None
 check(menu is not None and menu.GetAttribute("category") == "Radiosity",
       "no <ShowInMenu category=\"Radiosity\"/> hint: the filter would not be in Filters > Radiosity")
-for port, name in enumerate(("Elements", "Patches")):
+for port, name in enumerate(("Elements", "Patches", "Light")):
     check(proxy.GetOutputPortName(port) == name,
           f"output port {port} is named {proxy.GetOutputPortName(port)!r}, expected {name!r}")
 
@@ -78,7 +81,9 @@ ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", 
 BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering"}
 EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurvival",
             "ReuseShooting", "ReuseGathering", "PatchSize", "Seed", "NumberOfThreads",
-            "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit"}
+            "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit", "Exposure"}
+# Every property's documentation ends with its unit and its effect on the cost of a solve.
+UNIT_TAG, COST_TAG = "Unit:", "Cost:"
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
@@ -99,6 +104,10 @@ while not iterator.IsAtEnd():
     doc = prop.GetDocumentation()
     check(doc is not None and len(doc.GetDescription().split()) >= 8,
           f"{where}: documentation missing or shorter than a sentence")
+    text = doc.GetDescription() if doc is not None else ""
+    for tag, what in ((UNIT_TAG, "its unit"), (COST_TAG, "its effect on the cost")):
+        said = text.split(tag, 1)[1].split(".", 1)[0].strip() if tag in text else ""
+        check(len(said.split()) >= 1, f"{where}: the documentation does not give {what} ({tag!r})")
     own_domains = list(domains(prop))
     check(own_domains, f"{where}: no domain")
     visibility = prop.GetPanelVisibility()
@@ -155,17 +164,13 @@ from paraview.modules.vtkRemotingViews import vtkSMParaViewPipelineControllerWit
 
 view = CreateRenderView()
 controller = vtkSMParaViewPipelineControllerWithRendering()
-shown = [controller.ShowInPreferredView(proxy, port, view.SMProxy) for port in (0, 1)]
+shown = [controller.ShowInPreferredView(proxy, port, view.SMProxy) for port in (0, 1, 2)]
 check(shown[0] is not None, "Apply would not show the Elements output")
 check(shown[1] is None, "Apply would show the Patches output on top of the Elements")
+check(shown[2] is not None, "Apply would not show the Light output")
 display = GetDisplayProperties(radiosity, view)
-check(list(display.ColorArrayName) == ["CELLS", "Radiosity"],
-      f"the Elements are coloured by {list(display.ColorArrayName)}, expected cell Radiosity")
-lut = display.LookupTable
-check(lut is not None and lut.VectorMode == "Magnitude",
-      f"Radiosity colour map vector mode {lut.VectorMode if lut else None!r}, expected Magnitude")
-if lut is not None:
-    low, high = lut.RGBPoints[0], lut.RGBPoints[-4]
-    check(0 <= low < high, f"colour map range [{low}, {high}] is not that of a lit scene")
+check(list(display.ColorArrayName) == ["POINTS", "Color"],
+      f"the Elements are coloured by {list(display.ColorArrayName)}, expected point Color")
+check(display.MapScalars == 0, "the Elements' Color goes through a colour map (Map Scalars on)")
 
 checks.finish()

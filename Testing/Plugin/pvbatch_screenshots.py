@@ -1,7 +1,10 @@
 """Rendered pictures of the first and the last light position, in pvbatch under an X server
-(xvfb-run): neither is blank, and they differ where the light moved. The camera looks up at
-the floor of the box (seen from outside, Radiosity shows its lit inner side); the pictures
-are compared by pixel statistics around the spots under the light, not with golden images.
+(xvfb-run): neither is blank, and they differ where the light moved. The Elements are shown
+as Apply shows them (their display colours, one exposure for the whole animation, so that
+brightness compares across frames). The camera looks up at the floor of the box (seen from
+outside, the colours show its lit inner side); the pictures are compared by pixel
+statistics around the spots under the light (pvbatch_baseline.py compares a whole picture
+with a baseline).
 
     xvfb-run -a pvbatch pvbatch_screenshots.py --plugin MovingLightRadiosity.so [--keep DIR]"""
 import os
@@ -18,7 +21,6 @@ def options(parser):
 
 args = support.parse_arguments(__doc__.splitlines()[0], options)
 
-from paraview import servermanager
 from paraview.simple import *  # noqa: F401,F403
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkIOImage import vtkPNGReader
@@ -42,25 +44,12 @@ view.CameraFocalPoint = [0.0, 0.0, 0.0]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 view.CameraViewAngle = 30.0
 
+# As Apply shows it: true colours from the filter's point array Color (Map Scalars off, unlit).
+# The Light output is not shown: seen from below the floor it would hide the spots.
 display = Show(radiosity, view)
-# Radiosity already is the lighting: show the colour map flat, so a pixel's brightness is the
-# element's radiosity, on one grey scale shared by both pictures. The scale ends at the
-# floor's brightest element: the walls beside the light are far brighter still.
-display.Ambient = 1.0
-display.Diffuse = 0.0
-lut = GetColorTransferFunction("Radiosity")
-lut.ApplyPreset("Grayscale", True)
-highest = 0.0
-for time in (0.0, last):
-    radiosity.UpdatePipeline(time=time)
-    data = servermanager.Fetch(radiosity)
-    magnitude = numpy.linalg.norm(vtk_to_numpy(data.GetCellData().GetArray("Radiosity")), axis=1)
-    points = vtk_to_numpy(data.GetPoints().GetData())
-    triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
-    floor = numpy.abs(points[triangles][:, :, 2].mean(axis=1) - support.FLOOR_Z) < 1e-6
-    highest = max(highest, float(magnitude[floor].max()))
-lut.AutomaticRescaleRangeMode = "Never"
-lut.RescaleTransferFunction(0.0, highest)
+check(list(display.ColorArrayName) == ["POINTS", "Color"] and display.MapScalars == 0,
+      f"the Elements are shown with {list(display.ColorArrayName)}, MapScalars "
+      f"{display.MapScalars}: expected the true colours of point Color")
 
 scene = GetAnimationScene()
 scene.UpdateAnimationUsingDataTimeSteps()

@@ -1,0 +1,198 @@
+"""What the first Apply shows (issue 17), checked in pvbatch with ParaView sources only:
+
+- every output port shown as the Apply button shows it (ShowInPreferredView): the Elements
+  coloured by the point array Color with Map Scalars off and unlit (Ambient 1, Diffuse 0),
+  the Patches not shown, the Light shown in a solid colour distinct from the scene;
+- the Elements' point data holds Radiosity and Color (and the cells keep Radiosity);
+- the Light port at frames 0, 3 and the last: its area centroid is the trajectory's point
+  of that time, its Power adds up to Light Power;
+- Exposure +1 doubles the value before the tone map on the floor (a flat region), without a
+  new solve;
+- Path Start and Path End sit in a property group shown by ParaView's interactive line
+  widget, start from the scene's bounds, and moving their end points (what dragging the
+  widget's handles writes) solves again along the new path.
+
+    pvbatch --force-offscreen-rendering pvbatch_display.py --plugin MovingLightRadiosity.so"""
+import numpy
+
+import plugin_test_support as support
+
+args = support.parse_arguments(__doc__.splitlines()[0])
+
+from paraview import servermanager
+from paraview.simple import *  # noqa: F401,F403
+from paraview.modules.vtkRemotingViews import vtkSMParaViewPipelineControllerWithRendering
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+support.load_plugin(args.plugin, globals())
+checks = support.Checks("Plugin.Display")
+check = checks.check
+
+LAST = support.POSITIONS - 1
+radiosity, sources = support.box_pipeline()
+proxy = radiosity.SMProxy
+
+# --- Apply ----------------------------------------------------------------------------------
+radiosity.UpdatePipeline()
+view = CreateRenderView()
+controller = vtkSMParaViewPipelineControllerWithRendering()
+shown = [controller.ShowInPreferredView(proxy, port, view.SMProxy) for port in (0, 1, 2)]
+check(shown[0] is not None, "Apply does not show the Elements")
+check(shown[1] is None, "Apply shows the Patches on top of the Elements")
+check(shown[2] is not None, "Apply does not show the Light")
+check(proxy.GetOutputPortName(2) == "Light", f"output port 2 is {proxy.GetOutputPortName(2)!r}")
+
+elements_display = GetDisplayProperties(radiosity, view)
+check(list(elements_display.ColorArrayName) == ["POINTS", "Color"],
+      f"the Elements are coloured by {list(elements_display.ColorArrayName)}, expected point Color")
+check(elements_display.MapScalars == 0, "Map Scalars is on: Color would go through a colour map")
+check(elements_display.Representation == "Surface",
+      f"the Elements are shown as {elements_display.Representation!r}")
+check((elements_display.Ambient, elements_display.Diffuse) == (1.0, 0.0),
+      f"the Elements are lit by the view (Ambient {elements_display.Ambient}, Diffuse "
+      f"{elements_display.Diffuse}): the colours already are the lighting")
+light_display = GetDisplayProperties(OutputPort(radiosity, 2), view)
+check(light_display.ColorArrayName[1] == "",
+      f"the Light is coloured by {list(light_display.ColorArrayName)}, expected a solid colour")
+yellow = list(light_display.DiffuseColor)
+check(yellow[0] > 0.8 and yellow[1] > 0.6 and yellow[2] < 0.5,
+      f"the Light's colour {yellow} is not the documented yellow")
+
+
+def fetch(time, port=0):
+    radiosity.UpdatePipeline(time=time)
+    return servermanager.Fetch(radiosity, idx=port)
+
+
+def field(data, name):
+    array = data.GetFieldData().GetArray(name)
+    if array is None:
+        return None
+    return array.GetTuple(0) if array.GetNumberOfComponents() > 1 else array.GetValue(0)
+
+
+# --- Arrays ---------------------------------------------------------------------------------
+data = fetch(0.0)
+for name in ("Radiosity", "Color"):
+    array = data.GetPointData().GetArray(name)
+    check(array is not None and array.GetNumberOfComponents() == 3,
+          f"point data has no 3-component {name}")
+color = data.GetPointData().GetArray("Color")
+check(color is not None and color.GetDataTypeAsString() == "unsigned char",
+      f"point Color is {color.GetDataTypeAsString() if color else None}, expected unsigned char")
+for name in ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "Color", "PatchId"):
+    check(data.GetCellData().GetArray(name) is not None, f"cell data lost {name}")
+
+
+# --- The light ------------------------------------------------------------------------------
+def polygon_centroid(light):
+    points = vtk_to_numpy(light.GetPoints().GetData())
+    offsets = vtk_to_numpy(light.GetPolys().GetOffsetsArray())
+    ids = vtk_to_numpy(light.GetPolys().GetConnectivityArray())
+    weighted, total = numpy.zeros(3), 0.0
+    for begin, end in zip(offsets[:-1], offsets[1:]):
+        polygon = points[ids[begin:end]]
+        for k in range(1, len(polygon) - 1):
+            a, b, c = polygon[0], polygon[k], polygon[k + 1]
+            area = 0.5 * numpy.linalg.norm(numpy.cross(b - a, c - a))
+            weighted += area * (a + b + c) / 3
+            total += area
+    return weighted / total
+
+
+for frame in (0, 3, LAST):
+    light = fetch(float(frame), port=2)
+    if not check(light.GetNumberOfCells() > 0, f"frame {frame}: the Light output is empty"):
+        continue
+    centroid = polygon_centroid(light)
+    expected = numpy.array(support.light_position(frame))
+    check(numpy.allclose(centroid, expected, atol=1e-9),
+          f"frame {frame}: the Light's centroid is {centroid}, the trajectory's point {expected}")
+    power = light.GetCellData().GetArray("Power")
+    check(power is not None and numpy.allclose(vtk_to_numpy(power).sum(axis=0), radiosity.LightPower),
+          f"frame {frame}: the Light's Power does not add up to Light Power {list(radiosity.LightPower)}")
+    check(field(light, "FrameIndex") == frame, f"frame {frame}: the Light shows frame "
+          f"{field(light, 'FrameIndex')}")
+
+
+# --- Exposure -------------------------------------------------------------------------------
+def inverse_tone_map(byte):
+    """The exposed linear value an 8-bit colour shows, through sRGB and ACES (Narkowicz)."""
+    c = byte / 255.0
+    linear = numpy.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    # Solve 2.43 y x^2 + 0.59 y x + 0.14 y = 2.51 x^2 + 0.03 x for x.
+    a, b, k = 2.43 * linear - 2.51, 0.59 * linear - 0.03, 0.14 * linear
+    return (-b - numpy.sqrt(b * b - 4 * a * k)) / (2 * a)
+
+
+def floor_green(data):
+    points = vtk_to_numpy(data.GetPoints().GetData())
+    triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    floor = numpy.abs(points[triangles][:, :, 2].mean(axis=1) - support.FLOOR_Z) < 1e-6
+    return vtk_to_numpy(data.GetCellData().GetArray("Color"))[floor, 1].astype(float)
+
+
+before = fetch(4.0)
+solves = field(before, "SolveCount")
+radiosity.Exposure = 1.0
+after = fetch(4.0)
+check(field(after, "SolveCount") == solves, "Exposure 1 solved again")
+check(numpy.isclose(field(after, "ExposureScale"), 2 * field(before, "ExposureScale")),
+      f"Exposure 1 made ExposureScale {field(after, 'ExposureScale')}, expected twice "
+      f"{field(before, 'ExposureScale')}")
+g0, g1 = floor_green(before), floor_green(after)
+usable = (g0 > 40) & (g1 < 230)
+if check(usable.sum() > 10, f"only {usable.sum()} floor cells have mid-range colours"):
+    ratio = numpy.median(inverse_tone_map(g1[usable]) / inverse_tone_map(g0[usable]))
+    check(abs(ratio - 2) < 0.05, f"Exposure +1 multiplied the floor's value by {ratio:.3f}, not 2")
+radiosity.Exposure = 0.0
+
+# --- The path widget ------------------------------------------------------------------------
+group = None
+for index in range(proxy.GetNumberOfPropertyGroups()):
+    candidate = proxy.GetPropertyGroup(index)
+    if candidate.GetPanelWidget() == "InteractiveLine":
+        group = candidate
+if check(group is not None, "no property group with panel_widget=\"InteractiveLine\""):
+    roles = {function: group.GetProperty(function) for function in
+             ("Point1WorldPosition", "Point2WorldPosition", "Input")}
+    check(roles["Point1WorldPosition"] is proxy.GetProperty("PathStart") or
+          (roles["Point1WorldPosition"] and roles["Point1WorldPosition"].GetXMLName() == "PathStart"),
+          "the line widget's first point is not PathStart")
+    check(roles["Point2WorldPosition"] is not None and
+          roles["Point2WorldPosition"].GetXMLName() == "PathEnd",
+          "the line widget's second point is not PathEnd")
+    check(roles["Input"] is not None and roles["Input"].GetXMLName() == "Scene",
+          "the line widget does not take its bounds from the Scene")
+    # ParaView's own line widget proxy accepts the two ends.
+    widget = servermanager.rendering.LineWidgetRepresentation()
+    widget.Point1WorldPosition = list(radiosity.PathStart)
+    widget.Point2WorldPosition = list(radiosity.PathEnd)
+
+# Defaults from the scene's bounds: a Box of 1 centred on the origin, no Trajectory.
+box = Box()
+box.UpdatePipeline()
+straight = MovingLightRadiosity(Scene=box, Light=sources["light"], NumberOfPaths=support.TEST_PATHS,
+                                NumberOfPositions=4)
+check(numpy.allclose(straight.PathStart, [-0.5, 0, 0]) and numpy.allclose(straight.PathEnd, [0.5, 0, 0]),
+      f"the straight path starts {list(straight.PathStart)} and ends {list(straight.PathEnd)}, "
+      "expected the middles of the box's -x and +x faces")
+
+# Dragging the ends writes PathStart and PathEnd: the next update solves along the new path.
+straight.UpdatePipeline(0.0)
+first = servermanager.Fetch(straight)
+start, end = [-0.3, -0.2, support.LIGHT_Z], [0.25, 0.3, support.LIGHT_Z]
+straight.PathStart, straight.PathEnd = start, end
+for time, expected in ((0.0, start), (3.0, end)):
+    straight.UpdatePipeline(time)
+    moved = servermanager.Fetch(straight)
+    check(field(moved, "SolveCount") == field(first, "SolveCount") + 1,
+          f"time {time}: moving the path's ends made {field(moved, 'SolveCount')} solves, "
+          f"expected {field(first, 'SolveCount') + 1}")
+    check(numpy.allclose(field(moved, "LightPosition"), expected),
+          f"time {time}: the light is at {field(moved, 'LightPosition')}, expected {expected}")
+    lamp = servermanager.Fetch(straight, idx=2)
+    check(numpy.allclose(polygon_centroid(lamp), expected, atol=1e-9),
+          f"time {time}: the Light output is at {polygon_centroid(lamp)}, expected {expected}")
+
+checks.finish()
