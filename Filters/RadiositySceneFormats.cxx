@@ -22,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -1202,6 +1203,19 @@ std::string uriPath(const std::string& uri)
   return path;
 }
 
+/// One component of an accessor; a normalized integer maps to [0, 1] (unsigned) or [-1, 1].
+template <typename T>
+double component(const char* at, bool normalized)
+{
+  T value;
+  std::memcpy(&value, at, sizeof(T));
+  if (!normalized)
+  {
+    return static_cast<double>(value);
+  }
+  return std::max(static_cast<double>(value) / static_cast<double>(std::numeric_limits<T>::max()), -1.0);
+}
+
 /// A glTF document whose indices and sizes GltfChecks has checked: buffers loaded, accessors
 /// read as numbers.
 class GltfDocument
@@ -1299,46 +1313,22 @@ public:
         switch (type)
         {
           case 5120:
-          {
-            std::int8_t v;
-            std::memcpy(&v, at, 1);
-            value = normalized ? std::max(v / 127.0, -1.0) : v;
+            value = component<std::int8_t>(at, normalized);
             break;
-          }
           case 5121:
-          {
-            std::uint8_t v;
-            std::memcpy(&v, at, 1);
-            value = normalized ? v / 255.0 : v;
+            value = component<std::uint8_t>(at, normalized);
             break;
-          }
           case 5122:
-          {
-            std::int16_t v;
-            std::memcpy(&v, at, 2);
-            value = normalized ? std::max(v / 32767.0, -1.0) : v;
+            value = component<std::int16_t>(at, normalized);
             break;
-          }
           case 5123:
-          {
-            std::uint16_t v;
-            std::memcpy(&v, at, 2);
-            value = normalized ? v / 65535.0 : v;
+            value = component<std::uint16_t>(at, normalized);
             break;
-          }
           case 5125:
-          {
-            std::uint32_t v;
-            std::memcpy(&v, at, 4);
-            value = v;
+            value = component<std::uint32_t>(at, false);
             break;
-          }
           default:
-          {
-            float v;
-            std::memcpy(&v, at, 4);
-            value = v;
-          }
+            value = component<float>(at, false);
         }
         values[e * components + c] = value;
       }

@@ -187,6 +187,14 @@ std::string gltfJson(const std::string& bufferUri, const std::string& extra = ""
     extra + "\n}\n";
 }
 
+/// Replaces the first `from` in `text` (which must hold it) by `to`.
+void replaceOnce(std::string& text, const std::string& from, const std::string& to)
+{
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+}
+
 std::string dataUri(const std::string& bytes)
 {
   return "data:application/octet-stream;base64," + base64(bytes);
@@ -364,6 +372,8 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
   writeFile(folder / "scene.gltf", gltfJson(dataUri(gltfBuffer())));
   writeFile(folder / "scene.glb", glbFile(gltfJson(""), gltfBuffer()));
+  writeFile(folder / "scene data.bin", gltfBuffer());
+  writeFile(folder / "external.gltf", gltfJson("scene%20data.bin"));
 
   // PLY, ASCII with float face colours (exact) and binary with 8-bit vertex colours.
   std::string ascii = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
@@ -408,7 +418,7 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   const ReadResult obj = readScene(folder / "scene.obj");
   ASSERT_TRUE(obj.succeeded) << obj.errors();
   expectTwoMaterialScene(obj.output, 1e-6);
-  for (const char* name : { "scene.gltf", "scene.glb", "faces.ply", "vertices.ply" })
+  for (const char* name : { "scene.gltf", "scene.glb", "external.gltf", "faces.ply", "vertices.ply" })
   {
     SCOPED_TRACE(name);
     const ReadResult other = readScene(folder / name);
@@ -439,11 +449,11 @@ TEST(SceneReader, GltfNodeTransformsAndEmission)
   // The red material emits (1, 0.5, 0.25) x strength 4 as radiance, like Ke 4 2 1.
   std::string json = gltfJson(dataUri(gltfBuffer()), "", "[1, 2, 3]");
   const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
-  json.replace(json.find(red), red.size(),
+  replaceOnce(json, red,
     R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]},
         "emissiveFactor": [1, 0.5, 0.25],
         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})");
-  json.replace(json.find(R"("scene": 0,)"), 11,
+  replaceOnce(json, R"("scene": 0,)",
     R"("scene": 0, "extensionsUsed": ["KHR_materials_emissive_strength"],)");
   writeFile(folder / "lamp.gltf", json);
   const ReadResult result = readScene(folder / "lamp.gltf");
@@ -500,10 +510,10 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
   "textures": [{"source": 0}, {"source": 1}],
   "images": [{"uri": "data:image/png;base64,)" + base64(png) + R"("}, {"uri": "wood.png"}])");
   const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
-  json.replace(json.find(white), white.size(),
+  replaceOnce(json, white,
     R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 1, 0.6, 1], "baseColorTexture": {"index": 0}}})");
   const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
-  json.replace(json.find(red), red.size(),
+  replaceOnce(json, red,
     R"({"name": "red", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})");
   writeFile(folder / "textured.gltf", json);
   const ReadResult result = readScene(folder / "textured.gltf");
@@ -521,9 +531,9 @@ TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
   // default for it is white, which is clamped with a warning. Strips and fans make triangles.
   std::string json = gltfJson(dataUri(gltfBuffer()));
   const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
-  json.replace(json.find(white), white.size(), R"({"name": "lamp", "emissiveFactor": [1, 1, 1]})");
-  json.replace(json.find(R"("indices": 1, "material": 0, "mode": 4)"), 38, R"("indices": 1, "material": 0, "mode": 5)");
-  json.replace(json.find(R"("indices": 2, "material": 1, "mode": 4)"), 38, R"("indices": 2, "material": 1, "mode": 6)");
+  replaceOnce(json, white, R"({"name": "lamp", "emissiveFactor": [1, 1, 1]})");
+  replaceOnce(json, R"("indices": 1, "material": 0, "mode": 4)", R"("indices": 1, "material": 0, "mode": 5)");
+  replaceOnce(json, R"("indices": 2, "material": 1, "mode": 4)", R"("indices": 2, "material": 1, "mode": 6)");
   writeFile(folder / "modes.gltf", json);
   const ReadResult result = readScene(folder / "modes.gltf");
   ASSERT_TRUE(result.succeeded) << result.errors();
@@ -533,6 +543,32 @@ TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
   expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.99, 0.99, 0.99, 0);
   expectRgbNear(tuple3(result.output, "Emission", 0), Pi, Pi, Pi, 1e-12);
   expectRgbNear(tuple3(result.output, "Reflectance", 7), 0.63, 0.065, 0.05, 1e-6);
+}
+
+TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
+{
+  const fs::path folder = testFolder("gltf-colours");
+  // COLOR_0 (normalized 8-bit RGBA, linear) on the floor's primitive: every floor vertex
+  // (255, 128, 0), so its cells reflect White x (1, 128/255, 0); the wall keeps its factor.
+  std::string buffer = gltfBuffer();
+  for (int v = 0; v < 8; ++v)
+  {
+    buffer += std::string("\xff\x80\x00\xff", 4);
+  }
+  std::string json = gltfJson(dataUri(buffer));
+  replaceOnce(json, R"("byteLength": 120)", R"("byteLength": 152)");
+  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 120, "byteLength": 32}])");
+  replaceOnce(json, R"("count": 6, "type": "SCALAR"}])",
+    R"("count": 6, "type": "SCALAR"},
+    {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"}])");
+  replaceOnce(json, R"("POSITION": 0}, "indices": 1)", R"("POSITION": 0, "COLOR_0": 3}, "indices": 1)");
+  writeFile(folder / "colours.gltf", json);
+  const ReadResult result = readScene(folder / "colours.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), White[0], White[1] * 128 / 255.0, 0, 1e-6);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), Red[0], Red[1], Red[2], 1e-6);
 }
 
 TEST(SceneReader, AbortGivesAnEmptyOutputAndTheNextUpdateReads)
@@ -568,10 +604,15 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
   std::string lines = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 1);
   std::string points = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 0);
   std::string outside = gltfJson(dataUri(buffer));
-  outside.replace(outside.find(R"("count": 8)"), 10, R"("count": 9)");
+  replaceOnce(outside, R"("count": 8)", R"("count": 9)");
   std::string cycle = gltfJson(dataUri(buffer));
-  cycle.replace(cycle.find(R"({"mesh": 0})"), 11, R"({"mesh": 0, "children": [0]})");
+  replaceOnce(cycle, R"({"mesh": 0})", R"({"mesh": 0, "children": [0]})");
   std::string glb = glbFile(gltfJson(""), buffer);
+  std::string draco = gltfJson(dataUri(buffer));
+  replaceOnce(draco, R"("scene": 0,)", R"("scene": 0, "extensionsRequired": ["KHR_draco_mesh_compression"],)");
+  std::string version1 = gltfJson(dataUri(buffer));
+  replaceOnce(version1, R"("version": "2.0")", R"("version": "1.0")");
+  std::string notBase64 = gltfJson("data:application/octet-stream;base64,#!");
   const std::vector<BadFile> files = {
     { "lines.gltf", lines, "only points or lines" },
     { "points.gltf", points, "only points or lines" },
@@ -580,6 +621,10 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     { "cycle.gltf", cycle, "cycle through node" },
     { "truncated.glb", glb.substr(0, glb.size() - 10), "truncated or damaged" },
     { "empty.gltf", R"({"asset": {"version": "2.0"}})", "no triangles" },
+    { "draco.gltf", draco, "requires the extension KHR_draco_mesh_compression" },
+    { "version1.gltf", version1, "glTF version 1.0, not 2.x" },
+    { "nobin.gltf", gltfJson("missing.bin"), "missing.bin', which does not exist" },
+    { "base64.gltf", notBase64, "not base64" },
     { "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4: a face names vertex 4" },
     { "negative.obj", "v 0 0 0\nf -1 -2 -3\n", "names vertex -2" },
     { "word.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "'x' is not a vertex reference" },
