@@ -1,7 +1,6 @@
 #include "RadiositySceneFormats.h"
 
 #include "vtkCellArray.h"
-#include "vtkCellArrayIterator.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -1608,6 +1607,7 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   std::array<double, 16> identity{};
   identity[0] = identity[5] = identity[10] = identity[15] = 1;
   std::vector<std::pair<std::size_t, std::array<double, 16>>> stack;
+  std::size_t visited = 0;
   for (auto it = roots.rbegin(); it != roots.rend(); ++it)
   {
     stack.emplace_back(static_cast<std::size_t>(*it), identity);
@@ -1616,6 +1616,7 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   {
     const auto [nodeIndex, parent] = stack.back();
     stack.pop_back();
+    poll(0.3 + 0.6 * static_cast<double>(visited++) / static_cast<double>(std::max<std::size_t>(1, nodes.size())));
     const Json& node = nodes[nodeIndex];
     const std::array<double, 16> matrix = multiply(parent, document.localTransform(nodeIndex));
     const Json children = node.value("children", Json::array());
@@ -1736,7 +1737,6 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         vertexColourOfCell.push_back(mean);
       }
     }
-    poll(0.3 + 0.5 * static_cast<double>(scene.polygons->GetNumberOfCells() > 0));
   }
   if (scene.polygons->GetNumberOfCells() == 0)
   {
