@@ -20,9 +20,10 @@ import plugin_test_support as support
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 THRESHOLD = 10.0
-MEAN_LEVELS = 1.5
+MEAN_LEVELS = 3.0
+BLOCK = 10
 SIZE = (400, 300)
-PATHS = 100000
+PATHS = 600000
 
 
 def options(parser):
@@ -32,6 +33,8 @@ def options(parser):
     parser.add_argument("--keep", help="folder for the picture and, on failure, the difference")
     parser.add_argument("--exposure", type=float, default=0.0,
                         help="Exposure for the picture (to see that the comparison can fail)")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="Seed for the picture (to measure what noise alone changes)")
 
 
 args = support.parse_arguments(__doc__.splitlines()[0], options)
@@ -51,7 +54,7 @@ scene = XMLPolyDataReader(FileName=[os.path.join(data, "cornell_box.vtp")])
 light = XMLPolyDataReader(FileName=[os.path.join(data, "cornell_light.vtp")])
 trajectory = XMLPolyDataReader(FileName=[os.path.join(data, "cornell_trajectory.vtp")])
 radiosity = MovingLightRadiosity(Scene=scene, Light=light, Trajectory=trajectory,
-                                 NumberOfPaths=PATHS, Seed=0, Exposure=args.exposure)
+                                 NumberOfPaths=PATHS, Seed=args.seed, Exposure=args.exposure)
 radiosity.UpdatePipelineInformation()
 times = list(radiosity.TimestepValues)
 middle = times[len(times) // 2]
@@ -85,6 +88,12 @@ def pixels(path):
     return values.reshape(height, width, -1)[:, :, :3].astype(float)
 
 
+def blocks(image):
+    height, width = (image.shape[0] // BLOCK) * BLOCK, (image.shape[1] // BLOCK) * BLOCK
+    tiles = image[:height, :width].reshape(height // BLOCK, BLOCK, width // BLOCK, BLOCK, -1)
+    return tiles.mean(axis=(1, 3))
+
+
 folder = args.keep or tempfile.mkdtemp(prefix="mlr-plugin-baseline-")
 os.makedirs(folder, exist_ok=True)
 picture = os.path.join(folder, "cornell_middle_frame.png")
@@ -106,15 +115,17 @@ elif check(os.path.isfile(args.baseline), f"no baseline at {args.baseline}: run 
           f"{THRESHOLD}: see {folder}")
     # vtkImageDifference forgives each pixel up to a large colour difference, to absorb
     # rasterisation: a third of a stop of exposure or another tone curve passes it. The
-    # colours are what this picture is about, so they are held closer as well: at most
-    # MEAN_LEVELS levels of 255 on average (the same picture on another OpenGL gives well
-    # under 1; Exposure 0.3 gives several).
-    got, expected = pixels(picture), pixels(args.baseline)
+    # colours are what this picture is about, so they are held closer as well, on the means
+    # of BLOCK x BLOCK pixel blocks, where pixel-level noise averages out: another seed (the
+    # noise of another random stream, as a change in Core's sampling would give) moves them by
+    # about 1.6 levels of 255 on average, Exposure -0.15 by about 4, +0.3 by about 8.
+    got, expected = blocks(pixels(picture)), blocks(pixels(args.baseline))
     if check(got.shape == expected.shape, f"picture {got.shape}, baseline {expected.shape}"):
         mean = float(numpy.abs(got - expected).mean())
         check(mean <= MEAN_LEVELS, f"the colours differ from the baseline by {mean:.2f} levels on "
-              f"average (at most {MEAN_LEVELS}): see {folder}")
-        print(f"mean colour difference {mean:.2f} levels (at most {MEAN_LEVELS})")
+              f"average over {BLOCK} x {BLOCK} blocks (at most {MEAN_LEVELS}): see {folder}")
+        print(f"mean colour difference {mean:.2f} levels over {BLOCK} x {BLOCK} blocks "
+              f"(at most {MEAN_LEVELS})")
     print(f"image difference {testing.GetImageDifference():.2f} (threshold {THRESHOLD})")
     if passed and not args.keep:
         shutil.rmtree(folder, ignore_errors=True)
