@@ -1,5 +1,5 @@
 // Direct light on an unoccluded floor against Lambert's exact polygon form factor.
-#include "FormFactor.h"
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -9,26 +9,10 @@
 #include <iostream>
 
 using namespace mlr;
+using mlr::checks::elementFormFactor;
 
 namespace
 {
-/// The element-to-polygon form factor: the point form factor averaged over the element by
-/// a 4^4-triangle midpoint subdivision (its error is far below the Monte Carlo noise).
-double elementFormFactor(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& normal,
-  const std::vector<Vec3>& polygon, int depth = 4)
-{
-  if (depth == 0)
-  {
-    return pointToPolygonFormFactor((a + b + c) / 3.0, normal, polygon);
-  }
-  const Vec3 ab = (a + b) * 0.5, bc = (b + c) * 0.5, ca = (c + a) * 0.5;
-  return 0.25 *
-    (elementFormFactor(a, ab, ca, normal, polygon, depth - 1) +
-      elementFormFactor(ab, b, bc, normal, polygon, depth - 1) +
-      elementFormFactor(ca, bc, c, normal, polygon, depth - 1) +
-      elementFormFactor(ab, bc, ca, normal, polygon, depth - 1));
-}
-
 struct DirectLightCase
 {
   Scene scene;
