@@ -4,14 +4,13 @@
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
-#include "vtkImageReader2.h"
 #include "vtkJPEGReader.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
-#include "vtkPNGReader.h"
 #include "vtkPoints.h"
 
 #include "vtk_nlohmannjson.h"
+#include "vtk_png.h"
 #include VTK_NLOHMANN_JSON(json.hpp)
 
 #include <algorithm>
@@ -1215,6 +1214,40 @@ double component(const char* at, bool normalized)
   return std::max(static_cast<double>(value) / static_cast<double>(std::numeric_limits<T>::max()), -1.0);
 }
 
+/// A PNG file's texels as 8-bit sRGB RGBA, through libpng's simplified API, which reports a
+/// damaged file as an error (VTK 9.2's vtkPNGReader crashes on some damaged data).
+vtkSmartPointer<vtkImageData> decodePng(const std::string& bytes, std::string& problem)
+{
+  png_image png;
+  std::memset(&png, 0, sizeof(png));
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+  {
+    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
+    png_image_free(&png);
+    return nullptr;
+  }
+  // A texture's mean needs no more than this: larger images are refused rather than risking
+  // memory on a damaged header.
+  if (static_cast<std::uint64_t>(png.width) * png.height > (std::uint64_t(1) << 26))
+  {
+    problem = "its PNG image is larger than 64 Mpixels";
+    png_image_free(&png);
+    return nullptr;
+  }
+  png.format = PNG_FORMAT_RGBA;
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(static_cast<int>(png.width), static_cast<int>(png.height), 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 4);
+  if (!png_image_finish_read(&png, nullptr, image->GetScalarPointer(), 0, nullptr))
+  {
+    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
+    png_image_free(&png);
+    return nullptr;
+  }
+  return image;
+}
+
 /// A glTF document whose indices and sizes GltfChecks has checked: buffers loaded, accessors
 /// read as numbers.
 class GltfDocument
@@ -1366,21 +1399,13 @@ public:
       const bool png = bytes.size() >= 8 && bytes.compare(1, 3, "PNG") == 0;
       const bool jpeg = bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xff &&
         static_cast<unsigned char>(bytes[1]) == 0xd8;
-      vtkSmartPointer<vtkImageReader2> reader;
       if (png)
       {
-        reader = vtkSmartPointer<vtkPNGReader>::New();
+        image = decodePng(bytes, problem);
       }
       else if (jpeg)
       {
-        reader = vtkSmartPointer<vtkJPEGReader>::New();
-      }
-      if (!reader)
-      {
-        problem = "its image is neither PNG nor JPEG";
-      }
-      else
-      {
+        vtkNew<vtkJPEGReader> reader;
         vtkNew<ReaderMessages> messages;
         reader->AddObserver(vtkCommand::ErrorEvent, messages);
         reader->AddObserver(vtkCommand::WarningEvent, messages);
@@ -1393,6 +1418,10 @@ public:
           problem = "its image could not be decoded (" + messages->Errors.front() + ")";
           image = nullptr;
         }
+      }
+      else
+      {
+        problem = "its image is neither PNG nor JPEG";
       }
     }
     vtkDataArray* texels = image ? image->GetPointData()->GetScalars() : nullptr;

@@ -45,8 +45,9 @@
  * vtkPLYReader truncates float colours to 0 and crashes on some malformed headers, and
  * vtkGLTFDocumentLoader aborts (a failed assertion in Debian's build) on a material without
  * pbrMetallicRoughness, which glTF allows, and reads accessors past their buffers. The formats
- * are read here instead (glTF's JSON with VTK's nlohmann::json, textures with vtkPNGReader and
- * vtkJPEGReader), checking every index and size before using it.
+ * are read here instead (glTF's JSON with VTK's nlohmann::json, PNG textures with libpng's
+ * simplified API, since vtkPNGReader crashes on damaged images, JPEG ones with vtkJPEGReader),
+ * checking every index and size before using it.
  *
  * Bad input (a missing, unreadable or malformed file, an unknown extension, a file without
  * faces or triangles) gives an error naming the file and what is wrong, and an empty output.

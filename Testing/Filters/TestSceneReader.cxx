@@ -522,6 +522,17 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
   const double green = srgbToLinear(128 / 255.0);
   expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, green, 0.6 * 0.5, 1e-9, "data: URI texture");
   expectRgbNear(tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-9, "texture file beside the glTF");
+
+  // A damaged image (a byte of its pixel data changed: the chunk's CRC no longer matches) is
+  // a warning naming the material, and its factor alone gives the reflectance.
+  std::string damaged = png;
+  damaged[damaged.size() - 20] = static_cast<char>(damaged[damaged.size() - 20] ^ 0x5a);
+  writeFile(folder / "wood.png", damaged);
+  const ReadResult broken = readScene(folder / "textured.gltf");
+  ASSERT_TRUE(broken.succeeded) << broken.errors();
+  EXPECT_NE(broken.warnings().find("'red'"), std::string::npos) << broken.warnings();
+  EXPECT_NE(broken.warnings().find("could not be decoded"), std::string::npos) << broken.warnings();
+  expectRgbNear(tuple3(broken.output, "Reflectance", 2), 0.99, 0.99, 0.99, 0, "damaged texture");
 }
 
 TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
