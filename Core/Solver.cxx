@@ -117,6 +117,9 @@ struct Source
   /// The scene's emissive patches rather than a lamp: they occlude, and they are in the
   /// scene's own geometry.
   bool sceneEmitter = false;
+  /// Keys this source's shooting streams apart from the other sources' (0 for the first):
+  /// lights of one rig are independent estimates, not the same random numbers replayed.
+  std::uint64_t stream = 0;
 
   bool isStatic() const { return this->positions == 1; }
   bool isActive(std::size_t position) const { return this->factors[position].maxComponent() > 0; }
@@ -500,7 +503,7 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
   WorkerScratch& scratch = this->Scratch[static_cast<std::size_t>(worker)];
   const std::size_t origin = this->positionOfPath(path);
-  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, 0);
+  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream);
 
   Vec3 x, lightNormal;
   RayHit hit;
@@ -543,7 +546,8 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
 
 void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int worker)
 {
-  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, position + 1);
+  RandomStream random(
+    this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream + position + 1);
   Vec3 x, lightNormal;
   RayHit hit;
   if (!this->emit(random, position, worker, x, lightNormal, hit))
@@ -1128,6 +1132,7 @@ std::vector<Source> sourcesOf(const Scene& scene, const LightRig& rig,
     s.positions = light.frameCount();
     s.power = light.power();
     s.sceneEmitter = sceneEmitter;
+    s.stream = static_cast<std::uint64_t>(sources.size()) << 32;
     for (const LightPose& pose : light.poses())
     {
       s.factors.push_back(pose.power);
@@ -1151,6 +1156,7 @@ std::vector<Source> sourcesOf(const Scene& scene, const LightRig& rig,
     s.directional = &light;
     s.positions = light.frameCount();
     s.sphereCentre = centre;
+    s.stream = static_cast<std::uint64_t>(sources.size()) << 32;
     s.sphereRadius = radius;
     s.power = light.irradiance() * (M_PI * radius * radius);
     for (std::size_t k = 0; k < light.frameCount(); ++k)
