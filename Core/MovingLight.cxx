@@ -6,6 +6,7 @@
 #include "Scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace mlr
@@ -78,6 +79,7 @@ void MovingLight::setPoses(const std::vector<LightPose>& poses)
 MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const Rgb& power,
   const std::vector<LightPose>& poses)
   : Power(power)
+  , Polygons(polygons)
 {
   if (polygons.empty())
   {
@@ -170,6 +172,80 @@ void MovingLight::samplePoint(double u0, double u1, double u2, Vec3& point, Vec3
   const LightTriangle& t = this->Triangles[i];
   point = sampleTriangle(t.a, t.b, t.c, u1, u2);
   normal = t.normal;
+}
+
+Vec3 meanNormal(const std::vector<std::vector<Vec3>>& polygons)
+{
+  Vec3 sum;
+  for (const std::vector<Vec3>& polygon : polygons)
+  {
+    sum += newellNormal(polygon); // twice the area times the unit normal
+  }
+  const double norm = length(sum);
+  if (!(norm > 0) || !std::isfinite(norm))
+  {
+    throw Error("the light's polygons face opposite ways (their mean normal is zero), so a "
+                "Normal cannot turn it: give an Orientation (quaternion) per frame instead");
+  }
+  return sum / norm;
+}
+
+std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& polygons,
+  const std::vector<PoseInput>& inputs, std::vector<std::string>& warnings)
+{
+  std::vector<LightPose> poses(inputs.size());
+  Vec3 own;
+  bool haveOwn = false;
+  std::size_t normalised = 0;
+  for (std::size_t k = 0; k < inputs.size(); ++k)
+  {
+    const PoseInput& in = inputs[k];
+    LightPose& pose = poses[k];
+    pose.position = in.position;
+    pose.power = in.power;
+    if (in.hasOrientation)
+    {
+      const auto& q = in.orientation;
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (!(norm > 1e-12) || !std::isfinite(norm))
+      {
+        std::ostringstream s;
+        s << "the Orientation of light position " << k << " is (" << q[0] << ", " << q[1]
+          << ", " << q[2] << ", " << q[3] << "): a quaternion (w, x, y, z) must be finite and "
+          << "not zero ((1, 0, 0, 0) leaves the light as given)";
+        throw Error(s.str());
+      }
+      if (std::abs(norm - 1) > 1e-6)
+      {
+        ++normalised;
+      }
+      pose.rotation = Rotation::fromQuaternion(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+    }
+    else if (in.hasNormal)
+    {
+      const double norm = length(in.normal);
+      if (!(norm > 1e-12) || !std::isfinite(norm))
+      {
+        std::ostringstream s;
+        s << "the Normal of light position " << k << " is (" << in.normal.x << ", "
+          << in.normal.y << ", " << in.normal.z << "): give a finite direction of non-zero "
+          << "length, the way the light emits in that frame";
+        throw Error(s.str());
+      }
+      if (!haveOwn)
+      {
+        own = meanNormal(polygons);
+        haveOwn = true;
+      }
+      pose.rotation = Rotation::between(own, in.normal / norm);
+    }
+  }
+  if (normalised > 0)
+  {
+    warnings.push_back(std::to_string(normalised) +
+      " Orientation quaternions were not of unit length and were normalised");
+  }
+  return poses;
 }
 
 } // namespace mlr

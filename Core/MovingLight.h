@@ -5,7 +5,9 @@
 #include "Rotation.h"
 #include "Vec3.h"
 
+#include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace mlr
@@ -52,6 +54,8 @@ public:
   /// Area centroid of the light as given (frame-independent reference point).
   const Vec3& centroid() const { return this->Centroid; }
   const std::vector<LightTriangle>& triangles() const { return this->Triangles; }
+  /// The polygons as given (the light's own frame).
+  const std::vector<std::vector<Vec3>>& polygons() const { return this->Polygons; }
 
   std::size_t frameCount() const { return this->Poses.size(); }
   const LightPose& pose(std::size_t frame) const { return this->Poses[frame]; }
@@ -77,11 +81,37 @@ private:
   double Area = 0;
   Vec3 Centroid;
   std::vector<LightTriangle> Triangles;
+  std::vector<std::vector<Vec3>> Polygons;
   std::vector<double> CumulativeArea;
   std::vector<LightPose> Poses;
   bool Rotates = false;
 
   void setPoses(const std::vector<LightPose>& poses);
 };
+
+/// What users give for a light in one frame (a Trajectory point and its arrays).
+struct PoseInput
+{
+  Vec3 position; ///< the light's area centroid in this frame
+  bool hasNormal = false;
+  Vec3 normal; ///< the emission direction in this frame (any length but 0)
+  bool hasOrientation = false;
+  std::array<double, 4> orientation{ 1, 0, 0, 0 }; ///< quaternion w, x, y, z (any length but 0)
+  Rgb power{ 1, 1, 1 };                             ///< factor on the light's power
+};
+
+/// The area-weighted mean of the polygons' unit normals, normalised: the direction a light
+/// emits in as given, which a frame's Normal turns. Throws when it is zero (a light whose
+/// polygons face opposite ways must be posed with Orientation).
+Vec3 meanNormal(const std::vector<std::vector<Vec3>>& polygons);
+
+/**
+ * Poses from users' per-frame inputs. An orientation (a quaternion, normalised with a
+ * warning appended to `warnings` when it is not unit) wins over a normal; a normal turns the
+ * light about its centroid by the smallest rotation from meanNormal(polygons) to it.
+ * Throws mlr::Error naming the frame for a zero normal or quaternion.
+ */
+std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& polygons,
+  const std::vector<PoseInput>& inputs, std::vector<std::string>& warnings);
 
 } // namespace mlr

@@ -76,10 +76,10 @@ std::vector<Vec3> pointsOf(vtkPointSet* data)
   return result;
 }
 
-/// The Scene's cell array Reflectance (numeric, 1 or 3 components), or nullptr when absent.
-vtkDataArray* reflectanceArray(vtkPolyData* scene)
+/// The Scene's cell array `name` (numeric, 1 or 3 components), or nullptr when absent.
+vtkDataArray* colourArray(vtkPolyData* scene, const std::string& name, const char* values)
 {
-  vtkAbstractArray* array = scene->GetCellData()->GetAbstractArray("Reflectance");
+  vtkAbstractArray* array = name.empty() ? nullptr : scene->GetCellData()->GetAbstractArray(name.c_str());
   if (!array)
   {
     return nullptr;
@@ -87,52 +87,131 @@ vtkDataArray* reflectanceArray(vtkPolyData* scene)
   auto* numbers = vtkDataArray::SafeDownCast(array);
   if (!numbers)
   {
-    throw Error(std::string("the Scene's cell array Reflectance is a ") + array->GetClassName() +
-      ": give a numeric array (float or double) with values in [0, 1)");
+    throw Error("the Scene's cell array " + name + " is a " + array->GetClassName() +
+      ": give a numeric array (float or double) with values " + values);
   }
   const int components = numbers->GetNumberOfComponents();
   if (components != 1 && components != 3)
   {
-    throw Error("the Scene's cell array Reflectance has " + std::to_string(components) +
+    throw Error("the Scene's cell array " + name + " has " + std::to_string(components) +
       " components: give 3 (red, green, blue) or 1 (grey)");
   }
   if (numbers->GetNumberOfTuples() < scene->GetNumberOfCells())
   {
-    throw Error("the Scene's cell array Reflectance has " +
+    throw Error("the Scene's cell array " + name + " has " +
       std::to_string(numbers->GetNumberOfTuples()) + " values for " +
       std::to_string(scene->GetNumberOfCells()) + " cells: give one per cell");
   }
   return numbers;
 }
 
-Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId)
+Rgb colourOfCell(vtkDataArray* array, vtkIdType cellId)
 {
-  Rgb rho;
   if (array->GetNumberOfComponents() == 1)
   {
-    rho = Rgb(array->GetComponent(cellId, 0));
+    return Rgb(array->GetComponent(cellId, 0));
   }
-  else
-  {
-    rho = Rgb(array->GetComponent(cellId, 0), array->GetComponent(cellId, 1),
-      array->GetComponent(cellId, 2));
-  }
+  return Rgb(array->GetComponent(cellId, 0), array->GetComponent(cellId, 1),
+    array->GetComponent(cellId, 2));
+}
+
+Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& name)
+{
+  const Rgb rho = colourOfCell(array, cellId);
   for (int c = 0; c < 3; ++c)
   {
     if (!(rho[c] >= 0.0 && rho[c] < 1.0))
     {
       std::ostringstream s;
-      s << "Scene cell " << cellId << " has Reflectance (" << rho.r << ", " << rho.g << ", "
+      s << "Scene cell " << cellId << " has " << name << " (" << rho.r << ", " << rho.g << ", "
         << rho.b << "): every value must be >= 0 and < 1";
       throw Error(s.str());
     }
   }
   return rho;
 }
+
+Rgb emissionOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& name)
+{
+  const Rgb e = colourOfCell(array, cellId);
+  if (!e.isFinite() || e.minComponent() < 0)
+  {
+    std::ostringstream s;
+    s << "Scene cell " << cellId << " has " << name << " (" << e.r << ", " << e.g << ", " << e.b
+      << ") W/m^2: every value must be finite and >= 0";
+    throw Error(s.str());
+  }
+  return e;
+}
+
+/// The numeric point array `name` with `components` (or, when `alternative` is not 0,
+/// that many) components and one tuple per point, or nullptr when absent.
+vtkDataArray* pointArray(vtkPointSet* data, const char* name, int components, int alternative = 0)
+{
+  vtkAbstractArray* array = data->GetPointData()->GetAbstractArray(name);
+  if (!array)
+  {
+    return nullptr;
+  }
+  auto* numbers = vtkDataArray::SafeDownCast(array);
+  const int c = numbers ? numbers->GetNumberOfComponents() : 0;
+  if (!numbers || (c != components && (alternative == 0 || c != alternative)) ||
+    numbers->GetNumberOfTuples() != data->GetNumberOfPoints())
+  {
+    std::string shape = std::to_string(components);
+    if (alternative)
+    {
+      shape += " or " + std::to_string(alternative);
+    }
+    throw Error(std::string("the Trajectory's point array ") + name + " must be numeric with " +
+      shape + " components and one tuple per point (" + std::to_string(data->GetNumberOfPoints()) +
+      "): fix it or remove it");
+  }
+  return numbers;
+}
+
+/// The integer cell array LightId of the Light, or nullptr.
+vtkDataArray* lightIdArray(vtkPolyData* light)
+{
+  vtkAbstractArray* array = light ? light->GetCellData()->GetAbstractArray("LightId") : nullptr;
+  if (!array)
+  {
+    return nullptr;
+  }
+  auto* ids = vtkDataArray::SafeDownCast(array);
+  if (!ids || ids->GetNumberOfComponents() != 1 || ids->GetNumberOfTuples() < light->GetNumberOfCells())
+  {
+    throw Error("the Light's cell array LightId must be numeric with one integer per cell: fix "
+                "it or remove it to make every polygon one light");
+  }
+  return ids;
+}
+
+/// The sorted distinct LightId values, checked to be integers.
+std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
+{
+  std::vector<long long> values;
+  for (vtkIdType c = 0; c < light->GetNumberOfCells(); ++c)
+  {
+    const double v = ids->GetComponent(c, 0);
+    if (!std::isfinite(v) || v != std::floor(v))
+    {
+      std::ostringstream s;
+      s << "the Light's cell array LightId has " << v << " at cell " << c
+        << ": give integers (0, 1, ...) that group polygons into lights";
+      throw Error(s.str());
+    }
+    values.push_back(static_cast<long long>(v));
+  }
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+  return values;
+}
 }
 
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
-  std::uint64_t memoryLimitBytes)
+  std::uint64_t memoryLimitBytes, const std::string& reflectanceName,
+  const std::string& emissionName)
 {
   PolygonSoup soup;
   if (!scene || scene->GetNumberOfCells() == 0)
@@ -174,12 +253,13 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     return soup;
   }
 
-  vtkDataArray* reflectance = reflectanceArray(scene);
+  vtkDataArray* reflectance = colourArray(scene, reflectanceName, "in [0, 1)");
+  vtkDataArray* emission = colourArray(scene, emissionName, "in W/m^2, >= 0");
   if (!reflectance)
   {
     std::ostringstream s;
-    s << "the Scene has no cell array Reflectance: every surface is grey "
-      << Material{}.reflectance.g;
+    s << "the Scene has no cell array " << (reflectanceName.empty() ? "for reflectance" : reflectanceName)
+      << ": every surface is grey " << Material{}.reflectance.g;
     warnings.push_back(s.str());
   }
   soup.points = pointsOf(scene);
@@ -188,25 +268,49 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     Material material;
     if (reflectance)
     {
-      material.reflectance = reflectanceOfCell(reflectance, cellId);
+      material.reflectance = reflectanceOfCell(reflectance, cellId, reflectanceName);
+    }
+    if (emission)
+    {
+      material.emission = emissionOfCell(emission, cellId, emissionName);
     }
     soup.materials.push_back(material);
   });
   return soup;
 }
 
-std::vector<std::vector<Vec3>> lightPolygons(vtkPolyData* light)
+std::size_t lightCount(vtkPolyData* light)
 {
-  std::vector<std::vector<Vec3>> polygons;
+  vtkDataArray* ids = lightIdArray(light);
+  return ids ? std::max<std::size_t>(1, distinctLightIds(light, ids).size()) : 1;
+}
+
+std::vector<LightInput> lightInputs(vtkPolyData* light)
+{
+  std::vector<LightInput> lights;
   if (!light)
   {
-    return polygons;
+    return lights;
+  }
+  vtkDataArray* ids = lightIdArray(light);
+  const std::vector<long long> distinct = ids ? distinctLightIds(light, ids) : std::vector<long long>{ 0 };
+  lights.resize(distinct.size());
+  vtkDataArray* power = nullptr;
+  if (vtkAbstractArray* array = light->GetCellData()->GetAbstractArray("LightPower"))
+  {
+    power = vtkDataArray::SafeDownCast(array);
+    if (!power || (power->GetNumberOfComponents() != 3 && power->GetNumberOfComponents() != 1) ||
+      power->GetNumberOfTuples() < light->GetNumberOfCells())
+    {
+      throw Error("the Light's cell array LightPower must be numeric with 3 components (RGB, "
+                  "W) or 1 (white) per cell: fix it or remove it to use the LightPower property");
+    }
   }
   const std::vector<Vec3> points = pointsOf(light);
-  forEachSurfaceCell(light, [&](vtkIdType, const std::vector<std::uint32_t>& ids) {
+  forEachSurfaceCell(light, [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds) {
     std::vector<Vec3> polygon;
-    polygon.reserve(ids.size());
-    for (std::uint32_t id : ids)
+    polygon.reserve(pointIds.size());
+    for (std::uint32_t id : pointIds)
     {
       if (id >= points.size())
       {
@@ -215,58 +319,200 @@ std::vector<std::vector<Vec3>> lightPolygons(vtkPolyData* light)
       }
       polygon.push_back(points[id]);
     }
-    polygons.push_back(std::move(polygon));
+    const std::size_t which = ids
+      ? static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(),
+                                   static_cast<long long>(ids->GetComponent(cellId, 0))) -
+          distinct.begin())
+      : 0;
+    LightInput& target = lights[which];
+    target.polygons.push_back(std::move(polygon));
+    if (power)
+    {
+      const Rgb p = colourOfCell(power, cellId);
+      if (target.hasPower && p != target.power)
+      {
+        throw Error("the Light's cell array LightPower differs between the polygons of light " +
+          std::to_string(distinct[which]) + ": give every polygon of a light the same power");
+      }
+      target.power = p;
+      target.hasPower = true;
+    }
   });
-  return polygons;
+  for (std::size_t i = 0; i < lights.size(); ++i)
+  {
+    if (lights[i].polygons.empty())
+    {
+      throw Error((ids ? "light " + std::to_string(distinct[i]) + " of the Light" : std::string("the light")) +
+        " has no polygon (only vertices or lines): give at least one polygon with 3 or more points");
+    }
+  }
+  return lights;
 }
 
-Trajectory trajectoryFromPoints(vtkPointSet* trajectory)
+namespace
 {
-  Trajectory result;
-  if (trajectory)
+/// The inputs of the points `ids` of the trajectory, one per point.
+std::vector<PoseInput> poseInputsOf(vtkPointSet* trajectory, const std::vector<vtkIdType>& ids)
+{
+  vtkDataArray* normal = pointArray(trajectory, "Normal", 3);
+  vtkDataArray* orientation = pointArray(trajectory, "Orientation", 4);
+  vtkDataArray* power = pointArray(trajectory, "Power", 1, 3);
+  std::vector<PoseInput> inputs(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
   {
-    result.positions = pointsOf(trajectory);
+    const vtkIdType id = ids[i];
+    PoseInput& in = inputs[i];
+    double p[3];
+    trajectory->GetPoint(id, p);
+    in.position = { p[0], p[1], p[2] };
+    if (normal)
+    {
+      in.hasNormal = true;
+      in.normal = { normal->GetComponent(id, 0), normal->GetComponent(id, 1), normal->GetComponent(id, 2) };
+    }
+    if (orientation)
+    {
+      in.hasOrientation = true;
+      for (int c = 0; c < 4; ++c)
+      {
+        in.orientation[static_cast<std::size_t>(c)] = orientation->GetComponent(id, c);
+      }
+    }
+    if (power)
+    {
+      in.power = power->GetNumberOfComponents() == 1
+        ? Rgb(power->GetComponent(id, 0))
+        : Rgb(power->GetComponent(id, 0), power->GetComponent(id, 1), power->GetComponent(id, 2));
+      if (!in.power.isFinite() || in.power.minComponent() < 0)
+      {
+        std::ostringstream s;
+        s << "the Trajectory's point array Power has (" << in.power.r << ", " << in.power.g
+          << ", " << in.power.b << ") at point " << id
+          << ": a power factor must be finite and >= 0 (0 turns the light off)";
+        throw Error(s.str());
+      }
+    }
   }
-  const std::size_t n = result.positions.size();
-  if (n == 0)
-  {
-    throw Error("the Trajectory has no points: give one point per light position, or "
-                "disconnect it to move the light from PathStart to PathEnd");
-  }
+  return inputs;
+}
 
+/// The times of the points `ids`, from the point array Time, or 0, 1, ...
+std::vector<double> timesOf(vtkPointSet* trajectory, const std::vector<vtkIdType>& ids)
+{
+  const std::size_t n = ids.size();
+  std::vector<double> result(n);
   vtkAbstractArray* array = trajectory->GetPointData()->GetAbstractArray("Time");
   if (!array)
   {
-    result.times.resize(n);
     for (std::size_t i = 0; i < n; ++i)
     {
-      result.times[i] = static_cast<double>(i);
+      result[i] = static_cast<double>(i);
     }
     return result;
   }
   auto* times = vtkDataArray::SafeDownCast(array);
   if (!times || times->GetNumberOfComponents() != 1 ||
-    times->GetNumberOfTuples() != static_cast<vtkIdType>(n))
+    times->GetNumberOfTuples() != trajectory->GetNumberOfPoints())
   {
     throw Error("the Trajectory's point array Time must be numeric with one value per point (" +
-      std::to_string(n) + "): fix it or remove it to number the frames 0, 1, ...");
+      std::to_string(trajectory->GetNumberOfPoints()) +
+      "): fix it or remove it to number the frames 0, 1, ...");
   }
-  result.times.resize(n);
   for (std::size_t i = 0; i < n; ++i)
   {
-    const double t = times->GetComponent(static_cast<vtkIdType>(i), 0);
-    if (!std::isfinite(t) || (i > 0 && !(t > result.times[i - 1])))
+    const double t = times->GetComponent(ids[i], 0);
+    if (!std::isfinite(t) || (i > 0 && !(t > result[i - 1])))
     {
       std::ostringstream s;
       s << "the Trajectory's point array Time must increase strictly with finite values: "
-        << "point " << i << " has time " << t;
+        << "point " << ids[i] << " has time " << t;
       if (i > 0)
       {
-        s << " after " << result.times[i - 1];
+        s << " after " << result[i - 1];
       }
       throw Error(s.str());
     }
-    result.times[i] = t;
+    result[i] = t;
+  }
+  return result;
+}
+}
+
+Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
+{
+  const vtkIdType n = trajectory && trajectory->GetPoints() ? trajectory->GetNumberOfPoints() : 0;
+  if (n == 0)
+  {
+    throw Error("the Trajectory has no points: give one point per light position, or "
+                "disconnect it to move the light from PathStart to PathEnd");
+  }
+  // The point ids of each light's positions.
+  std::vector<std::vector<vtkIdType>> perLight;
+  if (lights <= 1)
+  {
+    perLight.emplace_back(static_cast<std::size_t>(n));
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      perLight[0][static_cast<std::size_t>(i)] = i;
+    }
+  }
+  else
+  {
+    auto* poly = vtkPolyData::SafeDownCast(trajectory);
+    const vtkIdType lines = poly ? poly->GetNumberOfLines() : 0;
+    if (static_cast<std::size_t>(lines) != lights)
+    {
+      throw Error("the Light holds " + std::to_string(lights) + " lights (LightId) but the "
+        "Trajectory has " + std::to_string(lines) + " polylines: give one polyline per light, "
+        "in LightId order (a single point for a light that does not move)");
+    }
+    auto it = vtkSmartPointer<vtkCellArrayIterator>::Take(poly->GetLines()->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+    {
+      vtkIdType count = 0;
+      const vtkIdType* ids = nullptr;
+      it->GetCurrentCell(count, ids);
+      if (count == 0)
+      {
+        throw Error("polyline " + std::to_string(perLight.size()) +
+          " of the Trajectory has no point: give each light at least one");
+      }
+      perLight.emplace_back(ids, ids + count);
+    }
+  }
+
+  Trajectory result;
+  std::size_t frames = 0;
+  for (std::size_t l = 0; l < perLight.size(); ++l)
+  {
+    const std::size_t count = perLight[l].size();
+    if (count > 1 && frames == 0)
+    {
+      frames = count;
+      result.times = timesOf(trajectory, perLight[l]);
+      for (const char* name : { "SunAzimuth", "SunElevation" })
+      {
+        if (vtkDataArray* angles = pointArray(trajectory, name, 1))
+        {
+          auto& into = name[3] == 'A' ? result.sunAzimuth : result.sunElevation;
+          for (vtkIdType id : perLight[l])
+          {
+            into.push_back(angles->GetComponent(id, 0));
+          }
+        }
+      }
+    }
+    else if (count > 1 && count != frames)
+    {
+      throw Error("polyline " + std::to_string(l) + " of the Trajectory has " +
+        std::to_string(count) + " points but polyline 0 has " + std::to_string(frames) +
+        ": every moving light needs one point per frame (one point: a light that does not move)");
+    }
+    result.lights.push_back(poseInputsOf(trajectory, perLight[l]));
+  }
+  if (frames == 0)
+  {
+    result.times = timesOf(trajectory, { perLight[0].front() });
   }
   return result;
 }
@@ -275,10 +521,13 @@ Trajectory straightTrajectory(const Vec3& start, const Vec3& end, int count)
 {
   Trajectory result;
   const int n = std::max(count, 1);
+  result.lights.emplace_back();
   for (int i = 0; i < n; ++i)
   {
     const double s = n > 1 ? static_cast<double>(i) / (n - 1) : 0.0;
-    result.positions.push_back(start + (end - start) * s);
+    PoseInput in;
+    in.position = start + (end - start) * s;
+    result.lights[0].push_back(in);
     result.times.push_back(static_cast<double>(i));
   }
   return result;

@@ -2,6 +2,7 @@
 // mlr::Error with a message that names the input port, the cell or the array to fix.
 #pragma once
 
+#include "MovingLight.h"
 #include "Remeshing.h"
 #include "Vec3.h"
 
@@ -15,28 +16,53 @@ class vtkPolyData;
 namespace mlr::vtkinputs
 {
 
-/// The Scene's polygons (strips split into triangles) with one material each, read from the
-/// cell array `Reflectance`. Recoverable oddities (ignored vertices and lines, no
-/// `Reflectance`) are appended to `warnings`. An empty soup means there is nothing to light.
-/// Throws mlr::Error, before copying anything, when the copy is estimated to need more than
-/// `memoryLimitBytes` (0: half the physical memory).
-PolygonSoup sceneSoup(
-  vtkPolyData* scene, std::vector<std::string>& warnings, std::uint64_t memoryLimitBytes = 0);
+/// The Scene's polygons (strips split into triangles) with one material each: reflectance
+/// from the cell array named `reflectanceName` (1 or 3 components, each in [0, 1)) and
+/// emission from the one named `emissionName` (1 or 3 components, W/m^2, >= 0), if present.
+/// Recoverable oddities (ignored vertices and lines, no reflectance) are appended to
+/// `warnings`. An empty soup means there is nothing to light. Throws mlr::Error, before
+/// copying anything, when the copy is estimated to need more than `memoryLimitBytes` (0: half
+/// the physical memory).
+PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
+  std::uint64_t memoryLimitBytes = 0, const std::string& reflectanceName = "Reflectance",
+  const std::string& emissionName = "Emission");
 
-/// The Light's polygons (strips split into triangles), in the light's own frame.
-std::vector<std::vector<Vec3>> lightPolygons(vtkPolyData* light);
-
-/// Light centroid positions, one per frame, and the frame times (strictly increasing).
-struct Trajectory
+/// One light of the Light input: its polygons (strips split into triangles) in the light's
+/// own frame, and its power from the cell array LightPower when there is one.
+struct LightInput
 {
-  std::vector<Vec3> positions;
-  std::vector<double> times;
+  std::vector<std::vector<Vec3>> polygons;
+  bool hasPower = false;
+  Rgb power;
 };
 
-/// The Trajectory's points in order, with times from the point array `Time` if present.
-Trajectory trajectoryFromPoints(vtkPointSet* trajectory);
+/// The Light's polygons grouped into lights by the integer cell array LightId, in increasing
+/// LightId order (one light without it). Throws for a LightPower that differs within a light.
+std::vector<LightInput> lightInputs(vtkPolyData* light);
 
-/// `count` evenly spaced positions from `start` to `end`, at times 0, 1, ..., count-1.
+/// How many lights the Light input holds: its distinct LightId values, or 1 without them.
+std::size_t lightCount(vtkPolyData* light);
+
+/// Every light's per-frame poses, and the frame times (strictly increasing).
+struct Trajectory
+{
+  std::vector<double> times;
+  /// Per light: one input per frame, or one for a light that does not move.
+  std::vector<std::vector<PoseInput>> lights;
+  /// Per frame, from the point arrays SunAzimuth and SunElevation (degrees) when present.
+  std::vector<double> sunAzimuth, sunElevation;
+};
+
+/**
+ * The Trajectory of `lights` lights. One light: the points in order, one per frame. Several:
+ * one polyline per light in LightId order; a polyline of one point is a light that does not
+ * move, and the others must have one point per frame. Point arrays: Time (frame times, else
+ * 0, 1, ...), Normal (3 components), Orientation (4, quaternion w, x, y, z, wins over Normal),
+ * Power (1 or 3, a factor on the light's power), SunAzimuth and SunElevation (passed on).
+ */
+Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights = 1);
+
+/// One light at `count` evenly spaced positions from `start` to `end`, at times 0, 1, ...
 Trajectory straightTrajectory(const Vec3& start, const Vec3& end, int count);
 
 /// The index of the time step at or below `time` (the first one if `time` is earlier).

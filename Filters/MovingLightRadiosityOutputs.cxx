@@ -117,6 +117,7 @@ void addElementRadiosity(
   auto total = rgbArray("Radiosity", n);
   auto direct = rgbArray("DirectRadiosity", n);
   auto indirect = rgbArray("IndirectRadiosity", n);
+  auto emitted = rgbArray("EmittedRadiosity", n);
   vtkSmartPointer<vtkFloatArray> front, back;
   if (twoSided)
   {
@@ -129,6 +130,7 @@ void addElementRadiosity(
     setRgb(total, e, solution.total(frame, e, lit));
     setRgb(direct, e, solution.direct(frame, e, lit));
     setRgb(indirect, e, solution.indirect(frame, e, lit));
+    setRgb(emitted, e, solution.emitted(e, lit));
     if (twoSided)
     {
       setRgb(front, e, solution.total(frame, e, Side::Front));
@@ -138,6 +140,7 @@ void addElementRadiosity(
   cellData->AddArray(total);
   cellData->AddArray(direct);
   cellData->AddArray(indirect);
+  cellData->AddArray(emitted);
   if (twoSided)
   {
     cellData->AddArray(front);

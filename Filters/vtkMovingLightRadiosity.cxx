@@ -3,13 +3,16 @@
 #include "MovingLightRadiosityInputs.h"
 #include "MovingLightRadiosityOutputs.h"
 
+#include "Animation.h"
 #include "Error.h"
 #include "MovingLight.h"
 #include "Remeshing.h"
 #include "Scene.h"
 #include "Solver.h"
 
+#include "vtkAppendPolyData.h"
 #include "vtkCellData.h"
+#include "vtkDoubleArray.h"
 #include "vtkDataObject.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
@@ -33,16 +36,6 @@
 static_assert(mlr::MaximumPathsPerFrame == 100000000000ULL,
   "keep the clamp of vtkMovingLightRadiosity::NumberOfPaths equal to Core's maximum");
 
-namespace
-{
-/// Share of the progress bar given to remeshing; the solve takes the rest.
-constexpr double RemeshingShare = 0.05;
-
-std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
-{
-  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
-}
-}
 
 /// The last solve: every frame of the animation, kept until an input or a property changes.
 struct vtkMovingLightRadiosity::vtkInternals
@@ -51,12 +44,11 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// Taken just before the inputs and properties were read for the solve.
   vtkTimeStamp SolveTime;
   std::vector<double> Times;
-  std::vector<mlr::Vec3> LightPositions;
-  mlr::Vec3 LightCentroid;
-  // Display (issue 17): the light as given, for the Light output, and what the colours of
-  // every frame need.
-  std::vector<std::vector<mlr::Vec3>> LightPolygons;
-  mlr::Rgb LightPower;
+  /// The lights with their poses, for the Light output and the frame's field data.
+  mlr::LightRig Rig;
+  /// Per frame, passed on from the Trajectory when it has them (degrees).
+  std::vector<double> SunAzimuth, SunElevation;
+  // Display (issue 17): what the colours of every frame need.
   mlr::vtkoutputs::SmoothShading Shading;
   double AutoExposure = 0;
   /// Taken when the properties were last found to match the solve: Exposure moves it on, as
@@ -105,6 +97,12 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->MemoryLimit = 0;
   this->SolveCount = 0;
   this->Exposure = 0.0;
+  this->LightType = AREA_LIGHT;
+  this->SunIrradiance = 1000.0;
+  this->AimAtPoint = 0;
+  this->AimPoint[0] = this->AimPoint[1] = this->AimPoint[2] = 0.0;
+  this->ReflectanceArrayName = "Reflectance";
+  this->EmissionArrayName = "Emission";
 
   this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
@@ -143,22 +141,43 @@ int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* 
     return 1;
   }
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  if (port == LIGHT_PORT)
+  {
+    // A directional light, or a scene whose surfaces emit, needs no Light.
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
   return 1;
 }
 
 namespace
 {
+/// The number of lights whose poses the Trajectory holds: the Light's LightId groups for
+/// area lights, one for a directional light.
+std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightInput)
+{
+  if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
+  {
+    return 1;
+  }
+  return mlr::vtkinputs::lightCount(vtkPolyData::GetData(lightInput, 0));
+}
+
 mlr::vtkinputs::Trajectory trajectoryOf(
-  vtkMovingLightRadiosity* self, vtkInformationVector* trajectoryInput)
+  vtkMovingLightRadiosity* self, vtkInformationVector* trajectoryInput, std::size_t lights)
 {
   if (self->GetNumberOfInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT) == 0)
   {
+    if (lights > 1)
+    {
+      throw mlr::Error("the Light holds " + std::to_string(lights) + " lights (LightId): "
+        "connect a Trajectory with one polyline per light");
+    }
     const double* start = self->GetPathStart();
     const double* end = self->GetPathEnd();
     return mlr::vtkinputs::straightTrajectory({ start[0], start[1], start[2] },
       { end[0], end[1], end[2] }, self->GetNumberOfPositions());
   }
-  return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0));
+  return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0), lights);
 }
 }
 
@@ -166,18 +185,23 @@ mlr::vtkinputs::Trajectory trajectoryOf(
 int vtkMovingLightRadiosity::RequestInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  if (this->GetNumberOfInputConnections(TRAJECTORY_PORT) > 0)
+  // The time steps are the trajectory's points (read per light, so the Light's LightId too),
+  // which exist only once they have executed: bring them up to date now rather than declare
+  // steps that RequestData would contradict.
+  for (int port : { LIGHT_PORT, TRAJECTORY_PORT })
   {
-    // The time steps are the trajectory's points, which exist only once it has executed:
-    // bring it up to date now rather than declare steps that RequestData would contradict.
-    int producerPort = 0;
-    vtkAlgorithm* producer = this->GetInputAlgorithm(TRAJECTORY_PORT, 0, producerPort);
-    producer->Update(producerPort);
+    if (this->GetNumberOfInputConnections(port) > 0)
+    {
+      int producerPort = 0;
+      vtkAlgorithm* producer = this->GetInputAlgorithm(port, 0, producerPort);
+      producer->Update(producerPort);
+    }
   }
   std::vector<double> times;
   try
   {
-    times = trajectoryOf(this, inputVector[TRAJECTORY_PORT]).times;
+    times = trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]))
+              .times;
   }
   catch (const mlr::Error& e)
   {
@@ -267,7 +291,6 @@ int vtkMovingLightRadiosity::RequestData(
     vtkPolyData* output = vtkPolyData::GetData(outputVector, port);
     if (cache.Elements)
     {
-      const mlr::Vec3& position = cache.LightPositions[frame];
       if (port == ELEMENTS_PORT)
       {
         output->ShallowCopy(cache.Elements);
@@ -285,16 +308,59 @@ int vtkMovingLightRadiosity::RequestData(
       }
       else
       {
-        // The light only translates for now: identity rotation.
-        mlr::vtkoutputs::LightTransform transform;
-        transform.translation = position - cache.LightCentroid;
-        output->ShallowCopy(
-          mlr::vtkoutputs::posedLight(cache.LightPolygons, transform, cache.LightPower));
+        // Every area light, posed as in this frame, at this frame's power.
+        vtkNew<vtkAppendPolyData> lights;
+        for (const mlr::MovingLight& light : cache.Rig.areaLights)
+        {
+          const std::size_t k = light.frameCount() > 1 ? frame : 0;
+          const mlr::LightPose& pose = light.pose(k);
+          const mlr::Rotation& r = pose.rotation;
+          mlr::vtkoutputs::LightTransform transform;
+          transform.rotation = { { { r.row0.x, r.row0.y, r.row0.z }, { r.row1.x, r.row1.y, r.row1.z },
+            { r.row2.x, r.row2.y, r.row2.z } } };
+          transform.translation = pose.position - r.apply(light.centroid());
+          lights->AddInputData(
+            mlr::vtkoutputs::posedLight(light.polygons(), transform, light.power() * pose.power));
+        }
+        if (lights->GetNumberOfInputConnections(0) > 0)
+        {
+          lights->Update();
+          output->ShallowCopy(lights->GetOutput());
+        }
       }
       vtkNew<vtkFieldData> fieldData;
       fieldData->ShallowCopy(cache.Statistics);
-      mlr::vtkoutputs::addFrameFieldData(
-        fieldData, frame, position, position - cache.LightCentroid, this->SolveCount);
+      // The first area light's place; a directional light's direction.
+      mlr::Vec3 position, translation;
+      if (!cache.Rig.areaLights.empty())
+      {
+        const mlr::MovingLight& light = cache.Rig.areaLights.front();
+        const std::size_t k = light.frameCount() > 1 ? frame : 0;
+        position = light.pose(k).position;
+        translation = light.translation(k);
+      }
+      mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
+      if (!cache.Rig.directionalLights.empty())
+      {
+        const mlr::DirectionalLight& sun = cache.Rig.directionalLights.front();
+        const mlr::Vec3& s = sun.direction(sun.frameCount() > 1 ? frame : 0);
+        vtkNew<vtkDoubleArray> direction;
+        direction->SetName("SunDirection");
+        direction->SetNumberOfComponents(3);
+        direction->InsertNextTuple3(s.x, s.y, s.z);
+        fieldData->AddArray(direction);
+        for (const auto& [name, values] : { std::make_pair("SunAzimuth", &cache.SunAzimuth),
+               std::make_pair("SunElevation", &cache.SunElevation) })
+        {
+          if (frame < values->size())
+          {
+            vtkNew<vtkDoubleArray> angle;
+            angle->SetName(name);
+            angle->InsertNextValue((*values)[frame]);
+            fieldData->AddArray(angle);
+          }
+        }
+      }
       mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
       output->SetFieldData(fieldData);
     }
@@ -311,103 +377,110 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   cache.SolveTime.Modified();
   cache.PropertiesTime.Modified();
 
-  // Core reports progress on this thread, so the abort flag can be polled right here.
-  auto progress = [this](double base, double share) {
-    return [this, base, share](double fraction) {
-      this->UpdateProgress(base + share * fraction);
-      return !this->CheckAbort();
-    };
-  };
-
   try
   {
-    const mlr::vtkinputs::Trajectory trajectory = trajectoryOf(this, inputVector[TRAJECTORY_PORT]);
     std::vector<std::string> warnings;
+    vtkPolyData* lightData = vtkPolyData::GetData(inputVector[LIGHT_PORT], 0);
+    const bool directional = this->LightType == DIRECTIONAL_LIGHT;
+    const mlr::vtkinputs::Trajectory trajectory = trajectoryOf(
+      this, inputVector[TRAJECTORY_PORT], directional ? 1 : mlr::vtkinputs::lightCount(lightData));
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(
       vtkPolyData::GetData(inputVector[SCENE_PORT], 0), warnings,
-      static_cast<std::uint64_t>(this->MemoryLimit) << 20);
-    for (const std::string& warning : warnings)
-    {
-      vtkWarningMacro(<< warning);
-    }
+      static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
+      this->EmissionArrayName);
     cache.Times = trajectory.times;
+    cache.SunAzimuth = trajectory.sunAzimuth;
+    cache.SunElevation = trajectory.sunElevation;
     if (soup.polygons.empty())
     {
+      for (const std::string& warning : warnings)
+      {
+        vtkWarningMacro(<< warning);
+      }
       cache.HasResult = true; // nothing to light: empty outputs, which is no error
       return true;
     }
 
-    // The light and the options are checked before remeshing, which may take a while.
-    const auto polygons =
-      mlr::vtkinputs::lightPolygons(vtkPolyData::GetData(inputVector[LIGHT_PORT], 0));
-    const mlr::Rgb power(this->LightPower[0], this->LightPower[1], this->LightPower[2]);
-    const mlr::Vec3 centroid = mlr::MovingLight(polygons, power, { mlr::Vec3() }).centroid();
-    std::vector<mlr::Vec3> translations;
-    for (const mlr::Vec3& position : trajectory.positions)
+    // The lights and the options are checked before remeshing, which may take a while.
+    mlr::LightRig rig;
+    if (directional)
     {
-      translations.push_back(position - centroid);
+      std::vector<mlr::Vec3> directions;
+      std::vector<mlr::Rgb> factors;
+      for (const mlr::PoseInput& in : trajectory.lights.front())
+      {
+        directions.push_back(in.position);
+        factors.push_back(in.power);
+      }
+      rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
     }
-    const mlr::MovingLight light(polygons, power, translations);
-    cache.LightPositions = trajectory.positions;
-    cache.LightCentroid = centroid;
-    cache.LightPolygons = polygons;
-    cache.LightPower = power;
-
-    mlr::SolverOptions options;
-    options.pathsPerFrame = static_cast<std::uint64_t>(this->NumberOfPaths);
-    options.gatheringRatio = this->GatheringRatio;
-    options.firstBounceSurvival = this->FirstBounceSurvival;
-    options.reuseShooting = this->ReuseShooting != 0;
-    options.reuseGathering = this->ReuseGathering != 0;
-    options.twoSided = this->TwoSided != 0;
-    options.seed = static_cast<std::uint64_t>(this->Seed);
-    options.threads = this->NumberOfThreads;
-    options.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
-    mlr::validateOptions(options);
-
-    mlr::RemeshOptions remeshOptions;
-    remeshOptions.targetEdgeLength = this->PatchSize;
-    remeshOptions.memoryLimitBytes = options.memoryLimitBytes;
-    // A solve that cannot fit is refused before remeshing does the work (CGAL may take a
-    // while): with the patch count remeshing expects once the polygons are triangulated,
-    // halved so that an estimate on the high side never refuses a solve that fits (the exact
-    // check follows remeshing).
-    remeshOptions.checkExpectedPatches = [&](std::size_t expected) {
-      const std::size_t patches = expected / 2;
-      mlr::checkSolveMemory(
-        saturatingSum(mlr::estimateSolveMemory(
-                        patches, 4 * patches, 2 * patches, translations.size(), options),
-          mlr::vtkoutputs::estimateOutputMemory(4 * patches, 2 * patches)),
-        translations.size(), patches, 4 * patches, options, true);
-    };
-    const mlr::RemeshResult remeshed =
-      mlr::remesh(soup, remeshOptions, progress(0.0, RemeshingShare));
-    for (const std::string& warning : remeshed.warnings)
+    else if (lightData && lightData->GetNumberOfCells() > 0)
     {
-      vtkWarningMacro(<< "Scene: " << warning);
+      const std::vector<mlr::vtkinputs::LightInput> lights = mlr::vtkinputs::lightInputs(lightData);
+      const mlr::Rgb defaultPower(this->LightPower[0], this->LightPower[1], this->LightPower[2]);
+      const mlr::Vec3 aim(this->AimPoint[0], this->AimPoint[1], this->AimPoint[2]);
+      for (std::size_t i = 0; i < lights.size(); ++i)
+      {
+        std::vector<mlr::PoseInput> inputs = trajectory.lights[i];
+        if (this->AimAtPoint)
+        {
+          for (mlr::PoseInput& in : inputs)
+          {
+            in.hasNormal = true;
+            in.normal = aim - in.position;
+          }
+        }
+        const std::vector<mlr::LightPose> poses =
+          mlr::posesFromInputs(lights[i].polygons, inputs, warnings);
+        rig.areaLights.emplace_back(
+          lights[i].polygons, lights[i].hasPower ? lights[i].power : defaultPower, poses);
+      }
     }
-    const mlr::Scene scene = mlr::Scene::fromPatchMesh(remeshed.mesh);
-    // The solve checks its own estimate; the outputs built from it come on top.
-    mlr::checkSolveMemory(saturatingSum(mlr::estimateSolveMemory(scene, translations.size(), options),
-                            mlr::vtkoutputs::estimateOutputMemory(scene.elementCount(), scene.points().size())),
-      translations.size(), scene.patchCount(), scene.elementCount(), options);
-
-    mlr::Solution solution =
-      mlr::solve(scene, light, options, progress(RemeshingShare, 1.0 - RemeshingShare));
-    solution.statistics.secondsRemeshing = remeshed.statistics.seconds;
-    for (const std::string& warning : solution.warnings)
+    for (const std::string& warning : warnings)
     {
       vtkWarningMacro(<< warning);
     }
 
+    mlr::AnimationOptions options;
+    mlr::SolverOptions& solverOptions = options.solver;
+    solverOptions.pathsPerFrame = static_cast<std::uint64_t>(this->NumberOfPaths);
+    solverOptions.gatheringRatio = this->GatheringRatio;
+    solverOptions.firstBounceSurvival = this->FirstBounceSurvival;
+    solverOptions.reuseShooting = this->ReuseShooting != 0;
+    solverOptions.reuseGathering = this->ReuseGathering != 0;
+    solverOptions.twoSided = this->TwoSided != 0;
+    solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
+    solverOptions.threads = this->NumberOfThreads;
+    solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
+    options.remeshing.targetEdgeLength = this->PatchSize;
+    // The outputs' estimate is linear in the counts; per item, rounded up.
+    constexpr std::size_t many = std::size_t(1) << 20;
+    options.outputBytesPerElement = (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many;
+    options.outputBytesPerPoint = (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
+    mlr::validateOptions(solverOptions);
+
+    mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
+      [this](double fraction) {
+        // Core reports progress on this thread, so the abort flag can be polled right here.
+        this->UpdateProgress(fraction);
+        return !this->CheckAbort();
+      });
+    for (const std::string& warning : animation.warnings)
+    {
+      vtkWarningMacro(<< warning);
+    }
+    const mlr::Scene& scene = animation.scene;
+    mlr::Solution& solution = animation.solution;
+    cache.Rig = std::move(rig);
+
     cache.Shading = mlr::vtkoutputs::smoothShading(scene, solution);
     cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
     cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
-    cache.Patches = mlr::vtkoutputs::patchMesh(scene, remeshed.mesh.points.size());
-    cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, options);
+    cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
+    cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
     cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
     cache.Solution = std::move(solution);
-    cache.TwoSided = options.twoSided;
+    cache.TwoSided = solverOptions.twoSided;
     cache.HasResult = true;
     // A statistic, not a property: it must not change the MTime and invalidate the cache.
     ++this->SolveCount;
@@ -458,6 +531,14 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << this->PathEnd[2] << ")\n";
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
+  os << indent << "LightType: " << (this->LightType == DIRECTIONAL_LIGHT ? "Directional" : "Area")
+     << "\n";
+  os << indent << "SunIrradiance: " << this->SunIrradiance << " W/m^2\n";
+  os << indent << "AimAtPoint: " << (this->AimAtPoint ? "On" : "Off") << "\n";
+  os << indent << "AimPoint: (" << this->AimPoint[0] << ", " << this->AimPoint[1] << ", "
+     << this->AimPoint[2] << ")\n";
+  os << indent << "ReflectanceArrayName: " << this->ReflectanceArrayName << "\n";
+  os << indent << "EmissionArrayName: " << this->EmissionArrayName << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)

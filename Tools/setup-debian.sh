@@ -10,7 +10,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   paraview paraview-dev python3-paraview
-  libcgal-dev libembree-dev libtbb-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
+  libcgal-dev libembree-dev libtbb-dev libgtest-dev libbenchmark-dev libnova-dev nlohmann-json3-dev
   xvfb python3-numpy python3-pytest python3-matplotlib
   libopenmpi-dev libglew-dev libx11-dev libgl-dev
   clang libclang-rt-14-dev

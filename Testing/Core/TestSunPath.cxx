@@ -1,0 +1,129 @@
+// Solar positions against published references, and the sun path's directions and errors.
+#include "CoreChecks.h"
+#include "SunPath.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace mlr;
+using mlr::checks::expectError;
+
+namespace
+{
+/// The Julian day of a UTC calendar time (the proleptic Gregorian calendar, after 1582).
+double julianDay(int year, int month, int day, double hours)
+{
+  const int a = (14 - month) / 12;
+  const int y = year + 4800 - a;
+  const int m = month + 12 * a - 3;
+  const long jdn = day + (153 * m + 2) / 5 + 365L * y + y / 4 - y / 100 + y / 400 - 32045;
+  return static_cast<double>(jdn) - 0.5 + hours / 24.0;
+}
+}
+
+TEST(SunPath, MatchesTheSolarPositionAlgorithmExample)
+{
+  // Reda & Andreas, "Solar Position Algorithm for Solar Radiation Applications" (NREL, 2004),
+  // table A4.1: Golden, Colorado, 2003-10-17 12:30:30 local time (UTC-7): topocentric zenith
+  // 50.11162 degrees (with refraction, about 0.02 degrees at this height), azimuth 194.34024.
+  double azimuth = 0, elevation = 0;
+  sunAzimuthElevation(39.742476, -105.1786, julianDay(2003, 10, 17, 19.5 + 30.0 / 3600), azimuth,
+    elevation);
+  EXPECT_NEAR(elevation, 90 - 50.11162, 0.1);
+  EXPECT_NEAR(azimuth, 194.34024, 0.1);
+}
+
+TEST(SunPath, MatchesTheAlmanacAtJ2000)
+{
+  // At J2000.0 (2000-01-01 12:00 UTC) the Sun's apparent declination is -23.03 degrees and
+  // the equation of time -3.3 minutes (Astronomical Almanac): at the Greenwich observatory
+  // (51.4769 N) the Sun is 0.8 degrees of hour angle before transit, at an elevation of
+  // 90 - 51.4769 - 23.0325 = 15.49 degrees, nearly due south.
+  double azimuth = 0, elevation = 0;
+  sunAzimuthElevation(51.4769, -0.0005, julianDay(2000, 1, 1, 12), azimuth, elevation);
+  EXPECT_NEAR(elevation, 15.49, 0.1);
+  EXPECT_NEAR(azimuth, 179.1, 0.3);
+}
+
+TEST(SunPath, DirectionsFollowNorthAndUp)
+{
+  // Equator at an equinox, local noon at longitude 0: the sun is nearly overhead. With north
+  // +y and up +z, the morning sun is in the east (+x), the evening sun in the west (-x).
+  SunPathRequest r;
+  r.latitude = 0;
+  r.longitude = 0;
+  r.year = 2024;
+  r.month = 3;
+  r.day = 20;
+  r.startHour = 6.5;
+  r.endHour = 17.5;
+  r.stepMinutes = 60;
+  const std::vector<SunPosition> path = sunPath(r);
+  ASSERT_EQ(path.size(), 12u);
+  EXPECT_DOUBLE_EQ(path.front().clockHours, 6.5);
+  EXPECT_DOUBLE_EQ(path.back().clockHours, 17.5);
+  for (const SunPosition& p : path)
+  {
+    EXPECT_NEAR(length(p.direction), 1.0, 1e-12);
+    EXPECT_NEAR(std::asin(p.direction.z) * 180 / M_PI, p.elevationDegrees, 1e-9);
+  }
+  EXPECT_GT(path.front().direction.x, 0.9);
+  EXPECT_LT(path.back().direction.x, -0.9);
+  EXPECT_GT(path[5].elevationDegrees, 80); // 11:30
+  EXPECT_GT(path[6].elevationDegrees, 80); // 12:30
+
+  // A scene whose north is +x and up +y: the morning sun is in the east, -z (x cross y = z
+  // points west... east = north x up).
+  r.north = { 1, 0, 0 };
+  r.up = { 0, 1, 0 };
+  const std::vector<SunPosition> turned = sunPath(r);
+  const Vec3 east = cross(r.north, r.up);
+  EXPECT_GT(dot(turned.front().direction, east), 0.9);
+}
+
+TEST(SunPath, NightFramesAreKeptBelowTheHorizon)
+{
+  SunPathRequest r;
+  r.latitude = 48.85;
+  r.longitude = 2.35;
+  r.year = 2021;
+  r.month = 12;
+  r.day = 21;
+  r.timeZoneHours = 1;
+  r.startHour = 0;
+  r.endHour = 24;
+  r.stepMinutes = 30;
+  const std::vector<SunPosition> path = sunPath(r);
+  ASSERT_EQ(path.size(), 49u);
+  EXPECT_LT(path.front().elevationDegrees, -50); // midnight in Paris in winter
+  EXPECT_LT(path.front().direction.z, 0);
+  double highest = -90;
+  for (const SunPosition& p : path)
+  {
+    highest = std::max(highest, p.elevationDegrees);
+  }
+  // Winter solstice noon: 90 - 48.85 - 23.44 = 17.7 degrees.
+  EXPECT_NEAR(highest, 17.7, 0.3);
+}
+
+TEST(SunPath, BadRequestsSayWhatToFix)
+{
+  SunPathRequest r;
+  r.latitude = 91;
+  expectError([&] { sunPath(r); }, "latitude");
+  r = SunPathRequest();
+  r.month = 2;
+  r.day = 30;
+  expectError([&] { sunPath(r); }, "does not exist");
+  r = SunPathRequest();
+  r.startHour = 18;
+  r.endHour = 6;
+  expectError([&] { sunPath(r); }, "end time is not after the start");
+  r = SunPathRequest();
+  r.stepMinutes = 0;
+  expectError([&] { sunPath(r); }, "step");
+  r = SunPathRequest();
+  r.north = { 0, 0, 1 };
+  expectError([&] { sunPath(r); }, "north");
+}
