@@ -144,7 +144,7 @@ double fieldValue(vtkDataObject* data, const char* name)
                                                  : std::numeric_limits<double>::quiet_NaN();
 }
 
-double triangleArea(vtkPolyData* mesh, vtkIdType cell)
+Vec3 triangleAreaVector(vtkPolyData* mesh, vtkIdType cell)
 {
   vtkIdType count = 0;
   const vtkIdType* ids = nullptr;
@@ -153,8 +153,12 @@ double triangleArea(vtkPolyData* mesh, vtkIdType cell)
   mesh->GetPoint(ids[0], a);
   mesh->GetPoint(ids[1], b);
   mesh->GetPoint(ids[2], c);
-  const Vec3 n = triangleAreaVector({ a[0], a[1], a[2] }, { b[0], b[1], b[2] }, { c[0], c[1], c[2] });
-  return 0.5 * length(n);
+  return mlr::triangleAreaVector({ a[0], a[1], a[2] }, { b[0], b[1], b[2] }, { c[0], c[1], c[2] });
+}
+
+double triangleArea(vtkPolyData* mesh, vtkIdType cell)
+{
+  return 0.5 * length(triangleAreaVector(mesh, cell));
 }
 
 void MessageRecorder::Execute(vtkObject*, unsigned long event, void* data)

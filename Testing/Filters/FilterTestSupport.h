@@ -46,6 +46,9 @@ std::vector<double> timeSteps(vtkAlgorithm* algorithm);
 /// The first value of the field data array `name`, or NaN when it is missing.
 double fieldValue(vtkDataObject* data, const char* name);
 
+/// Twice the area times the unit normal (right-hand rule) of cell `cell` of a triangle mesh.
+Vec3 triangleAreaVector(vtkPolyData* mesh, vtkIdType cell);
+
 /// Area of cell `cell` of a triangle mesh.
 double triangleArea(vtkPolyData* mesh, vtkIdType cell);
 

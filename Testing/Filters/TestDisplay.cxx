@@ -56,15 +56,7 @@ double luminance(const double rgb[3])
 
 Vec3 cellNormal(vtkPolyData* mesh, vtkIdType cell)
 {
-  vtkIdType count = 0;
-  const vtkIdType* ids = nullptr;
-  mesh->GetCellPoints(cell, count, ids);
-  double a[3], b[3], c[3];
-  mesh->GetPoint(ids[0], a);
-  mesh->GetPoint(ids[1], b);
-  mesh->GetPoint(ids[2], c);
-  return normalize(
-    triangleAreaVector({ a[0], a[1], a[2] }, { b[0], b[1], b[2] }, { c[0], c[1], c[2] }));
+  return normalize(triangleAreaVector(mesh, cell));
 }
 
 /// The cells around each point.
