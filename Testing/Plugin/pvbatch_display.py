@@ -9,8 +9,10 @@
 - Exposure +1 doubles the value before the tone map on the floor (a flat region), without a
   new solve;
 - Path Start and Path End sit in a property group shown by ParaView's interactive line
-  widget, start from the scene's bounds, and moving their end points (what dragging the
-  widget's handles writes) solves again along the new path.
+  widget and start from the scene's bounds; ParaView's line widget proxy, linked to them as
+  the Properties panel links it, moves their end points, and after Apply the filter solves
+  again along the new path. The mouse drag itself is not simulated: it ends in the widget's
+  end-point properties, which the test sets.
 
     pvbatch --force-offscreen-rendering pvbatch_display.py --plugin MovingLightRadiosity.so"""
 import numpy
@@ -148,26 +150,22 @@ if check(usable.sum() > 10, f"only {usable.sum()} floor cells have mid-range col
 radiosity.Exposure = 0.0
 
 # --- The path widget ------------------------------------------------------------------------
-group = None
-for index in range(proxy.GetNumberOfPropertyGroups()):
-    candidate = proxy.GetPropertyGroup(index)
-    if candidate.GetPanelWidget() == "InteractiveLine":
-        group = candidate
+def line_widget_group(source):
+    found = None
+    for index in range(source.GetNumberOfPropertyGroups()):
+        candidate = source.GetPropertyGroup(index)
+        if candidate.GetPanelWidget() == "InteractiveLine":
+            found = candidate
+    return found
+
+
+group = line_widget_group(proxy)
 if check(group is not None, "no property group with panel_widget=\"InteractiveLine\""):
-    roles = {function: group.GetProperty(function) for function in
-             ("Point1WorldPosition", "Point2WorldPosition", "Input")}
-    check(roles["Point1WorldPosition"] is proxy.GetProperty("PathStart") or
-          (roles["Point1WorldPosition"] and roles["Point1WorldPosition"].GetXMLName() == "PathStart"),
-          "the line widget's first point is not PathStart")
-    check(roles["Point2WorldPosition"] is not None and
-          roles["Point2WorldPosition"].GetXMLName() == "PathEnd",
-          "the line widget's second point is not PathEnd")
-    check(roles["Input"] is not None and roles["Input"].GetXMLName() == "Scene",
-          "the line widget does not take its bounds from the Scene")
-    # ParaView's own line widget proxy accepts the two ends.
-    widget = servermanager.rendering.LineWidgetRepresentation()
-    widget.Point1WorldPosition = list(radiosity.PathStart)
-    widget.Point2WorldPosition = list(radiosity.PathEnd)
+    for function, name in (("Point1WorldPosition", "PathStart"), ("Point2WorldPosition", "PathEnd"),
+                           ("Input", "Scene")):
+        prop = group.GetProperty(function)
+        check(prop is not None and prop is proxy.GetProperty(name),
+              f"the line widget's {function} is not the property {name}")
 
 # Defaults from the scene's bounds: a Box of 1 centred on the origin, no Trajectory.
 box = Box()
@@ -177,12 +175,32 @@ straight = MovingLightRadiosity(Scene=box, Light=sources["light"], NumberOfPaths
 check(numpy.allclose(straight.PathStart, [-0.5, 0, 0]) and numpy.allclose(straight.PathEnd, [0.5, 0, 0]),
       f"the straight path starts {list(straight.PathStart)} and ends {list(straight.PathEnd)}, "
       "expected the middles of the box's -x and +x faces")
-
-# Dragging the ends writes PathStart and PathEnd: the next update solves along the new path.
 straight.UpdatePipeline(0.0)
 first = servermanager.Fetch(straight)
+
+# Drag the ends as the Properties panel's line widget does: ParaView's LineWidgetRepresentation
+# linked to the property group (pqInteractivePropertyWidget::setupConnections), its end points
+# moved (a drag ends in those properties), then Apply (the unchecked values become the values).
+from paraview.modules.vtkRemotingServerManager import vtkSMParaViewPipelineController  # noqa: E402
+
+widget = servermanager.rendering.LineWidgetRepresentation()
+vtkSMParaViewPipelineController().InitializeProxy(widget.SMProxy)
+straight_group = line_widget_group(straight.SMProxy)
+check(widget.SMProxy.LinkProperties(straight.SMProxy, straight_group),
+      "the line widget does not link to the path's properties")
+check(numpy.allclose(widget.Point1WorldPosition, straight.PathStart) and
+      numpy.allclose(widget.Point2WorldPosition, straight.PathEnd),
+      f"the line widget shows {list(widget.Point1WorldPosition)} - {list(widget.Point2WorldPosition)}, "
+      f"not the path {list(straight.PathStart)} - {list(straight.PathEnd)}")
 start, end = [-0.3, -0.2, support.LIGHT_Z], [0.25, 0.3, support.LIGHT_Z]
-straight.PathStart, straight.PathEnd = start, end
+widget.Point1WorldPosition, widget.Point2WorldPosition = start, end
+for name in ("PathStart", "PathEnd"):
+    prop = straight.SMProxy.GetProperty(name)
+    pending = [prop.GetUncheckedElement(i) for i in range(3)]
+    check(numpy.allclose(pending, start if name == "PathStart" else end),
+          f"dragging the widget left {name} pending at {pending}")
+    prop.SetElements(pending)  # Apply
+straight.SMProxy.UpdateVTKObjects()
 for time, expected in ((0.0, start), (3.0, end)):
     straight.UpdatePipeline(time)
     moved = servermanager.Fetch(straight)
