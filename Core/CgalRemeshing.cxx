@@ -385,6 +385,12 @@ Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
     }
     s.of[i] = surface;
   }
+  return s;
+}
+
+/// Fills in the edges of `s` and which of its surfaces are closed.
+void findEdges(const RepairedSoup& soup, Surfaces& s, CancellationPoll& poll)
+{
   s.closed.assign(s.count, true);
   s.edges.reserve(3 * soup.triangles.size());
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
@@ -413,7 +419,6 @@ Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
     }
     i = j;
   }
-  return s;
 }
 
 using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
@@ -422,14 +427,38 @@ using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::si
 /// (box_intersection_d), then CGAL's exact triangle-triangle predicate.
 std::vector<bool> touchingTriangles(const RepairedSoup& soup, const Surfaces& surfaces, CancellationPoll& poll)
 {
+  std::vector<bool> touching(soup.triangles.size(), false);
+  if (surfaces.count < 2)
+  {
+    return touching;
+  }
   std::vector<TriangleBox> boxes;
   boxes.reserve(soup.triangles.size());
+  std::vector<CGAL::Bbox_3> surfaceBox(surfaces.count);
+  std::vector<bool> started(surfaces.count, false);
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
     const CgalTriangle& t = soup.triangles[i];
     boxes.emplace_back(soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox(), i);
+    const std::size_t s = surfaces.of[i];
+    surfaceBox[s] = started[s] ? surfaceBox[s] + boxes.back().bbox() : boxes.back().bbox();
+    started[s] = true;
   }
-  std::vector<bool> touching(soup.triangles.size(), false);
+  // Only triangles within the box of another surface can touch it: on most scenes this
+  // leaves a small fraction, and none on a single surface however large.
+  std::vector<TriangleBox> surfaceBoxes;
+  for (std::size_t s = 0; s < surfaces.count; ++s)
+  {
+    surfaceBoxes.emplace_back(surfaceBox[s], s);
+  }
+  std::vector<bool> candidate(soup.triangles.size(), false);
+  CGAL::box_intersection_d(boxes.begin(), boxes.end(), surfaceBoxes.begin(), surfaceBoxes.end(),
+    [&](const TriangleBox& triangle, const TriangleBox& surface) {
+      poll.tick();
+      candidate[triangle.info()] = candidate[triangle.info()] || surfaces.of[triangle.info()] != surface.info();
+    });
+  boxes.erase(std::remove_if(boxes.begin(), boxes.end(), [&](const TriangleBox& b) { return !candidate[b.info()]; }),
+    boxes.end());
   CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const TriangleBox& a, const TriangleBox& b) {
     poll.tick();
     const std::size_t i = a.info(), j = b.info();
@@ -594,13 +623,19 @@ std::vector<std::size_t> refinementSet(const Surfaces& surfaces, const std::vect
  * Splits the soup along the lines where triangles of different surfaces touch or cross, and
  * drops the pieces lying face to face on closed surfaces. Only the triangles near a contact go through
  * CGAL's autorefinement (it takes seconds on 200,000 triangles); the rest are kept as they
- * are. Leaves the soup unchanged when nothing touches. CGAL may throw: the caller guards this.
+ * are. Returns false, leaving the soup unchanged, when nothing touches. CGAL may throw: the
+ * caller guards this.
  */
-void splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, CgalRemeshOutput& out,
+bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, CgalRemeshOutput& out,
   CancellationPoll& poll)
 {
-  const Surfaces surfaces = findSurfaces(soup, poll);
+  Surfaces surfaces = findSurfaces(soup, poll);
   const std::vector<bool> touching = touchingTriangles(soup, surfaces, poll);
+  if (std::find(touching.begin(), touching.end(), true) == touching.end())
+  {
+    return false; // nothing touches, so nothing lies on a closed surface either
+  }
+  findEdges(soup, surfaces, poll);
   const std::vector<std::size_t> set = refinementSet(surfaces, touching);
   std::vector<bool> inSet(soup.triangles.size(), false);
   for (std::size_t i : set)
@@ -767,7 +802,7 @@ void splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   }
   if (out.coveredTriangles == 0 && split.contactEdges.empty() && mesh.number_of_faces() == set.size())
   {
-    return; // nothing touches, nothing is covered: keep the soup as it is
+    return false; // touching at points or edges the surfaces already have
   }
   keepTriangles(split, keepTriangle);
   out.contactEdges = split.contactEdges.size();
@@ -787,6 +822,7 @@ void splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     }
   }
   soup = std::move(split);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -926,6 +962,17 @@ ComponentLayout layOutComponent(Mesh& mesh, const RepairedSoup& soup, const Tria
   ComponentLayout layout;
   layout.constrained = markConstrainedEdges(mesh, soup, input, faces, pointOfVertex, sharpEdgeAngle);
   layout.corner = markCorners(mesh, layout.constrained);
+  // Contact lines keep every point: both surfaces along a line keep the same polyline, so
+  // remeshing opens no crack between them, and a curved line is not cut short.
+  for (EdgeIndex e : mesh.edges())
+  {
+    const std::size_t p = pointOfVertex[mesh.vertex(e, 0)], q = pointOfVertex[mesh.vertex(e, 1)];
+    if (std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(), std::make_pair(std::min(p, q), std::max(p, q))))
+    {
+      layout.corner[mesh.vertex(e, 0)] = true;
+      layout.corner[mesh.vertex(e, 1)] = true;
+    }
+  }
   layout.region = mesh.add_property_map<FaceIndex, std::size_t>("f:region", 0).first;
   const std::size_t count = PMP::connected_components(
     mesh, layout.region, CGAL::parameters::edge_is_constrained_map(layout.constrained));
@@ -1297,17 +1344,20 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
     CgalRemeshOutput counts;
     std::string failure;
     bool ok = false;
+    bool changed = false;
+    const auto start = std::chrono::steady_clock::now();
     try
     {
-      ok = guarded([&] { splitAtContacts(split, settings, counts, poll); }, failure);
+      ok = guarded([&] { changed = splitAtContacts(split, settings, counts, poll); }, failure);
     }
     catch (const OverLimit& e)
     {
       throw Error(e.message);
     }
     std::vector<std::vector<std::size_t>> splitComponents;
-    ok = ok && guarded([&] { splitComponents = connectedComponents(split); }, failure);
-    if (ok)
+    ok = ok && (!changed || guarded([&] { splitComponents = connectedComponents(split); }, failure));
+    out.contactSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (ok && changed)
     {
       soup = std::move(split);
       components = std::move(splitComponents);
@@ -1317,7 +1367,7 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
       out.coveredArea = counts.coveredArea;
       out.splitPoints += counts.splitPoints;
     }
-    else
+    else if (!ok)
     {
       out.warnings.push_back("surfaces were not split where they touch or cross (" + failure +
         "): patches may straddle contact lines, where light and shadow then leak");

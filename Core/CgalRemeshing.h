@@ -41,6 +41,7 @@ struct CgalRemeshOutput
   std::size_t contactEdges = 0;          ///< edges of the contact lines, once split
   std::size_t coveredTriangles = 0;      ///< pieces dropped, face to face on a closed surface
   double coveredArea = 0;
+  double contactSeconds = 0;             ///< finding contacts, splitting, dropping covered
   std::vector<std::string> warnings;
 };
 

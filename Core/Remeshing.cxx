@@ -459,6 +459,7 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     result.statistics.contactSplitTriangles = cgal.contactSplitTriangles;
     result.statistics.coveredTriangles = cgal.coveredTriangles;
     result.statistics.coveredArea = cgal.coveredArea;
+    result.statistics.secondsContacts = cgal.contactSeconds;
     result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
     refineOnly(cgal.refinePoints, cgal.refineOnly, refined, materials, h, progress, CgalShare, result.mesh);
   }

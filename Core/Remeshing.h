@@ -80,6 +80,7 @@ struct RemeshStatistics
   double inputArea = 0;  ///< of the triangulated polygons that were kept
   double outputArea = 0; ///< of the patches
   double seconds = 0;    ///< wall-clock time of remesh(); callers copy it to secondsRemeshing
+  double secondsContacts = 0; ///< of which finding contacts, splitting and dropping covered pieces
 };
 
 struct RemeshResult
