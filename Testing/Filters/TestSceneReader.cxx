@@ -33,14 +33,22 @@ namespace
 namespace fs = std::filesystem;
 constexpr double Pi = 3.14159265358979323846;
 
-/// A fresh folder for one test's files.
-fs::path testFolder(const std::string& name)
+/// A fresh folder for one test's files, removed with them at the end of the test.
+struct TestFolder
 {
-  const fs::path folder = fs::temp_directory_path() / ("mlr-scene-reader-" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
+  explicit TestFolder(const std::string& name)
+    : path(fs::temp_directory_path() / ("mlr-scene-reader-" + name))
+  {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TestFolder()
+  {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+  const fs::path path;
+};
 
 void writeFile(const fs::path& path, const std::string& text)
 {
@@ -244,7 +252,8 @@ std::string twoMaterialObj(const std::string& mtllib)
 
 TEST(SceneReader, ObjMaterialsGiveReflectanceEmissionAndIds)
 {
-  const fs::path folder = testFolder("obj");
+  const TestFolder scratch("obj");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "room.mtl", R"(# two reflectors, a lamp and a glowing panel
 newmtl white
 Kd 0.725 0.71 0.68
@@ -319,7 +328,8 @@ f 4 3 2
 
 TEST(SceneReader, ReflectanceOfOneIsClampedWithAWarningNamingTheMaterial)
 {
-  const fs::path folder = testFolder("clamp");
+  const TestFolder scratch("clamp");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "scene.mtl", "newmtl paper\nKd 1 1 1\nnewmtl red\nKd 0.63 0.065 0.05\n");
   writeFile(folder / "scene.obj",
     "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paper\nf 1 2 3\nusemtl red\nf 1 3 2\n");
@@ -334,7 +344,8 @@ TEST(SceneReader, ReflectanceOfOneIsClampedWithAWarningNamingTheMaterial)
 
 TEST(SceneReader, MissingMtlFallsBackToGreyWithAWarningNamingTheFile)
 {
-  const fs::path folder = testFolder("missing-mtl");
+  const TestFolder scratch("missing-mtl");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "scene.obj", twoMaterialObj("absent.mtl"));
   const ReadResult result = readScene(folder / "scene.obj");
   ASSERT_TRUE(result.succeeded) << result.errors();
@@ -352,7 +363,8 @@ TEST(SceneReader, MissingMtlFallsBackToGreyWithAWarningNamingTheFile)
 
 TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
 {
-  const fs::path folder = testFolder("undefined-material");
+  const TestFolder scratch("undefined-material");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "scene.mtl", "newmtl white\nKd 0.725 0.71 0.68\n");
   writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
   const ReadResult result = readScene(folder / "scene.obj");
@@ -366,7 +378,8 @@ TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
 
 TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
 {
-  const fs::path folder = testFolder("formats");
+  const TestFolder scratch("formats");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "scene.mtl",
     "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
   writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
@@ -445,7 +458,8 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
 
 TEST(SceneReader, GltfNodeTransformsAndEmission)
 {
-  const fs::path folder = testFolder("gltf-emission");
+  const TestFolder scratch("gltf-emission");
+  const fs::path& folder = scratch.path;
   // The red material emits (1, 0.5, 0.25) x strength 4 as radiance, like Ke 4 2 1.
   std::string json = gltfJson(dataUri(gltfBuffer()), "", "[1, 2, 3]");
   const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
@@ -500,7 +514,8 @@ double srgbToLinear(double value)
 
 TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
 {
-  const fs::path folder = testFolder("gltf-texture");
+  const TestFolder scratch("gltf-texture");
+  const fs::path& folder = scratch.path;
   // Half the texels white, half black in red and blue; green 128 everywhere (sRGB, so 0.2159
   // in linear light). The factor multiplies the mean.
   const std::string png = pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
@@ -537,7 +552,8 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
 
 TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
 {
-  const fs::path folder = testFolder("gltf-modes");
+  const TestFolder scratch("gltf-modes");
+  const fs::path& folder = scratch.path;
   // VTK 9.2's vtkGLTFDocumentLoader aborts on a material without pbrMetallicRoughness; glTF's
   // default for it is white, which is clamped with a warning. Strips and fans make triangles.
   std::string json = gltfJson(dataUri(gltfBuffer()));
@@ -558,7 +574,8 @@ TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
 
 TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
 {
-  const fs::path folder = testFolder("gltf-colours");
+  const TestFolder scratch("gltf-colours");
+  const fs::path& folder = scratch.path;
   // COLOR_0 (normalized 8-bit RGBA, linear) on the floor's primitive: every floor vertex
   // (255, 128, 0), so its cells reflect White x (1, 128/255, 0); the wall keeps its factor.
   std::string buffer = gltfBuffer();
@@ -584,7 +601,8 @@ TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
 
 TEST(SceneReader, AbortGivesAnEmptyOutputAndTheNextUpdateReads)
 {
-  const fs::path folder = testFolder("abort");
+  const TestFolder scratch("abort");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "scene.obj", twoMaterialObj(""));
   auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
   reader->SetFileName((folder / "scene.obj").string().c_str());
@@ -610,7 +628,8 @@ struct BadFile
 
 TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
 {
-  const fs::path folder = testFolder("bad");
+  const TestFolder scratch("bad");
+  const fs::path& folder = scratch.path;
   const std::string buffer = gltfBuffer();
   std::string lines = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 1);
   std::string points = gltfJson(dataUri(buffer), "", "[0, 0, 0]", 0);
@@ -671,7 +690,8 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
 
 TEST(SceneReader, MissingFileAndNoFileNameAreErrors)
 {
-  const fs::path folder = testFolder("missing");
+  const TestFolder scratch("missing");
+  const fs::path& folder = scratch.path;
   const ReadResult missing = readScene(folder / "nowhere.obj");
   EXPECT_FALSE(missing.succeeded);
   EXPECT_NE(missing.errors().find("nowhere.obj' does not exist"), std::string::npos) << missing.errors();
@@ -690,7 +710,8 @@ TEST(SceneReader, MissingFileAndNoFileNameAreErrors)
 
 TEST(SceneReader, ABadFileAfterAGoodOneLeavesNoStaleOutput)
 {
-  const fs::path folder = testFolder("stale");
+  const TestFolder scratch("stale");
+  const fs::path& folder = scratch.path;
   writeFile(folder / "good.obj", twoMaterialObj(""));
   writeFile(folder / "bad.obj", "v 0 0 0\nf 1 2 3\n");
   auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();

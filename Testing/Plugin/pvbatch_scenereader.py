@@ -11,6 +11,7 @@
     pvbatch --force-offscreen-rendering pvbatch_scenereader.py --plugin MovingLightRadiosity.so"""
 import math
 import os
+import shutil
 import tempfile
 
 import plugin_test_support as support
@@ -101,4 +102,6 @@ missing = RadiositySceneReader(FileName=os.path.join(folder, "nowhere.obj"))  # 
 missing.UpdatePipeline()
 check(servermanager.Fetch(missing).GetNumberOfCells() == 0, "a missing file gave cells")
 
+Delete(missing)  # noqa: F405
+shutil.rmtree(folder, ignore_errors=True)
 checks.finish()
