@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace mlr::cli
 {
@@ -73,6 +74,59 @@ Triple parseTriple(const std::string& option, const std::string& text)
   return values;
 }
 
+/// HH:MM (00:00 to 24:00) as hours.
+double parseClock(const std::string& option, const std::string& text)
+{
+  int hours = -1, minutes = -1;
+  char colon = 0;
+  std::istringstream in(text);
+  in >> hours >> colon >> minutes;
+  if (!in || colon != ':' || in.peek() != std::char_traits<char>::eof() || hours < 0 ||
+    minutes < 0 || minutes > 59 || hours > 24 || (hours == 24 && minutes > 0) || text.size() > 5)
+  {
+    throw UsageError(option + " has the time '" + text + "': give HH:MM from 00:00 to 24:00");
+  }
+  return hours + minutes / 60.0;
+}
+
+SunPathSpec parseSunPath(const std::string& option, const std::string& text)
+{
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  for (;;)
+  {
+    const std::size_t comma = text.find(',', start);
+    fields.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos)
+    {
+      break;
+    }
+    start = comma + 1;
+  }
+  if (fields.size() != 6)
+  {
+    throw UsageError(option + " is '" + text +
+      "': give LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES (e.g. 48.85,2.35,2024-06-21,06:00,21:00,15)");
+  }
+  SunPathSpec spec;
+  spec.latitude = parseNumber(option + " (latitude)", fields[0]);
+  spec.longitude = parseNumber(option + " (longitude)", fields[1]);
+  {
+    char dash1 = 0, dash2 = 0;
+    std::istringstream in(fields[2]);
+    in >> spec.year >> dash1 >> spec.month >> dash2 >> spec.day;
+    if (!in || dash1 != '-' || dash2 != '-' || in.peek() != std::char_traits<char>::eof() ||
+      fields[2].size() != 10)
+    {
+      throw UsageError(option + " has the date '" + fields[2] + "': give YYYY-MM-DD");
+    }
+  }
+  spec.startHour = parseClock(option, fields[3]);
+  spec.endHour = parseClock(option, fields[4]);
+  spec.stepMinutes = parseNumber(option + " (minutes between frames)", fields[5]);
+  return spec;
+}
+
 struct OptionSpec
 {
   const char* value; ///< what to give, for messages
@@ -92,6 +146,22 @@ const std::map<std::string, OptionSpec>& optionSpecs()
       { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.to = parseTriple(n, v); } } },
     { "--frames",
       { "N", [](Options& o, const auto& n, const auto& v) { o.frames = parseInteger(n, v); } } },
+    { "--aim",
+      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.aim = parseTriple(n, v); } } },
+    { "--sun-directions",
+      { "FILE", [](Options& o, const auto&, const auto& v) { o.sunDirections = v; } } },
+    { "--sun-path",
+      { "LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES",
+        [](Options& o, const auto& n, const auto& v) { o.sunPath = parseSunPath(n, v); } } },
+    { "--sun-irradiance",
+      { "W/m2",
+        [](Options& o, const auto& n, const auto& v) { o.sunIrradiance = parseNumber(n, v); } } },
+    { "--time-zone",
+      { "HOURS", [](Options& o, const auto& n, const auto& v) { o.timeZone = parseNumber(n, v); } } },
+    { "--north",
+      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.north = parseTriple(n, v); } } },
+    { "--up",
+      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.up = parseTriple(n, v); } } },
     { "--light-power",
       { "R,G,B",
         [](Options& o, const auto& n, const auto& v) {
@@ -215,6 +285,35 @@ Options parseCommandLine(int argc, const char* const* argv)
     return o;
   }
 
+  if (!o.sunDirections.empty() && o.sunPath)
+  {
+    throw UsageError("give either --sun-directions FILE or --sun-path ..., not both");
+  }
+  if (o.usesSun())
+  {
+    if (!o.light.empty() || !o.trajectory.empty() || o.from || o.to || o.aim || o.lightPower)
+    {
+      throw UsageError("the sun replaces the light: --sun-directions and --sun-path go without "
+                       "--light, --trajectory, --from/--to, --aim and --light-power");
+    }
+    if (o.usesEmbeddedScene())
+    {
+      throw UsageError("the sun needs --scene FILE: the built-in Cornell box is closed");
+    }
+  }
+  else if (o.sunIrradiance)
+  {
+    throw UsageError("--sun-irradiance needs --sun-directions FILE or --sun-path ...");
+  }
+  if (!o.sunPath && (o.timeZone || o.north || o.up))
+  {
+    throw UsageError("--time-zone, --north and --up need --sun-path ...");
+  }
+  if (o.sunIrradiance && !(*o.sunIrradiance > 0))
+  {
+    throw UsageError("--sun-irradiance is " + std::to_string(*o.sunIrradiance) +
+      ": give the irradiance on a surface facing the sun in W/m^2, above 0 (1000 by default)");
+  }
   if (!o.trajectory.empty() && (o.from || o.to))
   {
     throw UsageError("give either --trajectory FILE or --from X,Y,Z --to X,Y,Z, not both");
@@ -231,7 +330,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     o.frames = 30;
   }
-  if (!o.usesEmbeddedScene())
+  if (!o.usesEmbeddedScene() && !o.usesSun())
   {
     if (o.light.empty())
     {
@@ -263,6 +362,16 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
       checkRange("--light-power", p, 0.0, 1e30);
     }
     filter->SetLightPower(o.lightPower->data());
+  }
+  if (o.aim)
+  {
+    filter->SetAimAtPoint(true);
+    filter->SetAimPoint(o.aim->data());
+  }
+  if (o.usesSun())
+  {
+    filter->SetLightTypeToDirectional();
+    filter->SetSunIrradiance(o.sunIrradiance.value_or(1000.0));
   }
   if (o.paths)
   {
@@ -327,7 +436,7 @@ std::string helpText()
 Computes the radiosity of a scene lit by a light that moves along a path, all light
 positions at once with reuse of paths, and writes the animation as a .pvd + .vtu series
 (one unstructured grid per frame with the cell arrays Radiosity, DirectRadiosity,
-IndirectRadiosity, RadiosityFront/RadiosityBack, Reflectance and PatchId).
+IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Reflectance and PatchId).
 
 Without any option it runs the built-in example: the Cornell box with its ceiling light
 moving through 30 positions along a diagonal just below the ceiling, and writes
@@ -342,11 +451,33 @@ Scene and light:
                         --scene; default: the Cornell box's ceiling light)
   --light-power R,G,B   total power of the light in W, per channel, or one number for all
                         (default 100,100,100)
+                        A cell array LightId groups the polygons into several lights, and
+                        a cell array LightPower (RGB, W) gives each its power.
+                        Scene cells with a cell array Emission (RGB or grey, W/m^2) emit
+                        from their front side in every frame, and reflect too.
 Light path (the positions of the light's area centroid, one per frame):
-  --trajectory FILE     the points of a .vtp .vtu .vtk .obj .ply .stl file, in order; a
-                        point array Time gives the frame times (else 0, 1, 2, ...)
+  --trajectory FILE     the points of a .vtp .vtu .vtk .obj .ply .stl file, in order (with
+                        several lights: one polyline per light in LightId order; one point
+                        for a light that does not move). Point arrays: Time (frame times,
+                        else 0, 1, 2, ...), Normal (the light's emission direction in that
+                        frame), Orientation (quaternion w,x,y,z, wins over Normal), Power
+                        (a factor on the light's power in that frame; 0 is off)
   --from X,Y,Z --to X,Y,Z [--frames N]
                         a straight path in N frames (default 30)
+  --aim X,Y,Z           in every frame, turn the light to face this point
+The sun (a directional light, instead of --light; needs --scene):
+  --sun-directions FILE the points of a file are directions towards the sun, one per frame
+                        (any length but 0); point arrays Time and Power as above
+  --sun-path LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES
+                        the sun seen from latitude LAT, longitude LON (degrees, north and
+                        east positive) on that day, from the first clock time to the
+                        second every MINUTES (solar positions from libnova); frames with
+                        the sun below the horizon are kept, dark, and the series' times
+                        are the clock times in hours
+  --time-zone HOURS     the clock times' offset from UTC (default 0: UTC; e.g. 2 for CEST)
+  --north X,Y,Z         the scene's north (default 0,1,0)
+  --up X,Y,Z            the scene's zenith (default 0,0,1)
+  --sun-irradiance W/m2 on a surface facing the sun (default 1000)
 Solver:
   --paths N             effective shooting paths per frame (default 600000)
   --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)

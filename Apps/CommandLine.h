@@ -20,6 +20,15 @@ public:
 
 using Triple = std::array<double, 3>;
 
+/// --sun-path LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES as given (checked by Core's sunPath).
+struct SunPathSpec
+{
+  double latitude = 0, longitude = 0;
+  int year = 0, month = 0, day = 0;
+  double startHour = 0, endHour = 0; ///< local clock time, hours
+  double stepMinutes = 0;
+};
+
 /// What the command line asked for. Unset optionals keep the filter's defaults.
 struct Options
 {
@@ -32,6 +41,15 @@ struct Options
   std::string trajectory;
   std::optional<Triple> from, to;
   std::optional<long long> frames;
+
+  std::optional<Triple> aim; ///< every frame, the light faces this point
+
+  /// The sun (a directional light) instead of --light: directions from a file, or computed.
+  std::string sunDirections;
+  std::optional<SunPathSpec> sunPath;
+  std::optional<double> sunIrradiance; ///< W/m^2
+  std::optional<double> timeZone;      ///< hours from UTC of the clock times of --sun-path
+  std::optional<Triple> north, up;     ///< the scene's north and zenith for --sun-path
 
   std::optional<Triple> lightPower;
   std::optional<long long> paths;
@@ -48,6 +66,7 @@ struct Options
   std::string png;    ///< DIR, or empty for no pictures
 
   bool usesEmbeddedScene() const { return this->scene.empty(); }
+  bool usesSun() const { return !this->sunDirections.empty() || this->sunPath.has_value(); }
 };
 
 /// Parses argv, fills the defaults that depend on other options and checks the combinations.

@@ -21,6 +21,7 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkSunPathSource.h"
 
 #include <atomic>
 #include <cerrno>
@@ -189,6 +190,44 @@ void tripleOf(vtkFieldData* data, const char* name, double out[3])
   }
 }
 
+/// The sun's directions over the day of --sun-path, with the clock times as Time.
+vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
+{
+  const SunPathSpec& spec = *options.sunPath;
+  vtkNew<vtkSunPathSource> source;
+  source->SetLatitude(spec.latitude);
+  source->SetLongitude(spec.longitude);
+  source->SetYear(spec.year);
+  source->SetMonth(spec.month);
+  source->SetDay(spec.day);
+  source->SetStartTime(spec.startHour);
+  source->SetEndTime(spec.endHour);
+  source->SetStepMinutes(spec.stepMinutes);
+  source->SetTimeZone(options.timeZone.value_or(0.0));
+  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
+  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
+  source->SetNorth(north.data());
+  source->SetUp(up.data());
+  std::string error;
+  vtkNew<vtkCallbackCommand> onError;
+  onError->SetClientData(&error);
+  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message) {
+    *static_cast<std::string*>(into) = static_cast<const char*>(message);
+  });
+  source->AddObserver(vtkCommand::ErrorEvent, onError);
+  source->Update();
+  if (!error.empty())
+  {
+    // The source's message ends with what to fix; drop VTK's location prefix.
+    const std::size_t colon = error.find("): ");
+    std::string reason = colon == std::string::npos ? error : error.substr(colon + 3);
+    reason.erase(reason.find_last_not_of(" \n") + 1);
+    throw UsageError("--sun-path: " + reason);
+  }
+  vtkSmartPointer<vtkPolyData> path = source->GetOutput();
+  return path;
+}
+
 int run(int argc, char** argv)
 {
   const Options options = parseCommandLine(argc, argv);
@@ -210,10 +249,22 @@ int run(int argc, char** argv)
   const auto scene = options.usesEmbeddedScene()
     ? readEmbeddedFile("cornell_box.vtp")
     : readSurfaceFile(options.scene, "scene", memoryLimit);
-  const auto light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
-                                           : readSurfaceFile(options.light, "light", memoryLimit);
+  vtkSmartPointer<vtkPolyData> light;
+  if (!options.usesSun())
+  {
+    light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
+                                  : readSurfaceFile(options.light, "light", memoryLimit);
+  }
   vtkSmartPointer<vtkPolyData> trajectory;
-  if (!options.trajectory.empty())
+  if (options.sunPath)
+  {
+    trajectory = sunPathTrajectory(options);
+  }
+  else if (!options.sunDirections.empty())
+  {
+    trajectory = readSurfaceFile(options.sunDirections, "sun directions", memoryLimit);
+  }
+  else if (!options.trajectory.empty())
   {
     trajectory = readSurfaceFile(options.trajectory, "trajectory", memoryLimit);
   }
@@ -222,7 +273,10 @@ int run(int argc, char** argv)
     trajectory = readEmbeddedFile("cornell_trajectory.vtp");
   }
   filter->SetInputData(vtkMovingLightRadiosity::SCENE_PORT, scene);
-  filter->SetInputData(vtkMovingLightRadiosity::LIGHT_PORT, light);
+  if (light)
+  {
+    filter->SetInputData(vtkMovingLightRadiosity::LIGHT_PORT, light);
+  }
   if (trajectory)
   {
     filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectory);
