@@ -24,9 +24,12 @@ namespace mlr::vtkoutputs
 
 namespace
 {
-vtkSmartPointer<vtkFloatArray> rgbArray(const char* name, std::size_t tuples)
+/// A named 3-component array with components R, G, B: floats for physical values, unsigned
+/// chars for display colours.
+template <typename ArrayType = vtkFloatArray>
+vtkSmartPointer<ArrayType> rgbArray(const char* name, std::size_t tuples)
 {
-  auto array = vtkSmartPointer<vtkFloatArray>::New();
+  auto array = vtkSmartPointer<ArrayType>::New();
   array->SetName(name);
   array->SetNumberOfComponents(3);
   array->SetComponentName(0, "R");
@@ -474,18 +477,6 @@ vtkSmartPointer<vtkPolyData> smoothElementMesh(const Scene& scene, const SmoothS
 
 namespace
 {
-vtkSmartPointer<vtkUnsignedCharArray> colorArray(std::size_t tuples)
-{
-  auto array = vtkSmartPointer<vtkUnsignedCharArray>::New();
-  array->SetName("Color");
-  array->SetNumberOfComponents(3);
-  array->SetComponentName(0, "R");
-  array->SetComponentName(1, "G");
-  array->SetComponentName(2, "B");
-  array->SetNumberOfTuples(static_cast<vtkIdType>(tuples));
-  return array;
-}
-
 void setColor(vtkUnsignedCharArray* array, std::size_t i, const Rgb& radiosity, double scale)
 {
   const std::array<unsigned char, 3> color = displayColor(radiosity, scale);
@@ -493,12 +484,12 @@ void setColor(vtkUnsignedCharArray* array, std::size_t i, const Rgb& radiosity, 
 }
 }
 
-void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame, double exposureScale, vtkPointData* pointData,
-  vtkCellData* cellData)
+void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  double exposureScale, vtkPointData* pointData, vtkCellData* cellData)
 {
   const std::size_t n = solution.elementCount();
   const std::size_t pointCount = shading.scenePoints.size();
-  auto cellColor = colorArray(n);
+  auto cellColor = rgbArray<vtkUnsignedCharArray>("Color", n);
   std::vector<Rgb> pointSum(pointCount);
   for (std::size_t e = 0; e < n; ++e)
   {
@@ -511,7 +502,7 @@ void addDisplayArrays(const Solution& solution, const SmoothShading& shading, st
     }
   }
   auto pointRadiosity = rgbArray("Radiosity", pointCount);
-  auto pointColor = colorArray(pointCount);
+  auto pointColor = rgbArray<vtkUnsignedCharArray>("Color", pointCount);
   for (std::size_t p = 0; p < pointCount; ++p)
   {
     const Rgb radiosity = pointSum[p] * shading.inverseArea[p];

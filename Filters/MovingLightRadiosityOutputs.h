@@ -114,8 +114,8 @@ vtkSmartPointer<vtkPolyData> smoothElementMesh(const Scene& scene, const SmoothS
 /// Adds the display arrays of `frame`: cell `Color` from the cells' lit-side Radiosity, point
 /// `Radiosity` (area-weighted over the cells around each point) and point `Color`, and makes
 /// `Color` the active scalars of both. `exposureScale` is 2^(automatic + user exposure).
-void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame, double exposureScale, vtkPointData* pointData,
-  vtkCellData* cellData);
+void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  double exposureScale, vtkPointData* pointData, vtkCellData* cellData);
 
 /// Adds `AutoExposure` and `Exposure` (EV) and `ExposureScale`, 2^(AutoExposure + Exposure),
 /// the factor applied to radiosity before the tone map.

@@ -62,8 +62,8 @@
  * first update solves every frame at once and keeps the result; requests for other times
  * are served from it without solving again, until an input or a property other than
  * Exposure changes. A time between two steps shows the step at or below it. All the outputs
- * show the time requested on the port being updated. The filter's time is not passed upstream: the inputs are used as
- * they are.
+ * show the time requested on the port being updated. The filter's time is not passed
+ * upstream: the inputs are used as they are.
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with

@@ -46,8 +46,9 @@ void vtkMovingLightRadiosityRepresentationDefaults::PostInitializeProxy(
     if (colorBy)
     {
       const char* association = element->GetAttributeOrDefault("association", "POINTS");
-      const int field = std::strcmp(association, "CELLS") == 0 ? vtkDataObject::FIELD_ASSOCIATION_CELLS
-                                                                 : vtkDataObject::FIELD_ASSOCIATION_POINTS;
+      const int field = std::strcmp(association, "CELLS") == 0
+        ? vtkDataObject::FIELD_ASSOCIATION_CELLS
+        : vtkDataObject::FIELD_ASSOCIATION_POINTS;
       vtkSMPropertyHelper(property).SetInputArrayToProcess(
         field, element->GetAttributeOrDefault("array", ""));
       continue;
