@@ -9,7 +9,9 @@ fixed camera, a 400 x 300 view, no orientation axes, black background.
         [--baseline Baseline/cornell_middle_frame.png] [--update-baseline] [--keep DIR]
 
 On failure vtkTesting writes the picture, the baseline and their difference into the
---keep folder (default: a temporary one, printed)."""
+--keep folder (default: a temporary one, printed). A deliberate change of what the picture
+shows (the remeshing, the solver's sampling, the tone map) needs a new baseline: look at the
+picture in the --keep folder, then run again with --update-baseline and commit it."""
 import math
 import os
 import shutil
