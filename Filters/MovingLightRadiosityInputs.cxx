@@ -1,6 +1,7 @@
 #include "MovingLightRadiosityInputs.h"
 
 #include "Error.h"
+#include "PolygonTriangulation.h"
 #include "Solver.h"
 
 #include "vtkCellArray.h"
@@ -12,6 +13,8 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
+#include "vtkFieldData.h"
 
 #include <algorithm>
 #include <cmath>
@@ -170,6 +173,17 @@ vtkDataArray* pointArray(vtkPointSet* data, const char* name, int components, in
   return numbers;
 }
 
+/// The Scene's cell array MaterialId (one integer per cell), or nullptr.
+vtkDataArray* materialIdArray(vtkPolyData* scene)
+{
+  auto* ids = vtkDataArray::SafeDownCast(scene->GetCellData()->GetAbstractArray("MaterialId"));
+  if (!ids || ids->GetNumberOfComponents() != 1 || ids->GetNumberOfTuples() < scene->GetNumberOfCells())
+  {
+    return nullptr;
+  }
+  return ids;
+}
+
 /// The integer cell array LightId of the Light, or nullptr.
 vtkDataArray* lightIdArray(vtkPolyData* light)
 {
@@ -211,7 +225,7 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
 
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   std::uint64_t memoryLimitBytes, const std::string& reflectanceName,
-  const std::string& emissionName)
+  const std::string& emissionName, int skipMaterial)
 {
   PolygonSoup soup;
   if (!scene || scene->GetNumberOfCells() == 0)
@@ -263,7 +277,12 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     warnings.push_back(s.str());
   }
   soup.points = pointsOf(scene);
+  vtkDataArray* materialIds = skipMaterial >= 0 ? materialIdArray(scene) : nullptr;
   forEachSurfaceCell(scene, [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids) {
+    if (materialIds && materialIds->GetComponent(cellId, 0) == skipMaterial)
+    {
+      return;
+    }
     soup.polygons.push_back(ids);
     Material material;
     if (reflectance)
@@ -277,6 +296,71 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     soup.materials.push_back(material);
   });
   return soup;
+}
+
+MaterialLight materialLight(
+  vtkPolyData* scene, const std::string& material, const std::string& emissionName)
+{
+  auto* names = scene
+    ? vtkStringArray::SafeDownCast(scene->GetFieldData()->GetAbstractArray("MaterialNames"))
+    : nullptr;
+  vtkDataArray* ids = scene ? materialIdArray(scene) : nullptr;
+  if (!names || !ids)
+  {
+    throw Error("the Scene has no materials (field data MaterialNames and cell array "
+                "MaterialId, as the radiosity scene reader gives for OBJ+MTL, glTF and PLY "
+                "files), so no light can be taken from its material '" + material + "'");
+  }
+  MaterialLight result;
+  std::string found;
+  for (vtkIdType i = 0; i < names->GetNumberOfValues(); ++i)
+  {
+    if (names->GetValue(i) == material)
+    {
+      result.materialId = static_cast<int>(i);
+    }
+    found += (i > 0 ? ", '" : "'") + names->GetValue(i) + "'";
+  }
+  if (result.materialId < 0)
+  {
+    throw Error("the Scene has no material named '" + material + "': its materials are " +
+      (found.empty() ? std::string("none") : found));
+  }
+  vtkDataArray* emission = colourArray(scene, emissionName, "in W/m^2, >= 0");
+  const std::vector<Vec3> points = pointsOf(scene);
+  Rgb power;
+  forEachSurfaceCell(scene, [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds) {
+    if (ids->GetComponent(cellId, 0) != result.materialId)
+    {
+      return;
+    }
+    std::vector<Vec3> polygon;
+    for (std::uint32_t id : pointIds)
+    {
+      if (id >= points.size())
+      {
+        throw Error("a Scene polygon uses point " + std::to_string(id) + " but the Scene has " +
+          std::to_string(points.size()) + " points: fix its connectivity");
+      }
+      polygon.push_back(points[id]);
+    }
+    if (emission)
+    {
+      power += emissionOfCell(emission, cellId, emissionName) * (0.5 * length(newellNormal(polygon)));
+    }
+    result.light.polygons.push_back(std::move(polygon));
+  });
+  if (result.light.polygons.empty())
+  {
+    throw Error("the Scene's material '" + material + "' has no polygon: choose a material "
+      "with surfaces (its materials are " + found + ")");
+  }
+  if (power.maxComponent() > 0)
+  {
+    result.light.hasPower = true;
+    result.light.power = power;
+  }
+  return result;
 }
 
 std::size_t lightCount(vtkPolyData* light)

@@ -23,9 +23,10 @@ namespace mlr::vtkinputs
 /// `warnings`. An empty soup means there is nothing to light. Throws mlr::Error, before
 /// copying anything, when the copy is estimated to need more than `memoryLimitBytes` (0: half
 /// the physical memory).
+/// Cells whose `MaterialId` is `skipMaterial` (>= 0) are left out: they are the light.
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   std::uint64_t memoryLimitBytes = 0, const std::string& reflectanceName = "Reflectance",
-  const std::string& emissionName = "Emission");
+  const std::string& emissionName = "Emission", int skipMaterial = -1);
 
 /// One light of the Light input: its polygons (strips split into triangles) in the light's
 /// own frame, and its power from the cell array LightPower when there is one.
@@ -39,6 +40,23 @@ struct LightInput
 /// The Light's polygons grouped into lights by the integer cell array LightId, in increasing
 /// LightId order (one light without it). Throws for a LightPower that differs within a light.
 std::vector<LightInput> lightInputs(vtkPolyData* light);
+
+/// A light taken out of the Scene: the polygons of one material.
+struct MaterialLight
+{
+  int materialId = -1;
+  LightInput light; ///< hasPower when the material emits: the sum of emission times area
+};
+
+/**
+ * The Scene's polygons of the material named `material` (field data `MaterialNames`, cell
+ * array `MaterialId`, as vtkRadiositySceneReader gives them), with the power they emit
+ * (cell array `emissionName` times their area; pi Ke area for an OBJ material with Ke).
+ * Throws mlr::Error listing the materials found when none is named so, and when the material
+ * has no polygon.
+ */
+MaterialLight materialLight(
+  vtkPolyData* scene, const std::string& material, const std::string& emissionName);
 
 /// How many lights the Light input holds: its distinct LightId values, or 1 without them.
 std::size_t lightCount(vtkPolyData* light);

@@ -103,6 +103,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->AimPoint[0] = this->AimPoint[1] = this->AimPoint[2] = 0.0;
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
+  this->LightPowerFromMaterial = 1;
 
   this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
@@ -155,7 +156,8 @@ namespace
 /// area lights, one for a directional light.
 std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightInput)
 {
-  if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
+  if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT ||
+    *self->GetLightMaterial())
   {
     return 1;
   }
@@ -285,6 +287,9 @@ int vtkMovingLightRadiosity::RequestData(
     ? trigger->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
     : cache.Times.front();
   const std::size_t frame = mlr::vtkinputs::frameAtOrBelow(cache.Times, requested);
+  // A scene lit only by things that do not move (its emitters, static lights) is solved once,
+  // whatever time steps the Trajectory or NumberOfPositions declare: every step shows it.
+  const std::size_t solved = cache.Solution.frameCount() > 1 ? frame : 0;
 
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
@@ -295,8 +300,8 @@ int vtkMovingLightRadiosity::RequestData(
       {
         output->ShallowCopy(cache.Elements);
         mlr::vtkoutputs::addElementRadiosity(
-          cache.Solution, frame, cache.TwoSided, output->GetCellData());
-        mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, frame,
+          cache.Solution, solved, cache.TwoSided, output->GetCellData());
+        mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
           std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
           output->GetCellData());
       }
@@ -304,7 +309,7 @@ int vtkMovingLightRadiosity::RequestData(
       {
         output->ShallowCopy(cache.Patches);
         mlr::vtkoutputs::addPatchRadiosity(
-          cache.Solution, cache.PatchLitSides, frame, output->GetCellData());
+          cache.Solution, cache.PatchLitSides, solved, output->GetCellData());
       }
       else
       {
@@ -382,12 +387,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     std::vector<std::string> warnings;
     vtkPolyData* lightData = vtkPolyData::GetData(inputVector[LIGHT_PORT], 0);
     const bool directional = this->LightType == DIRECTIONAL_LIGHT;
-    const mlr::vtkinputs::Trajectory trajectory = trajectoryOf(
-      this, inputVector[TRAJECTORY_PORT], directional ? 1 : mlr::vtkinputs::lightCount(lightData));
-    const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(
-      vtkPolyData::GetData(inputVector[SCENE_PORT], 0), warnings,
+    const mlr::vtkinputs::Trajectory trajectory =
+      trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]));
+    vtkPolyData* sceneData = vtkPolyData::GetData(inputVector[SCENE_PORT], 0);
+    const bool fromMaterial = !directional && !this->LightMaterial.empty();
+    mlr::vtkinputs::MaterialLight materialLight;
+    if (fromMaterial)
+    {
+      materialLight = mlr::vtkinputs::materialLight(sceneData, this->LightMaterial, this->EmissionArrayName);
+    }
+    const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
-      this->EmissionArrayName);
+      this->EmissionArrayName, materialLight.materialId);
     cache.Times = trajectory.times;
     cache.SunAzimuth = trajectory.sunAzimuth;
     cache.SunElevation = trajectory.sunElevation;
@@ -414,9 +425,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       }
       rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
     }
-    else if (lightData && lightData->GetNumberOfCells() > 0)
+    else if (fromMaterial || (lightData && lightData->GetNumberOfCells() > 0))
     {
-      const std::vector<mlr::vtkinputs::LightInput> lights = mlr::vtkinputs::lightInputs(lightData);
+      std::vector<mlr::vtkinputs::LightInput> lights;
+      if (fromMaterial)
+      {
+        lights.push_back(materialLight.light);
+        lights.back().hasPower = lights.back().hasPower && this->LightPowerFromMaterial;
+      }
+      else
+      {
+        lights = mlr::vtkinputs::lightInputs(lightData);
+      }
       const mlr::Rgb defaultPower(this->LightPower[0], this->LightPower[1], this->LightPower[2]);
       const mlr::Vec3 aim(this->AimPoint[0], this->AimPoint[1], this->AimPoint[2]);
       for (std::size_t i = 0; i < lights.size(); ++i)
@@ -539,6 +559,8 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << this->AimPoint[2] << ")\n";
   os << indent << "ReflectanceArrayName: " << this->ReflectanceArrayName << "\n";
   os << indent << "EmissionArrayName: " << this->EmissionArrayName << "\n";
+  os << indent << "LightMaterial: " << this->LightMaterial << "\n";
+  os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off") << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)

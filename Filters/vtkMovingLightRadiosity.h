@@ -297,6 +297,28 @@ public:
 
   ///@{
   /**
+   * The name of a Scene material (field data `MaterialNames`, cell array `MaterialId`, as
+   * vtkRadiositySceneReader gives them) whose polygons are taken out of the scene to become
+   * the light that moves along the Trajectory; the Light input is then not used. Other
+   * emissive materials stay in the scene as static emitters. Default "" (the Light input).
+   */
+  vtkSetStdStringFromCharMacro(LightMaterial);
+  vtkGetCharFromStdStringMacro(LightMaterial);
+  ///@}
+
+  ///@{
+  /**
+   * With LightMaterial: take the light's power from the material's emission (Emission times
+   * area, pi Ke area for an OBJ material with Ke) when it emits; off, or for a material that
+   * does not emit, LightPower. Default on.
+   */
+  vtkSetMacro(LightPowerFromMaterial, vtkTypeBool);
+  vtkGetMacro(LightPowerFromMaterial, vtkTypeBool);
+  vtkBooleanMacro(LightPowerFromMaterial, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Refuse work estimated to need more memory than this (MiB), before allocating it: taking
    * the scene for remeshing, remeshing it, and the solve with its outputs (a solve that
    * cannot fit is refused before remeshing runs, from the patch count expected); 0 means
@@ -360,6 +382,8 @@ protected:
   double AimPoint[3];
   std::string ReflectanceArrayName;
   std::string EmissionArrayName;
+  std::string LightMaterial;
+  vtkTypeBool LightPowerFromMaterial;
   vtkIdType SolveCount;
   double Exposure;
 
