@@ -303,3 +303,293 @@ TEST(ContactLines, SceneWithoutContactsIsUnchangedBySplitting)
   EXPECT_EQ(split.mesh.points, unsplit.mesh.points);
   EXPECT_EQ(split.mesh.triangles, unsplit.mesh.triangles);
 }
+
+// --- Light at the contact ---------------------------------------------------------------------
+
+namespace
+{
+// A square light above the floor beside the block: the block shadows part of the floor next to
+// it, and the floor lights the block's sides.
+const Vec3 LightCentre{ 0.35, 1.0, 1.2 };
+constexpr double LightSide = 0.4;
+const Rgb LightPower(10, 10, 10);
+
+/// The ring of floor next to the block: [0.5, 1.5]^2 minus the footprint [0.7, 1.3]^2.
+const Point2 RingLo{ 0.5, 0.5 }, RingHi{ 1.5, 1.5 };
+
+struct LitBlock
+{
+  Scene scene;
+  Solution solution;
+  std::uint64_t paths = 0;
+};
+
+LitBlock solveBlockOnFloor(double h, bool split, std::uint64_t paths, std::uint64_t seed)
+{
+  const RemeshResult remeshed = remesh(blockOnFloor(2.0, BlockLo, BlockHi, FloorRho, BlockRho), withEdgeLength(h, split));
+  EXPECT_EQ(remeshed.statistics.fallbackRegions, 0u) << joined(remeshed.warnings);
+  LitBlock lit{ Scene::fromPatchMesh(remeshed.mesh), Solution(), paths };
+  SolverOptions options;
+  options.pathsPerFrame = paths;
+  options.reuseShooting = false;
+  options.reuseGathering = false;
+  options.seed = seed;
+  lit.solution = solve(lit.scene, MovingLight(squareLightFacingDown(LightCentre, LightSide), LightPower, { Vec3() }), options);
+  return lit;
+}
+
+bool isFloorElement(const Scene& scene, std::size_t e)
+{
+  const Triangle& t = scene.elementTriangles()[e];
+  return scene.elementReflectance(e) == FloorRho && scene.elementNormal(e).z > 0.999 &&
+    std::abs(scene.points()[t[0]].z) < 1e-12;
+}
+
+/// Whether the segment from p to q passes through the block (slab test; the ends excluded).
+bool blockHides(const Vec3& p, const Vec3& q)
+{
+  double enter = 1e-12, leave = 1 - 1e-12;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double d = q[axis] - p[axis];
+    if (std::abs(d) < 1e-300)
+    {
+      if (p[axis] <= BlockLo[axis] || p[axis] >= BlockHi[axis])
+      {
+        return false;
+      }
+      continue;
+    }
+    double t0 = (BlockLo[axis] - p[axis]) / d, t1 = (BlockHi[axis] - p[axis]) / d;
+    if (t0 > t1)
+    {
+      std::swap(t0, t1);
+    }
+    enter = std::max(enter, t0);
+    leave = std::min(leave, t1);
+  }
+  return enter < leave;
+}
+
+/// Irradiance at floor point x from the light, by midpoint quadrature over steps x steps
+/// points of the light, each seen or hidden by the block exactly.
+double irradiance(const Vec3& x, double power, int steps)
+{
+  const double radiance = power / (Pi * LightSide * LightSide);
+  const double cell = LightSide / steps;
+  double sum = 0;
+  for (int a = 0; a < steps; ++a)
+  {
+    for (int b = 0; b < steps; ++b)
+    {
+      const Vec3 y{ LightCentre.x - LightSide / 2 + (a + 0.5) * cell, LightCentre.y - LightSide / 2 + (b + 0.5) * cell,
+        LightCentre.z };
+      if (!blockHides(x, y))
+      {
+        const Vec3 d = y - x;
+        const double r2 = lengthSquared(d);
+        // The cosines at the floor and at the light are both d.z / r.
+        sum += radiance * (d.z * d.z / r2) / r2 * cell * cell;
+      }
+    }
+  }
+  return sum;
+}
+
+/// rho * integral over the ring of the irradiance from the light, by midpoint quadrature:
+/// 1 cm cells on the floor (the ring's edges fall on cell edges), 16 x 16 points on the light.
+double ringDirectPowerReference(double rho, double power)
+{
+  constexpr double Cell = 0.01;
+  double sum = 0;
+  const int cells = static_cast<int>(std::lround((RingHi.x - RingLo.x) / Cell));
+  for (int i = 0; i < cells; ++i)
+  {
+    for (int j = 0; j < cells; ++j)
+    {
+      const Vec3 x{ RingLo.x + (i + 0.5) * Cell, RingLo.y + (j + 0.5) * Cell, 0 };
+      if (x.x > FootprintLo.x && x.x < FootprintHi.x && x.y > FootprintLo.y && x.y < FootprintHi.y)
+      {
+        continue;
+      }
+      sum += rho * irradiance(x, power, 16) * Cell * Cell;
+    }
+  }
+  return sum;
+}
+
+struct RingPower
+{
+  double value = 0;
+  double sigma = 0; ///< binomial standard deviation of the path count estimate
+};
+
+/// The solver's direct power on the ring, taking each element's radiosity as uniform over it
+/// (as it is drawn), channel 0; sigma from the paths whose first hit may count.
+RingPower ringDirectPower(const LitBlock& lit)
+{
+  RingPower ring;
+  double touchingPower = 0;
+  const auto& p = lit.scene.points();
+  for (std::size_t e = 0; e < lit.scene.elementCount(); ++e)
+  {
+    if (!isFloorElement(lit.scene, e))
+    {
+      continue;
+    }
+    const Triangle& t = lit.scene.elementTriangles()[e];
+    const double overlap = areaInside(p[t[0]], p[t[1]], p[t[2]], RingLo, RingHi) -
+      areaInside(p[t[0]], p[t[1]], p[t[2]], FootprintLo, FootprintHi);
+    const double B = lit.solution.direct(0, e, Side::Front).r;
+    ring.value += overlap * B;
+    touchingPower += overlap > 1e-12 ? lit.scene.elementArea(e) * B : 0.0;
+  }
+  // Each path adds at most rho Phi / N, and only if its first hit is on an element that
+  // overlaps the ring, which a fraction touchingPower / (rho Phi) of them do.
+  const double unit = FloorRho.r * LightPower.r;
+  ring.sigma = unit * std::sqrt(touchingPower / unit / double(lit.paths));
+  return ring;
+}
+
+/// Power landing on the part of triangle abc outside the footprint: midpoints of a 4^3-triangle
+/// subdivision, those under the block left out.
+double landingPower(const Vec3& a, const Vec3& b, const Vec3& c, double rho, double power, int depth = 3)
+{
+  if (depth == 0)
+  {
+    const Vec3 x = (a + b + c) / 3.0;
+    const bool under = x.x > FootprintLo.x && x.x < FootprintHi.x && x.y > FootprintLo.y && x.y < FootprintHi.y;
+    return under ? 0.0 : rho * irradiance(x, power, 8) * triangleArea(a, b, c);
+  }
+  const Vec3 ab = (a + b) * 0.5, bc = (b + c) * 0.5, ca = (c + a) * 0.5;
+  return landingPower(a, ab, ca, rho, power, depth - 1) + landingPower(ab, b, bc, rho, power, depth - 1) +
+    landingPower(ca, bc, c, rho, power, depth - 1) + landingPower(ab, bc, ca, rho, power, depth - 1);
+}
+
+struct ZScores
+{
+  double meanSquare = 0;
+  double minimum = 0;
+  std::size_t count = 0;
+};
+
+/**
+ * z = (B - B_seen) / sigma for every floor element in the ring, channel 0. B_seen is the
+ * radiosity of the element's visible part: the power landing on it over its area outside the
+ * footprint. An element across the footprint's edge shows its power spread over its whole
+ * area, too dark by the share of it under the block. sigma is the binomial deviation of the
+ * paths' first hits.
+ */
+ZScores ringElementScores(const LitBlock& lit)
+{
+  ZScores z;
+  const auto& p = lit.scene.points();
+  const double unit = FloorRho.r * LightPower.r;
+  for (std::size_t e = 0; e < lit.scene.elementCount(); ++e)
+  {
+    if (!isFloorElement(lit.scene, e))
+    {
+      continue;
+    }
+    const Triangle& t = lit.scene.elementTriangles()[e];
+    const double area = lit.scene.elementArea(e);
+    const double under = areaInside(p[t[0]], p[t[1]], p[t[2]], FootprintLo, FootprintHi);
+    if (areaInside(p[t[0]], p[t[1]], p[t[2]], RingLo, RingHi) - under < 1e-12 || area - under < 1e-9 * area)
+    {
+      continue;
+    }
+    const double landing = landingPower(p[t[0]], p[t[1]], p[t[2]], FloorRho.r, LightPower.r);
+    const double hitProbability = landing / unit;
+    if (hitProbability * double(lit.paths) < 20)
+    {
+      continue; // in shadow: too few hits for a normal z-score
+    }
+    const double seen = landing / (area - under);
+    const double sigma = unit / (double(lit.paths) * area) *
+      std::sqrt(double(lit.paths) * hitProbability * (1 - hitProbability));
+    const double score = (lit.solution.direct(0, e, Side::Front).r - seen) / sigma;
+    z.meanSquare += score * score;
+    z.minimum = std::min(z.minimum, score);
+    ++z.count;
+  }
+  z.meanSquare /= double(std::max<std::size_t>(1, z.count));
+  return z;
+}
+
+/// Indirect power leaving the block's four vertical sides (front: out of the block), channel 0.
+double sidesIndirectPower(const LitBlock& lit)
+{
+  double sum = 0;
+  for (std::size_t e = 0; e < lit.scene.elementCount(); ++e)
+  {
+    if (lit.scene.elementReflectance(e) == BlockRho && std::abs(lit.scene.elementNormal(e).z) < 1e-9)
+    {
+      sum += lit.scene.elementArea(e) * lit.solution.indirect(0, e, Side::Front).r;
+    }
+  }
+  return sum;
+}
+}
+
+TEST(ContactLines, DirectPowerOnTheFloorNextToTheBlockMatchesQuadrature)
+{
+  const double reference = ringDirectPowerReference(FloorRho.r, LightPower.r);
+  const LitBlock split = solveBlockOnFloor(0.1, true, 400000, 3);
+  const RingPower ring = ringDirectPower(split);
+  std::cout << "ring direct power: reference " << reference << " W, split " << ring.value << " +- "
+            << ring.sigma << " W\n";
+  // 4 sigma of the path count, and 0.5% for taking each element's radiosity as uniform
+  // where the ring's outer edge cuts elements.
+  EXPECT_NEAR(ring.value, reference, 4 * ring.sigma + 0.005 * reference);
+}
+
+TEST(ContactLines, FloorElementsNextToTheBlockShowTheLightTheyReceive)
+{
+  const std::uint64_t paths = 1000000;
+  const ZScores split = ringElementScores(solveBlockOnFloor(0.1, true, paths, 5));
+  const ZScores leaky = ringElementScores(solveBlockOnFloor(0.1, false, paths, 5));
+  std::cout << "floor elements next to the block: mean z^2 " << split.meanSquare << " (min z " << split.minimum
+            << ", " << split.count << " elements); unsplit " << leaky.meanSquare << " (min z " << leaky.minimum
+            << ")\n";
+  // Independent binomial errors: mean z^2 is 1 up to sqrt(2 / count) (~0.06 here).
+  ASSERT_GT(split.count, 200u);
+  EXPECT_NEAR(split.meanSquare, 1.0, 0.25);
+  EXPECT_GT(split.minimum, -5.0);
+  // Unsplit, the elements across the footprint's edge are too dark: the check sees it.
+  EXPECT_GT(leaky.meanSquare, 1.5);
+  EXPECT_LT(leaky.minimum, -6.0);
+}
+
+TEST(ContactLines, IndirectLightOnTheBlockSidesDoesNotDependOnThePatchSize)
+{
+  // Gathering on the block's sides reads the floor next to them. Coarse floor patches across
+  // the footprint's edge average it with the dark under the block, so the sides come out
+  // dark unless the floor is split there. Means and standard errors over seeds.
+  auto sides = [](double h, bool split) {
+    std::vector<double> values;
+    for (std::uint64_t seed = 1; seed <= 4; ++seed)
+    {
+      values.push_back(sidesIndirectPower(solveBlockOnFloor(h, split, 300000, seed)));
+    }
+    double mean = 0, square = 0;
+    for (double v : values)
+    {
+      mean += v / double(values.size());
+    }
+    for (double v : values)
+    {
+      square += (v - mean) * (v - mean);
+    }
+    return std::make_pair(mean, std::sqrt(square / double(values.size() - 1) / double(values.size())));
+  };
+  const auto fine = sides(0.05, true);
+  const auto coarse = sides(0.5, true);
+  const auto leaky = sides(0.5, false);
+  std::cout << "block sides, indirect power: fine " << fine.first << " +- " << fine.second << ", coarse "
+            << coarse.first << " +- " << coarse.second << ", coarse unsplit " << leaky.first << " +- "
+            << leaky.second << " W\n";
+  const double noise = std::sqrt(fine.second * fine.second + coarse.second * coarse.second);
+  // 4 standard errors, and 1.5% for what coarse patches change elsewhere (measured 0.4%).
+  EXPECT_NEAR(coarse.first, fine.first, 4 * noise + 0.015 * fine.first);
+  EXPECT_LT(leaky.first, fine.first - 4 * noise - 0.015 * fine.first);
+}
