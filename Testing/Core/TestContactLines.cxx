@@ -1,5 +1,6 @@
 // Contact lines (issue 11, item 4): surfaces are split where others touch or cross them, so
 // that no patch straddles a contact and averages lit floor with the dark under a block.
+#include "Error.h"
 #include "GeneratedScenes.h"
 #include "Remeshing.h"
 #include "Solver.h"
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -592,4 +594,47 @@ TEST(ContactLines, IndirectLightOnTheBlockSidesDoesNotDependOnThePatchSize)
   // 4 standard errors, and 1.5% for what coarse patches change elsewhere (measured 0.4%).
   EXPECT_NEAR(coarse.first, fine.first, 4 * noise + 0.015 * fine.first);
   EXPECT_LT(leaky.first, fine.first - 4 * noise - 0.015 * fine.first);
+}
+
+// --- Cost and cancellation --------------------------------------------------------------------
+
+TEST(ContactLines, SplittingIsCancellableAndReportsProgressInOrder)
+{
+  // A 32,000-triangle sphere crossing a floor: about 600 of its triangles cross it.
+  PolygonSoup soup = icosphere(40);
+  addPolygon(soup, { { -2, -2, -0.5 }, { 2, -2, -0.5 }, { 2, 2, -0.5 }, { -2, 2, -0.5 } }, Rgb(0.3));
+  std::vector<double> reported;
+  const RemeshResult result = remesh(soup, RemeshOptions{}, [&](double f) {
+    reported.push_back(f);
+    return true;
+  });
+  EXPECT_GT(result.statistics.contactSplitTriangles, 300u);
+  EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+  EXPECT_EQ(reported.back(), 1.0);
+  std::cout << "contacts took " << result.statistics.secondsContacts << " s of " << result.statistics.seconds << " s\n";
+
+  // Contacts are split once the surface is repaired, with progress held just under 5%: the
+  // second report of that value comes from within the phase, and stopping there stops it.
+  std::chrono::steady_clock::time_point asked;
+  int held = 0;
+  bool cancelled = false;
+  try
+  {
+    remesh(soup, RemeshOptions{}, [&](double f) {
+      held += f >= 0.04 ? 1 : 0;
+      if (held < 2 && f < 0.05)
+      {
+        return true;
+      }
+      asked = std::chrono::steady_clock::now();
+      return false;
+    });
+  }
+  catch (const Cancelled&)
+  {
+    cancelled = true;
+    const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+    EXPECT_LT(latency, 0.5);
+  }
+  EXPECT_TRUE(cancelled);
 }
