@@ -1,0 +1,190 @@
+"""Light rigs (issue 12) and the sun (issue 14) from Python: inputs built from vtkmodules
+sources, the arrays and time steps the filter gives back.
+
+Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.txt), or by hand:
+    PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
+"""
+import math
+
+import pytest
+
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray
+from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+from vtkmodules.vtkFiltersCore import vtkAppendPolyData
+from vtkmodules.vtkFiltersSources import vtkCubeSource, vtkLineSource, vtkPlaneSource
+from vtkmodules.util.misc import calldata_type
+from vtkmodules.util.vtkConstants import VTK_STRING
+
+from movinglightradiosity import vtkMovingLightRadiosity
+
+FRAMES = 3
+ELEMENT_ARRAYS = ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "EmittedRadiosity",
+                  "Reflectance", "Color")
+
+
+def output(source):
+    source.Update()
+    return source.GetOutput()
+
+
+def time_steps(algorithm):
+    algorithm.UpdateInformation()
+    return algorithm.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+
+
+def field(data, name):
+    array = data.GetFieldData().GetArray(name)
+    assert array is not None, f"no field array {name}"
+    return array.GetTuple(0) if array.GetNumberOfComponents() > 1 else array.GetValue(0)
+
+
+def square_light(centre, side=0.2):
+    """A square facing down (-z): (P1 - O) x (P2 - O) points down."""
+    x, y, z = centre
+    plane = vtkPlaneSource()
+    plane.SetOrigin(x - side / 2, y - side / 2, z)
+    plane.SetPoint1(x - side / 2, y + side / 2, z)
+    plane.SetPoint2(x + side / 2, y - side / 2, z)
+    return plane
+
+
+def cell_array(name, values, components=1, array_type=vtkDoubleArray):
+    array = array_type()
+    array.SetName(name)
+    array.SetNumberOfComponents(components)
+    for value in values:
+        array.InsertNextTuple(value if components > 1 else (value,))
+    return array
+
+
+@pytest.fixture(scope="module")
+def rig():
+    """A unit cube (grey 0.5 without a Reflectance array) lit by two lights inside it, each
+    moving along its own line: LightId 0 and 1 with their own LightPower."""
+    cube = vtkCubeSource()
+    cube.SetBounds(0, 1, 0, 1, 0, 1)
+    scene = output(cube)
+
+    # A connection does not keep its producer alive: the sources are held until updated.
+    squares = [square_light((0.5, 0.5, 0.9)), square_light((0.5, 0.5, 0.6))]
+    lights = vtkAppendPolyData()
+    for square in squares:
+        lights.AddInputConnection(square.GetOutputPort())
+    light = output(lights)
+    light.GetCellData().AddArray(cell_array("LightId", (0, 1), array_type=vtkIntArray))
+    light.GetCellData().AddArray(cell_array("LightPower", ((2, 3, 4), (4, 3, 2)), 3))
+
+    paths = vtkAppendPolyData()  # one polyline per light, in LightId order
+    lines = []
+    for start, end in (((0.3, 0.3, 0.9), (0.7, 0.7, 0.9)), ((0.7, 0.3, 0.6), (0.3, 0.7, 0.6))):
+        lines.append(vtkLineSource())
+        lines[-1].SetPoint1(start)
+        lines[-1].SetPoint2(end)
+        lines[-1].SetResolution(FRAMES - 1)
+        paths.AddInputConnection(lines[-1].GetOutputPort())
+    trajectory = output(paths)
+    trajectory.GetPointData().AddArray(
+        cell_array("Power", (1, 0.5, 1, 1, 1, 1)))
+
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(scene)
+    radiosity.SetLightData(light)
+    radiosity.SetTrajectoryData(trajectory)
+    radiosity.SetNumberOfPaths(20000)
+    radiosity.SetPatchSize(0.25)
+    radiosity.SetNumberOfThreads(2)
+    return {"filter": radiosity, "trajectory": trajectory}
+
+
+def test_rig_time_steps_are_the_polylines_points(rig):
+    assert time_steps(rig["filter"]) == tuple(float(i) for i in range(FRAMES))
+
+
+def test_rig_arrays_and_posed_lights(rig):
+    radiosity = rig["filter"]
+    trajectory = rig["trajectory"]
+    for frame in range(FRAMES):
+        assert radiosity.UpdateTimeStep(float(frame))
+        elements = radiosity.GetOutput(0)
+        for name in ELEMENT_ARRAYS:
+            assert elements.GetCellData().GetArray(name) is not None, name
+        assert elements.GetCellData().GetArray("Radiosity").GetRange(-1)[1] > 0
+        assert field(elements, "FrameIndex") == frame
+        # The first light's centroid, where its polyline puts it.
+        assert field(elements, "LightPosition") == pytest.approx(trajectory.GetPoint(frame))
+        lights = radiosity.GetOutput(2)
+        assert lights.GetNumberOfCells() == 2
+        power = lights.GetCellData().GetArray("Power")
+        assert power is not None
+        factor = 0.5 if frame == 1 else 1.0  # the first light's Power in this frame
+        assert power.GetTuple3(0) == pytest.approx((2 * factor, 3 * factor, 4 * factor))
+        assert power.GetTuple3(1) == pytest.approx((4, 3, 2))
+    assert radiosity.GetSolveCount() == 1
+
+
+def test_rig_without_its_polyline_is_an_error(rig):
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(rig["filter"].GetInputDataObject(0, 0))
+    radiosity.SetLightData(rig["filter"].GetInputDataObject(1, 0))
+    line = vtkLineSource()
+    line.SetResolution(FRAMES - 1)
+    radiosity.SetTrajectoryData(output(line))  # one polyline for two lights
+    errors = []
+
+    @calldata_type(VTK_STRING)
+    def record(_caller, _event, message):
+        errors.append(message)
+
+    radiosity.AddObserver("ErrorEvent", record)
+    assert not radiosity.UpdateTimeStep(0.0)
+    assert any("2 lights (LightId) but the Trajectory has 1 polylines" in e for e in errors), errors
+    assert radiosity.GetOutput(0).GetNumberOfCells() == 0
+
+
+@pytest.fixture(scope="module")
+def sun():
+    """A 1 m ground plane facing up under the sun at elevations 30, 90 and 150 degrees
+    (morning, noon, evening), from a line source's points as directions."""
+    ground = vtkPlaneSource()
+    ground.SetResolution(4, 4)
+    directions = vtkLineSource()
+    directions.SetPoint1(math.sqrt(3), 0, 1)
+    directions.SetPoint2(-math.sqrt(3), 0, 1)
+    directions.SetResolution(2)
+    trajectory = output(directions)
+    trajectory.GetPointData().AddArray(cell_array("SunElevation", (30, 90, 150)))
+    trajectory.GetPointData().AddArray(cell_array("SunAzimuth", (90, 180, 270)))
+
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(output(ground))
+    radiosity.SetTrajectoryData(trajectory)
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetSunIrradiance(800)
+    radiosity.SetNumberOfPaths(50000)
+    radiosity.SetPatchSize(0.25)
+    radiosity.SetNumberOfThreads(2)
+    return radiosity
+
+
+def test_sun_time_steps_and_field_data(sun):
+    assert sun.GetLightType() == vtkMovingLightRadiosity.DIRECTIONAL_LIGHT
+    assert time_steps(sun) == (0.0, 1.0, 2.0)
+    elevations = (30, 90, 150)
+    for frame, elevation in enumerate(elevations):
+        assert sun.UpdateTimeStep(float(frame))
+        elements = sun.GetOutput(0)
+        for name in ELEMENT_ARRAYS:
+            assert elements.GetCellData().GetArray(name) is not None, name
+        assert field(elements, "SunElevation") == elevation
+        assert field(elements, "SunAzimuth") == 90 * (frame + 1)
+        s = math.radians(elevation)
+        assert field(elements, "SunDirection") == pytest.approx((math.cos(s), 0, math.sin(s)))
+        # Direct light on the ground: rho E sin(elevation), grey 0.5 (no Reflectance array).
+        direct = elements.GetCellData().GetArray("DirectRadiosity")
+        total = area = 0.0
+        for cell in range(elements.GetNumberOfCells()):
+            a = elements.GetCell(cell).ComputeArea()
+            total += a * direct.GetComponent(cell, 1)
+            area += a
+        assert total / area == pytest.approx(0.5 * 800 * math.sin(s), rel=0.03)
+        assert sun.GetOutput(2).GetNumberOfCells() == 0  # no area light to show
