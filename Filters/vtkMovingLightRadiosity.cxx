@@ -444,10 +444,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         std::vector<mlr::PoseInput> inputs = trajectory.lights[i];
         if (this->AimAtPoint)
         {
-          for (mlr::PoseInput& in : inputs)
+          for (std::size_t k = 0; k < inputs.size(); ++k)
           {
+            mlr::PoseInput& in = inputs[k];
             in.hasNormal = true;
             in.normal = aim - in.position;
+            // Core would blame a zero Normal, which the user never gave: name AimPoint.
+            if (!in.hasOrientation && !(mlr::length(in.normal) > 1e-12))
+            {
+              throw mlr::Error("light " + std::to_string(i) + " (in LightId order) is at "
+                "AimPoint in frame " + std::to_string(k) + " and cannot face it: move "
+                "AimPoint off the light's Trajectory, or turn AimAtPoint off");
+            }
           }
         }
         const std::vector<mlr::LightPose> poses =

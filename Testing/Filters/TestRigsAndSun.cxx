@@ -947,3 +947,60 @@ TEST(FilterRigs, OrientationWinsOverAimAtPoint)
   posedLight(filter->GetOutput(vtkMovingLightRadiosity::LIGHT_OUTPUT_PORT), centroid, normal);
   EXPECT_NEAR(length(normal - TiltedNormal), 0.0, 1e-9);
 }
+
+TEST(FilterRigs, AimPointAtALightsCentroidIsAnError)
+{
+  // A light cannot face the point it is at: the error names AimPoint, which is what to fix.
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = boxFilter(setup);
+  filter->AimAtPointOn();
+  filter->SetAimPoint(setup.positions[1].x, setup.positions[1].y, setup.positions[1].z);
+  expectError(filter, "AimPoint");
+}
+
+TEST(FilterRigs, RigWithoutTrajectoryOrWithMixedLightPowerIsAnError)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  setup.light = twoLights({ 1, 1, 1 }, { 1, 1, 1 });
+  auto filter = boxFilter(setup);
+  filter->SetTrajectoryConnection(nullptr);
+  expectError(filter, "connect a Trajectory with one polyline per light");
+
+  // Light 0 is two triangles with different LightPower.
+  setup.light = lightPolyData({ { { 0.4, 0.4, 0.9 }, { 0.4, 0.6, 0.9 }, { 0.6, 0.4, 0.9 } },
+    { { 0.6, 0.6, 0.9 }, { 0.6, 0.4, 0.9 }, { 0.4, 0.6, 0.9 } },
+    { { 0.4, 0.4, 0.7 }, { 0.4, 0.6, 0.7 }, { 0.6, 0.4, 0.7 } } });
+  vtkNew<vtkIntArray> ids;
+  ids->SetName("LightId");
+  vtkNew<vtkDoubleArray> power;
+  power->SetName("LightPower");
+  for (int c = 0; c < 3; ++c)
+  {
+    ids->InsertNextValue(c < 2 ? 0 : 1);
+    power->InsertNextValue(c == 0 ? 1 : 2);
+  }
+  setup.light->GetCellData()->AddArray(ids);
+  setup.light->GetCellData()->AddArray(power);
+  setup.trajectory = twoLightTrajectory(false);
+  expectError(boxFilter(setup), "LightPower differs between the polygons of light 0");
+}
+
+TEST(FilterSun, WithoutTrajectoryTheDirectionGoesFromPathStartToPathEnd)
+{
+  auto filter = sunFilter(ground(), nullptr, 20000);
+  filter->SetTrajectoryConnection(nullptr);
+  filter->SetPathStart(-1, 0, 1);
+  filter->SetPathEnd(1, 0, 1);
+  filter->SetNumberOfPositions(3);
+  EXPECT_EQ(timeSteps(filter), (std::vector<double>{ 0, 1, 2 }));
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  vtkDataArray* sun = filter->GetOutput()->GetFieldData()->GetArray("SunDirection");
+  ASSERT_NE(sun, nullptr);
+  EXPECT_NEAR(sun->GetComponent(0, 2), 1.0, 1e-12); // the middle one is straight up
+  ASSERT_TRUE(filter->UpdateTimeStep(2));
+  EXPECT_NEAR(filter->GetOutput()->GetFieldData()->GetArray("SunDirection")->GetComponent(0, 0),
+    std::sqrt(0.5), 1e-12);
+  // The defaults start at the origin, which is no direction: an error, not a crash.
+  filter->SetPathStart(0, 0, 0);
+  expectError(filter, "direction 0 towards the light is (0, 0, 0)");
+}
