@@ -56,7 +56,7 @@ candidates = {"polydata": Box(), "tetrahedra": Tetrahedralize(Input=Wavelet(Whol
 for candidate in candidates.values():
     candidate.UpdatePipeline()
 for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False),
-                                                   ("Light", {"polydata"}, False),
+                                                   ("Light", {"polydata"}, True),
                                                    ("Trajectory", {"polydata", "tetrahedra"}, True))):
     prop = proxy.GetProperty(name)
     if not check(prop is not None and prop.IsA("vtkSMInputProperty"), f"no input property {name}"):
@@ -78,10 +78,14 @@ for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False
 
 # --- Properties ---------------------------------------------------------------------------
 ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", "MemoryLimit"}
-BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering"}
+BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering", "AimAtPoint", "LightPowerFromMaterial"}
+# Free text (names of arrays and materials): no domain to check against.
+STRINGS = {"LightMaterial", "ReflectanceArrayName", "EmissionArrayName"}
 EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurvival",
             "ReuseShooting", "ReuseGathering", "PatchSize", "Seed", "NumberOfThreads",
-            "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit", "Exposure"}
+            "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit", "Exposure",
+            "LightType", "SunIrradiance", "LightMaterial", "LightPowerFromMaterial", "AimAtPoint",
+            "AimPoint", "ReflectanceArrayName", "EmissionArrayName"}
 # Every property's documentation ends with its unit and its effect on the cost of a solve.
 UNIT_TAG, COST_TAG = "Unit:", "Cost:"
 vtk_defaults = vtkMovingLightRadiosity()
@@ -109,7 +113,7 @@ while not iterator.IsAtEnd():
         said = text.split(tag, 1)[1].split(".", 1)[0].strip() if tag in text else ""
         check(len(said.split()) >= 1, f"{where}: the documentation does not give {what} ({tag!r})")
     own_domains = list(domains(prop))
-    check(own_domains, f"{where}: no domain")
+    check(own_domains or name in STRINGS, f"{where}: no domain")
     visibility = prop.GetPanelVisibility()
     expected_visibility = "advanced" if name in ADVANCED else "default"
     check(visibility == expected_visibility, f"{where}: panel_visibility {visibility!r}, expected "
@@ -124,8 +128,12 @@ while not iterator.IsAtEnd():
     vtk_value = list(vtk_value) if isinstance(vtk_value, tuple) else [vtk_value]
     default = pristine.GetProperty(name)
     xml_value = [default.GetElement(i) for i in range(default.GetNumberOfElements())]
-    check([float(v) for v in xml_value] == [float(v) for v in vtk_value],
-          f"{where}: XML default {xml_value}, VTK default {vtk_value}")
+    if name in STRINGS:
+        check([str(v) for v in xml_value] == [str(v) for v in vtk_value],
+              f"{where}: XML default {xml_value}, VTK default {vtk_value}")
+    else:
+        check([float(v) for v in xml_value] == [float(v) for v in vtk_value],
+              f"{where}: XML default {xml_value}, VTK default {vtk_value}")
 
     # Where the filter clamps a scalar, the domain must give the same range, else the panel
     # would accept values the filter silently changes.
