@@ -1004,3 +1004,46 @@ TEST(FilterSun, WithoutTrajectoryTheDirectionGoesFromPathStartToPathEnd)
   filter->SetPathStart(0, 0, 0);
   expectError(filter, "direction 0 towards the light is (0, 0, 0)");
 }
+
+TEST(FilterSun, NoSurfaceFacingTheSunIsDarkWithAWarning)
+{
+  // The sun below a one-sided ground: all zero, with a warning, not an error.
+  auto filter = sunFilter(ground(), trajectoryPolyData({ { 0, 0.2, -1 }, { 0.3, 0, -1 } }), 20000);
+  filter->TwoSidedOff();
+  const FilterRun r = run(filter);
+  ASSERT_TRUE(r.succeeded) << r.messages->allErrors();
+  EXPECT_NE(r.messages->allWarnings().find("face away"), std::string::npos)
+    << r.messages->allWarnings();
+  EXPECT_GT(r.cells[0], 0);
+  EXPECT_EQ(maxValue(cellValues(filter->GetOutput(), "Radiosity")), 0.0);
+}
+
+TEST(FilterRigs, LightOffInEveryFrameIsDarkWithAWarning)
+{
+  for (bool directional : { false, true })
+  {
+    SCOPED_TRACE(directional ? "directional" : "area");
+    vtkSmartPointer<vtkMovingLightRadiosity> filter;
+    if (directional)
+    {
+      auto directions = trajectoryPolyData({ { 0, 0.2, 1 }, { 0.3, 0, 1 } });
+      addPointArray(directions, "Power", 1, { 0, 0 });
+      filter = sunFilter(ground(), directions, 20000);
+    }
+    else
+    {
+      BoxSetup setup = closedBoxSetup(3);
+      addPointArray(setup.trajectory, "Power", 1, { 0, 0, 0 });
+      filter = boxFilter(setup);
+    }
+    const FilterRun r = run(filter);
+    ASSERT_TRUE(r.succeeded) << r.messages->allErrors();
+    EXPECT_NE(r.messages->allWarnings().find("off in every frame"), std::string::npos)
+      << r.messages->allWarnings();
+    for (const auto& frame : everyFrame(filter, "Radiosity"))
+    {
+      ASSERT_FALSE(frame.empty());
+      EXPECT_EQ(maxValue(frame), 0.0);
+    }
+  }
+}
