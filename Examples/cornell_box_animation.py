@@ -21,15 +21,15 @@ DIR defaults to output/paraview. The plugin defaults to the one built in build/ 
 $MLR_BUILD_DIR); a plugin already loaded through PV_PLUGIN_PATH is used as it is.
 """
 import argparse
-import ctypes
-import glob
 import math
 import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PLUGIN_NAME = "MovingLightRadiosity"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import example_support  # noqa: E402
+
+ROOT = example_support.ROOT
 
 
 def parse_arguments():
@@ -61,50 +61,14 @@ def parse_arguments():
     return args, parser
 
 
-def default_plugin():
-    """The plugin in the build tree: <build>/<libdir>/paraview-5.11/plugins/<Name>/<Name>.so."""
-    build = os.environ.get("MLR_BUILD_DIR", os.path.join(ROOT, "build"))
-    found = sorted(glob.glob(os.path.join(build, "lib*", "**", PLUGIN_NAME, PLUGIN_NAME + ".so"),
-                             recursive=True))
-    return found[0] if found else None
-
-
-def hold_x_display():
-    """Keeps one connection to the X server open for the whole run. ParaView connects to X,
-    disconnects and connects again to render; an Xvfb server (xvfb-run) resets when its last
-    client leaves and drops a connection arriving meanwhile, and pvpython then aborts with
-    "bad X server connection" now and then. A client that stays prevents the reset."""
-    if not os.environ.get("DISPLAY"):
-        return None
-    try:
-        xlib = ctypes.CDLL("libX11.so.6")
-    except OSError:
-        return None
-    xlib.XOpenDisplay.restype = ctypes.c_void_p
-    xlib.XOpenDisplay.argtypes = [ctypes.c_char_p]
-    return xlib.XOpenDisplay(None)
-
-
 args, parser = parse_arguments()
-if not os.environ.get("DISPLAY"):
-    # Checked first: Debian's ParaView renders through X only and would abort at the first
-    # picture, after the whole solve.
-    parser.error("no X display (DISPLAY is not set): run it as "
-                 "xvfb-run -a pvpython Examples/cornell_box_animation.py ...")
-x_connection = hold_x_display()
+x_connection = example_support.require_display(parser, "Examples/cornell_box_animation.py")
 
 # Only now: importing paraview.simple starts ParaView, which --help need not wait for.
 import paraview.simple as pv  # noqa: E402
 
-if not hasattr(pv, PLUGIN_NAME):
-    plugin = args.plugin or default_plugin()
-    if not plugin or not os.path.isfile(plugin):
-        parser.error(f"no plugin {plugin or PLUGIN_NAME + '.so'}: build the project "
-                     f"(cmake --build build) or give --plugin PATH")
-    pv.LoadPlugin(plugin, remote=False)  # adds the filter to paraview.simple
-    if not hasattr(pv, PLUGIN_NAME):
-        sys.exit(f"{plugin} loaded, but it does not provide the {PLUGIN_NAME} filter")
-MovingLightRadiosity = getattr(pv, PLUGIN_NAME)
+example_support.load_plugin(pv, parser, args.plugin)  # adds the filter to paraview.simple
+MovingLightRadiosity = getattr(pv, example_support.PLUGIN_NAME)
 
 # --- The pipeline, as built in the GUI ------------------------------------------------------
 scene = pv.XMLPolyDataReader(registrationName="cornell_box.vtp",

@@ -1,0 +1,55 @@
+"""What the ParaView examples share: finding and loading the plugin, and holding the X display.
+
+Run the examples with pvpython on an X display (xvfb-run -a pvpython ... without one).
+"""
+import ctypes
+import glob
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PLUGIN_NAME = "MovingLightRadiosity"
+
+
+def default_plugin():
+    """The plugin in the build tree: <build>/<libdir>/paraview-5.11/plugins/<Name>/<Name>.so."""
+    build = os.environ.get("MLR_BUILD_DIR", os.path.join(ROOT, "build"))
+    found = sorted(glob.glob(os.path.join(build, "lib*", "**", PLUGIN_NAME, PLUGIN_NAME + ".so"),
+                             recursive=True))
+    return found[0] if found else None
+
+
+def hold_x_display():
+    """Keeps one connection to the X server open for the whole run. ParaView connects to X,
+    disconnects and connects again to render; an Xvfb server (xvfb-run) resets when its last
+    client leaves and drops a connection arriving meanwhile, and pvpython then aborts with
+    "bad X server connection" now and then. A client that stays prevents the reset."""
+    if not os.environ.get("DISPLAY"):
+        return None
+    try:
+        xlib = ctypes.CDLL("libX11.so.6")
+    except OSError:
+        return None
+    xlib.XOpenDisplay.restype = ctypes.c_void_p
+    xlib.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    return xlib.XOpenDisplay(None)
+
+
+def require_display(parser, script):
+    """Debian's ParaView renders through X only and would abort at the first picture, after
+    the whole solve: refuse to start without a display."""
+    if not os.environ.get("DISPLAY"):
+        parser.error(f"no X display (DISPLAY is not set): run it as xvfb-run -a pvpython {script} ...")
+    return hold_x_display()
+
+
+def load_plugin(pv, parser, plugin=None):
+    """Loads the plugin into paraview.simple unless PV_PLUGIN_PATH already did."""
+    if not hasattr(pv, PLUGIN_NAME):
+        plugin = plugin or default_plugin()
+        if not plugin or not os.path.isfile(plugin):
+            parser.error(f"no plugin {plugin or PLUGIN_NAME + '.so'}: build the project "
+                         f"(cmake --build build) or give --plugin PATH")
+        pv.LoadPlugin(plugin, remote=False)
+        if not hasattr(pv, PLUGIN_NAME):
+            sys.exit(f"{plugin} loaded, but it does not provide the {PLUGIN_NAME} filter")
