@@ -1,0 +1,533 @@
+#include "RigBenchmarks.h"
+
+#include "Error.h"
+#include "GeneratedScenes.h"
+#include "Solver.h"
+#include "SunPath.h"
+#include "TownScenes.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+namespace mlr::bench
+{
+namespace
+{
+
+// Bump when the solver's output for the same inputs changes, so that cached references go
+// stale (the cache key covers the inputs and options, not the solver's code).
+constexpr std::uint64_t ReferenceVersion = 1;
+constexpr std::uint64_t ReferenceSeed = 12345;
+constexpr char CacheMagic[8] = { 'M', 'L', 'R', 'R', 'E', 'F', '1', '\n' };
+
+/// FNV-1a over the inputs a reference depends on: its cache key.
+class Hasher
+{
+public:
+  void bytes(const void* data, std::size_t size)
+  {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i)
+    {
+      this->Value = (this->Value ^ p[i]) * 1099511628211ULL;
+    }
+  }
+  void number(double v) { this->bytes(&v, sizeof v); }
+  void count(std::uint64_t v) { this->bytes(&v, sizeof v); }
+  void vec(const Vec3& v)
+  {
+    this->number(v.x);
+    this->number(v.y);
+    this->number(v.z);
+  }
+  void rgb(const Rgb& c)
+  {
+    this->number(c.r);
+    this->number(c.g);
+    this->number(c.b);
+  }
+  std::uint64_t value() const { return this->Value; }
+
+private:
+  std::uint64_t Value = 14695981039346656037ULL;
+};
+
+std::uint64_t referenceKey(const std::string& name, const PatchMesh& mesh, const LightRig& rig,
+  const SolverOptions& options)
+{
+  Hasher h;
+  h.count(ReferenceVersion);
+  h.bytes(name.data(), name.size());
+  for (const Vec3& p : mesh.points)
+  {
+    h.vec(p);
+  }
+  for (const Triangle& t : mesh.triangles)
+  {
+    h.bytes(t.data(), sizeof(t));
+  }
+  for (const Rgb& c : mesh.reflectance)
+  {
+    h.rgb(c);
+  }
+  for (const MovingLight& light : rig.areaLights)
+  {
+    for (const auto& polygon : light.polygons())
+    {
+      h.count(polygon.size());
+      for (const Vec3& p : polygon)
+      {
+        h.vec(p);
+      }
+    }
+    h.rgb(light.power());
+    for (const LightPose& pose : light.poses())
+    {
+      h.vec(pose.position);
+      h.vec(pose.rotation.row0);
+      h.vec(pose.rotation.row1);
+      h.vec(pose.rotation.row2);
+      h.rgb(pose.power);
+    }
+  }
+  for (const DirectionalLight& light : rig.directionalLights)
+  {
+    h.rgb(light.irradiance());
+    for (std::size_t f = 0; f < light.frameCount(); ++f)
+    {
+      h.vec(light.direction(f));
+      h.rgb(light.powerFactor(f));
+    }
+  }
+  h.count(options.pathsPerFrame);
+  h.number(options.gatheringRatio);
+  h.number(options.firstBounceSurvival);
+  h.count(options.seed);
+  h.count(options.twoSided ? 1 : 0);
+  return h.value();
+}
+
+/// A classic solution at many paths: the lit side's total radiosity of every element and frame.
+struct Reference
+{
+  std::uint64_t frames = 0, elements = 0, paths = 0;
+  double seconds = 0; ///< what the solve took when it was computed
+  bool cached = false;
+  std::string file;
+  std::vector<std::uint8_t> litSide;
+  std::vector<double> radiosity; ///< [frame][element][channel]
+
+  double at(std::size_t frame, std::size_t element, int channel) const
+  {
+    return this->radiosity[(frame * this->elements + element) * 3 + static_cast<std::size_t>(channel)];
+  }
+};
+
+template <typename T>
+bool readValues(std::ifstream& in, T* data, std::size_t count)
+{
+  in.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(T)));
+  return static_cast<bool>(in);
+}
+
+bool loadReference(const std::string& file, std::uint64_t key, std::size_t frames,
+  std::size_t elements, Reference& ref)
+{
+  std::ifstream in(file, std::ios::binary);
+  char magic[8];
+  std::uint64_t header[4]; // key, frames, elements, paths
+  if (!in || !readValues(in, magic, 8) || std::memcmp(magic, CacheMagic, 8) != 0 ||
+    !readValues(in, header, 4) || header[0] != key || header[1] != frames || header[2] != elements ||
+    !readValues(in, &ref.seconds, 1))
+  {
+    return false;
+  }
+  ref.frames = frames;
+  ref.elements = elements;
+  ref.paths = header[3];
+  ref.litSide.resize(elements);
+  ref.radiosity.resize(frames * elements * 3);
+  return readValues(in, ref.litSide.data(), elements) &&
+    readValues(in, ref.radiosity.data(), ref.radiosity.size());
+}
+
+/// Writes under a temporary name and renames, so that a cache file is never half written.
+void storeReference(const std::string& file, std::uint64_t key, const Reference& ref)
+{
+  const std::filesystem::path path(file);
+  std::filesystem::create_directories(path.parent_path());
+  const std::string partial = file + ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    const std::uint64_t header[4] = { key, ref.frames, ref.elements, ref.paths };
+    out.write(CacheMagic, 8);
+    out.write(reinterpret_cast<const char*>(header), sizeof header);
+    out.write(reinterpret_cast<const char*>(&ref.seconds), sizeof ref.seconds);
+    out.write(reinterpret_cast<const char*>(ref.litSide.data()), static_cast<std::streamsize>(ref.litSide.size()));
+    out.write(reinterpret_cast<const char*>(ref.radiosity.data()),
+      static_cast<std::streamsize>(ref.radiosity.size() * sizeof(double)));
+    if (!out)
+    {
+      throw Error("cannot write the reference cache " + partial + ": pass --cache DIR with a "
+                  "writable folder, or --cache '' to keep no cache");
+    }
+  }
+  std::filesystem::rename(partial, path);
+}
+
+/// Classic at referenceFactor x N with its own seed, from the cache when it holds it.
+Reference referenceSolution(const std::string& name, const PatchMesh& mesh, const Scene& scene,
+  const LightRig& rig, const SolverOptions& base, const RigCaseOptions& caseOptions)
+{
+  SolverOptions o = base;
+  o.pathsPerFrame = base.pathsPerFrame * static_cast<std::uint64_t>(caseOptions.referenceFactor);
+  o.reuseShooting = false;
+  o.reuseGathering = false;
+  o.seed = ReferenceSeed;
+  const std::size_t frames = frameCount(rig, scene.hasEmission());
+  const std::uint64_t key = referenceKey(name, mesh, rig, o);
+  Reference ref;
+  if (!caseOptions.cacheDirectory.empty())
+  {
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(key));
+    ref.file = (std::filesystem::path(caseOptions.cacheDirectory) / (name + "-" + hex + ".bin")).string();
+    if (loadReference(ref.file, key, frames, scene.elementCount(), ref))
+    {
+      ref.cached = true;
+      std::printf("Reference: classic, %llu paths per frame (%dx N), seed %llu: cached in %s "
+                  "(computed in %.1f s)\n",
+        static_cast<unsigned long long>(ref.paths), caseOptions.referenceFactor,
+        static_cast<unsigned long long>(ReferenceSeed), ref.file.c_str(), ref.seconds);
+      return ref;
+    }
+  }
+  std::printf("Reference: classic, %llu paths per frame (%dx N), seed %llu ...\n",
+    static_cast<unsigned long long>(o.pathsPerFrame), caseOptions.referenceFactor,
+    static_cast<unsigned long long>(ReferenceSeed));
+  std::fflush(stdout);
+  const Solution s = solve(scene, rig, o);
+  ref.frames = frames;
+  ref.elements = scene.elementCount();
+  ref.paths = o.pathsPerFrame;
+  ref.seconds = s.statistics.secondsTotal;
+  ref.litSide.resize(ref.elements);
+  ref.radiosity.resize(frames * ref.elements * 3);
+  for (std::size_t e = 0; e < ref.elements; ++e)
+  {
+    const Side side = s.litSide(e);
+    ref.litSide[e] = static_cast<std::uint8_t>(side);
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      const Rgb b = s.total(f, e, side);
+      for (int c = 0; c < 3; ++c)
+      {
+        ref.radiosity[(f * ref.elements + e) * 3 + static_cast<std::size_t>(c)] = b[c];
+      }
+    }
+  }
+  std::printf("           computed in %.1f s%s%s\n", ref.seconds,
+    ref.file.empty() ? "" : ", cached in ", ref.file.c_str());
+  if (!ref.file.empty())
+  {
+    storeReference(ref.file, key, ref);
+  }
+  return ref;
+}
+
+/// Area-weighted mean over elements and channels of (B - B_ref)^2 in `frame`, on the
+/// reference's lit sides (as the paper benchmark measures).
+double meanSquaredError(const Scene& scene, const Solution& s, const Reference& ref, std::size_t frame)
+{
+  double sum = 0, area = 0;
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    const Rgb b = s.total(frame, e, static_cast<Side>(ref.litSide[e]));
+    double squared = 0;
+    for (int c = 0; c < 3; ++c)
+    {
+      const double d = b[c] - ref.at(frame, e, c);
+      squared += d * d;
+    }
+    sum += scene.elementArea(e) * squared / 3;
+    area += scene.elementArea(e);
+  }
+  return sum / area;
+}
+
+/// The reference's area-weighted mean radiosity in `frame` (over channels): the scale of the error.
+double meanRadiosity(const Scene& scene, const Reference& ref, std::size_t frame)
+{
+  double sum = 0, area = 0;
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    sum += scene.elementArea(e) * (ref.at(frame, e, 0) + ref.at(frame, e, 1) + ref.at(frame, e, 2)) / 3;
+    area += scene.elementArea(e);
+  }
+  return sum / area;
+}
+
+struct ModeRun
+{
+  std::string name;
+  SolverStatistics stats;
+  std::vector<double> mse; ///< at each reported frame
+  double meanMse = 0;      ///< over all frames
+  int repeats = 1;
+};
+
+/// Solves in one mode; a solve under 3 s is timed as the median of three (same rays, same result).
+ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig,
+  SolverOptions o, bool reuse, const Reference& ref, const std::vector<std::size_t>& frames)
+{
+  o.reuseShooting = reuse;
+  o.reuseGathering = reuse;
+  ModeRun run;
+  run.name = name;
+  const Solution s = solve(scene, rig, o);
+  std::vector<SolverStatistics> timings = { s.statistics };
+  if (s.statistics.secondsTotal < 3.0)
+  {
+    timings.push_back(solve(scene, rig, o).statistics);
+    timings.push_back(solve(scene, rig, o).statistics);
+    std::sort(timings.begin(), timings.end(),
+      [](const SolverStatistics& a, const SolverStatistics& b) { return a.secondsTotal < b.secondsTotal; });
+  }
+  run.stats = timings[timings.size() / 2];
+  run.repeats = static_cast<int>(timings.size());
+  for (std::size_t f : frames)
+  {
+    run.mse.push_back(meanSquaredError(scene, s, ref, f));
+  }
+  for (std::size_t f = 0; f < ref.frames; ++f)
+  {
+    run.meanMse += meanSquaredError(scene, s, ref, f) / double(ref.frames);
+  }
+  return run;
+}
+
+/// The table and ratios both cases print, and their JSON.
+std::string report(const std::string& title, const Scene& scene, std::size_t frames,
+  const SolverOptions& options, const Reference& ref, const std::vector<std::size_t>& at,
+  const std::vector<std::string>& labels, const ModeRun& classic, const ModeRun& full,
+  const std::string& extraJson)
+{
+  std::printf("\n%-12s %8s %8s %8s %8s %12s %12s %12s", "mode", "total s", "s/frame", "shoot s",
+    "gather s", "nearest-hit", "shadow", "gathering");
+  for (const std::string& label : labels)
+  {
+    std::printf(" %14s", ("MSE " + label).c_str());
+  }
+  std::printf(" %14s\n", "MSE mean");
+  for (const ModeRun* m : { &classic, &full })
+  {
+    const SolverStatistics& s = m->stats;
+    std::printf("%-12s %8.2f %8.3f %8.2f %8.2f %12llu %12llu %12llu", m->name.c_str(),
+      s.secondsTotal, s.secondsTotal / double(frames), s.secondsShooting, s.secondsGathering,
+      static_cast<unsigned long long>(s.shootingRays), static_cast<unsigned long long>(s.shadowRays),
+      static_cast<unsigned long long>(s.gatheringRays));
+    for (double e : m->mse)
+    {
+      std::printf(" %14.4g", e);
+    }
+    std::printf(" %14.4g\n", m->meanMse);
+  }
+  std::printf("%-12s %8s %8s %8s %8s %12s %12s %12s", "reference", "", "", "", "", "", "", "");
+  for (std::size_t f : at)
+  {
+    char text[32];
+    std::snprintf(text, sizeof text, "mean B %.3g", meanRadiosity(scene, ref, f));
+    std::printf(" %14s", text);
+  }
+  std::printf("\n");
+
+  const double speedup = classic.stats.secondsTotal / full.stats.secondsTotal;
+  std::printf("\n%s: full reuse is %.2fx faster than classic (%.2f s against %.2f s; %.3f s "
+              "against %.3f s per frame).\n",
+    title.c_str(), speedup, full.stats.secondsTotal, classic.stats.secondsTotal,
+    full.stats.secondsTotal / double(frames), classic.stats.secondsTotal / double(frames));
+  std::printf("MSE of full reuse / classic:");
+  for (std::size_t i = 0; i < at.size(); ++i)
+  {
+    std::printf(" %s %.2f%s", labels[i].c_str(), full.mse[i] / classic.mse[i], i + 1 < at.size() ? ";" : "");
+  }
+  std::printf("; mean over frames %.2f.\nTime x MSE gain of full reuse:", full.meanMse / classic.meanMse);
+  for (std::size_t i = 0; i < at.size(); ++i)
+  {
+    std::printf(" %s %.1fx%s", labels[i].c_str(),
+      speedup * classic.mse[i] / full.mse[i], i + 1 < at.size() ? ";" : ".\n");
+  }
+  std::printf("MSE in (W/m^2)^2 against the reference, on its lit sides, area-weighted; it "
+              "includes the reference's own error (about 1/%d of classic's). Solves under 3 s "
+              "show the median time of 3 runs.\n",
+    ref.paths / options.pathsPerFrame > 0 ? int(ref.paths / options.pathsPerFrame) : 1);
+
+  std::ostringstream json;
+  json << "{\n    \"patches\": " << scene.patchCount() << ", \"elements\": " << scene.elementCount()
+       << ", \"frames\": " << frames << ",\n    \"paths_per_frame\": " << options.pathsPerFrame
+       << ", \"k\": " << options.gatheringRatio << ", \"lambda\": " << options.firstBounceSurvival
+       << ",\n    \"reference_paths_per_frame\": " << ref.paths << ", \"reference_seconds\": "
+       << ref.seconds << ", \"reference_cached\": " << (ref.cached ? "true" : "false")
+       << ",\n    \"threads\": " << classic.stats.threads << ", \"speedup\": " << speedup
+       << ",\n    \"frames_reported\": [";
+  for (std::size_t i = 0; i < at.size(); ++i)
+  {
+    json << (i ? ", " : "") << "{\"frame\": " << at[i] + 1 << ", \"label\": \"" << labels[i]
+         << "\", \"reference_mean_radiosity\": " << meanRadiosity(scene, ref, at[i]) << "}";
+  }
+  json << "],\n    \"modes\": [\n";
+  for (const ModeRun* m : { &classic, &full })
+  {
+    const SolverStatistics& s = m->stats;
+    json << "      {\"name\": \"" << m->name << "\", \"seconds\": " << s.secondsTotal
+         << ", \"seconds_shooting\": " << s.secondsShooting << ", \"seconds_gathering\": "
+         << s.secondsGathering << ", \"nearest_hit_rays\": " << s.shootingRays
+         << ", \"shadow_rays\": " << s.shadowRays << ", \"gathering_rays\": " << s.gatheringRays
+         << ", \"mse\": [";
+    for (std::size_t i = 0; i < m->mse.size(); ++i)
+    {
+      json << (i ? ", " : "") << m->mse[i];
+    }
+    json << "], \"mse_mean\": " << m->meanMse << "}" << (m == &classic ? ",\n" : "\n");
+  }
+  json << "    ]" << extraJson << "\n  }";
+  return json.str();
+}
+
+SolverOptions paperOptions(const RigCaseOptions& c)
+{
+  SolverOptions o;
+  o.pathsPerFrame = c.paths;
+  o.threads = c.threads;
+  o.gatheringRatio = 1;
+  o.firstBounceSurvival = 0.25;
+  o.seed = 1;
+  return o;
+}
+
+void checkOptions(const RigCaseOptions& c)
+{
+  if (c.referenceFactor < 1)
+  {
+    throw Error("--reference-factor must be at least 1");
+  }
+}
+
+} // namespace
+
+std::string runTurningLight(const RigCaseOptions& c)
+{
+  checkOptions(c);
+  if (c.frames < 2)
+  {
+    throw Error("the turning light needs at least 2 frames (--frames)");
+  }
+  const scenes::PaperRoom room = scenes::paperScaleRoom(1);
+  const Scene scene = Scene::fromPatchMesh(room.mesh);
+  // At the room's centre, low enough that the turned square (half side 0.575 m, so +-0.41 m
+  // at 45 degrees) stays clear of the ceiling at 5.5 m.
+  const Vec3 centre(2.75, 2.75, 4.8);
+  const double halfTurn = 45.0 * M_PI / 180.0;
+  std::vector<LightPose> poses;
+  for (std::size_t k = 0; k < c.frames; ++k)
+  {
+    // About +y by theta from +45 to -45 degrees: the normal (-sin theta, 0, -cos theta) goes
+    // from down towards -x (the red wall) to down towards +x (the green wall).
+    const double theta = halfTurn - 2 * halfTurn * double(k) / double(c.frames - 1);
+    LightPose pose;
+    pose.position = centre;
+    pose.rotation = Rotation::fromQuaternion(std::cos(theta / 2), 0, std::sin(theta / 2), 0);
+    poses.push_back(pose);
+  }
+  LightRig rig;
+  rig.areaLights.emplace_back(scenes::squareLightFacingDown(centre, 1.15), Rgb(100, 100, 100), poses);
+  const SolverOptions options = paperOptions(c);
+
+  std::printf("\n=== Turning light (issue 12) ===\nPaper-scale room: %zu patches, %zu elements; a "
+              "1.15 m square light (100 W) fixed at (2.75, 2.75, 4.8) turning 90 degrees about y "
+              "over %zu frames (facing 45 degrees towards -x, then towards +x); N = %llu, k = %g, "
+              "lambda = %g\n",
+    scene.patchCount(), scene.elementCount(), c.frames,
+    static_cast<unsigned long long>(options.pathsPerFrame), options.gatheringRatio,
+    options.firstBounceSurvival);
+  const Reference ref = referenceSolution("turning-light", room.mesh, scene, rig, options, c);
+  const std::vector<std::size_t> at = { c.frames / 2, c.frames - 1 };
+  const std::vector<std::string> labels = { "frame " + std::to_string(at[0] + 1),
+    "frame " + std::to_string(at[1] + 1) };
+  const ModeRun classic = runMode("classic", scene, rig, options, false, ref, at);
+  const ModeRun full = runMode("full reuse", scene, rig, options, true, ref, at);
+  return report("Turning light", scene, c.frames, options, ref, at, labels, classic, full, "");
+}
+
+std::string runSunOverTown(const RigCaseOptions& c)
+{
+  checkOptions(c);
+  const scenes::TownBlock town = scenes::townBlock();
+  const Scene scene = Scene::fromPatchMesh(town.mesh);
+  SunPathRequest request;
+  request.latitude = 48.85;
+  request.longitude = 2.35;
+  request.year = 2024;
+  request.month = 6;
+  request.day = 21;
+  request.startHour = 8;
+  request.endHour = 19.75;
+  request.stepMinutes = 15;
+  request.timeZoneHours = 2;
+  request.north = town.north;
+  request.up = town.up;
+  const std::vector<SunPosition> sun = sunPath(request);
+  std::vector<Vec3> directions;
+  std::size_t highest = 0;
+  for (std::size_t f = 0; f < sun.size(); ++f)
+  {
+    if (sun[f].elevationDegrees <= 0)
+    {
+      throw Error("the sun benchmark expects daytime frames only");
+    }
+    directions.push_back(sun[f].direction);
+    highest = sun[f].elevationDegrees > sun[highest].elevationDegrees ? f : highest;
+  }
+  LightRig rig;
+  rig.directionalLights.emplace_back(directions, Rgb(1000, 1000, 1000));
+  const SolverOptions options = paperOptions(c);
+
+  auto clock = [&](std::size_t f) {
+    const int minutes = static_cast<int>(std::lround(sun[f].clockHours * 60));
+    char text[8];
+    std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);
+    return std::string(text);
+  };
+  std::printf("\n=== Sun over a town block (issue 14) ===\nTown block: %zu buildings, %zu patches "
+              "(%zu ground), %zu elements; %zu sun positions on 2024-06-21 at 48.85 N, 2.35 E, "
+              "%s to %s (UTC+2) every 15 min, sun elevation %.1f, %.1f (highest, %s) and %.1f "
+              "degrees; E = 1000 W/m^2; N = %llu, k = %g, lambda = %g\n",
+    town.buildings.size(), scene.patchCount(), town.groundPatches, scene.elementCount(), sun.size(),
+    clock(0).c_str(), clock(sun.size() - 1).c_str(), sun.front().elevationDegrees,
+    sun[highest].elevationDegrees, clock(highest).c_str(), sun.back().elevationDegrees,
+    static_cast<unsigned long long>(options.pathsPerFrame), options.gatheringRatio,
+    options.firstBounceSurvival);
+  const Reference ref = referenceSolution("sun-town", town.mesh, scene, rig, options, c);
+  const std::vector<std::size_t> at = { 0, highest, sun.size() - 1 };
+  const std::vector<std::string> labels = { clock(0), clock(highest), clock(sun.size() - 1) };
+  const ModeRun classic = runMode("classic", scene, rig, options, false, ref, at);
+  const ModeRun full = runMode("full reuse", scene, rig, options, true, ref, at);
+  std::ostringstream extra;
+  extra << ",\n    \"sun_elevation_degrees\": [";
+  for (std::size_t f = 0; f < sun.size(); ++f)
+  {
+    extra << (f ? ", " : "") << sun[f].elevationDegrees;
+  }
+  extra << "]";
+  return report("Sun over the town block", scene, sun.size(), options, ref, at, labels, classic,
+    full, extra.str());
+}
+
+} // namespace mlr::bench

@@ -1,0 +1,38 @@
+// mlr-benchmark's light-rig cases: a turning light (issue 12) and the sun over a town block
+// (issue 14), each full reuse against classic with errors against a high-N classic reference.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace mlr::bench
+{
+
+struct RigCaseOptions
+{
+  std::uint64_t paths = 600000; ///< N, effective paths per frame
+  std::size_t frames = 30;      ///< the turning light's frames
+  int threads = 0;
+  /// The reference is classic with this many times N paths per frame.
+  int referenceFactor = 16;
+  /// Where references are cached between runs; empty: computed in every run, never stored.
+  std::string cacheDirectory = "output/benchmark-cache";
+};
+
+/**
+ * A 1.15 m square light in the paper-scale room, fixed at the room's centre 0.7 m below the
+ * ceiling, turning 90 degrees about the y axis over the frames (facing down towards the red
+ * wall, then down towards the green one). Prints classic and full reuse: seconds, speed-up,
+ * MSE at the middle and last frames. Returns the results as a JSON object.
+ */
+std::string runTurningLight(const RigCaseOptions& options);
+
+/**
+ * The town block of scenes::townBlock() under 48 sun positions (2024-06-21 at 48.85 N,
+ * 2.35 E, 08:00 to 19:45 local time, UTC+2, every 15 minutes: symmetric about solar noon),
+ * E = 1000 W/m^2. Prints classic and full reuse: seconds, seconds per frame, speed-up, MSE
+ * at the first frame, the highest sun and the last frame. Returns the results as JSON.
+ */
+std::string runSunOverTown(const RigCaseOptions& options);
+
+} // namespace mlr::bench
