@@ -41,7 +41,7 @@ run_ctest() {
   record "$name" "$passed" "$failed" $((SECONDS - start))
   if [ "$failed" -gt 0 ]; then
     summaries+=("  failed in $name:")
-    while IFS= read -r line; do summaries+=("  $line"); done \
+    while read -r line; do summaries+=("    $line"); done \
       < <(sed -n '/^The following tests FAILED:/,/^Errors while running/p' "$log" | grep -E '^\s+[0-9]+ - ')
   fi
 }
