@@ -73,9 +73,12 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   {
     remeshProgress = [&](double f) { return progress(RemeshingShare * f); };
   }
+  // Ranks of a distributed solve remesh the same scene alike; they agree before solving, so
+  // that one cancelled or over its memory limit stops them all.
+  Animation animation;
+  agreeAcrossRanks(options.solver, [&] {
   RemeshResult remeshed = remesh(soup, remeshing, remeshProgress);
 
-  Animation animation;
   animation.warnings = std::move(remeshed.warnings);
   animation.remeshing = remeshed.statistics;
   animation.scene = Scene::fromPatchMesh(remeshed.mesh);
@@ -84,6 +87,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver),
                      outputBytes(options, scene.elementCount(), scene.points().size())),
     frames, scene.patchCount(), scene.elementCount(), options.solver);
+  });
+  const Scene& scene = animation.scene;
 
   ProgressCallback solveProgress;
   if (progress)

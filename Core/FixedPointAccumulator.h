@@ -143,6 +143,24 @@ public:
     return false;
   }
 
+  /// Adds every worker's copy into worker 0's and zeroes the others: the sums are unchanged,
+  /// and worker 0's copy (copySize() values) can then be summed over processes as a whole.
+  std::int64_t* collapse()
+  {
+    std::int64_t* first = this->Values.get();
+    for (std::size_t w = 1; w * this->Stride < this->Size; ++w)
+    {
+      std::int64_t* copy = first + w * this->Stride;
+      for (std::size_t i = 0; i < this->Stride; ++i)
+      {
+        first[i] += copy[i];
+        copy[i] = 0;
+      }
+    }
+    return first;
+  }
+  std::size_t copySize() const { return this->Stride; }
+
   static std::uint64_t bytes(int workers, std::size_t records, std::size_t frames)
   {
     return static_cast<std::uint64_t>(workers) * records * 2 * frames * Channels *

@@ -10,9 +10,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <initializer_list>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <unistd.h>
@@ -68,6 +70,57 @@ constexpr std::size_t ReachabilityPatchesPerTask = 64;
 constexpr std::uint64_t ReachabilityProbesPerLight = 16384;
 /// The fixed seed of the reachability probes.
 constexpr std::uint64_t ReachabilitySeed = 0x5eed;
+
+/// A phase shared by several ranks runs in this many rounds, with an agreement between them:
+/// a rank cancelled or failed stops the others within one round, and 32 tiny sums per phase
+/// cost nothing next to the rays.
+constexpr std::size_t RoundsPerPhase = 32;
+
+/**
+ * Runs `tasks` tasks of one phase over this rank's workers. One rank runs them all in one
+ * parallelFor. Several ranks cut the phase into rounds and rank r runs the tasks r, r + R,
+ * r + 2R, ... of each: every task (path block or side block, keyed by its global index) runs
+ * on exactly one rank, and interleaving spreads the dearer light positions over all ranks.
+ * `fraction` gets this rank's share done, in [0, 1].
+ */
+void runOnRanks(std::size_t tasks, int workers, const SolverOptions& options,
+  const std::function<void(std::size_t task, int worker)>& body,
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing)
+{
+  const std::size_t ranks = static_cast<std::size_t>(options.ranks);
+  const std::size_t rank = static_cast<std::size_t>(options.rank);
+  if (ranks <= 1)
+  {
+    parallelFor(tasks, workers, body, [&](std::size_t done) {
+      return fraction(static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1)));
+    });
+    return;
+  }
+  const std::size_t rounds = std::min(RoundsPerPhase, std::max<std::size_t>(tasks, 1));
+  auto mineOf = [&](std::size_t length) { return length > rank ? (length - rank + ranks - 1) / ranks : 0; };
+  std::size_t mineTotal = 0;
+  for (std::size_t q = 0; q < rounds; ++q)
+  {
+    mineTotal += mineOf(tasks * (q + 1) / rounds - tasks * q / rounds);
+  }
+  std::size_t doneBefore = 0;
+  for (std::size_t q = 0; q < rounds; ++q)
+  {
+    const std::size_t begin = tasks * q / rounds;
+    const std::size_t mine = mineOf(tasks * (q + 1) / rounds - begin);
+    agreeAcrossRanks(options,
+      [&] {
+        parallelFor(mine, workers,
+          [&](std::size_t task, int worker) { body(begin + rank + task * ranks, worker); },
+          [&](std::size_t done) {
+            return fraction(static_cast<double>(doneBefore + done) /
+              static_cast<double>(std::max<std::size_t>(mineTotal, 1)));
+          });
+      },
+      &secondsReducing);
+    doneBefore += mine;
+  }
+}
 
 struct alignas(64) WorkerCounters
 {
@@ -245,6 +298,14 @@ public:
   void addTo(Solution& solution) const;
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
+
+  /// Sums the scores over ranks (SolverOptions::sumAcrossRanks): integers, so every rank then
+  /// holds exactly the serial sums, whatever rank and worker traced each path.
+  void sumAcrossRanks()
+  {
+    this->Options.sumAcrossRanks(this->ElementShare.collapse(), this->ElementShare.copySize());
+    this->Options.sumAcrossRanks(this->PatchPower.collapse(), this->PatchPower.copySize());
+  }
 
   /// Which active position path `path` of a reuse solve starts from.
   std::size_t positionOfPath(std::uint64_t path) const
@@ -969,6 +1030,66 @@ void validateOptions(const SolverOptions& options)
     throw Error("the thread count is " + std::to_string(options.threads) +
       ": give 0 (every core) or a count from 1 to 1024");
   }
+  if (options.ranks < 1 || options.rank < 0 || options.rank >= options.ranks)
+  {
+    throw Error("rank " + std::to_string(options.rank) + " of " + std::to_string(options.ranks) +
+      " ranks: give 1 rank or more, and a rank from 0 to ranks - 1");
+  }
+  if (options.ranks > 1 && (!options.sumAcrossRanks || !options.sumDoublesAcrossRanks))
+  {
+    throw Error("a solve over " + std::to_string(options.ranks) +
+      " ranks needs the sums over ranks (SolverOptions::sumAcrossRanks and "
+      "sumDoublesAcrossRanks)");
+  }
+}
+
+void agreeAcrossRanks(
+  const SolverOptions& options, const std::function<void()>& phase, double* secondsAgreeing)
+{
+  if (options.ranks <= 1)
+  {
+    phase();
+    return;
+  }
+  if (!options.sumAcrossRanks)
+  {
+    throw Error("a solve over several ranks needs SolverOptions::sumAcrossRanks");
+  }
+  std::exception_ptr failure;
+  std::int64_t status[2] = { 0, 0 }; // ranks cancelled, ranks failed
+  try
+  {
+    phase();
+  }
+  catch (const Cancelled&)
+  {
+    failure = std::current_exception();
+    status[0] = 1;
+  }
+  catch (...)
+  {
+    failure = std::current_exception();
+    status[1] = 1;
+  }
+  const auto start = Clock::now();
+  options.sumAcrossRanks(status, 2);
+  if (secondsAgreeing)
+  {
+    *secondsAgreeing += secondsSince(start);
+  }
+  if (failure)
+  {
+    std::rethrow_exception(failure);
+  }
+  if (status[1] > 0)
+  {
+    throw Error("the solve failed on " + std::to_string(status[1]) + " other rank" +
+      (status[1] > 1 ? "s" : "") + " of " + std::to_string(options.ranks));
+  }
+  if (status[0] > 0)
+  {
+    throw Cancelled();
+  }
 }
 
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
@@ -1181,14 +1302,27 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   const ProgressCallback& progress)
 {
   const auto start = Clock::now();
+  // Setup, up to the allocations, is one phase the ranks agree on: a rank over its memory
+  // limit (checked per rank) or cancelled stops every rank here.
+  std::size_t frames = 0;
+  int workers = 1;
+  std::uint64_t memory = 0;
+  std::vector<MovingLight> emitters;
+  std::vector<Source> sources;
+  std::vector<double> shootingCost;
+  double totalCost = 0, reachabilityCost = 0, gatheringCost = 0;
+  std::optional<RayTracer> tracerStorage;
+  Solution solution;
+  double secondsReducing = 0;
+  agreeAcrossRanks(options, [&] {
   validateOptions(options);
-  const std::size_t frames = frameCount(rig, scene.hasEmission());
-  const int workers = resolveThreadCount(options.threads);
-  const std::uint64_t memory = estimateSolveMemory(scene, frames, options);
+  frames = frameCount(rig, scene.hasEmission());
+  workers = resolveThreadCount(options.threads);
+  memory = estimateSolveMemory(scene, frames, options);
   checkSolveMemory(memory, frames, scene.patchCount(), scene.elementCount(), options);
 
-  const std::vector<MovingLight> emitters = sceneEmitters(scene);
-  const std::vector<Source> sources = sourcesOf(scene, rig, emitters);
+  emitters = sceneEmitters(scene);
+  sources = sourcesOf(scene, rig, emitters);
   for (std::size_t i = 0; i < sources.size(); ++i)
   {
     const Source& source = sources[i];
@@ -1211,8 +1345,6 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   // Progress: phases weighted by their expected ray counts.
   const double N = static_cast<double>(options.pathsPerFrame);
   const double lambda = options.firstBounceSurvival;
-  std::vector<double> shootingCost;
-  double totalCost = 0;
   for (const Source& source : sources)
   {
     const double n = static_cast<double>(source.positions);
@@ -1220,26 +1352,17 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     shootingCost.push_back(reuse ? N * (1 + 1.5 * lambda + 0.2 * (n - 1)) : n * N * (1 + 1.5 * lambda));
     totalCost += shootingCost.back();
   }
-  const double reachabilityCost =
-    static_cast<double>(scene.patchCount() * 2 * ReachabilityProbesPerSide);
-  const double gatheringCost =
+  reachabilityCost = static_cast<double>(scene.patchCount() * 2 * ReachabilityProbesPerSide);
+  gatheringCost =
     options.gatheringRatio * N * (options.reuseGathering ? 1.0 : static_cast<double>(frames));
   totalCost += reachabilityCost + gatheringCost;
-  double progressBase = 0;
-  auto phaseTick = [&](double share, std::size_t total) {
-    const double base = progressBase;
-    return [&progress, base, share, total](std::size_t done) {
-      return !progress ||
-        progress(base + share * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)));
-    };
-  };
   if (progress && !progress(0.0))
   {
     throw Cancelled();
   }
 
-  RayTracer tracer(scene);
-  Solution solution(frames, scene.elementCount(), scene.patchCount());
+  tracerStorage.emplace(scene);
+  solution = Solution(frames, scene.elementCount(), scene.patchCount());
   if (scene.hasEmission())
   {
     solution.emissionData().resize(scene.elementCount());
@@ -1248,6 +1371,17 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       solution.emissionData()[e] = scene.elementEmission(e);
     }
   }
+  }, &secondsReducing);
+  const RayTracer& tracer = *tracerStorage;
+  const double N = static_cast<double>(options.pathsPerFrame);
+  const double lambda = options.firstBounceSurvival;
+  double progressBase = 0;
+  auto phaseTick = [&](double share) {
+    const double base = progressBase;
+    return [&progress, base, share](double fraction) {
+      return !progress || progress(base + share * fraction);
+    };
+  };
   SolverStatistics& stats = solution.statistics;
   stats.secondsSetup = secondsSince(start);
 
@@ -1268,7 +1402,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     else if (run.reuses())
     {
       const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
-      parallelFor(tasks, workers,
+      runOnRanks(tasks, workers, options,
         [&](std::size_t task, int worker) {
           const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
           for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
@@ -1276,7 +1410,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
             run.shootReused(p, worker);
           }
         },
-        phaseTick(share, tasks));
+        phaseTick(share), secondsReducing);
       cast = paths;
     }
     else
@@ -1284,7 +1418,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       const std::vector<std::size_t>& positions = run.activePositions();
       const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
       const std::uint64_t tasks = tasksPerFrame * positions.size();
-      parallelFor(tasks, workers,
+      runOnRanks(tasks, workers, options,
         [&](std::size_t task, int worker) {
           const std::size_t position = positions[task / tasksPerFrame];
           const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
@@ -1294,10 +1428,16 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
             run.shootClassic(position, p, worker);
           }
         },
-        phaseTick(share, tasks));
+        phaseTick(share), secondsReducing);
       cast = paths * positions.size();
     }
     progressBase += share;
+    if (options.ranks > 1 && !run.activePositions().empty())
+    {
+      const auto sumStart = Clock::now();
+      run.sumAcrossRanks();
+      secondsReducing += secondsSince(sumStart);
+    }
     run.addTo(solution);
     stats.pathsCast += cast;
     stats.staticPathsCast += source.isStatic() ? cast : 0;
@@ -1320,10 +1460,13 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   {
     const double share = reachabilityCost / totalCost;
     const double base = progressBase;
-    const std::vector<std::uint8_t> reachable = reachableSides(scene, tracer, sources, options,
-      workers,
-      [&](double fraction) { return !progress || progress(base + share * fraction); },
-      stats.reachabilityRays);
+    // Deterministic and cheap: every rank probes every side.
+    std::vector<std::uint8_t> reachable;
+    agreeAcrossRanks(options, [&] {
+      reachable = reachableSides(scene, tracer, sources, options, workers,
+        [&](double fraction) { return !progress || progress(base + share * fraction); },
+        stats.reachabilityRays);
+    }, &secondsReducing);
     progressBase += share;
     stats.reachableSides = static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
     std::uint64_t raysPerSide = 0;
@@ -1333,7 +1476,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
     std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
     const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
-    parallelFor(tasks, workers,
+    runOnRanks(tasks, workers, options,
       [&](std::size_t task, int worker) {
         const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
         for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
@@ -1342,7 +1485,17 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
             sums[static_cast<std::size_t>(worker)], counters[static_cast<std::size_t>(worker)]);
         }
       },
-      phaseTick(1.0 - progressBase, tasks));
+      phaseTick(1.0 - progressBase), secondsReducing);
+    if (options.ranks > 1)
+    {
+      // Each element side gathered on one rank and is exactly zero on the others, so the sum
+      // over ranks is that rank's value, bit for bit.
+      static_assert(sizeof(Rgb) == 3 * sizeof(double), "Rgb is summed as doubles");
+      const auto sumStart = Clock::now();
+      std::vector<Rgb>& indirect = solution.indirectData();
+      options.sumDoublesAcrossRanks(reinterpret_cast<double*>(indirect.data()), 3 * indirect.size());
+      secondsReducing += secondsSince(sumStart);
+    }
     for (const WorkerCounters& c : counters)
     {
       stats.gatheringRays += c.gatheringRays;
@@ -1354,6 +1507,24 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     indirectFromPatches(scene, solution);
   }
   stats.secondsGathering = secondsSince(gatheringStart);
+  if (options.ranks > 1)
+  {
+    // The counters of the rays each rank traced (reachability's are every rank's own).
+    std::int64_t counts[6] = { static_cast<std::int64_t>(stats.shootingRays),
+      static_cast<std::int64_t>(stats.shadowRays), static_cast<std::int64_t>(stats.gatheringRays),
+      static_cast<std::int64_t>(stats.missedRays), static_cast<std::int64_t>(firstHits),
+      static_cast<std::int64_t>(backAbsorbed) };
+    const auto sumStart = Clock::now();
+    options.sumAcrossRanks(counts, 6);
+    secondsReducing += secondsSince(sumStart);
+    stats.shootingRays = static_cast<std::uint64_t>(counts[0]);
+    stats.shadowRays = static_cast<std::uint64_t>(counts[1]);
+    stats.gatheringRays = static_cast<std::uint64_t>(counts[2]);
+    stats.missedRays = static_cast<std::uint64_t>(counts[3]);
+    firstHits = static_cast<std::uint64_t>(counts[4]);
+    backAbsorbed = static_cast<std::uint64_t>(counts[5]);
+  }
+  stats.secondsReducing = secondsReducing;
   chooseLitSides(scene, solution);
 
   stats.frames = frames;

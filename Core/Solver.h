@@ -38,6 +38,17 @@ struct SolverOptions
   /// Refuse solves whose memory estimate exceeds this many bytes; 0 means half of the
   /// physical memory.
   std::uint64_t memoryLimitBytes = 0;
+
+  /// A solve shared by `ranks` processes (MPI ranks of pvbatch or pvserver), this one being
+  /// `rank`. Every rank gives the same scene, rig and options; each traces a disjoint share
+  /// of the shooting paths and gathering sides, keyed by their global index, and the sums are
+  /// added over ranks, so every rank ends with the serial solution, bit for bit.
+  int rank = 0;
+  int ranks = 1;
+  /// Sums `count` values over every rank, in place, on every rank (an MPI AllReduce): every
+  /// rank calls it at the same points of the solve. Required when ranks > 1; Core has no MPI.
+  std::function<void(std::int64_t* values, std::size_t count)> sumAcrossRanks;
+  std::function<void(double* values, std::size_t count)> sumDoublesAcrossRanks;
 };
 
 /// The largest pathsPerFrame accepted: past it a solve would run for months.
@@ -89,6 +100,9 @@ struct SolverStatistics
   double secondsSetup = 0;     ///< validation, allocation and building the BVH
   double secondsShooting = 0;
   double secondsGathering = 0;
+  /// Of shooting and gathering, the time spent in sums over ranks and the agreements
+  /// between phases (waiting for slower ranks included); 0 on one rank.
+  double secondsReducing = 0;
   double secondsTotal = 0;
   std::uint64_t memoryEstimateBytes = 0;
   int threads = 0;
@@ -199,6 +213,18 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
 
 /// Throws mlr::Error naming the first option that is out of range.
 void validateOptions(const SolverOptions& options);
+
+/**
+ * Runs `phase` on this rank and, when options.ranks > 1, agrees with the other ranks on how
+ * it went before any rank goes on (one sum over ranks): when any rank was cancelled or
+ * failed, every rank throws, mlr::Cancelled or mlr::Error (its own exception on the rank
+ * that threw, "failed on another rank" elsewhere), so that no rank is left waiting in a
+ * later sum. Every rank must call it at the same points. With one rank it only runs `phase`.
+ */
+/// `secondsAgreeing`, when given, is increased by the time the agreement took (waiting for
+/// the slowest rank included).
+void agreeAcrossRanks(const SolverOptions& options, const std::function<void()>& phase,
+  double* secondsAgreeing = nullptr);
 
 /**
  * Solves every frame of the animation lit by `rig` and the scene's emissive surfaces.
