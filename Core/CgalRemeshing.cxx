@@ -636,37 +636,65 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     return false; // nothing touches, so nothing lies on a closed surface either
   }
   findEdges(soup, surfaces, poll);
-  const std::vector<std::size_t> set = refinementSet(surfaces, touching);
+  std::vector<std::size_t> set = refinementSet(surfaces, touching);
   std::vector<bool> inSet(soup.triangles.size(), false);
   for (std::size_t i : set)
   {
     inSet[i] = true;
   }
 
-  // The set as a mesh of its own; its first vertices are soup points.
+  // The set as a mesh of its own; its first vertices are soup points. Where the set touches
+  // itself at a point only (a pinch, which a mesh cannot hold), it grows by the triangles
+  // around its points, a few times, and at worst to the whole soup.
   std::vector<std::size_t> localIndex(soup.points.size(), NoOrigin);
   std::vector<std::size_t> globalPoint;
   std::vector<Point> localPoints;
   std::vector<CgalTriangle> localTriangles;
-  for (std::size_t i : set)
+  for (int growth = 0;; ++growth)
   {
-    CgalTriangle local;
-    for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t p : globalPoint)
     {
-      const std::size_t p = soup.triangles[i][k];
-      if (localIndex[p] == NoOrigin)
-      {
-        localIndex[p] = localPoints.size();
-        localPoints.push_back(soup.points[p]);
-        globalPoint.push_back(p);
-      }
-      local[k] = localIndex[p];
+      localIndex[p] = NoOrigin;
     }
-    localTriangles.push_back(local);
-  }
-  if (!PMP::is_polygon_soup_a_polygon_mesh(localTriangles))
-  {
-    throw Error("the triangles around the contacts do not form a manifold surface");
+    globalPoint.clear();
+    localPoints.clear();
+    localTriangles.clear();
+    for (std::size_t i : set)
+    {
+      CgalTriangle local;
+      for (std::size_t k = 0; k < 3; ++k)
+      {
+        const std::size_t p = soup.triangles[i][k];
+        if (localIndex[p] == NoOrigin)
+        {
+          localIndex[p] = localPoints.size();
+          localPoints.push_back(soup.points[p]);
+          globalPoint.push_back(p);
+        }
+        local[k] = localIndex[p];
+      }
+      localTriangles.push_back(local);
+    }
+    poll.check();
+    if (PMP::is_polygon_soup_a_polygon_mesh(localTriangles))
+    {
+      break;
+    }
+    if (set.size() == soup.triangles.size())
+    {
+      throw Error("the triangles around the contacts do not form a manifold surface");
+    }
+    set.clear();
+    for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+    {
+      const CgalTriangle& t = soup.triangles[i];
+      inSet[i] = growth >= 2 || inSet[i] || localIndex[t[0]] != NoOrigin || localIndex[t[1]] != NoOrigin ||
+        localIndex[t[2]] != NoOrigin;
+      if (inSet[i])
+      {
+        set.push_back(i);
+      }
+    }
   }
   Mesh mesh;
   PMP::polygon_soup_to_polygon_mesh(localPoints, localTriangles, mesh);

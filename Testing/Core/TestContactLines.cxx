@@ -295,6 +295,31 @@ TEST(ContactLines, StackedBlocksLoseBothContactFaces)
   EXPECT_NEAR(totalArea(result.mesh), 6 + 6 * 0.25 - 2 * 0.25, 0.005 * 7);
 }
 
+TEST(ContactLines, ContactsOnOppositeTrianglesOfAFanAreSplit)
+{
+  // A floor of 8 triangles around one point, and two small blocks on two opposite triangles:
+  // those triangles and their neighbours meet at the centre only, which a mesh cannot hold
+  // unless the triangles between them join in.
+  PolygonSoup soup;
+  soup.points.push_back({ 0, 0, 0 });
+  for (int k = 0; k < 8; ++k)
+  {
+    soup.points.push_back({ std::cos(k * Pi / 4), std::sin(k * Pi / 4), 0 });
+  }
+  for (std::uint32_t k = 0; k < 8; ++k)
+  {
+    soup.polygons.push_back({ 0, 1 + k, 1 + (k + 1) % 8 });
+    soup.materials.push_back(Material{ FloorRho });
+  }
+  const Vec3 centre{ 0.6 * std::cos(Pi / 8), 0.6 * std::sin(Pi / 8), 0 }, half{ 0.025, 0.025, 0 };
+  append(soup, boxOfQuads(centre - half, centre + half + Vec3{ 0, 0, 0.05 }, { BlockRho }));
+  append(soup, boxOfQuads(-1.0 * centre - half, -1.0 * centre + half + Vec3{ 0, 0, 0.05 }, { BlockRho }));
+  const RemeshResult result = remesh(soup, withEdgeLength(0.05));
+  EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
+  EXPECT_GE(result.statistics.contactSplitTriangles, 2u);
+  EXPECT_NEAR(result.statistics.coveredArea, 2 * 0.05 * 0.05, 1e-12);
+}
+
 TEST(ContactLines, SceneWithoutContactsIsUnchangedBySplitting)
 {
   const PolygonSoup box = boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) });
