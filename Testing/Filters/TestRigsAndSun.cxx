@@ -495,6 +495,8 @@ TEST(FilterRigs, OnePointPolylineIsAStaticLight)
   EXPECT_GT(maxValue(frames[0]), 0.0);
   EXPECT_EQ(relativeDifference(frames[1], frames[0]), 0.0);
   EXPECT_EQ(relativeDifference(frames[2], frames[0]), 0.0);
+  // It is cast once for all frames, not once per frame (light 0, off, casts nothing).
+  EXPECT_EQ(fieldValue(filter->GetOutput(), "PathsCast"), 20000.0);
   // And the Light output shows the static light at its one point in every frame.
   for (double t : timeSteps(filter))
   {
