@@ -298,10 +298,6 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
   return soup;
 }
 
-using TriangleList = std::vector<Kernel::Triangle_3>;
-using TreePrimitive = CGAL::AABB_triangle_primitive<Kernel, TriangleList::const_iterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TreePrimitive>>;
-
 // ---------------------------------------------------------------------------------------
 // Contact lines. Where a surface touches or crosses another (a block standing on a floor, a
 // panel through a wall), a patch on both sides of the line would average the lit side with
@@ -310,6 +306,11 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TreePrimitive>>;
 // lines become remeshing constraints.
 
 constexpr std::size_t NoOrigin = std::numeric_limits<std::size_t>::max();
+
+/// Triangles and their AABB tree, for distances here and projection in remeshing below.
+using TriangleList = std::vector<Kernel::Triangle_3>;
+using TreePrimitive = CGAL::AABB_triangle_primitive<Kernel, TriangleList::const_iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, TreePrimitive>>;
 
 /// Where autorefinement is in the soup, shared by the visitor's copies.
 struct SplitTracking
