@@ -182,11 +182,19 @@ def read_series(directory, collection="out/series.pvd"):
     return [(float(d.get("timestep")), Frame(path.parent / d.get("file"))) for d in datasets]
 
 
+class Series(list):
+    """[(timestep, Frame)], and the run's messages."""
+
+    def __init__(self, frames, stderr):
+        super().__init__(frames)
+        self.stderr = stderr
+
+
 def solve(directory, args, collection="out/series.pvd", paths=PATHS):
     result = run(args + ["--output", collection, "--paths", str(paths), "--threads", "2"],
                  directory)
     assert result.returncode == 0, result.stderr
-    return read_series(directory, collection)
+    return Series(read_series(directory, collection), result.stderr)
 
 
 # --- Closed forms and tolerances -------------------------------------------------------------
@@ -285,6 +293,16 @@ def test_sun_path_is_dark_at_night_and_rho_e_sin_elevation_by_day(tmp_path):
         assert frame.mean("DirectRadiosity", region) == pytest.approx(
             [expected] * 3, rel=sun_tolerance(frame, region, active))
         assert not frame.cells("EmittedRadiosity").any()
+
+
+def test_sun_path_through_the_night_is_dark_with_a_warning(tmp_path):
+    frames = solve(tmp_path, ["--scene", write_town(tmp_path), "--sun-path",
+                              PARIS + ",00:00,02:00,60"])
+    assert "no light reached the scene" in frames.stderr
+    assert [t for t, _ in frames] == [0.0, 1.0, 2.0]
+    for _, frame in frames:
+        assert frame.field("SunElevation") < 0
+        assert not frame.cells("Radiosity").any()
 
 
 def test_sun_path_noon_elevation_matches_the_almanac(tmp_path):
@@ -402,12 +420,15 @@ def test_trajectory_power_normal_and_orientation(tmp_path):
     power = [1.0, 1.0, 0.0, 0.5]
     base = ["--scene", write_floor(tmp_path), "--light", write_lamp(tmp_path)]
     with_normal = write_points(tmp_path / "normal.vtp", points, Normal=normals, Power=power)
+    # Twice the unit quaternion: normalised, with a warning.
     with_orientation = write_points(
         tmp_path / "orientation.vtp", points, Power=power,
-        Orientation=[quaternion_turning((0, 0, -1), n) for n in normals])
+        Orientation=[tuple(2 * c for c in quaternion_turning((0, 0, -1), n)) for n in normals])
     plain = write_points(tmp_path / "plain.vtp", points, Power=power)
     by_normal = solve(tmp_path, base + ["--trajectory", with_normal], "n/s.pvd", paths)
     by_orientation = solve(tmp_path, base + ["--trajectory", with_orientation], "o/s.pvd", paths)
+    assert "4 Orientation quaternions were not of unit length and were normalised" in \
+        by_orientation.stderr
     unturned = solve(tmp_path, base + ["--trajectory", plain], "p/s.pvd", paths)
 
     # Power 0: the light is off, the frame is dark.
@@ -513,6 +534,15 @@ def lamp_path(points, lines=None, lamp_kwargs=None, **arrays):
 
 TWO_LAMPS = {"centres": ((0, 0, 1), (0, 1, 1)), "LightId": [0, 1]}
 
+
+def emissive_scene(emission):
+    def make(directory):
+        scene = Polygons().add(square_z((0, 0, 0), FLOOR_HALF), Emission=(0.0, 0.0, 0.0))
+        scene.add([(1, -1, 0.01), (1, 1, 0.01), (1, 1, 1), (1, -1, 1)], Emission=emission)
+        return ["--scene", scene.write(directory / "emissive.vtp"), "--light",
+                write_lamp(directory), "--from", "0,0,1", "--to", "-1,0,1", "--frames", "2"]
+    return make
+
 BAD = {
     "latitude above 90": (sun_path("91,0,2024-06-21,06:00,08:00,60"), 2,
                           "the latitude is 91"),
@@ -539,6 +569,23 @@ BAD = {
                            1, "the Normal of light position 1 is (0, 0, 0)"),
     "negative power": (lamp_path([(0, 0, 1), (0.5, 0, 1)], Power=[1.0, -0.5]), 1,
                        "point array Power has (-0.5, -0.5, -0.5) at point 1"),
+    "power nan": (lamp_path([(0, 0, 1), (0.5, 0, 1)], Power=[1.0, math.nan]), 1,
+                  "point array Power has (nan, nan, nan) at point 1"),
+    "light id without polyline": (
+        lamp_path([(0, 0, 1), (0.5, 0, 1)], lines=[[0, 1]], lamp_kwargs=TWO_LAMPS), 1,
+        "the Light holds 2 lights (LightId) but the Trajectory has 1 polylines"),
+    "negative emission": (emissive_scene((1.0, -2.0, 0.0)), 1,
+                          "Scene cell 1 has Emission (1, -2, 0) W/m^2"),
+    "sun path and sun directions": (
+        lambda d: paris("--sun-directions", write_points(d / "sun.vtp", [(0, 0, 1)]))(d), 2,
+        "give either --sun-directions FILE or --sun-path ..., not both"),
+    "sun path without a scene": (lambda d: ["--sun-path", PARIS + ",06:00,08:00,60"], 2,
+                                 "the sun needs --scene FILE"),
+    "sun path of three fields": (sun_path("48.85,2.35,2024-06-21"), 2,
+                                 "give LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES"),
+    "time zone without the sun": (
+        lambda d: lamp_path([(0, 0, 1), (0.5, 0, 1)])(d) + ["--time-zone", "2"], 2,
+        "--time-zone, --north and --up need --sun-path"),
     "lights with different point counts": (
         lamp_path([(0, 0, 1), (0.5, 0, 1), (1, 0, 1), (0, 1, 1), (0.5, 1, 1)],
                   lines=[[0, 1, 2], [3, 4]], lamp_kwargs=TWO_LAMPS), 1,
