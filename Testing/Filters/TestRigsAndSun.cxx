@@ -75,6 +75,20 @@ double relativeDifference(const std::vector<double>& a, const std::vector<double
   return scale > 0 ? difference / scale : difference;
 }
 
+/// The largest relativeDifference of Radiosity between the two filters' frames (infinite
+/// when they have different frame counts).
+double frameDifference(vtkMovingLightRadiosity* a, vtkMovingLightRadiosity* b)
+{
+  const auto x = everyFrame(a, "Radiosity");
+  const auto y = everyFrame(b, "Radiosity");
+  double worst = x.size() == y.size() && !x.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  for (std::size_t f = 0; f < std::min(x.size(), y.size()); ++f)
+  {
+    worst = std::max(worst, relativeDifference(x[f], y[f]));
+  }
+  return worst;
+}
+
 double maxValue(const std::vector<double>& values)
 {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
@@ -249,13 +263,7 @@ TEST(FilterRigs, OrientationWinsOverNormal)
   auto both = boxFilter(turnedBox(
     { { "Normal", { -TiltedNormal.x, 0.0, TiltedNormal.z } }, { "Orientation", TiltQuaternion } }));
   auto orientation = boxFilter(turnedBox({ { "Orientation", TiltQuaternion } }));
-  const auto b = everyFrame(both, "Radiosity");
-  const auto o = everyFrame(orientation, "Radiosity");
-  ASSERT_EQ(b.size(), 3u);
-  for (std::size_t f = 0; f < 3; ++f)
-  {
-    EXPECT_EQ(relativeDifference(b[f], o[f]), 0.0) << "frame " << f;
-  }
+  EXPECT_EQ(frameDifference(both, orientation), 0.0);
 }
 
 TEST(FilterRigs, NonUnitQuaternionIsNormalisedWithAWarning)
@@ -273,13 +281,8 @@ TEST(FilterRigs, NonUnitQuaternionIsNormalisedWithAWarning)
   EXPECT_TRUE(unitRun.messages->warnings.empty()) << unitRun.messages->allWarnings();
   EXPECT_NE(scaledRun.messages->allWarnings().find("Orientation"), std::string::npos)
     << scaledRun.messages->allWarnings();
-  const auto a = everyFrame(unit, "Radiosity");
-  const auto b = everyFrame(scaled, "Radiosity");
-  ASSERT_EQ(a.size(), 3u);
-  for (std::size_t f = 0; f < 3; ++f)
-  {
-    EXPECT_EQ(relativeDifference(b[f], a[f]), 0.0) << "frame " << f;
-  }
+  EXPECT_EQ(timeSteps(scaled).size(), 3u);
+  EXPECT_EQ(frameDifference(scaled, unit), 0.0);
 }
 
 TEST(FilterRigs, ZeroNormalIsAnError)
