@@ -146,6 +146,8 @@ const std::map<std::string, OptionSpec>& optionSpecs()
       { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.to = parseTriple(n, v); } } },
     { "--frames",
       { "N", [](Options& o, const auto& n, const auto& v) { o.frames = parseInteger(n, v); } } },
+    { "--light-material",
+      { "NAME", [](Options& o, const auto&, const auto& v) { o.lightMaterial = v; } } },
     { "--aim",
       { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.aim = parseTriple(n, v); } } },
     { "--sun-directions",
@@ -285,6 +287,19 @@ Options parseCommandLine(int argc, const char* const* argv)
     return o;
   }
 
+  if (o.lightMaterial)
+  {
+    if (!o.light.empty() || o.usesSun())
+    {
+      throw UsageError("--light-material takes the light from the scene: give it without "
+                       "--light, --sun-directions and --sun-path");
+    }
+    if (o.usesEmbeddedScene())
+    {
+      throw UsageError("--light-material needs --scene FILE (an .obj with its .mtl, a .gltf, "
+                       ".glb or .ply with materials)");
+    }
+  }
   if (!o.sunDirections.empty() && o.sunPath)
   {
     throw UsageError("give either --sun-directions FILE or --sun-path ..., not both");
@@ -332,9 +347,10 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   if (!o.usesEmbeddedScene() && !o.usesSun())
   {
-    if (o.light.empty())
+    if (o.light.empty() && !o.lightMaterial)
     {
-      throw UsageError("--scene needs --light FILE: the built-in light belongs to the Cornell box");
+      throw UsageError("--scene needs --light FILE or --light-material NAME: the built-in light "
+                       "belongs to the Cornell box");
     }
     if (o.trajectory.empty() && !o.from)
     {
@@ -362,6 +378,12 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
       checkRange("--light-power", p, 0.0, 1e30);
     }
     filter->SetLightPower(o.lightPower->data());
+  }
+  if (o.lightMaterial)
+  {
+    filter->SetLightMaterial(o.lightMaterial->c_str());
+    // An explicit --light-power wins over the material's emission.
+    filter->SetLightPowerFromMaterial(!o.lightPower.has_value());
   }
   if (o.aim)
   {
@@ -444,11 +466,19 @@ output/cornell.pvd, output/cornell_0000.vtu ... and output/png/cornell_0000.png 
 under the current directory.
 
 Scene and light:
-  --scene FILE          surfaces to light: .vtp .vtu .vtk .obj .ply .stl; a cell array
-                        Reflectance (RGB or grey, in [0,1)) gives their colour, else grey 0.5
-                        (default: the built-in Cornell box)
+  --scene FILE          surfaces to light: .vtp .vtu .vtk .obj .gltf .glb .ply .stl; a
+                        cell array Reflectance (RGB or grey, in [0,1)) gives their colour,
+                        else grey 0.5; .obj (with its .mtl), .gltf, .glb and .ply files
+                        bring their materials: Kd or baseColorFactor is the reflectance
+                        (1 or more clamped to 0.99 with a warning), Ke or emissiveFactor
+                        the emission (default: the built-in Cornell box)
   --light FILE          the light's polygons, emitting along their normals (required with
                         --scene; default: the Cornell box's ceiling light)
+  --light-material NAME the polygons of this material of the scene (an .obj's usemtl, a
+                        glTF material) are the light, taken out of the scene; without
+                        --light-power its power is the material's emission, pi Ke area
+                        (Ke read as radiance, as path tracers do). Other emissive
+                        materials stay in the scene and emit in every frame
   --light-power R,G,B   total power of the light in W, per channel, or one number for all
                         (default 100,100,100)
                         A cell array LightId groups the polygons into several lights, and

@@ -43,6 +43,8 @@ struct Options
   std::optional<long long> frames;
 
   std::optional<Triple> aim; ///< every frame, the light faces this point
+  /// The scene's material whose polygons become the light, instead of --light.
+  std::optional<std::string> lightMaterial;
 
   /// The sun (a directional light) instead of --light: directions from a file, or computed.
   std::string sunDirections;

@@ -3,26 +3,50 @@
 #include "EmbeddedData.h"
 
 #include "vtkNew.h"
+#include "vtkRadiositySceneReader.h"
 #include "vtkPolyData.h"
 #include "vtkXMLPolyDataReader.h"
 
 namespace mlr::cli
 {
 
-vtkSmartPointer<vtkPolyData> readSurfaceFile(
-  const std::string& path, const std::string& role, std::uint64_t memoryLimitBytes)
+namespace
+{
+vtkSmartPointer<vtkPolyData> guardedRead(const std::string& path, const std::string& role,
+  std::uint64_t memoryLimitBytes, const mlr::guarded::ReaderFactory& ownReader)
 {
   mlr::guarded::ReadLimits limits;
   limits.memoryBytes = memoryLimitBytes;
   try
   {
-    return mlr::guarded::readSurfaceFile(path, role, limits);
+    return mlr::guarded::readSurfaceFile(path, role, limits, ownReader);
   }
   catch (const mlr::guarded::ReadInterrupted& interrupted)
   {
     // Every input is read before anything is written.
     throw InputError(std::string(interrupted.what()) + ": nothing was written");
   }
+}
+}
+
+vtkSmartPointer<vtkPolyData> readSurfaceFile(
+  const std::string& path, const std::string& role, std::uint64_t memoryLimitBytes)
+{
+  return guardedRead(path, role, memoryLimitBytes, {});
+}
+
+vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes)
+{
+  return guardedRead(path, "scene", memoryLimitBytes,
+    [](const std::string& file, const std::string& extension) -> vtkSmartPointer<vtkAlgorithm> {
+      if (extension != ".obj" && extension != ".gltf" && extension != ".glb" && extension != ".ply")
+      {
+        return nullptr;
+      }
+      auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+      reader->SetFileName(file.c_str());
+      return reader;
+    });
 }
 
 vtkSmartPointer<vtkPolyData> readEmbeddedFile(const std::string& name)

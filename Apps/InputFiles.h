@@ -27,6 +27,13 @@ using InputError = mlr::guarded::InputError;
 vtkSmartPointer<vtkPolyData> readSurfaceFile(
   const std::string& path, const std::string& role, std::uint64_t memoryLimitBytes = 0);
 
+/**
+ * The scene file: as readSurfaceFile, but .obj (with its .mtl), .gltf, .glb and .ply files are
+ * read with their materials by vtkRadiositySceneReader (cell arrays Reflectance, Emission,
+ * MaterialId, field data MaterialNames), in the same guarded reading process.
+ */
+vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes = 0);
+
 /// A .vtp file of Data/ compiled into the program (cornell_box.vtp, cornell_light.vtp,
 /// cornell_trajectory.vtp).
 vtkSmartPointer<vtkPolyData> readEmbeddedFile(const std::string& name);

@@ -248,9 +248,9 @@ int run(int argc, char** argv)
     options.memoryLimit ? static_cast<std::uint64_t>(*options.memoryLimit) << 20 : 0;
   const auto scene = options.usesEmbeddedScene()
     ? readEmbeddedFile("cornell_box.vtp")
-    : readSurfaceFile(options.scene, "scene", memoryLimit);
+    : readSceneFile(options.scene, memoryLimit);
   vtkSmartPointer<vtkPolyData> light;
-  if (!options.usesSun())
+  if (!options.usesSun() && !options.lightMaterial)
   {
     light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
                                   : readSurfaceFile(options.light, "light", memoryLimit);

@@ -493,8 +493,8 @@ vtkSmartPointer<vtkPolyData> polygonsOf(vtkAlgorithm* reader)
   return counter.errors() == 0 ? surface->GetOutput() : nullptr;
 }
 
-vtkSmartPointer<vtkPolyData> readSurfaceFile(
-  const std::string& path, const std::string& role, const ReadLimits& limits)
+vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std::string& role,
+  const ReadLimits& limits, const ReaderFactory& ownReader)
 {
   const std::string what = "the " + role + " file '" + path + "'";
   std::error_code error;
@@ -513,7 +513,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
   }
 
   const std::string extension = extensionOf(path);
-  const vtkSmartPointer<vtkAlgorithm> probe = makeReader(path, extension, what);
+  const vtkSmartPointer<vtkAlgorithm> own = ownReader ? ownReader(path, extension) : nullptr;
+  const vtkSmartPointer<vtkAlgorithm> probe = own ? own : makeReader(path, extension, what);
   if (auto* xml = vtkXMLReader::SafeDownCast(probe))
   {
     if (!xml->CanReadFile(path.c_str()))
@@ -523,7 +524,11 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
     }
   }
   // What is known to crash or mislead VTK's readers, with a message naming the problem.
-  if (extension == ".obj")
+  if (own)
+  {
+    // The caller's reader checks its files itself.
+  }
+  else if (extension == ".obj")
   {
     checkObjFile(path, what);
   }
@@ -557,7 +562,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
         // silenced.
         vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
       }
-      const vtkSmartPointer<vtkPolyData> polygons = polygonsOf(makeReader(path, extension, what));
+      const vtkSmartPointer<vtkPolyData> polygons =
+        polygonsOf(own ? probe.GetPointer() : makeReader(path, extension, what).GetPointer());
       if (!polygons)
       {
         return ReadFailed;
@@ -575,7 +581,7 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
     room, cpuSeconds, wallSeconds);
 
   using End = ChildOutcome::End;
-  const std::string reader = "VTK's " + extension + " reader";
+  const std::string reader = own ? std::string(own->GetClassName()) : "VTK's " + extension + " reader";
   switch (outcome.end)
   {
     case End::Interrupted:

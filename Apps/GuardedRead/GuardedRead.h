@@ -74,8 +74,14 @@ struct ReadLimits
  * says the reading was interrupted. The reading process dies with the calling thread
  * (PR_SET_PDEATHSIG), so nothing is left running whatever ends the caller.
  */
-vtkSmartPointer<vtkPolyData> readSurfaceFile(
-  const std::string& path, const std::string& role, const ReadLimits& limits = {});
+/// A reader of the caller's own for some files (e.g. with materials), given the path and
+/// its lowercase extension (".obj"); null for the files VTK's readers take as usual. It runs
+/// in the guarded reading process, in place of VTK's reader and its checks.
+using ReaderFactory =
+  std::function<vtkSmartPointer<vtkAlgorithm>(const std::string& path, const std::string& extension)>;
+
+vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std::string& role,
+  const ReadLimits& limits = {}, const ReaderFactory& ownReader = {});
 
 /**
  * Runs `reader` in this process and returns its output as polygons (the surface of other

@@ -1,0 +1,142 @@
+"""Scene files with materials on the command line (issue 13): the Cornell box OBJ+MTL of Data/
+brings its colours and its lamp, and --light-material moves the lamp.
+
+ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
+    MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps/test_cli_materials.py
+"""
+import math
+import os
+import shutil
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from cli_support import DATA, all_files, run  # noqa: E402
+
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter
+from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+OBJ = os.path.join(DATA, "CornellBox-Original.obj")
+# The lamp (material 'light', Ke 17 12 4) under the ceiling at y = 1.98, moved 0.3 to the side.
+PATH = ["--from", "-0.15,1.97,-0.1", "--to", "0.15,1.97,0.1", "--frames", "3"]
+FAST = ["--paths", "60000", "--threads", "2"]
+
+
+def frame(directory, index):
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(directory / "out" / f"cornell_{index:04d}.vtu"))
+    sizes = vtkCellSizeFilter()
+    sizes.SetInputConnection(reader.GetOutputPort())
+    sizes.Update()
+    return sizes.GetOutput()
+
+
+def copy_scene(tmp_path):
+    for name in ("CornellBox-Original.obj", "CornellBox-Original.mtl"):
+        shutil.copy(os.path.join(DATA, name), tmp_path / name)
+    return str(tmp_path / "CornellBox-Original.obj")
+
+
+def test_light_material_is_the_moving_lamp_with_its_own_power(tmp_path):
+    result = run(["--scene", OBJ, "--light-material", "light", "--output", "out/cornell.pvd",
+                  "--stats", "out/stats.json"] + PATH + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    data = frame(tmp_path, 1)
+    # The materials' Kd, not grey: the left wall red, the right wall green.
+    rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))
+    assert (abs(rho - (0.63, 0.065, 0.05)).max(axis=1) < 1e-6).any()
+    assert (abs(rho - (0.14, 0.45, 0.091)).max(axis=1) < 1e-6).any()
+    # The lamp left the geometry: no element carries its Kd 0.78, and nothing emits.
+    assert not (abs(rho - 0.78).max(axis=1) < 1e-6).any()
+    assert vtk_to_numpy(data.GetCellData().GetArray("EmittedRadiosity")).max() == 0.0
+    # Its power is pi Ke times its area. The box's front is open, so some of it leaves
+    # without a hit: the first-hit power sum A B_direct / rho is most of it (81% measured),
+    # never more (a lamp of a wrong power, e.g. LightPower's 100 W, fails either bound).
+    area = vtk_to_numpy(data.GetCellData().GetArray("Area"))
+    direct = vtk_to_numpy(data.GetCellData().GetArray("DirectRadiosity"))
+    hit = (area[:, None] * direct / rho).sum(axis=0)
+    power = [math.pi * ke * lamp_area() for ke in (17, 12, 4)]
+    for channel in range(3):
+        assert 0.7 * power[channel] < hit[channel] < 1.01 * power[channel], (hit, power)
+
+
+def lamp_area():
+    """The area of the OBJ's 'light' faces, read from the file."""
+    points, area, current = [], 0.0, None
+    with open(OBJ) as obj:
+        for line in obj:
+            words = line.split()
+            if not words:
+                continue
+            if words[0] == "v":
+                points.append([float(w) for w in words[1:4]])
+            elif words[0] == "usemtl":
+                current = words[1]
+            elif words[0] == "f" and current == "light":
+                # 1-based, or negative: counted back from the last vertex so far.
+                ids = [int(w.split("/")[0]) for w in words[1:]]
+                corners = [points[i - 1] if i > 0 else points[len(points) + i] for i in ids]
+                for i in range(1, len(corners) - 1):
+                    a, b, c = corners[0], corners[i], corners[i + 1]
+                    u = [b[k] - a[k] for k in range(3)]
+                    v = [c[k] - a[k] for k in range(3)]
+                    cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+                    area += 0.5 * math.sqrt(sum(x * x for x in cross))
+    assert area > 0
+    return area
+
+
+def test_light_power_option_wins_over_the_material(tmp_path):
+    args = ["--scene", OBJ, "--light-material", "light", "--output", "out/cornell.pvd"] + PATH + FAST
+    (tmp_path / "own").mkdir()
+    (tmp_path / "given").mkdir()
+    own = run(args, tmp_path / "own")
+    assert own.returncode == 0, own.stderr
+    given = run(args + ["--light-power", "10"], tmp_path / "given")
+    assert given.returncode == 0, given.stderr
+    own_direct = vtk_to_numpy(frame(tmp_path / "own", 0).GetCellData().GetArray("DirectRadiosity"))
+    given_direct = vtk_to_numpy(frame(tmp_path / "given", 0).GetCellData().GetArray("DirectRadiosity"))
+    # Same paths, other power: channel ratios 10 / (pi Ke A).
+    ratio = given_direct.sum(axis=0) / own_direct.sum(axis=0)
+    expected = [10 / (math.pi * ke * lamp_area()) for ke in (17, 12, 4)]
+    for got, want in zip(ratio, expected):
+        assert abs(got / want - 1) < 1e-3, (ratio, expected)
+
+
+def test_without_light_material_the_lamp_emits_in_place(tmp_path):
+    """The lamp is an emissive material: without --light-material it stays in the scene and
+    emits from its front side in every frame, with another light moving."""
+    result = run(["--scene", OBJ, "--light", os.path.join(DATA, "cornell_light.vtp"),
+                  "--light-power", "1", "--output", "out/cornell.pvd"] + PATH + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    emitted = vtk_to_numpy(frame(tmp_path, 0).GetCellData().GetArray("EmittedRadiosity"))
+    # pi Ke on the lamp's elements.
+    lamp = emitted[:, 0] > 0
+    assert lamp.any()
+    assert abs(emitted[lamp] - [math.pi * 17, math.pi * 12, math.pi * 4]).max() < 1e-3
+
+
+def test_unknown_material_lists_the_materials_and_writes_nothing(tmp_path):
+    result = run(["--scene", OBJ, "--light-material", "lamp", "--output", "out/cornell.pvd"] + PATH + FAST,
+                 tmp_path)
+    assert result.returncode == 1
+    assert "no material named 'lamp'" in result.stderr and "'light'" in result.stderr \
+        and "'floor'" in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_light_material_goes_without_light(tmp_path):
+    result = run(["--scene", OBJ, "--light-material", "light", "--light",
+                  os.path.join(DATA, "cornell_light.vtp")] + PATH + FAST, tmp_path)
+    assert result.returncode == 2
+    assert "--light-material" in result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_missing_mtl_falls_back_to_grey_with_a_warning(tmp_path):
+    scene = copy_scene(tmp_path)
+    os.remove(tmp_path / "CornellBox-Original.mtl")
+    result = run(["--scene", scene, "--light", os.path.join(DATA, "cornell_light.vtp"),
+                  "--output", "out/cornell.pvd"] + PATH + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "CornellBox-Original.mtl" in result.stderr, result.stderr
