@@ -2,6 +2,7 @@
 
 #include "MovingLightRadiosityInputs.h"
 #include "MovingLightRadiosityOutputs.h"
+#include "MovingLightRadiosityParallel.h"
 
 #include "Animation.h"
 #include "Error.h"
@@ -18,6 +19,7 @@
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
@@ -27,6 +29,7 @@
 #include "vtkTimeStamp.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <new>
@@ -71,6 +74,12 @@ struct vtkMovingLightRadiosity::vtkInternals
 
   /// The last solve stopped because AbortExecute was set (it stays set: see RequestData).
   bool Aborted = false;
+
+  // Several ranks (issue 15): this rank outputs only the elements and patches that come from
+  // its own input cells, and rank 0 the Light.
+  bool Distributed = false;
+  std::vector<vtkIdType> OwnedElements, OwnedPatches;
+  bool OutputsLight = true;
 };
 
 vtkStandardNewMacro(vtkMovingLightRadiosity);
@@ -221,6 +230,11 @@ int vtkMovingLightRadiosity::RequestInformation(
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
     vtkInformation* outInfo = outputVector->GetInformationObject(port);
+    if (mlr::vtkparallel::controller())
+    {
+      // Every rank must execute, whatever piece it asks for: the ranks solve together.
+      outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
+    }
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(),
       static_cast<int>(times.size()));
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
@@ -272,6 +286,11 @@ int vtkMovingLightRadiosity::RequestData(
     vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
     current = !input || input->GetMTime() <= cache.SolveTime.GetMTime();
   }
+  if (vtkMultiProcessController* controller = mlr::vtkparallel::controller())
+  {
+    // The ranks solve together: when one finds its cache stale, all solve.
+    current = !mlr::vtkparallel::anyRank(controller, !current);
+  }
   if (!current && !this->Solve(inputVector))
   {
     return 0;
@@ -304,14 +323,24 @@ int vtkMovingLightRadiosity::RequestData(
         mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
           std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
           output->GetCellData());
+        if (cache.Distributed)
+        {
+          // Cut from the whole frame, so that the point arrays at the cut average over the
+          // cells of both sides, as in serial.
+          output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedElements));
+        }
       }
       else if (port == PATCHES_PORT)
       {
         output->ShallowCopy(cache.Patches);
         mlr::vtkoutputs::addPatchRadiosity(
           cache.Solution, cache.PatchLitSides, solved, output->GetCellData());
+        if (cache.Distributed)
+        {
+          output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedPatches));
+        }
       }
-      else
+      else if (cache.OutputsLight)
       {
         // Every area light, posed as in this frame, at this frame's power.
         vtkNew<vtkAppendPolyData> lights;
@@ -382,14 +411,55 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   cache.SolveTime.Modified();
   cache.PropertiesTime.Modified();
 
+  // Several ranks (pvbatch --symmetric, pvserver under mpiexec) agree twice: once their
+  // inputs are read (A) and once the solve's outputs are built (B); Core agrees in between.
+  // A rank that fails anywhere still joins the next agreement, so no rank waits forever and
+  // every rank reports the error.
+  vtkMultiProcessController* controller = mlr::vtkparallel::controller();
+  enum class Stage
+  {
+    Reading,
+    Solving,
+    Agreed
+  };
+  Stage stage = Stage::Reading;
+  vtkInformationVector* inputs[3] = { inputVector[0], inputVector[1], inputVector[2] };
+  vtkNew<vtkInformationVector> gathered[3];
+  vtkSmartPointer<vtkDataObject> wholeInputs[3];
+  std::vector<int> cellRanks;
+  double secondsGatheringInputs = 0;
+  std::string failure;
+  bool cancelled = false;
   try
   {
+    if (controller)
+    {
+      // Every rank gets the whole Scene, Light and Trajectory, whatever pieces arrived.
+      const auto start = std::chrono::steady_clock::now();
+      const char* names[3] = { "Scene", "Light", "Trajectory" };
+      for (int port = 0; port < 3; ++port)
+      {
+        if (inputVector[port]->GetNumberOfInformationObjects() == 0)
+        {
+          continue; // an optional input not connected, on every rank alike
+        }
+        wholeInputs[port] = mlr::vtkparallel::gatherPieces(controller,
+          vtkDataObject::GetData(inputVector[port], 0), names[port],
+          port == SCENE_PORT ? &cellRanks : nullptr);
+        vtkNew<vtkInformation> info;
+        info->Set(vtkDataObject::DATA_OBJECT(), wholeInputs[port]);
+        gathered[port]->Append(info);
+        inputs[port] = gathered[port];
+      }
+      secondsGatheringInputs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     std::vector<std::string> warnings;
-    vtkPolyData* lightData = vtkPolyData::GetData(inputVector[LIGHT_PORT], 0);
+    vtkPolyData* lightData = vtkPolyData::GetData(inputs[LIGHT_PORT], 0);
     const bool directional = this->LightType == DIRECTIONAL_LIGHT;
     const mlr::vtkinputs::Trajectory trajectory =
-      trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]));
-    vtkPolyData* sceneData = vtkPolyData::GetData(inputVector[SCENE_PORT], 0);
+      trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]));
+    vtkPolyData* sceneData = vtkPolyData::GetData(inputs[SCENE_PORT], 0);
     const bool fromMaterial = !directional && !this->LightMaterial.empty();
     mlr::vtkinputs::MaterialLight materialLight;
     if (fromMaterial)
@@ -486,11 +556,26 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     options.outputBytesPerElement = (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many;
     options.outputBytesPerPoint = (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
     mlr::validateOptions(solverOptions);
+    if (controller)
+    {
+      const mlr::vtkparallel::Verdict verdict = mlr::vtkparallel::agree(controller, false, false, {});
+      stage = verdict.failed ? Stage::Agreed : Stage::Solving;
+      if (verdict.failed)
+      {
+        throw mlr::Error(verdict.message);
+      }
+      mlr::vtkparallel::shareSolve(controller, solverOptions);
+    }
+    const bool reportsProgress = !controller || controller->GetLocalProcessId() == 0;
 
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
-      [this](double fraction) {
+      [this, reportsProgress](double fraction) {
         // Core reports progress on this thread, so the abort flag can be polled right here.
-        this->UpdateProgress(fraction);
+        // Rank 0 reports for all: the ranks advance together.
+        if (reportsProgress)
+        {
+          this->UpdateProgress(fraction);
+        }
         return !this->CheckAbort();
       });
     for (const std::string& warning : animation.warnings)
@@ -509,6 +594,48 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
     cache.Solution = std::move(solution);
     cache.TwoSided = solverOptions.twoSided;
+    if (controller)
+    {
+      const int rank = controller->GetLocalProcessId();
+      vtkPolyData* wholeScene = vtkPolyData::SafeDownCast(wholeInputs[SCENE_PORT]);
+      const std::vector<int> elementOwners =
+        mlr::vtkparallel::owners(wholeScene, cellRanks, scene.points(), scene.elementTriangles());
+      const std::vector<int> patchOwners =
+        mlr::vtkparallel::owners(wholeScene, cellRanks, scene.points(), scene.patchTriangles());
+      for (std::size_t e = 0; e < elementOwners.size(); ++e)
+      {
+        if (elementOwners[e] == rank)
+        {
+          cache.OwnedElements.push_back(static_cast<vtkIdType>(e));
+        }
+      }
+      for (std::size_t p = 0; p < patchOwners.size(); ++p)
+      {
+        if (patchOwners[p] == rank)
+        {
+          cache.OwnedPatches.push_back(static_cast<vtkIdType>(p));
+        }
+      }
+      cache.Distributed = cache.OwnedElements.size() != elementOwners.size() ||
+        cache.OwnedPatches.size() != patchOwners.size();
+      cache.OutputsLight = rank == 0;
+      for (const auto& [name, value] :
+        { std::make_pair("Ranks", static_cast<double>(controller->GetNumberOfProcesses())),
+          std::make_pair("SecondsGatheringInputs", secondsGatheringInputs),
+          std::make_pair("SecondsReducing", cache.Solution.statistics.secondsReducing) })
+      {
+        vtkNew<vtkDoubleArray> array;
+        array->SetName(name);
+        array->InsertNextValue(value);
+        cache.Statistics->AddArray(array);
+      }
+      const mlr::vtkparallel::Verdict verdict = mlr::vtkparallel::agree(controller, false, false, {});
+      stage = Stage::Agreed;
+      if (verdict.failed)
+      {
+        throw mlr::Error(verdict.message);
+      }
+    }
     cache.HasResult = true;
     // A statistic, not a property: it must not change the MTime and invalidate the cache.
     ++this->SolveCount;
@@ -516,25 +643,34 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   }
   catch (const mlr::Cancelled& e)
   {
-    vtkErrorMacro(<< "aborted: " << e.what());
-    cache.Clear();
-    cache.Aborted = true;
-    return false;
+    failure = std::string("aborted: ") + e.what();
+    cancelled = true;
   }
   catch (const mlr::Error& e)
   {
-    vtkErrorMacro(<< e.what());
+    failure = e.what();
   }
   catch (const std::bad_alloc&)
   {
-    vtkErrorMacro(<< "out of memory: use fewer light positions, a larger PatchSize or a lower "
-                     "MemoryLimit so that the solve is refused before it starts");
+    failure = "out of memory: use fewer light positions, a larger PatchSize or a lower "
+              "MemoryLimit so that the solve is refused before it starts";
   }
   catch (const std::exception& e)
   {
-    vtkErrorMacro(<< "the solve failed: " << e.what());
+    failure = std::string("the solve failed: ") + e.what();
   }
+  if (controller && stage != Stage::Agreed)
+  {
+    const mlr::vtkparallel::Verdict verdict =
+      mlr::vtkparallel::agree(controller, !cancelled, cancelled, failure);
+    if (!cancelled && failure.empty())
+    {
+      failure = verdict.message;
+    }
+  }
+  vtkErrorMacro(<< failure);
   cache.Clear();
+  cache.Aborted = cancelled;
   return false;
 }
 

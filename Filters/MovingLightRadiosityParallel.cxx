@@ -1,0 +1,488 @@
+#include "MovingLightRadiosityParallel.h"
+
+#include "Error.h"
+
+#include "vtkCellData.h"
+#include "vtkCharArray.h"
+#include "vtkCommunicator.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkFieldData.h"
+#include "vtkGenericCell.h"
+#include "vtkIdList.h"
+#include "vtkIdTypeArray.h"
+#include "vtkMultiProcessController.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStaticCellLocator.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+#include <tuple>
+
+namespace mlr::vtkparallel
+{
+
+vtkMultiProcessController* controller()
+{
+  vtkMultiProcessController* c = vtkMultiProcessController::GetGlobalController();
+  return c && c->GetNumberOfProcesses() > 1 ? c : nullptr;
+}
+
+namespace
+{
+bool isEmpty(vtkDataObject* data)
+{
+  return !data || data->GetNumberOfElements(vtkDataObject::POINT) == 0;
+}
+
+/// Cell ids that make the order canonical: the global ids, else vtkOriginalCellIds; null when
+/// neither exists.
+vtkDataArray* cellIdsOf(vtkPolyData* piece)
+{
+  vtkCellData* cd = piece->GetCellData();
+  if (vtkDataArray* ids = cd->GetGlobalIds())
+  {
+    return ids;
+  }
+  vtkDataArray* ids = cd->GetArray("vtkOriginalCellIds");
+  return ids && ids->GetNumberOfComponents() == 1 ? ids : nullptr;
+}
+
+/// A description of a piece's cell arrays, to check that pieces agree.
+std::map<std::string, int> cellArraysOf(vtkPolyData* piece)
+{
+  std::map<std::string, int> arrays;
+  vtkCellData* cd = piece->GetCellData();
+  for (int i = 0; i < cd->GetNumberOfArrays(); ++i)
+  {
+    vtkAbstractArray* a = cd->GetAbstractArray(i);
+    // Arrays the distribution itself adds (ids, ghosts) may differ between pieces.
+    const std::string name = a && a->GetName() ? a->GetName() : "";
+    if (!a || name.empty() || name.rfind("vtk", 0) == 0)
+    {
+      continue;
+    }
+    arrays[name] = a->GetNumberOfComponents();
+  }
+  return arrays;
+}
+
+/// Joins the non-empty polydata pieces in the canonical cell order (see gatherPieces).
+vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
+  const std::vector<int>& pieceRanks, const std::string& port, std::vector<int>* cellRanks)
+{
+  const std::map<std::string, int> expected = cellArraysOf(pieces.front());
+  for (std::size_t p = 1; p < pieces.size(); ++p)
+  {
+    const std::map<std::string, int> found = cellArraysOf(pieces[p]);
+    if (found != expected)
+    {
+      std::string difference;
+      for (const auto& [name, components] : expected)
+      {
+        auto it = found.find(name);
+        if (difference.empty() && (it == found.end() || it->second != components))
+        {
+          difference = "cell array '" + name + "' (" + std::to_string(components) +
+            " components) is on rank " + std::to_string(pieceRanks.front()) + "'s piece but not on rank " +
+            std::to_string(pieceRanks[p]) + "'s";
+        }
+      }
+      for (const auto& [name, components] : found)
+      {
+        auto it = expected.find(name);
+        if (difference.empty() && (it == expected.end() || it->second != components))
+        {
+          difference = "cell array '" + name + "' (" + std::to_string(components) +
+            " components) is on rank " + std::to_string(pieceRanks[p]) + "'s piece but not on rank " +
+            std::to_string(pieceRanks.front()) + "'s";
+        }
+      }
+      throw Error("the " + port + " arrives in pieces over the ranks that disagree: the " +
+        difference + ": give every piece the same cell arrays");
+    }
+  }
+
+  // Every cell once, keyed by its global id when every piece has one, else by (rank, index).
+  bool byIds = true;
+  for (vtkPolyData* piece : pieces)
+  {
+    byIds = byIds && cellIdsOf(piece) != nullptr;
+  }
+  struct Cell
+  {
+    long long key;
+    std::size_t piece;
+    vtkIdType id;
+  };
+  std::vector<Cell> cells;
+  for (std::size_t p = 0; p < pieces.size(); ++p)
+  {
+    vtkPolyData* piece = pieces[p];
+    vtkDataArray* ids = byIds ? cellIdsOf(piece) : nullptr;
+    vtkUnsignedCharArray* ghosts = piece->GetCellGhostArray();
+    for (vtkIdType c = 0; c < piece->GetNumberOfCells(); ++c)
+    {
+      if (ghosts && (ghosts->GetValue(c) & vtkDataSetAttributes::DUPLICATECELL))
+      {
+        continue;
+      }
+      const long long key = ids ? static_cast<long long>(ids->GetComponent(c, 0))
+                                : static_cast<long long>(cells.size());
+      cells.push_back({ key, p, c });
+    }
+  }
+  // Cells of one id on several ranks must be one cell (a ghost copy): ids that are only
+  // local (0, 1, ... on every rank) name different cells, and then rank order is used.
+  auto sameCell = [&](const Cell& a, const Cell& b) {
+    vtkPolyData* pa = pieces[a.piece];
+    vtkPolyData* pb = pieces[b.piece];
+    if (a.piece == b.piece || pa->GetCellSize(a.id) != pb->GetCellSize(b.id))
+    {
+      return false;
+    }
+    vtkNew<vtkIdList> ia, ib;
+    pa->GetCellPoints(a.id, ia);
+    pb->GetCellPoints(b.id, ib);
+    for (vtkIdType i = 0; i < ia->GetNumberOfIds(); ++i)
+    {
+      double xa[3], xb[3];
+      pa->GetPoint(ia->GetId(i), xa);
+      pb->GetPoint(ib->GetId(i), xb);
+      if (xa[0] != xb[0] || xa[1] != xb[1] || xa[2] != xb[2])
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  if (byIds)
+  {
+    std::vector<Cell> sorted = cells;
+    std::stable_sort(sorted.begin(), sorted.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
+    bool global = true;
+    for (std::size_t i = 1; i < sorted.size() && global; ++i)
+    {
+      global = sorted[i].key != sorted[i - 1].key || sameCell(sorted[i], sorted[i - 1]);
+    }
+    if (global)
+    {
+      sorted.erase(std::unique(sorted.begin(), sorted.end(),
+                     [](const Cell& a, const Cell& b) { return a.key == b.key; }),
+        sorted.end());
+      cells = std::move(sorted);
+    }
+  }
+
+  vtkNew<vtkPolyData> joined;
+  vtkNew<vtkPoints> points;
+  points->SetDataType(pieces.front()->GetPoints()->GetDataType());
+  joined->SetPoints(points);
+  joined->AllocateExact(static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 4);
+  joined->GetCellData()->CopyAllocate(pieces.front()->GetCellData(), static_cast<vtkIdType>(cells.size()));
+  joined->GetPointData()->CopyAllocate(pieces.front()->GetPointData());
+  joined->GetFieldData()->ShallowCopy(pieces.front()->GetFieldData());
+  // Points at equal coordinates are one point, as they were before the split.
+  std::map<std::array<double, 3>, vtkIdType> pointIds;
+  std::vector<vtkIdType> ids;
+  if (cellRanks)
+  {
+    cellRanks->clear();
+  }
+  for (const Cell& cell : cells)
+  {
+    vtkPolyData* piece = pieces[cell.piece];
+    vtkIdType count = 0;
+    const vtkIdType* from = nullptr;
+    vtkNew<vtkIdList> scratch;
+    piece->GetCellPoints(cell.id, count, from, scratch);
+    ids.resize(static_cast<std::size_t>(count));
+    for (vtkIdType i = 0; i < count; ++i)
+    {
+      std::array<double, 3> x;
+      piece->GetPoint(from[i], x.data());
+      auto [it, added] = pointIds.emplace(x, points->GetNumberOfPoints());
+      if (added)
+      {
+        points->InsertNextPoint(x.data());
+        joined->GetPointData()->CopyData(piece->GetPointData(), from[i], it->second);
+      }
+      ids[static_cast<std::size_t>(i)] = it->second;
+    }
+    const vtkIdType id = joined->InsertNextCell(piece->GetCellType(cell.id), count, ids.data());
+    joined->GetCellData()->CopyData(piece->GetCellData(), cell.id, id);
+    if (cellRanks)
+    {
+      cellRanks->push_back(pieceRanks[cell.piece]);
+    }
+  }
+  joined->Squeeze();
+  return joined;
+}
+}
+
+vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controller,
+  vtkDataObject* piece, const std::string& port, std::vector<int>* cellRanks)
+{
+  const int ranks = controller->GetNumberOfProcesses();
+  // Each piece travels as bytes and every rank decodes every piece from the same bytes, its
+  // own included: the ranks then hold identical inputs and remesh them identically.
+  vtkNew<vtkCharArray> bytes;
+  if (!isEmpty(piece) && !vtkCommunicator::MarshalDataObject(piece, bytes))
+  {
+    throw Error("the " + port + " piece of this rank could not be serialized for the other ranks");
+  }
+  const vtkIdType length = bytes->GetNumberOfValues();
+  std::vector<vtkIdType> lengths(static_cast<std::size_t>(ranks), 0);
+  std::vector<long long> sent{ static_cast<long long>(length) }, received(lengths.size());
+  if (!controller->AllGather(sent.data(), received.data(), 1))
+  {
+    throw Error("gathering the " + port + " over the ranks failed");
+  }
+  std::vector<vtkIdType> offsets(lengths.size(), 0);
+  vtkIdType total = 0;
+  for (std::size_t r = 0; r < lengths.size(); ++r)
+  {
+    lengths[r] = static_cast<vtkIdType>(received[r]);
+    offsets[r] = total;
+    total += lengths[r];
+  }
+  std::vector<char> all(static_cast<std::size_t>(std::max<vtkIdType>(total, 1)));
+  if (!controller->AllGatherV(length > 0 ? bytes->GetPointer(0) : all.data(), all.data(), length,
+        lengths.data(), offsets.data()))
+  {
+    throw Error("gathering the " + port + " over the ranks failed");
+  }
+  std::vector<vtkSmartPointer<vtkDataObject>> pieces;
+  std::vector<int> pieceRanks;
+  int first = -1;
+  for (int r = 0; r < ranks; ++r)
+  {
+    const std::size_t i = static_cast<std::size_t>(r);
+    if (lengths[i] == 0)
+    {
+      continue;
+    }
+    if (first < 0)
+    {
+      first = r;
+    }
+    else if (lengths[i] == lengths[static_cast<std::size_t>(first)] &&
+      std::equal(all.data() + offsets[i], all.data() + offsets[i] + lengths[i],
+        all.data() + offsets[static_cast<std::size_t>(first)]))
+    {
+      // The same bytes as an earlier rank's: the input is whole on every rank that has it
+      // (a source that ignores pieces, or one asked for the whole extent), not a piece.
+      continue;
+    }
+    vtkNew<vtkCharArray> buffer;
+    buffer->SetArray(all.data() + offsets[static_cast<std::size_t>(r)], lengths[static_cast<std::size_t>(r)], 1);
+    vtkSmartPointer<vtkDataObject> decoded = vtkCommunicator::UnMarshalDataObject(buffer);
+    if (!decoded)
+    {
+      throw Error("the " + port + " piece of rank " + std::to_string(r) + " could not be read back");
+    }
+    pieces.push_back(decoded);
+    pieceRanks.push_back(r);
+  }
+  if (pieces.empty())
+  {
+    if (cellRanks)
+    {
+      cellRanks->clear();
+    }
+    vtkSmartPointer<vtkDataObject> empty;
+    empty.TakeReference(piece ? piece->NewInstance() : vtkPolyData::New());
+    return empty;
+  }
+  if (pieces.size() == 1)
+  {
+    if (cellRanks)
+    {
+      cellRanks->assign(static_cast<std::size_t>(pieces.front()->GetNumberOfElements(vtkDataObject::CELL)),
+        pieceRanks.front());
+    }
+    return pieces.front();
+  }
+  std::vector<vtkPolyData*> polyData;
+  for (const auto& p : pieces)
+  {
+    vtkPolyData* pd = vtkPolyData::SafeDownCast(p);
+    if (!pd)
+    {
+      throw Error("the " + port + " arrives in pieces over " + std::to_string(pieces.size()) +
+        " ranks as a " + p->GetClassName() + ": give it whole on one rank, or as polydata");
+    }
+    polyData.push_back(pd);
+  }
+  return joinPieces(polyData, pieceRanks, port, cellRanks);
+}
+
+/// Sums go in chunks: MPI counts are ints.
+constexpr std::size_t Chunk = std::size_t(1) << 24;
+
+void shareSolve(vtkMultiProcessController* controller, SolverOptions& options)
+{
+  options.rank = controller->GetLocalProcessId();
+  options.ranks = controller->GetNumberOfProcesses();
+  options.sumAcrossRanks = [controller](std::int64_t* values, std::size_t count) {
+    std::vector<long long> send, receive;
+    for (std::size_t first = 0; first < count; first += Chunk)
+    {
+      const std::size_t n = std::min(Chunk, count - first);
+      send.assign(values + first, values + first + n);
+      receive.resize(n);
+      if (!controller->AllReduce(send.data(), receive.data(), static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
+      {
+        throw Error("the sum over ranks failed");
+      }
+      std::copy(receive.begin(), receive.end(), values + first);
+    }
+  };
+  options.sumDoublesAcrossRanks = [controller](double* values, std::size_t count) {
+    std::vector<double> send;
+    for (std::size_t first = 0; first < count; first += Chunk)
+    {
+      const std::size_t n = std::min(Chunk, count - first);
+      send.assign(values + first, values + first + n);
+      if (!controller->AllReduce(send.data(), values + first, static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
+      {
+        throw Error("the sum over ranks failed");
+      }
+    }
+  };
+}
+
+bool anyRank(vtkMultiProcessController* controller, bool value)
+{
+  const int mine = value ? 1 : 0;
+  int any = 0;
+  controller->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP);
+  return any != 0;
+}
+
+Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
+  const std::string& message)
+{
+  const int mine[2] = { failed ? 1 : 0, cancelled ? 1 : 0 };
+  int all[2] = { 0, 0 };
+  controller->AllReduce(mine, all, 2, vtkCommunicator::MAX_OP);
+  Verdict verdict;
+  verdict.failed = all[0] != 0;
+  verdict.cancelled = all[1] != 0;
+  if (!verdict.failed)
+  {
+    return verdict;
+  }
+  // Every rank reports the failure; those that did not fail name the first rank that did.
+  const std::string own = failed ? message : std::string();
+  const int ranks = controller->GetNumberOfProcesses();
+  const long long length = static_cast<long long>(own.size());
+  std::vector<long long> lengths(static_cast<std::size_t>(ranks));
+  controller->AllGather(&length, lengths.data(), 1);
+  std::vector<vtkIdType> counts(lengths.begin(), lengths.end()), offsets(lengths.size(), 0);
+  vtkIdType total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r)
+  {
+    offsets[r] = total;
+    total += counts[r];
+  }
+  std::vector<char> text(static_cast<std::size_t>(std::max<vtkIdType>(total, 1)));
+  std::vector<char> sent(own.begin(), own.end());
+  sent.push_back('\0');
+  controller->AllGatherV(sent.data(), text.data(), static_cast<vtkIdType>(own.size()), counts.data(), offsets.data());
+  if (failed)
+  {
+    verdict.message = message;
+    return verdict;
+  }
+  for (int r = 0; r < ranks; ++r)
+  {
+    if (counts[static_cast<std::size_t>(r)] > 0)
+    {
+      verdict.message = "rank " + std::to_string(r) + " of " + std::to_string(ranks) + ": " +
+        std::string(text.data() + offsets[static_cast<std::size_t>(r)],
+          static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]));
+      break;
+    }
+  }
+  if (verdict.message.empty())
+  {
+    verdict.message = "another rank failed";
+  }
+  return verdict;
+}
+
+std::vector<int> owners(vtkPolyData* scene, const std::vector<int>& cellRanks,
+  const std::vector<Vec3>& points, const std::vector<Triangle>& triangles)
+{
+  std::vector<int> owner(triangles.size(), cellRanks.empty() ? 0 : cellRanks.front());
+  if (cellRanks.empty() ||
+    std::all_of(cellRanks.begin(), cellRanks.end(), [&](int r) { return r == cellRanks.front(); }))
+  {
+    return owner;
+  }
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(scene);
+  locator->BuildLocator();
+  vtkNew<vtkGenericCell> cell;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+  {
+    const Triangle& tri = triangles[t];
+    const Vec3 c = (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0;
+    const double x[3] = { c.x, c.y, c.z };
+    double closest[3];
+    vtkIdType cellId = -1;
+    int subId = 0;
+    double distance2 = 0;
+    locator->FindClosestPoint(x, closest, cell, cellId, subId, distance2);
+    if (cellId >= 0 && static_cast<std::size_t>(cellId) < cellRanks.size())
+    {
+      owner[t] = cellRanks[static_cast<std::size_t>(cellId)];
+    }
+  }
+  return owner;
+}
+
+vtkSmartPointer<vtkPolyData> extractCells(vtkPolyData* full, const std::vector<vtkIdType>& cells)
+{
+  vtkNew<vtkPolyData> out;
+  vtkNew<vtkPoints> points;
+  points->SetDataType(full->GetPoints() ? full->GetPoints()->GetDataType() : VTK_FLOAT);
+  out->SetPoints(points);
+  out->GetFieldData()->ShallowCopy(full->GetFieldData());
+  out->GetPointData()->CopyAllocate(full->GetPointData());
+  out->GetCellData()->CopyAllocate(full->GetCellData(), static_cast<vtkIdType>(cells.size()));
+  out->AllocateExact(static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 3);
+  std::vector<vtkIdType> newId(static_cast<std::size_t>(full->GetNumberOfPoints()), -1);
+  std::vector<vtkIdType> ids;
+  vtkNew<vtkIdList> scratch;
+  for (vtkIdType c : cells)
+  {
+    vtkIdType count = 0;
+    const vtkIdType* from = nullptr;
+    full->GetCellPoints(c, count, from, scratch);
+    ids.resize(static_cast<std::size_t>(count));
+    for (vtkIdType i = 0; i < count; ++i)
+    {
+      vtkIdType& id = newId[static_cast<std::size_t>(from[i])];
+      if (id < 0)
+      {
+        id = points->InsertNextPoint(full->GetPoint(from[i]));
+        out->GetPointData()->CopyData(full->GetPointData(), from[i], id);
+      }
+      ids[static_cast<std::size_t>(i)] = id;
+    }
+    const vtkIdType to = out->InsertNextCell(full->GetCellType(c), count, ids.data());
+    out->GetCellData()->CopyData(full->GetCellData(), c, to);
+  }
+  out->Squeeze();
+  return out;
+}
+
+} // namespace mlr::vtkparallel

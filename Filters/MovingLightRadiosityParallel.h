@@ -1,0 +1,74 @@
+// The filter on ParaView's MPI engine (issue 15): pvbatch --symmetric or pvserver under
+// mpiexec. Every rank gathers the whole inputs, remeshes them alike and solves its share of
+// the paths and gathering rays (Core sums the shares through the hooks set here); each rank
+// then outputs the elements that come from its own input cells.
+#pragma once
+
+#include "Scene.h"
+#include "Solver.h"
+
+#include "vtkSmartPointer.h"
+#include "vtkType.h"
+
+#include <string>
+#include <vector>
+
+class vtkDataObject;
+class vtkMultiProcessController;
+class vtkPolyData;
+
+namespace mlr::vtkparallel
+{
+
+/// The global controller when it has more than one process; null otherwise (serial runs,
+/// pvpython, a one-rank pvbatch), where the filter behaves exactly as before.
+vtkMultiProcessController* controller();
+
+/**
+ * Every rank's piece of one input, as one data object on every rank (a collective call).
+ * Pieces equal byte for byte count once (the lowest rank's): an input that several ranks hold
+ * whole, as the Light and Trajectory often are, is not joined with itself. When one rank
+ * holds all the data (a reader or source that does not split), its piece is
+ * returned as it is, so that the solve is the serial one bit for bit. Otherwise the pieces
+ * are joined in a canonical cell order that does not depend on how the input was split: by
+ * the global cell ids (vtkGlobalIds attribute, as RedistributeDataSet makes them) or else the
+ * vtkOriginalCellIds array, or else by rank and then cell order; a cell present on several
+ * ranks (ghost or duplicate, same id) is kept once, and points at equal coordinates are
+ * merged. `cellRanks`, when given, receives the rank each cell of the result came from.
+ * Throws mlr::Error when pieces disagree (a cell array on one rank's piece and not another's).
+ */
+vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controller,
+  vtkDataObject* piece, const std::string& port, std::vector<int>* cellRanks = nullptr);
+
+/// Sets options.rank, ranks and the sums over ranks (the controller's AllReduce).
+void shareSolve(vtkMultiProcessController* controller, SolverOptions& options);
+
+/// What the ranks agreed on: whether any failed or was cancelled, and the message to report
+/// (this rank's own, or the first failed rank's, named).
+struct Verdict
+{
+  bool failed = false;
+  bool cancelled = false;
+  std::string message;
+};
+
+/// A collective agreement: every rank calls it at the same point with its own outcome.
+Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
+  const std::string& message);
+
+/// True on every rank when any rank passes true (a collective call).
+bool anyRank(vtkMultiProcessController* controller, bool value);
+
+/**
+ * The rank that owns each triangle (given by `triangles` on `points`): the rank of the input
+ * cell of `scene` nearest its centroid, `cellRanks` giving each cell's rank. Every rank
+ * computes the same, from the same gathered scene.
+ */
+std::vector<int> owners(vtkPolyData* scene, const std::vector<int>& cellRanks,
+  const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
+
+/// The cells of `full` whose owner is `rank` with the points they use and every point, cell
+/// and field array (active attributes kept). Empty `cells` gives an empty mesh.
+vtkSmartPointer<vtkPolyData> extractCells(vtkPolyData* full, const std::vector<vtkIdType>& cells);
+
+} // namespace mlr::vtkparallel
