@@ -488,9 +488,14 @@ struct ClosedSurface
   std::unique_ptr<Tree> tree;
 };
 
-std::vector<ClosedSurface> findClosedSurfaces(const RepairedSoup& soup, const Surfaces& surfaces)
+/// The closed surfaces, each with only its triangles that touch another surface: a piece lying
+/// on a closed surface lies on those.
+std::vector<ClosedSurface> findClosedSurfaces(
+  const RepairedSoup& soup, const Surfaces& surfaces, const std::vector<bool>& touching)
 {
   std::vector<ClosedSurface> closed(surfaces.count);
+  std::vector<CGAL::Bbox_3> whole(surfaces.count);
+  std::vector<bool> started(surfaces.count, false);
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
     const std::size_t s = surfaces.of[i];
@@ -498,17 +503,22 @@ std::vector<ClosedSurface> findClosedSurfaces(const RepairedSoup& soup, const Su
     {
       const CgalTriangle& t = soup.triangles[i];
       const CGAL::Bbox_3 box = soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox();
-      closed[s].box = closed[s].triangles.empty() ? box : closed[s].box + box;
-      closed[s].triangles.push_back(i);
+      whole[s] = started[s] ? whole[s] + box : box;
+      started[s] = true;
+      if (touching[i])
+      {
+        closed[s].box = closed[s].triangles.empty() ? box : closed[s].box + box;
+        closed[s].triangles.push_back(i);
+      }
     }
   }
-  for (ClosedSurface& c : closed)
+  for (std::size_t s = 0; s < surfaces.count; ++s)
   {
-    const CGAL::Bbox_3& b = c.box;
+    const CGAL::Bbox_3& b = whole[s];
     const double diagonal = std::sqrt(CGAL::square(b.xmax() - b.xmin()) + CGAL::square(b.ymax() - b.ymin()) +
       CGAL::square(b.zmax() - b.zmin()));
     // Contact points are rounded once to doubles: far above that, far below any real gap.
-    c.tolerance = 1e-9 * diagonal;
+    closed[s].tolerance = 1e-9 * diagonal;
   }
   return closed;
 }
@@ -538,7 +548,8 @@ const Tree& distanceTree(ClosedSurface& closed, const RepairedSoup& soup)
  * solid, and only the light's position could tell.
  */
 std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<std::size_t>& surfaceOf,
-  const RepairedSoup& original, std::vector<ClosedSurface>& closed, CancellationPoll& poll)
+  const std::vector<bool>& piece, const RepairedSoup& original, std::vector<ClosedSurface>& closed,
+  CancellationPoll& poll)
 {
   std::vector<bool> covered(split.triangles.size(), false);
   std::vector<TriangleBox> closedBoxes;
@@ -560,9 +571,13 @@ std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<
   std::vector<Point> centroidOf(split.triangles.size());
   for (std::size_t i = 0; i < split.triangles.size(); ++i)
   {
-    const CgalTriangle& t = split.triangles[i];
-    centroidOf[i] = CGAL::centroid(split.points[t[0]], split.points[t[1]], split.points[t[2]]);
-    centroids.emplace_back(centroidOf[i].bbox(), i);
+    // Only pieces of triangles that touched another surface can lie on one.
+    if (piece[i])
+    {
+      const CgalTriangle& t = split.triangles[i];
+      centroidOf[i] = CGAL::centroid(split.points[t[0]], split.points[t[1]], split.points[t[2]]);
+      centroids.emplace_back(centroidOf[i].bbox(), i);
+    }
   }
   CGAL::box_intersection_d(centroids.begin(), centroids.end(), closedBoxes.begin(), closedBoxes.end(),
     [&](const TriangleBox& triangle, const TriangleBox& closedBox) {
@@ -780,7 +795,9 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   }
 
   std::vector<std::size_t> surfaceOf;
+  std::vector<bool> piece;
   auto keep = [&](const CgalTriangle& t, std::size_t origin) {
+    piece.push_back(inSet[origin]);
     split.triangles.push_back(t);
     split.input.push_back(soup.input[origin]);
     split.flipped.push_back(soup.flipped[origin]);
@@ -794,6 +811,7 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     }
   }
   std::vector<std::size_t> pieces(soup.triangles.size(), 0);
+  std::size_t degenerate = 0;
   for (FaceIndex f : mesh.faces())
   {
     const HalfedgeIndex h = mesh.halfedge(f);
@@ -803,6 +821,10 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     {
       keep(t, tracking.origin[f]);
       ++pieces[tracking.origin[f]];
+    }
+    else
+    {
+      ++degenerate;
     }
   }
   for (EdgeIndex e : mesh.edges())
@@ -816,8 +838,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   std::sort(split.contactEdges.begin(), split.contactEdges.end());
   split.contactEdges.erase(std::unique(split.contactEdges.begin(), split.contactEdges.end()), split.contactEdges.end());
 
-  std::vector<ClosedSurface> closed = findClosedSurfaces(soup, surfaces);
-  const std::vector<bool> covered = coveredTriangles(split, surfaceOf, soup, closed, poll);
+  std::vector<ClosedSurface> closed = findClosedSurfaces(soup, surfaces, touching);
+  const std::vector<bool> covered = coveredTriangles(split, surfaceOf, piece, soup, closed, poll);
   std::vector<bool> keepTriangle(split.triangles.size());
   for (std::size_t i = 0; i < split.triangles.size(); ++i)
   {
@@ -841,8 +863,9 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   {
     throw Error("every face lies on a closed surface");
   }
-  // Dropping covered faces can leave surfaces that meet at one point only.
-  if (!PMP::is_polygon_soup_a_polygon_mesh(split.triangles))
+  // Dropping covered or degenerate pieces can leave surfaces that meet at one point only (and
+  // checking 200,000 triangles takes a tenth of a second, so only then).
+  if ((out.coveredTriangles > 0 || degenerate > 0) && !PMP::is_polygon_soup_a_polygon_mesh(split.triangles))
   {
     out.splitPoints += orientSoup(split);
     if (!PMP::is_polygon_soup_a_polygon_mesh(split.triangles))
