@@ -429,7 +429,7 @@ void appendCgalPatches(
 }
 /// Remeshes with CGAL (unless told not to) and refines what it refused, or everything.
 void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles,
-  const std::vector<Material>& materials, double h, const RemeshOptions& options,
+  const std::vector<Material>& materials, double h, double expectedPatches, const RemeshOptions& options,
   const RemeshProgress& progress, RemeshResult& result)
 {
   if (options.useCgal)
@@ -438,8 +438,9 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     settings.targetEdgeLength = h;
     settings.sharpEdgeAngle = options.sharpEdgeAngle;
     settings.splitAtContacts = options.splitAtContacts;
+    // Splitting at contacts adds triangles: the estimate checked before is checked again.
     settings.checkTriangleCount = [&](std::size_t split) {
-      checkRemeshMemory(static_cast<double>(split), remeshedPatchCount(result.statistics.inputArea, h), h, options);
+      checkRemeshMemory(static_cast<double>(split), expectedPatches, h, options);
     };
     const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
       settings, [&](double f) { return !progress || progress(CgalShare * f); });
@@ -535,7 +536,7 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
     options.checkExpectedPatches(static_cast<std::size_t>(std::min(expected, MaximumPatches)));
   }
 
-  buildPatches(soup, triangles, materials, h, options, progress, result);
+  buildPatches(soup, triangles, materials, h, expected, options, progress, result);
   if (result.mesh.triangles.empty())
   {
     throw Error("the scene has no surface left after merging duplicate points (" +

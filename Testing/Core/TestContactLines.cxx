@@ -1,5 +1,6 @@
 // Contact lines (issue 11, item 4): surfaces are split where others touch or cross them, so
 // that no patch straddles a contact and averages lit floor with the dark under a block.
+#include "CoreChecks.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
 #include "Remeshing.h"
@@ -622,6 +623,46 @@ TEST(ContactLines, IndirectLightOnTheBlockSidesDoesNotDependOnThePatchSize)
 }
 
 // --- Cost and cancellation --------------------------------------------------------------------
+
+TEST(ContactLines, TrianglesAddedBySplittingCountAgainstTheMemoryLimit)
+{
+  const PolygonSoup soup = blockOnFloor(2.0, BlockLo, BlockHi, FloorRho, BlockRho);
+  // The smallest limit that passes the check made before any work: checkExpectedPatches runs
+  // right after it, and stops the remeshing there.
+  struct Passed
+  {
+  };
+  auto passesFirstCheck = [&](std::uint64_t limit) {
+    RemeshOptions options = withEdgeLength(0.1);
+    options.memoryLimitBytes = limit;
+    options.checkExpectedPatches = [](std::size_t) { throw Passed{}; };
+    try
+    {
+      remesh(soup, options);
+    }
+    catch (const Passed&)
+    {
+      return true;
+    }
+    catch (const Error&)
+    {
+    }
+    return false;
+  };
+  std::uint64_t refused = 1, passes = std::uint64_t(1) << 40;
+  ASSERT_TRUE(passesFirstCheck(passes));
+  while (passes - refused > 1)
+  {
+    const std::uint64_t middle = refused + (passes - refused) / 2;
+    (passesFirstCheck(middle) ? passes : refused) = middle;
+  }
+  RemeshOptions options = withEdgeLength(0.1);
+  options.memoryLimitBytes = passes;
+  const std::string message = checks::errorOf([&] { remesh(soup, options); });
+  EXPECT_NE(message.find("over the memory limit"), std::string::npos) << message;
+  options.splitAtContacts = false;
+  EXPECT_NO_THROW(remesh(soup, options));
+}
 
 TEST(ContactLines, SplittingIsCancellableAndReportsProgressInOrder)
 {
