@@ -106,10 +106,14 @@ using RemeshProgress = std::function<bool(double fraction)>;
  * another (CGAL's autorefinement, exact predicates), so that a floor is cut along the
  * footprint of a block standing on it and a wall along the line where a panel passes
  * through it; these lines are kept as constraints by the remeshing below, so no patch, and
- * no element, straddles a contact and averages light with shadow there. Pieces that lie face
- * to face on a closed surface (the floor under a closed block) are dropped: one side faces
- * into the closed surface and receives no light, the other coincides with the closed
- * surface's own face, and rays would hit both at the same distance. The closed surface is
+ * no element, straddles a contact and averages light with shadow there. Every point of a
+ * contact line stays, so that both surfaces keep the same polyline and no crack opens between
+ * them; a finely tessellated curved object crossing a surface thus adds small patches along
+ * the line (a 200,000-triangle sphere crossing a floor at h = 0.12: about 9,000 patches where
+ * 5,400 were aimed at). Pieces that lie face to face on a closed surface (the floor under a
+ * closed block) are dropped: one side faces into the closed surface and receives no light,
+ * the other coincides with the closed surface's own face, and rays would hit both at the same
+ * distance. The closed surface is
  * kept whole, so it stays closed; where two closed surfaces touch face to face (stacked
  * boxes) both contact faces go and one closed surface remains around both. What lies inside a
  * closed surface without touching it is kept: surfaces are two-sided, so a closed box may be
