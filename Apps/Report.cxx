@@ -83,7 +83,7 @@ std::string summaryLine(vtkFieldData* statistics)
 
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
   vtkMovingLightRadiosity* filter, vtkFieldData* statistics,
-  const std::vector<FrameRecord>& frames)
+  const std::vector<FrameRecord>& frames, const StageTimes& stages)
 {
   const std::string builtIn = "built-in Cornell box";
   nlohmann::ordered_json json;
@@ -130,6 +130,14 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     }
   }
   json["statistics"] = values;
+  json["timing"] = {
+    { "secondsReading", jsonNumber(stages.reading) },
+    { "secondsRemeshing", jsonNumber(stages.remeshing) },
+    { "secondsSolving", jsonNumber(stages.solving) },
+    { "secondsWriting", jsonNumber(stages.writing) },
+    { "secondsRendering", jsonNumber(stages.rendering) },
+    { "secondsTotal", jsonNumber(stages.total) },
+  };
 
   nlohmann::ordered_json records = nlohmann::ordered_json::array();
   for (const FrameRecord& frame : frames)

@@ -23,14 +23,26 @@ struct FrameRecord
   std::array<double, 3> lightPosition{};
 };
 
+/// Wall-clock seconds of the stages of a run.
+struct StageTimes
+{
+  double reading = 0;   ///< reading and checking the input files
+  double remeshing = 0; ///< the filter's remeshing of the scene
+  double solving = 0;   ///< the rest of the filter's first update: the solve of all frames
+  double writing = 0;   ///< converting and writing the .vtu frames and the .pvd
+  double rendering = 0; ///< the pictures of --png
+  double total = 0;     ///< from the start until the statistics are written
+};
+
 /// "30 frames, 12912 elements (3228 patches), 600000 paths/frame, 15.3 M rays (...), 1.16 s
 /// (...), predicted speed-up of reuse 2.4x" from the filter's statistics field data.
 std::string summaryLine(vtkFieldData* statistics);
 
-/// Writes the inputs, the filter's settings, the statistics and the frames as JSON.
+/// Writes the inputs, the filter's settings, the statistics, the stages' times and the frames
+/// as JSON.
 /// Throws std::runtime_error.
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
   vtkMovingLightRadiosity* filter, vtkFieldData* statistics,
-  const std::vector<FrameRecord>& frames);
+  const std::vector<FrameRecord>& frames, const StageTimes& stages);
 
 } // namespace mlr::cli

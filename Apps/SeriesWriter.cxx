@@ -1,14 +1,24 @@
 #include "SeriesWriter.h"
 
+#include "vtkAOSDataArrayTemplate.h"
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkCellType.h"
+#include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkXMLUnstructuredGridWriter.h"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -36,29 +46,237 @@ std::string SeriesNaming::frameName(std::size_t frame, const std::string& extens
   return name.str();
 }
 
-void writeFrame(vtkPolyData* elements, double time, const std::filesystem::path& path)
+namespace
 {
-  // The element mesh is all triangles: reuse its points and connectivity as they are.
-  vtkNew<vtkUnstructuredGrid> grid;
-  grid->SetPoints(elements->GetPoints());
-  grid->SetCells(VTK_TRIANGLE, elements->GetPolys());
-  grid->GetCellData()->ShallowCopy(elements->GetCellData());
-  grid->GetFieldData()->ShallowCopy(elements->GetFieldData());
-  vtkNew<vtkDoubleArray> timeValue;
-  timeValue->SetName("TimeValue");
-  timeValue->InsertNextValue(time);
-  grid->GetFieldData()->AddArray(timeValue);
+/// The XML writer writes the value range of every array (RangeMin, RangeMax: the range of a
+/// single component, else of the tuples' norms), which VTK computes at about 20 ns a value and
+/// caches in the array's information object: for the arrays of a frame, that took longer than
+/// compressing and writing them. Here the same ranges are computed in one pass over AOS arrays
+/// and cached under VTK's keys, which VTK uses while the array is not modified afterwards.
+template <typename T>
+bool cacheRangeOf(vtkDataArray* array)
+{
+  auto* typed = vtkAOSDataArrayTemplate<T>::FastDownCast(array);
+  if (!typed)
+  {
+    return false;
+  }
+  const int components = typed->GetNumberOfComponents();
+  const vtkIdType tuples = typed->GetNumberOfTuples();
+  const T* values = typed->GetPointer(0);
+  double range[2] = { std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() };
+  double norms[2] = { range[0], range[1] }; // squared
+  for (vtkIdType t = 0; t < tuples; ++t)
+  {
+    const T* tuple = values + t * components;
+    double squared = 0;
+    for (int c = 0; c < components; ++c)
+    {
+      const double v = static_cast<double>(tuple[c]);
+      squared += v * v;
+    }
+    if (std::isnan(squared))
+    {
+      continue; // VTK's ranges skip NaN too
+    }
+    norms[0] = std::min(norms[0], squared);
+    norms[1] = std::max(norms[1], squared);
+    if (components == 1)
+    {
+      range[0] = std::min(range[0], static_cast<double>(tuple[0]));
+      range[1] = std::max(range[1], static_cast<double>(tuple[0]));
+    }
+  }
+  if (!(norms[0] <= norms[1]))
+  {
+    return false; // empty or all NaN: left to VTK
+  }
+  vtkInformation* info = typed->GetInformation();
+  const double l2[2] = { std::sqrt(norms[0]), std::sqrt(norms[1]) };
+  info->Set(vtkDataArray::L2_NORM_RANGE(), l2, 2);
+  if (components == 1)
+  {
+    vtkNew<vtkInformationVector> perComponent;
+    perComponent->SetNumberOfInformationObjects(1);
+    perComponent->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), range, 2);
+    info->Set(vtkDataArray::PER_COMPONENT(), perComponent);
+  }
+  return true;
+}
 
+/// Caches the range the XML writer asks for. Called on the converting thread only, and only
+/// once for an array that frames share, so that the writing threads only read the cache.
+void cacheRange(vtkDataArray* array)
+{
+  if (!array)
+  {
+    return;
+  }
+  const int component = array->GetNumberOfComponents() == 1 ? 0 : -1;
+  vtkInformation* info = array->HasInformation() ? array->GetInformation() : nullptr;
+  const bool cached = info &&
+    (component < 0 ? info->Has(vtkDataArray::L2_NORM_RANGE())
+                   : info->Has(vtkDataArray::PER_COMPONENT()));
+  if (!cached)
+  {
+    cacheRangeOf<float>(array) || cacheRangeOf<double>(array) || cacheRangeOf<int>(array) ||
+      cacheRangeOf<long long>(array) || cacheRangeOf<long>(array) ||
+      cacheRangeOf<unsigned char>(array);
+  }
+  // VTK's own look-up: computes the range here if the cache above does not serve.
+  double range[2];
+  array->GetRange(range, component);
+}
+
+void cacheRanges(vtkFieldData* data)
+{
+  for (int i = 0; data && i < data->GetNumberOfArrays(); ++i)
+  {
+    cacheRange(data->GetArray(i));
+  }
+}
+
+void writeGrid(vtkUnstructuredGrid* grid, const std::filesystem::path& path)
+{
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
   writer->SetInputData(grid);
   writer->SetFileName(path.string().c_str());
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
-  writer->SetCompressorTypeToZLib();
+  writer->SetCompressorTypeToLZ4();
   if (!writer->Write() || writer->GetErrorCode() != 0)
   {
     throw std::runtime_error("cannot write '" + path.string() + "': check the disk space and "
                              "the permissions of its directory");
+  }
+}
+}
+
+FrameWriter::FrameWriter(unsigned threads)
+  : MaxQueued(2 * std::max(threads, 1u))
+{
+  for (unsigned i = 0; i < std::max(threads, 1u); ++i)
+  {
+    this->Threads.emplace_back([this] { this->work(); });
+  }
+}
+
+FrameWriter::~FrameWriter()
+{
+  this->stop();
+}
+
+void FrameWriter::stop() noexcept
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    this->Stopping = true;
+    this->Queue.clear();
+  }
+  this->Changed.notify_all();
+  for (std::thread& thread : this->Threads)
+  {
+    if (thread.joinable())
+    {
+      thread.join();
+    }
+  }
+}
+
+void FrameWriter::write(vtkPolyData* elements, double time, const std::filesystem::path& path)
+{
+  // The element mesh is all triangles, and the same in every frame: its points, cells and
+  // cell types are converted once and shared.
+  if (elements->GetPoints() != this->Points || elements->GetPolys() != this->Polys ||
+    !this->CellTypes || this->CellTypes->GetNumberOfTuples() != elements->GetNumberOfPolys())
+  {
+    this->Points = elements->GetPoints();
+    this->Polys = elements->GetPolys();
+    this->CellTypes = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    this->CellTypes->SetNumberOfTuples(elements->GetNumberOfPolys());
+    this->CellTypes->FillValue(VTK_TRIANGLE);
+    cacheRange(this->Points ? this->Points->GetData() : nullptr);
+    cacheRange(this->Polys ? this->Polys->GetConnectivityArray() : nullptr);
+    cacheRange(this->Polys ? this->Polys->GetOffsetsArray() : nullptr);
+    cacheRange(this->CellTypes);
+  }
+  Job job{ this->Points, this->Polys, this->CellTypes, vtkSmartPointer<vtkCellData>::New(),
+    vtkSmartPointer<vtkFieldData>::New(), path };
+  job.cellData->ShallowCopy(elements->GetCellData());
+  job.fieldData->ShallowCopy(elements->GetFieldData());
+  vtkNew<vtkDoubleArray> timeValue;
+  timeValue->SetName("TimeValue");
+  timeValue->InsertNextValue(time);
+  job.fieldData->AddArray(timeValue);
+  cacheRanges(job.cellData);
+  cacheRanges(job.fieldData);
+
+  std::unique_lock<std::mutex> lock(this->Mutex);
+  // Bounded: frames are produced faster than written on a slow disk.
+  this->Changed.wait(lock, [this] { return this->Queue.size() < this->MaxQueued || this->Failure; });
+  if (this->Failure)
+  {
+    std::rethrow_exception(this->Failure);
+  }
+  this->Queue.push_back(std::move(job));
+  lock.unlock();
+  this->Changed.notify_all();
+}
+
+void FrameWriter::finish()
+{
+  std::unique_lock<std::mutex> lock(this->Mutex);
+  this->Changed.wait(
+    lock, [this] { return (this->Queue.empty() && this->Busy == 0) || this->Failure; });
+  if (this->Failure)
+  {
+    std::rethrow_exception(this->Failure);
+  }
+}
+
+void FrameWriter::work()
+{
+  // Kept from frame to frame: VTK caches what it derives from the mesh (the distinct cell
+  // types, which the writer asks for) in the grid, and that cache holds while only the cell
+  // and field data change.
+  vtkNew<vtkUnstructuredGrid> grid;
+  std::unique_lock<std::mutex> lock(this->Mutex);
+  for (;;)
+  {
+    this->Changed.wait(lock, [this] { return this->Stopping || !this->Queue.empty(); });
+    if (this->Stopping)
+    {
+      return;
+    }
+    Job job = std::move(this->Queue.front());
+    this->Queue.pop_front();
+    ++this->Busy;
+    lock.unlock();
+    std::exception_ptr failure;
+    try
+    {
+      if (grid->GetPoints() != job.points || grid->GetCells() != job.polys)
+      {
+        grid->SetPoints(job.points);
+        grid->SetCells(job.cellTypes, job.polys);
+      }
+      grid->GetCellData()->ShallowCopy(job.cellData);
+      grid->GetFieldData()->ShallowCopy(job.fieldData);
+      writeGrid(grid, job.path);
+    }
+    catch (...)
+    {
+      failure = std::current_exception();
+    }
+    job = Job(); // released here, not under the lock
+    lock.lock();
+    --this->Busy;
+    if (failure && !this->Failure)
+    {
+      this->Failure = failure;
+    }
+    this->Changed.notify_all();
   }
 }
 

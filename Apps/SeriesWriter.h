@@ -1,13 +1,25 @@
 // The .pvd + .vtu time series: file names, frames and the collection file.
 #pragma once
 
+#include "vtkSmartPointer.h"
+
+#include <condition_variable>
 #include <cstddef>
+#include <deque>
+#include <exception>
 #include <filesystem>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
+class vtkCellArray;
+class vtkCellData;
+class vtkFieldData;
+class vtkPoints;
 class vtkPolyData;
+class vtkUnsignedCharArray;
 
 namespace mlr::cli
 {
@@ -25,9 +37,61 @@ struct SeriesNaming
   std::string frameName(std::size_t frame, const std::string& extension) const;
 };
 
-/// Writes one frame (the filter's Elements output) as an unstructured grid of triangles with
-/// its cell and field data and a field array TimeValue. Throws std::runtime_error.
-void writeFrame(vtkPolyData* elements, double time, const std::filesystem::path& path);
+/**
+ * Writes the frames of a series, each the filter's Elements output as an unstructured grid of
+ * triangles with its cell, point and field data and a field array TimeValue, LZ4-compressed
+ * (VTK's vtkLZ4DataCompressor, which ParaView and VTK's readers read; zlib took as long as the
+ * solve). The calling thread takes each frame's cell and field data; background threads, each
+ * with one unstructured grid of the element mesh's points and cells (converted once while the
+ * filter hands out the same mesh), swap them in, compress and write the frame meanwhile, so
+ * that writing overlaps the next frame's update.
+ */
+class FrameWriter
+{
+public:
+  /// `threads` background writers (at least 1); at most twice that many frames wait in memory.
+  explicit FrameWriter(unsigned threads = 1);
+  /// Waits for the frames being written (their files are the caller's to remove).
+  ~FrameWriter();
+  FrameWriter(const FrameWriter&) = delete;
+  FrameWriter& operator=(const FrameWriter&) = delete;
+
+  /// Converts `elements` now and writes it to `path` in the background. Throws the
+  /// std::runtime_error of an earlier frame that could not be written.
+  void write(vtkPolyData* elements, double time, const std::filesystem::path& path);
+
+  /// Waits until every frame is written; throws std::runtime_error if one could not be.
+  void finish();
+
+private:
+  /// One frame: the shared mesh and the frame's own cell and field data.
+  struct Job
+  {
+    vtkSmartPointer<vtkPoints> points;
+    vtkSmartPointer<vtkCellArray> polys;
+    vtkSmartPointer<vtkUnsignedCharArray> cellTypes;
+    vtkSmartPointer<vtkCellData> cellData;
+    vtkSmartPointer<vtkFieldData> fieldData;
+    std::filesystem::path path;
+  };
+  void work();
+  void stop() noexcept;
+
+  // The geometry of the last frame, shared by the next ones while the filter hands out the
+  // same points and cells.
+  vtkSmartPointer<vtkPoints> Points;
+  vtkSmartPointer<vtkCellArray> Polys;
+  vtkSmartPointer<vtkUnsignedCharArray> CellTypes;
+
+  std::mutex Mutex;
+  std::condition_variable Changed;
+  std::deque<Job> Queue;
+  std::size_t Busy = 0;
+  std::size_t MaxQueued = 2;
+  bool Stopping = false;
+  std::exception_ptr Failure;
+  std::vector<std::thread> Threads;
+};
 
 /// Writes the .pvd collection: (time, file name relative to the .pvd) per frame.
 void writeCollection(const std::filesystem::path& path,

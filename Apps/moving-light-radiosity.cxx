@@ -23,7 +23,9 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkSunPathSource.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cerrno>
 #include <climits>
 #include <csignal>
@@ -32,6 +34,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -55,6 +58,21 @@ std::atomic<bool> Interrupted{ false };
 extern "C" void onSignal(int)
 {
   Interrupted = true;
+}
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Threads that compress and write frames while the main thread converts the next one: one
+/// per core beyond the first, up to 3 (beyond that the main thread's frame updates limit).
+unsigned writerThreads()
+{
+  const unsigned cores = std::thread::hardware_concurrency();
+  return std::clamp(cores > 1 ? cores - 1 : 1u, 1u, 3u);
 }
 
 void throwIfInterrupted()
@@ -230,6 +248,7 @@ vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
 
 int run(int argc, char** argv)
 {
+  const Clock::time_point started = Clock::now();
   const Options options = parseCommandLine(argc, argv);
   if (options.help)
   {
@@ -244,6 +263,7 @@ int run(int argc, char** argv)
   }
 
   // Every input is read and checked before anything is written.
+  const Clock::time_point readingStarted = Clock::now();
   const std::uint64_t memoryLimit =
     options.memoryLimit ? static_cast<std::uint64_t>(*options.memoryLimit) << 20 : 0;
   const auto scene = options.usesEmbeddedScene()
@@ -272,6 +292,8 @@ int run(int argc, char** argv)
   {
     trajectory = readEmbeddedFile("cornell_trajectory.vtp");
   }
+  StageTimes stages;
+  stages.reading = secondsSince(readingStarted);
   filter->SetInputData(vtkMovingLightRadiosity::SCENE_PORT, scene);
   if (light)
   {
@@ -332,7 +354,9 @@ int run(int argc, char** argv)
     prepareDirectory(output, options.png);
   }
 
+  const Clock::time_point solveStarted = Clock::now();
   vtkPolyData* first = frameAt(filter, times.front()); // the solve
+  const double update = secondsSince(solveStarted);
   // Later updates only copy frames out of the filter's cache: their progress is not the solve's.
   filter->RemoveObserver(solving);
   bar.finish();
@@ -344,26 +368,40 @@ int run(int argc, char** argv)
   // A copy: the next update clears the output's field data in place.
   vtkNew<vtkFieldData> statistics;
   statistics->ShallowCopy(first->GetFieldData());
+  vtkDataArray* remeshing = statistics->GetArray("SecondsRemeshing");
+  stages.remeshing = remeshing ? std::min(remeshing->GetComponent(0, 0), update) : 0.0;
+  stages.solving = update - stages.remeshing;
 
+  const Clock::time_point writingStarted = Clock::now();
   std::vector<FrameRecord> records;
   double brightLevel = 0;
-  for (std::size_t f = 0; f < times.size(); ++f)
   {
-    throwIfInterrupted();
-    vtkPolyData* elements = frameAt(filter, times[f]);
-    FrameRecord record;
-    record.time = times[f];
-    record.file = naming.frameName(f, ".vtu");
-    tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
-    writeFrame(elements, times[f], output.stage(naming.directory / record.file));
-    brightLevel = std::max(brightLevel, FrameRenderer::brightLevel(elements));
-    records.push_back(record);
-    bar.show(double(f + 1) / double(times.size()), "writing frames");
+    // Destroyed before `output`: no frame is still being written when a failure rolls back.
+    FrameWriter writer(writerThreads());
+    for (std::size_t f = 0; f < times.size(); ++f)
+    {
+      throwIfInterrupted();
+      vtkPolyData* elements = frameAt(filter, times[f]);
+      FrameRecord record;
+      record.time = times[f];
+      record.file = naming.frameName(f, ".vtu");
+      tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+      writer.write(elements, times[f], output.stage(naming.directory / record.file));
+      if (!options.png.empty())
+      {
+        brightLevel = std::max(brightLevel, FrameRenderer::brightLevel(elements));
+      }
+      records.push_back(record);
+      bar.show(double(f + 1) / double(times.size()), "writing frames");
+    }
+    writer.finish();
   }
   output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
+  stages.writing = secondsSince(writingStarted);
 
   if (!options.png.empty())
   {
+    const Clock::time_point renderingStarted = Clock::now();
     const fs::path pictures = options.png;
     FrameRenderer renderer(light, scene->GetBounds());
     renderer.setBrightLevel(brightLevel);
@@ -378,6 +416,7 @@ int run(int argc, char** argv)
       bar.show(double(f + 1) / double(times.size()), "rendering pictures");
     }
     output.replaceSeries(pictures, naming.framePrefix(), ".png");
+    stages.rendering = secondsSince(renderingStarted);
   }
 
   std::vector<std::pair<double, std::string>> entries;
@@ -385,11 +424,14 @@ int run(int argc, char** argv)
   {
     entries.emplace_back(record.time, record.file);
   }
+  const Clock::time_point collectionStarted = Clock::now();
   writeCollection(output.stage(collection), entries); // staged after its frames
+  stages.writing += secondsSince(collectionStarted);
+  stages.total = secondsSince(started);
   if (!options.stats.empty())
   {
     const fs::path statsPath = options.stats;
-    writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records);
+    writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records, stages);
   }
   throwIfInterrupted();
   output.commit();
