@@ -18,8 +18,20 @@
 #include "vtkWindowToImageFilter.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <poll.h>
+#include <random>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 namespace mlr::cli
@@ -168,6 +180,202 @@ void FrameRenderer::render(
   if (writer->GetErrorCode() != 0)
   {
     throw std::runtime_error("cannot write the picture '" + png.string() + "'");
+  }
+}
+
+namespace
+{
+std::string findInPath(const std::string& program)
+{
+  const char* path = std::getenv("PATH");
+  std::istringstream directories(path ? path : "/usr/bin:/bin");
+  std::string directory;
+  while (std::getline(directories, directory, ':'))
+  {
+    const std::string candidate = (directory.empty() ? "." : directory) + "/" + program;
+    if (access(candidate.c_str(), X_OK) == 0)
+    {
+      return candidate;
+    }
+  }
+  return {};
+}
+
+std::string displayVariable()
+{
+  const char* display = std::getenv("DISPLAY");
+  return display ? display : "";
+}
+
+/// Stops the server: SIGTERM, then SIGKILL if it has not exited within 10 s.
+void stopServer(pid_t server)
+{
+  kill(server, SIGTERM);
+  for (int i = 0; i < 1000; ++i)
+  {
+    const pid_t done = waitpid(server, nullptr, WNOHANG);
+    if (done == server || (done < 0 && errno != EINTR))
+    {
+      return;
+    }
+    usleep(10000);
+  }
+  kill(server, SIGKILL);
+  while (waitpid(server, nullptr, 0) < 0 && errno == EINTR)
+  {
+  }
+}
+
+/// Reads what the server wrote to `fd` until a newline, its end or `seconds`; true when a
+/// display number came.
+bool readReadyLine(int fd, int seconds)
+{
+  std::string line;
+  for (int waited = 0; waited < seconds * 10;)
+  {
+    pollfd ready{ fd, POLLIN, 0 };
+    const int polled = poll(&ready, 1, 100);
+    if (polled < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (polled == 0)
+    {
+      ++waited;
+      continue;
+    }
+    char c;
+    const ssize_t n = read(fd, &c, 1);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n <= 0 || c == '\n')
+    {
+      return !line.empty();
+    }
+    line += c;
+  }
+  return false;
+}
+
+std::string fileText(int fd)
+{
+  std::string text;
+  char buffer[4096];
+  lseek(fd, 0, SEEK_SET);
+  for (ssize_t n; (n = read(fd, buffer, sizeof(buffer))) > 0;)
+  {
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  text.erase(text.find_last_not_of(" \n") + 1);
+  return text;
+}
+}
+
+void PictureDisplay::checkAvailable()
+{
+  if (displayVariable().empty() && findInPath("Xvfb").empty())
+  {
+    throw std::runtime_error("--png needs an X display: set DISPLAY, or install Xvfb "
+                             "(Debian's package xvfb) to render the pictures off-screen");
+  }
+}
+
+PictureDisplay::PictureDisplay()
+  : Name(displayVariable())
+{
+  if (!this->Name.empty())
+  {
+    return;
+  }
+  checkAvailable();
+  const std::string xvfb = findInPath("Xvfb");
+  const pid_t parent = getpid();
+  std::mt19937 random(std::random_device{}());
+  std::uniform_int_distribution<int> numbers(1000, 29999);
+  std::string failure = "no attempt";
+  for (int attempt = 0; attempt < 20; ++attempt)
+  {
+    // Everything the child needs is prepared before fork(): this process has threads, and the
+    // child may only make async-signal-safe calls until it runs Xvfb.
+    const std::string display = ":" + std::to_string(numbers(random));
+    int ready[2]; // Xvfb writes the display number here once it accepts connections
+    if (pipe2(ready, O_CLOEXEC) != 0)
+    {
+      throw std::runtime_error(std::string("cannot start Xvfb: ") + std::strerror(errno));
+    }
+    char logName[] = "/tmp/mlr-xvfb-XXXXXX";
+    const int log = mkostemp(logName, O_CLOEXEC);
+    if (log >= 0)
+    {
+      unlink(logName);
+    }
+    const std::string readyFd = std::to_string(ready[1]);
+    const char* arguments[] = { "Xvfb", display.c_str(), "-displayfd", readyFd.c_str(), "-screen",
+      "0", "1280x1024x24", "-nolisten", "tcp", "-noreset", nullptr };
+    const pid_t child = fork();
+    if (child == 0)
+    {
+      // The server must not outlive this process, even one that is killed or crashes.
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != parent)
+      {
+        _exit(127);
+      }
+      // Its own process group: Ctrl-C interrupts the run, which then stops the server itself
+      // after the render window has closed its connection.
+      setpgid(0, 0);
+      const int null = open("/dev/null", O_RDONLY);
+      dup2(null, 0);
+      if (log >= 0)
+      {
+        dup2(log, 1);
+        dup2(log, 2);
+      }
+      fcntl(ready[1], F_SETFD, 0); // inherited by Xvfb
+      execv(xvfb.c_str(), const_cast<char* const*>(arguments));
+      _exit(127);
+    }
+    close(ready[1]);
+    if (child < 0)
+    {
+      close(ready[0]);
+      if (log >= 0)
+      {
+        close(log);
+      }
+      throw std::runtime_error(std::string("cannot start Xvfb: ") + std::strerror(errno));
+    }
+    const bool started = readReadyLine(ready[0], 30);
+    close(ready[0]);
+    if (started)
+    {
+      if (log >= 0)
+      {
+        close(log);
+      }
+      this->Server = child;
+      this->Name = display;
+      setenv("DISPLAY", display.c_str(), 1);
+      return;
+    }
+    // The number is taken (the server exits), or Xvfb cannot start at all.
+    stopServer(child);
+    failure = display + ": " + (log >= 0 ? fileText(log) : std::string("no log"));
+    if (log >= 0)
+    {
+      close(log);
+    }
+  }
+  throw std::runtime_error("--png: Xvfb did not start: " + failure);
+}
+
+PictureDisplay::~PictureDisplay()
+{
+  if (this->Server > 0)
+  {
+    stopServer(this->Server);
   }
 }
 

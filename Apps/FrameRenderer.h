@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <sys/types.h>
 
 class vtkPolyData;
 
@@ -41,6 +43,37 @@ public:
 private:
   struct Pipeline;
   std::unique_ptr<Pipeline> Internals;
+};
+
+/**
+ * The X display the pictures are rendered on: $DISPLAY when it is set, else a private Xvfb
+ * server started here and stopped by the destructor. The project's one way to get a display
+ * off-screen, as Testing/Plugin/xvfb_display.py does it for the tests and the examples: a
+ * display number drawn among thousands (the X server refuses one in use by its lock file),
+ * -displayfd to know when it accepts clients, and -noreset, because ParaView's VTK opens a
+ * first X connection and closes it before the render window opens its own, and a resetting
+ * server drops a connection that arrives meanwhile. The server dies with this process even
+ * when it is killed.
+ */
+class PictureDisplay
+{
+public:
+  /// Throws std::runtime_error when there is no DISPLAY and Xvfb is not installed: call it
+  /// before the solve, so that a run that cannot render fails at once.
+  static void checkAvailable();
+
+  /// Sets DISPLAY for this process, starting Xvfb when needed. Throws std::runtime_error.
+  PictureDisplay();
+  ~PictureDisplay();
+  PictureDisplay(const PictureDisplay&) = delete;
+  PictureDisplay& operator=(const PictureDisplay&) = delete;
+
+  /// The display's name (":1234").
+  const std::string& name() const { return this->Name; }
+
+private:
+  std::string Name;
+  pid_t Server = -1; ///< the Xvfb started here, or -1
 };
 
 } // namespace mlr::cli

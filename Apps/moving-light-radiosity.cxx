@@ -27,7 +27,6 @@
 #include <atomic>
 #include <chrono>
 #include <cerrno>
-#include <climits>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -81,66 +80,6 @@ void throwIfInterrupted()
   {
     throw InputError("interrupted: nothing was written");
   }
-}
-
-std::string findInPath(const std::string& program)
-{
-  const char* path = std::getenv("PATH");
-  std::istringstream directories(path ? path : "/usr/bin:/bin");
-  std::string directory;
-  while (std::getline(directories, directory, ':'))
-  {
-    const std::string candidate = (directory.empty() ? "." : directory) + "/" + program;
-    if (access(candidate.c_str(), X_OK) == 0)
-    {
-      return candidate;
-    }
-  }
-  return {};
-}
-
-/// Pictures need an X display (ParaView's VTK renders through GLX). Without one, run this
-/// same command again under `xvfb-run -a`, once; this call then does not return.
-void ensureDisplay(int argc, char** argv)
-{
-  const char* display = std::getenv("DISPLAY");
-  if (display && *display)
-  {
-    return;
-  }
-  if (std::getenv("MLR_UNDER_XVFB"))
-  {
-    throw InputError("--png needs an X display and xvfb-run did not provide one: check that "
-                     "Xvfb runs on this machine");
-  }
-  const std::string xvfbRun = findInPath("xvfb-run");
-  if (xvfbRun.empty())
-  {
-    throw InputError("--png needs an X display: set DISPLAY, or install xvfb (xvfb-run) to "
-                     "render the pictures off-screen");
-  }
-  char self[PATH_MAX] = {};
-  const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
-  if (length <= 0)
-  {
-    throw InputError(std::string("cannot find this program to run it under xvfb-run: ") +
-      std::strerror(errno));
-  }
-  setenv("MLR_UNDER_XVFB", "1", 1);
-  // xvfb-run -a takes the first free display from 99 on; two runs starting together can both
-  // pick the same one and one of them then aborts. Starting the search at a number drawn
-  // from the process id keeps concurrent runs (parallel tests, batch jobs) apart.
-  std::string firstDisplay = std::to_string(100 + getpid() % 4000);
-  std::vector<char*> arguments = { const_cast<char*>("xvfb-run"), const_cast<char*>("-a"),
-    const_cast<char*>("-n"), firstDisplay.data(), self };
-  for (int i = 1; i < argc; ++i)
-  {
-    arguments.push_back(argv[i]);
-  }
-  arguments.push_back(nullptr);
-  std::cout.flush();
-  execv(xvfbRun.c_str(), arguments.data());
-  throw InputError(std::string("cannot run xvfb-run: ") + std::strerror(errno));
 }
 
 /// Refuses an output file name that is taken by a directory.
@@ -259,7 +198,7 @@ int run(int argc, char** argv)
   configureFilter(options, filter);
   if (!options.png.empty())
   {
-    ensureDisplay(argc, argv);
+    PictureDisplay::checkAvailable();
   }
 
   // Every input is read and checked before anything is written.
@@ -403,6 +342,7 @@ int run(int argc, char** argv)
   {
     const Clock::time_point renderingStarted = Clock::now();
     const fs::path pictures = options.png;
+    const PictureDisplay display; // outlives the renderer's connection to it
     FrameRenderer renderer(light, scene->GetBounds());
     renderer.setBrightLevel(brightLevel);
     for (std::size_t f = 0; f < times.size(); ++f)

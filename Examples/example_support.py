@@ -1,7 +1,10 @@
-"""What the ParaView examples share: finding and loading the plugin, and holding the X display.
+"""What the ParaView examples share: finding and loading the plugin, and the X display.
 
-Run the examples with pvpython on an X display (xvfb-run -a pvpython ... without one).
+Run the examples with pvpython. Without an X display (DISPLAY unset) they start a private
+Xvfb for the run, the way the tests and the command line do (Testing/Plugin/xvfb_display.py).
 """
+import atexit
+import contextlib
 import ctypes
 import glob
 import os
@@ -37,10 +40,20 @@ def hold_x_display():
 
 def require_display(parser, script):
     """Debian's ParaView renders through X only and would abort at the first picture, after
-    the whole solve: refuse to start without a display."""
-    if not os.environ.get("DISPLAY"):
-        parser.error(f"no X display (DISPLAY is not set): run it as xvfb-run -a pvpython {script} ...")
-    return hold_x_display()
+    the whole solve: without DISPLAY, start a private Xvfb for this run (stopped at exit), or
+    refuse to start when Xvfb is not installed. Keep what it returns until the end."""
+    if os.environ.get("DISPLAY"):
+        return hold_x_display()
+    sys.path.insert(0, os.path.join(ROOT, "Testing", "Plugin"))
+    from xvfb_display import virtual_display
+    stack = contextlib.ExitStack()
+    try:
+        os.environ["DISPLAY"] = stack.enter_context(virtual_display())
+    except RuntimeError as error:  # Xvfb missing, or it did not start
+        parser.error(f"no X display (DISPLAY is not set) and {error}; on a desktop, run "
+                     f"pvpython {script} ... there")
+    atexit.register(stack.close)
+    return stack
 
 
 def load_plugin(pv, parser, plugin=None):

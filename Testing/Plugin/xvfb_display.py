@@ -1,5 +1,8 @@
-"""A private virtual X display for the rendering tests (Debian's ParaView renders through GLX
-only, so pvbatch screenshots and the paraview GUI need an X server).
+"""A private virtual X display for the rendering tests and the examples (Debian's ParaView
+renders through GLX only, so pvbatch screenshots and the paraview GUI need an X server). It is
+the project's one way to get a display off-screen: Examples/example_support.py uses this module
+when DISPLAY is unset, and the command line does the same in C++ for --png (PictureDisplay in
+Apps/FrameRenderer.cxx).
 
 Two ways an X display fails ParaView with "bad X server connection" (SIGABRT):
 - ParaView opens a first X connection and closes it before the render window opens its own.

@@ -1,0 +1,197 @@
+"""How the command line writes its series and pictures (issue 16): LZ4-compressed frames
+written on background threads read back whole and consistent, --stats times the stages, and
+pictures without DISPLAY come from a private Xvfb that does not outlive the run.
+
+ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
+    MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps/test_cli_series.py
+"""
+import json
+import os
+import re
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run  # noqa: E402
+
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader  # noqa: E402
+import numpy  # noqa: E402
+
+PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40"]
+FRAMES = 6
+STAGES = ("secondsReading", "secondsRemeshing", "secondsSolving", "secondsWriting",
+          "secondsRendering", "secondsTotal")
+
+
+def read_grid(path):
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+@pytest.fixture(scope="module")
+def series(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("series")
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", str(FRAMES), "--output", "out/s.pvd", "--stats", "out/s.json"] +
+                 FAST, directory)
+    assert result.returncode == 0, result.stderr
+    return directory / "out"
+
+
+def test_frames_are_lz4_compressed_and_complete(series):
+    assert all_files(series) == ["s.json", "s.pvd"] + [f"s_{i:04d}.vtu" for i in range(FRAMES)]
+    for i in range(FRAMES):
+        header = (series / f"s_{i:04d}.vtu").read_bytes()[:200].decode("latin-1")
+        assert 'compressor="vtkLZ4DataCompressor"' in header
+
+
+def test_frames_read_back_with_their_times_and_one_mesh(series):
+    datasets = ElementTree.parse(series / "s.pvd").findall(".//DataSet")
+    stats = json.loads((series / "s.json").read_text())
+    assert len(datasets) == FRAMES
+    first = None
+    for frame, dataset in enumerate(datasets):
+        grid = read_grid(series / dataset.get("file"))
+        fields = grid.GetFieldData()
+        # Each file holds its own frame, whichever thread wrote it.
+        assert fields.GetArray("FrameIndex").GetValue(0) == frame
+        assert fields.GetArray("TimeValue").GetValue(0) == float(dataset.get("timestep"))
+        assert fields.GetArray("LightPosition").GetTuple3(0) == pytest.approx(
+            stats["frames"][frame]["lightPosition"], abs=0)
+        points = vtk_to_numpy(grid.GetPoints().GetData())
+        cells = vtk_to_numpy(grid.GetCells().GetConnectivityArray())
+        types = vtk_to_numpy(grid.GetCellTypesArray())
+        assert set(types.tolist()) == {5}  # VTK_TRIANGLE
+        if first is None:
+            first = (points, cells)
+        else:
+            assert numpy.array_equal(points, first[0]) and numpy.array_equal(cells, first[1])
+        cell_data = grid.GetCellData()
+        total = vtk_to_numpy(cell_data.GetArray("Radiosity")).astype(numpy.float64)
+        parts = sum(vtk_to_numpy(cell_data.GetArray(name)).astype(numpy.float64)
+                    for name in ("DirectRadiosity", "IndirectRadiosity", "EmittedRadiosity"))
+        # Float32 arrays: the sum agrees within a few units in the last place.
+        assert numpy.allclose(total, parts, rtol=1e-5, atol=1e-6 * total.max())
+        assert cell_data.GetArray("Radiosity").GetDataType() == 10  # VTK_FLOAT, as before
+
+
+def test_header_ranges_are_those_of_the_data(series):
+    """The writer puts each array's range in the file (RangeMin/RangeMax, the norm's range for
+    several components); the command line computes those ranges itself, so they are checked
+    against VTK's on the arrays read back."""
+    text = (series / "s_0002.vtu").read_bytes().split(b"<AppendedData")[0].decode()
+    grid = read_grid(series / "s_0002.vtu")
+    checked = 0
+    for match in re.finditer(r'<DataArray [^>]*Name="([^"]+)"[^>]*>', text):
+        tag, name = match.group(0), match.group(1)
+        low = re.search(r'RangeMin="([^"]*)"', tag)
+        high = re.search(r'RangeMax="([^"]*)"', tag)
+        components = int(re.search(r'NumberOfComponents="(\d+)"', tag).group(1)) \
+            if "NumberOfComponents" in tag else 1
+        array = (grid.GetCellData().GetArray(name) or grid.GetFieldData().GetArray(name)
+                 or (grid.GetPoints().GetData() if name == "Points" else None))
+        if array is None or not low or not low.group(1):
+            continue
+        expected = array.GetRange(-1 if components > 1 else 0)
+        assert (float(low.group(1)), float(high.group(1))) == pytest.approx(expected, rel=1e-9), name
+        checked += 1
+    assert checked >= 10
+
+
+def test_stats_time_the_stages(series):
+    stats = json.loads((series / "s.json").read_text())
+    timing = stats["timing"]
+    assert list(timing) == list(STAGES)
+    assert all(timing[key] >= 0 for key in STAGES)
+    assert timing["secondsSolving"] > 0 and timing["secondsWriting"] > 0
+    assert timing["secondsRendering"] == 0  # no --png
+    # Disjoint stretches of the run, all within its total.
+    assert sum(timing[key] for key in STAGES[:4]) <= timing["secondsTotal"]
+    # The keys that were there before stay.
+    assert {"scene", "light", "trajectory", "output", "settings", "statistics",
+            "frames"} <= set(stats)
+    assert stats["statistics"]["Frames"] == FRAMES
+
+
+def fake_xvfb(directory):
+    """An Xvfb on PATH that notes its process id and then becomes the real Xvfb."""
+    real = shutil.which("Xvfb")
+    bin_dir = directory / "bin"
+    bin_dir.mkdir()
+    script = bin_dir / "Xvfb"
+    script.write_text(f'#!/bin/sh\necho $$ >> "{directory}/xvfb.pids"\nexec "{real}" "$@"\n')
+    script.chmod(script.stat().st_mode | stat.S_IEXEC)
+    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    env["PATH"] = f"{bin_dir}:{env.get('PATH', '/usr/bin:/bin')}"
+    return env, directory / "xvfb.pids"
+
+
+def alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+@pytest.mark.skipif(shutil.which("Xvfb") is None, reason="needs Xvfb")
+def test_pictures_without_display_use_a_private_xvfb_that_stops(tmp_path):
+    env, pids = fake_xvfb(tmp_path)
+    result = run(["--scene", SCENE, "--light", LIGHT, "--output", "s.pvd", "--png", "pictures",
+                  "--frames", "2", "--stats", "s.json"] + PATH + FAST, tmp_path, env=env)
+    assert result.returncode == 0, result.stderr
+    assert all_files(tmp_path / "pictures") == ["s_0000.png", "s_0001.png"]
+    started = [int(line) for line in pids.read_text().split()]
+    assert len(started) >= 1
+    assert not any(alive(pid) for pid in started)  # stopped and reaped before the exit
+    assert json.loads((tmp_path / "s.json").read_text())["timing"]["secondsRendering"] > 0
+
+
+@pytest.mark.skipif(shutil.which("Xvfb") is None, reason="needs Xvfb")
+def test_killed_run_takes_its_xvfb_along(tmp_path):
+    env, pids = fake_xvfb(tmp_path)
+    process = subprocess.Popen(
+        [CLI, "--scene", SCENE, "--light", LIGHT, "--output", "s.pvd", "--png", "pictures",
+         "--frames", "30"] + PATH + FAST, cwd=tmp_path, env=env,
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 240
+        while not pids.exists() and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert pids.exists(), "the run never started Xvfb"
+        process.send_signal(signal.SIGKILL)  # no clean-up code runs
+        process.wait(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    started = [int(line) for line in pids.read_text().split()]
+    deadline = time.monotonic() + 30
+    while any(alive(pid) for pid in started) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    leftover = [pid for pid in started if alive(pid)]
+    for pid in leftover:
+        os.kill(pid, signal.SIGKILL)
+    assert not leftover, "Xvfb outlived the killed run"
+
+
+def test_pictures_without_display_or_xvfb_fail_before_the_solve(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    env["PATH"] = str(empty)
+    result = run(["--scene", SCENE, "--light", LIGHT, "--output", "out/s.pvd", "--png", "png",
+                  "--frames", "2"] + PATH + FAST, tmp_path, env=env)
+    assert result.returncode == 1
+    assert "--png needs an X display: set DISPLAY, or install Xvfb" in result.stderr
+    assert all_files(tmp_path) == []
