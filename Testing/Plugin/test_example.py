@@ -154,3 +154,69 @@ def test_spotlight_example_pans(tmp_path):
     green0, red0 = wall_direct(entries[0])
     green4, red4 = wall_direct(entries[-1])
     assert green0 > 3 * red0 and red4 > 3 * green4, (green0, red0, green4, red4)
+
+
+def test_material_scenes_example(tmp_path):
+    """Examples/material_scenes.py: the Cornell box OBJ + MTL (lamp material "light") and the
+    glTF room of Data/make_gltf_room.py (lamp material "panel"), each opened with the scene
+    reader and lit by its own lamp moving in 4 steps. The series' times are the steps; the
+    pictures are in the scenes' own colours (the Cornell box's red and green walls, the room's
+    red and blue walls and green box), not grey, and the lamp moves: the first and last
+    frames differ."""
+    if not shutil.which("Xvfb"):
+        pytest.skip("Xvfb is not installed")
+    plugin = os.environ.get("MLR_PLUGIN")
+    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
+    output = tmp_path / "materials"
+    frames = 4
+    env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
+    with virtual_display() as display:
+        run = subprocess.run(
+            [os.environ.get("MLR_PVPYTHON", "pvpython"),
+             os.path.join(ROOT, "Examples", "material_scenes.py"), "--plugin", plugin,
+             "--output", str(output), "--paths", "40000", "--frames", str(frames), "--size", "96"],
+            capture_output=True, text=True, timeout=300, env=dict(env, DISPLAY=display))
+    report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
+    assert run.returncode == 0, report
+
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+
+    def pixels(picture):
+        reader = vtkPNGReader()
+        reader.SetFileName(str(picture))
+        reader.Update()
+        return vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())[:, :3].astype(int)
+
+    def share(p, channel, over):
+        """The share of the picture where `channel` is bright and 1.5 times each of `over`."""
+        mask = p[:, channel] > 40
+        for other in over:
+            mask &= p[:, channel] > 1.5 * p[:, other]
+        return mask.mean()
+
+    R, G, B = 0, 1, 2
+    # name: the colours each picture must show, as (channel, channels it must exceed)
+    expected = {"cornell": {"red wall": (R, (G, B)), "green wall": (G, (R, B))},
+                "room": {"red wall": (R, (G, B)), "blue wall": (B, (R, G)), "green box": (G, (R, B))}}
+    for name, colours in expected.items():
+        pvd = output / f"{name}.pvd"
+        assert pvd.is_file(), report
+        entries = [(float(e.get("timestep")), e.get("file"))
+                   for e in ElementTree.parse(pvd).getroot().iter("DataSet")]
+        assert [t for t, _ in entries] == [float(i) for i in range(frames)], (name, entries)
+        assert all((output / f).is_file() and f.endswith(".vtu") for _, f in entries), entries
+        pictures = sorted((output / "png" / name).glob("frame_*.png"))
+        assert [p.name for p in pictures] == [f"frame_{i:04d}.png" for i in range(frames)], pictures
+        first, last = pixels(pictures[0]), pixels(pictures[-1])
+        for picture, p in ((pictures[0], first), (pictures[-1], last)):
+            lit = (p.max(axis=1) > 30).mean()
+            assert lit > 0.4, f"{name}/{picture.name}: only {100 * lit:.0f}% of the picture is lit"
+            # Grey would have R = G = B everywhere: the walls' own colours must show.
+            spread = (p.max(axis=1) - p.min(axis=1) > 40).mean()
+            assert spread > 0.2, f"{name}/{picture.name}: only {100 * spread:.0f}% of the picture is coloured"
+            for colour, (channel, over) in colours.items():
+                # A grey picture has none; the room's box, away from the lamp, shows 3% at 96 px.
+                seen = share(p, channel, over)
+                assert seen > 0.015, f"{name}/{picture.name}: the {colour} covers {100 * seen:.1f}% of the picture"
+        assert abs(first - last).mean() > 2, f"{name}: the first and last pictures are the same: the lamp did not move"
