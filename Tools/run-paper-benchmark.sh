@@ -10,5 +10,6 @@ build="${MLR_BUILD_DIR:-$root/build}"
 cd "$root"
 export PYTHONPATH="$build/lib/python3/dist-packages${PYTHONPATH:+:$PYTHONPATH}"
 out="${1:-output/paper}"
-xvfb-run -a /usr/bin/python3 Benchmarks/paper_benchmark.py --output "$out"
+# The middle-frame pictures need an X display: a private Xvfb, as the tests and examples use.
+/usr/bin/python3 Testing/Plugin/xvfb_display.py /usr/bin/python3 Benchmarks/paper_benchmark.py --output "$out"
 /usr/bin/python3 Benchmarks/plot_paper.py "$out/results.json"
