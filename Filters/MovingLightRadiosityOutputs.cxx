@@ -218,6 +218,11 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   real("PredictedSpeedup",
     predictedSpeedup(statistics.frames, options.gatheringRatio, options.firstBounceSurvival,
       statistics.meanPathLength));
+  // The solver has no length unit of its own: power is in watts, and radiosity (power per
+  // area) per square unit of the scene's coordinates: W/m^2 for a scene in metres, W/mm^2 for
+  // one in millimetres.
+  addValue<vtkStringArray>(fieldData, "PowerUnits", std::string("W"));
+  addValue<vtkStringArray>(fieldData, "RadiosityUnits", std::string("W/(scene unit)^2"));
   return fieldData;
 }
 
