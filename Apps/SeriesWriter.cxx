@@ -137,20 +137,6 @@ void cacheRanges(vtkFieldData* data)
   }
 }
 
-void writeGrid(vtkUnstructuredGrid* grid, const std::filesystem::path& path)
-{
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetInputData(grid);
-  writer->SetFileName(path.string().c_str());
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();
-  writer->SetCompressorTypeToLZ4();
-  if (!writer->Write() || writer->GetErrorCode() != 0)
-  {
-    throw std::runtime_error("cannot write '" + path.string() + "': check the disk space and "
-                             "the permissions of its directory");
-  }
-}
 }
 
 FrameWriter::FrameWriter(unsigned threads)
@@ -239,8 +225,13 @@ void FrameWriter::work()
 {
   // Kept from frame to frame: VTK caches what it derives from the mesh (the distinct cell
   // types, which the writer asks for) in the grid, and that cache holds while only the cell
-  // and field data change.
+  // and field data change. Both are created and destroyed on this thread.
   vtkNew<vtkUnstructuredGrid> grid;
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetInputData(grid);
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToLZ4();
   std::unique_lock<std::mutex> lock(this->Mutex);
   for (;;)
   {
@@ -263,7 +254,12 @@ void FrameWriter::work()
       }
       grid->GetCellData()->ShallowCopy(job.cellData);
       grid->GetFieldData()->ShallowCopy(job.fieldData);
-      writeGrid(grid, job.path);
+      writer->SetFileName(job.path.string().c_str());
+      if (!writer->Write() || writer->GetErrorCode() != 0)
+      {
+        throw std::runtime_error("cannot write '" + job.path.string() +
+          "': check the disk space and the permissions of its directory");
+      }
     }
     catch (...)
     {

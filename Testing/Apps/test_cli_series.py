@@ -195,3 +195,17 @@ def test_pictures_without_display_or_xvfb_fail_before_the_solve(tmp_path):
     assert result.returncode == 1
     assert "--png needs an X display: set DISPLAY, or install Xvfb" in result.stderr
     assert all_files(tmp_path) == []
+
+
+def test_frame_that_cannot_be_written_fails_the_run_and_leaves_nothing(tmp_path):
+    """A frame's file fails on a writing thread, after earlier frames were written: the run
+    stops with the message, and every file it wrote is removed again."""
+    blocker = tmp_path / "out" / ".s_0003.vtu.partial"  # the temporary name of frame 3
+    blocker.mkdir(parents=True)
+    (blocker / "keep").write_text("not the program's")
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", str(FRAMES), "--output", "out/s.pvd", "--stats", "out/s.json"] +
+                 FAST, tmp_path)
+    assert result.returncode == 1
+    assert "cannot write" in result.stderr and "s_0003.vtu" in result.stderr
+    assert all_files(tmp_path) == ["out/.s_0003.vtu.partial/keep"]
