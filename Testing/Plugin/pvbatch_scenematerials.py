@@ -9,7 +9,8 @@ shipped Data/CornellBox-Original.obj (issue 13):
 - every frame has the same elements, cell by cell (count, corners), and the same Radiosity to
   float32 precision: the two are one computation, not two estimates that agree on average;
 - every element carries the Kd of the material it lies on (from the .mtl), the lamp is gone
-  from the elements, and the Light output is the lamp at each frame's place.
+  from the elements, and the Light output is the lamp at each frame's place with the power
+  pi x Ke x area.
 
     pvbatch --force-offscreen-rendering pvbatch_scenematerials.py --plugin MovingLightRadiosity.so \
         --cli moving-light-radiosity"""
@@ -126,6 +127,12 @@ for index, (time, cli) in enumerate(cli_frames):
     expected = numpy.array(START) + f * (numpy.array(END) - numpy.array(START))
     check(centre is not None and numpy.abs(centre - expected).max() < 1e-3,
           f"{where}: the Light output is centred at {centre}, the path at {expected}")
+    # Its power is the material's emission, pi Ke area (Ke 17 12 4, 0.4676 x 0.3777).
+    power = cell_array(light, "Power")
+    lamp_power = numpy.pi * numpy.array([17.0, 12.0, 4.0]) * (2 * 0.2338) * (0.1892 + 0.1885)
+    check(power is not None and numpy.allclose(power.sum(axis=0), lamp_power, rtol=1e-6),
+          f"{where}: the Light output's Power sums to "
+          f"{None if power is None else power.sum(axis=0)}, expected pi Ke area = {lamp_power}")
 
 # --- Materials ----------------------------------------------------------------------------
 # Each element's reflectance is the Kd of the reader's cell it lies on (found by the cell's
