@@ -52,7 +52,8 @@
  *   rays by kind, seconds by phase, patches, elements, frames, reuse modes, predicted
  *   speed-up), the frame shown (`FrameIndex`), where the light is in it (`LightPosition`, its
  *   centroid, and `LightTranslation`, from the Light input), `SolveCount`, and the exposure
- *   (`AutoExposure`, `Exposure`, `ExposureScale`).
+ *   (`AutoExposure`, `Exposure`, `ExposureScale`). Every output's field data states the units:
+ *   `PowerUnits` "W" and `RadiosityUnits` "W/(scene unit)^2" (W/m^2 for a scene in metres).
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
  * - port 2, Light: the light's polygons where they are in the frame shown, with the cell
