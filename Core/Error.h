@@ -17,6 +17,17 @@ public:
   }
 };
 
+/// A solve shared by several ranks stopped because another rank failed (its error is the
+/// one to report; SolverOptions::ranks).
+class FailedOnAnotherRank : public Error
+{
+public:
+  explicit FailedOnAnotherRank(const std::string& message)
+    : Error(message)
+  {
+  }
+};
+
 /// The caller cancelled through the progress callback: no result exists.
 class Cancelled : public Error
 {

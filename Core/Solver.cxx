@@ -1083,7 +1083,7 @@ void agreeAcrossRanks(
   }
   if (status[1] > 0)
   {
-    throw Error("the solve failed on " + std::to_string(status[1]) + " other rank" +
+    throw FailedOnAnotherRank("the solve failed on " + std::to_string(status[1]) + " other rank" +
       (status[1] > 1 ? "s" : "") + " of " + std::to_string(options.ranks));
   }
   if (status[0] > 0)

@@ -218,7 +218,7 @@ void validateOptions(const SolverOptions& options);
  * Runs `phase` on this rank and, when options.ranks > 1, agrees with the other ranks on how
  * it went before any rank goes on (one sum over ranks): when any rank was cancelled or
  * failed, every rank throws, mlr::Cancelled or mlr::Error (its own exception on the rank
- * that threw, "failed on another rank" elsewhere), so that no rank is left waiting in a
+ * that threw, mlr::FailedOnAnotherRank elsewhere), so that no rank is left waiting in a
  * later sum. Every rank must call it at the same points. With one rank it only runs `phase`.
  */
 /// `secondsAgreeing`, when given, is increased by the time the agreement took (waiting for

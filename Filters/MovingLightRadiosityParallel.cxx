@@ -358,23 +358,26 @@ void shareSolve(vtkMultiProcessController* controller, SolverOptions& options)
   };
 }
 
-bool anyRank(vtkMultiProcessController* controller, bool value)
-{
-  const int mine = value ? 1 : 0;
-  int any = 0;
-  controller->AllReduce(&mine, &any, 1, vtkCommunicator::MAX_OP);
-  return any != 0;
-}
-
 Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
-  const std::string& message)
+  const std::string& message, std::uint64_t digest)
 {
-  const int mine[2] = { failed ? 1 : 0, cancelled ? 1 : 0 };
-  int all[2] = { 0, 0 };
-  controller->AllReduce(mine, all, 2, vtkCommunicator::MAX_OP);
+  // Flags, and the digest as its low and high halves, negated for the minimum.
+  const long long low = static_cast<long long>(digest & 0xffffffffULL);
+  const long long high = static_cast<long long>(digest >> 32);
+  const long long mine[6] = { failed ? 1 : 0, cancelled ? 1 : 0, low, high, -low, -high };
+  long long all[6] = { 0, 0, 0, 0, 0, 0 };
+  controller->AllReduce(mine, all, 6, vtkCommunicator::MAX_OP);
   Verdict verdict;
   verdict.failed = all[0] != 0;
   verdict.cancelled = all[1] != 0;
+  if (!verdict.failed && !verdict.cancelled && (all[2] != -all[4] || all[3] != -all[5]))
+  {
+    verdict.failed = true;
+    verdict.message = "the ranks are not solving the same thing: their properties or inputs "
+                      "differ (a rank updated alone, or a script set properties on one rank "
+                      "only): give every rank the same properties and update them together";
+    return verdict;
+  }
   if (!verdict.failed)
   {
     return verdict;

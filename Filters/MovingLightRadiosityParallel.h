@@ -10,6 +10,8 @@
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -52,12 +54,26 @@ struct Verdict
   std::string message;
 };
 
-/// A collective agreement: every rank calls it at the same point with its own outcome.
+/// A collective agreement: every rank calls it at the same point with its own outcome. When
+/// none failed, `digest` (of what each rank is about to solve; 0 to skip) must be equal on
+/// every rank, or all fail: ranks that disagree would add up two different solves.
 Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
-  const std::string& message);
+  const std::string& message, std::uint64_t digest = 0);
 
-/// True on every rank when any rank passes true (a collective call).
-bool anyRank(vtkMultiProcessController* controller, bool value);
+/// FNV-1a over the bytes of the values added.
+struct Digest
+{
+  std::uint64_t value = 14695981039346656037ULL;
+  template <typename T>
+  void add(const T& v)
+  {
+    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(&v);
+    for (std::size_t i = 0; i < sizeof(T); ++i)
+    {
+      this->value = (this->value ^ bytes[i]) * 1099511628211ULL;
+    }
+  }
+};
 
 /**
  * The rank that owns each triangle (given by `triangles` on `points`): the rank of the input

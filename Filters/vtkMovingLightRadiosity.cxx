@@ -286,11 +286,6 @@ int vtkMovingLightRadiosity::RequestData(
     vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
     current = !input || input->GetMTime() <= cache.SolveTime.GetMTime();
   }
-  if (vtkMultiProcessController* controller = mlr::vtkparallel::controller())
-  {
-    // The ranks solve together: when one finds its cache stale, all solve.
-    current = !mlr::vtkparallel::anyRank(controller, !current);
-  }
   if (!current && !this->Solve(inputVector))
   {
     return 0;
@@ -429,7 +424,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   std::vector<int> cellRanks;
   double secondsGatheringInputs = 0;
   std::string failure;
-  bool cancelled = false;
+  bool cancelled = false, elsewhere = false;
   try
   {
     if (controller)
@@ -558,7 +553,23 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     mlr::validateOptions(solverOptions);
     if (controller)
     {
-      const mlr::vtkparallel::Verdict verdict = mlr::vtkparallel::agree(controller, false, false, {});
+      // The ranks must solve the same thing: they compare a digest of the solve's settings
+      // and gathered inputs, so that a rank that re-executed alone fails them all rather
+      // than adding up two different solves.
+      mlr::vtkparallel::Digest digest;
+      digest.add(solverOptions.pathsPerFrame);
+      digest.add(solverOptions.gatheringRatio);
+      digest.add(solverOptions.firstBounceSurvival);
+      digest.add(static_cast<std::uint64_t>(solverOptions.reuseShooting) * 2 + solverOptions.reuseGathering);
+      digest.add(static_cast<std::uint64_t>(solverOptions.twoSided));
+      digest.add(solverOptions.seed);
+      digest.add(options.remeshing.targetEdgeLength);
+      digest.add(static_cast<std::uint64_t>(soup.points.size()));
+      digest.add(static_cast<std::uint64_t>(soup.polygons.size()));
+      digest.add(static_cast<std::uint64_t>(rig.areaLights.size() + rig.directionalLights.size()));
+      digest.add(static_cast<std::uint64_t>(trajectory.times.size()));
+      const mlr::vtkparallel::Verdict verdict =
+        mlr::vtkparallel::agree(controller, false, false, {}, digest.value);
       stage = verdict.failed ? Stage::Agreed : Stage::Solving;
       if (verdict.failed)
       {
@@ -646,6 +657,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     failure = std::string("aborted: ") + e.what();
     cancelled = true;
   }
+  catch (const mlr::FailedOnAnotherRank& e)
+  {
+    // The rank that failed has the message to report: the agreement below brings it here.
+    failure = e.what();
+    elsewhere = true;
+  }
   catch (const mlr::Error& e)
   {
     failure = e.what();
@@ -662,8 +679,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   if (controller && stage != Stage::Agreed)
   {
     const mlr::vtkparallel::Verdict verdict =
-      mlr::vtkparallel::agree(controller, !cancelled, cancelled, failure);
-    if (!cancelled && failure.empty())
+      mlr::vtkparallel::agree(controller, !cancelled && !elsewhere, cancelled, failure);
+    if (elsewhere && verdict.failed)
     {
       failure = verdict.message;
     }

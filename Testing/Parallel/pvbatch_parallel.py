@@ -1,0 +1,184 @@
+"""One rank of the parallel tests (issue 15), run by run_parallel.py as
+
+    mpiexec -n R pvbatch --symmetric --force-offscreen-rendering pvbatch_parallel.py \
+        --plugin MovingLightRadiosity.so --case CASE --out PREFIX
+
+(or by plain pvbatch for the serial reference). The scene is the shipped Cornell box, the
+light and its 30-position trajectory, remeshed coarsely (PatchSize 0.12) and solved with few
+paths on one thread per rank. Each rank writes what it outputs to PREFIX.rank<r>.npz, and
+run_parallel.py compares. Cases:
+
+- whole: the readers' outputs (whole on rank 0) go in as they are;
+- split: the Scene goes through RedistributeDataSet (and ExtractSurface back to polydata), so
+  every rank holds some of its cells; each rank also writes how much farther its elements lie
+  from its own piece of the scene than from the whole scene (0: they come from its cells);
+- time: steps through frames without a new solve (SolveCount), then a new Seed solves again;
+- abort: rank 0 sets AbortExecute from a progress event once the solve is under way;
+- bad: rank 1's Scene piece lacks the Reflectance array (the ranks' pieces disagree), then,
+  with consistent pieces, rank 1 alone has a memory limit the solve does not fit in.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--plugin", required=True)
+parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "bad"])
+parser.add_argument("--out", required=True, help="prefix of the .rank<r>.npz files written")
+parser.add_argument("--paths", type=int, default=20000)
+args = parser.parse_args()
+
+from paraview.simple import (ExtractSurface, LoadPlugin, PassArrays, RedistributeDataSet,  # noqa: E402
+                             XMLPolyDataReader)
+from vtkmodules.util.misc import calldata_type  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+from vtkmodules.util.vtkConstants import VTK_STRING  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator  # noqa: E402
+from vtkmodules.vtkParallelCore import vtkMultiProcessController  # noqa: E402
+
+LoadPlugin(args.plugin, remote=False, ns=globals())
+controller = vtkMultiProcessController.GetGlobalController()
+rank = controller.GetLocalProcessId() if controller else 0
+ranks = controller.GetNumberOfProcesses() if controller else 1
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "Data")
+FRAMES = (0.0, 14.0, 29.0)
+box = XMLPolyDataReader(FileName=[os.path.join(DATA, "cornell_box.vtp")])
+light = XMLPolyDataReader(FileName=[os.path.join(DATA, "cornell_light.vtp")])
+trajectory = XMLPolyDataReader(FileName=[os.path.join(DATA, "cornell_trajectory.vtp")])
+scene = box
+if args.case in ("split", "bad"):
+    scene = ExtractSurface(Input=RedistributeDataSet(Input=box))
+if args.case == "bad" and rank == 1:
+    # Only this rank's piece loses its material.
+    scene = PassArrays(Input=scene, CellDataArrays=["vtkOriginalCellIds"], PointDataArrays=[])
+radiosity = MovingLightRadiosity(Scene=scene, Light=light, Trajectory=trajectory,  # noqa: F821
+                                 PatchSize=0.12, NumberOfPaths=args.paths, NumberOfThreads=1,
+                                 Seed=1)
+algorithm = radiosity.GetClientSideObject()
+errors = []
+
+
+@calldata_type(VTK_STRING)
+def on_error(caller, event, message):
+    errors.append(str(message))
+
+
+algorithm.AddObserver("ErrorEvent", on_error)
+results = {"ranks": np.array(ranks)}
+
+
+def field(data, name):
+    array = data.GetFieldData().GetArray(name)
+    return array.GetValue(0) if array is not None else -1
+
+
+def record(prefix, time):
+    """Every array of the three outputs at `time`, under prefix."""
+    radiosity.UpdatePipeline(time=time)
+    elements = algorithm.GetOutputDataObject(0)
+    patches = algorithm.GetOutputDataObject(1)
+    results[prefix + "solves"] = np.array(field(elements, "SolveCount"))
+    results[prefix + "frame"] = np.array(field(elements, "FrameIndex"))
+    results[prefix + "light_cells"] = np.array(algorithm.GetOutputDataObject(2).GetNumberOfCells())
+    for name, data in (("e", elements), ("p", patches)):
+        cells = data.GetNumberOfCells()
+        results[f"{prefix}{name}_cells"] = np.array(cells)
+        if cells == 0:
+            continue
+        points = vtk_to_numpy(data.GetPoints().GetData()).astype(np.float64)
+        triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+        results[f"{prefix}{name}_corners"] = points[triangles]
+        for i in range(data.GetCellData().GetNumberOfArrays()):
+            array = data.GetCellData().GetArray(i)
+            if array is not None:
+                results[f"{prefix}{name}_cell_{array.GetName()}"] = vtk_to_numpy(array)
+        for i in range(data.GetPointData().GetNumberOfArrays()):
+            array = data.GetPointData().GetArray(i)
+            if array is not None:
+                # Per cell corner, so that cells can be matched across ranks.
+                results[f"{prefix}{name}_corner_{array.GetName()}"] = vtk_to_numpy(array)[triangles]
+    return elements
+
+
+def distances(data, centroids):
+    """The distance from each centroid to the nearest cell of `data`."""
+    from vtkmodules.vtkCommonCore import mutable
+    locator = vtkStaticCellLocator()
+    locator.SetDataSet(data)
+    locator.BuildLocator()
+    closest = [0.0, 0.0, 0.0]
+    cell, sub, d2 = mutable(0), mutable(0), mutable(0.0)
+    result = []
+    for centroid in centroids:
+        locator.FindClosestPoint(list(centroid), closest, cell, sub, d2)
+        result.append(float(d2) ** 0.5)
+    return np.array(result)
+
+
+def own_piece_excess(elements):
+    """How much farther an element's centroid lies from this rank's own piece of the scene
+    than from the whole scene (0 when its nearest input cell is this rank's: the Cornell box
+    has non-planar quads, so elements lie up to mm off the cells' bilinear surfaces)."""
+    if elements.GetNumberOfCells() == 0:
+        return 0.0
+    piece = scene.GetClientSideObject().GetOutputDataObject(0)
+    if piece.GetNumberOfCells() == 0:
+        return float("inf")
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    whole = vtkXMLPolyDataReader()
+    whole.SetFileName(os.path.join(DATA, "cornell_box.vtp"))
+    whole.Update()
+    centroids = results["f0_e_corners"].mean(axis=1)
+    return float((distances(piece, centroids) - distances(whole.GetOutput(), centroids)).max())
+
+
+if args.case in ("whole", "split"):
+    for f in FRAMES:
+        elements = record(f"f{int(f)}_", f)
+    if args.case == "split":
+        results["own_excess"] = np.array(own_piece_excess(algorithm.GetOutputDataObject(0)))
+elif args.case == "time":
+    for step, f in enumerate((0.0, 29.0, 14.0, 29.0, 0.0)):
+        record(f"s{step}_", f)
+    radiosity.Seed = 2
+    record("seed_", 14.0)
+elif args.case == "abort":
+    state = {"aborted": False}
+
+    def on_progress(caller, event):
+        # Past remeshing (the first 5%): the solve's phases are running.
+        if rank == 0 and not state["aborted"] and caller.GetProgress() > 0.2:
+            state["aborted"] = True
+            # As ParaView aborts: without Modified(), which would make this rank solve again.
+            caller.SetAbortExecuteAndUpdateTime()
+
+    observer = algorithm.AddObserver("ProgressEvent", on_progress)
+    # One update of the Elements port, as a view asks for it: a proxy's UpdatePipeline would
+    # go on to update the other ports, each solving again after the abort.
+    radiosity.UpdatePipelineInformation()
+    algorithm.UpdatePiece(rank, ranks, 0)
+    results["abort_errors"] = np.array(errors[:])
+    results["abort_e_cells"] = np.array(algorithm.GetOutputDataObject(0).GetNumberOfCells())
+    errors.clear()
+    algorithm.RemoveObserver(observer)
+    # A new request solves again and succeeds on every rank.
+    radiosity.NumberOfPaths = 20000
+    record("after_", 0.0)
+elif args.case == "bad":
+    record("bad_", 0.0)
+    results["bad_errors"] = np.array(errors[:])
+    errors.clear()
+    # Consistent pieces again, but rank 1 alone is over its memory limit.
+    radiosity.Scene = ExtractSurface(Input=RedistributeDataSet(Input=box))
+    if rank == 1:
+        radiosity.MemoryLimit = 1
+    record("memory_", 0.0)
+    results["memory_errors"] = np.array(errors[:])
+    errors.clear()
+
+results["errors"] = np.array(errors)
+np.savez(f"{args.out}.rank{rank}.npz", **results)
+print(f"rank {rank} of {ranks}: wrote {args.out}.rank{rank}.npz", flush=True)
