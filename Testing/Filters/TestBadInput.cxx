@@ -271,7 +271,8 @@ TEST(FilterBadInput, AbortStopsQuicklyWithEmptyOutputsAndRecovers)
   const FilterRun run = runFilter(filter);
   const double seconds = std::chrono::duration<double>(Clock::now() - state.abortedAt).count();
   ASSERT_TRUE(state.aborted);
-  EXPECT_LT(seconds, 0.5);
+  // 0.5 s on a quiet machine; ten times that so that load cannot change the verdict.
+  EXPECT_LT(seconds, 5.0);
   expectError(run, "aborted");
   EXPECT_EQ(filter->GetSolveCount(), 0);
 

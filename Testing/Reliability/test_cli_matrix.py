@@ -406,7 +406,9 @@ def test_interrupt_mid_solve_writes_nothing(tmp_path, sig):
     sent = time.monotonic()
     process.send_signal(sig)
     stdout, stderr = process.communicate(timeout=30)
-    assert time.monotonic() - sent < 2.0, "took too long to stop"
+    # Well under a second on a quiet machine; the bound only catches a process that ignores
+    # the signal, whatever the machine's load.
+    assert time.monotonic() - sent < 10.0, "took too long to stop"
     assert process.returncode == 1, stderr
     assert "interrupted: nothing was written" in stderr
     assert all_files(tmp_path) == []
