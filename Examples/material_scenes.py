@@ -52,7 +52,7 @@ def parse_arguments():
                         "in the build tree, build/ or $MLR_BUILD_DIR)")
     parser.add_argument("--output", default=os.path.join("output", "materials"),
                         help="folder for the series and png/ (default: %(default)s)")
-    parser.add_argument("--paths", type=int, default=300000,
+    parser.add_argument("--paths", type=int, default=600000,
                         help="effective shooting paths per light position; fewer is faster and "
                              "noisier (default: %(default)s)")
     parser.add_argument("--frames", type=int, default=30,
