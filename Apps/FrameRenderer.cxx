@@ -2,18 +2,21 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkCellDataToPointData.h"
 #include "vtkDataArray.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkPolyDataNormals.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkWindowToImageFilter.h"
 
@@ -55,6 +58,11 @@ struct FrameRenderer::Pipeline
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkPolyData> scene;
   vtkNew<vtkPolyDataNormals> creases;
+  // The element mesh split along its creases, computed once: it is the same in every frame.
+  vtkNew<vtkPolyData> split;
+  vtkSmartPointer<vtkPoints> splitPoints; // held: a new mesh cannot take their addresses
+  vtkSmartPointer<vtkCellArray> splitPolys;
+  vtkNew<vtkPolyData> frame; ///< `split` with the frame's Radiosity
   vtkNew<vtkCellDataToPointData> smooth;
   vtkNew<vtkPolyData> shown;
   vtkNew<vtkPolyDataMapper> sceneMapper;
@@ -82,7 +90,8 @@ FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6])
   p.creases->ConsistencyOff();
   p.creases->AutoOrientNormalsOff();
   p.creases->ComputeCellNormalsOff();
-  p.smooth->SetInputConnection(p.creases->GetOutputPort());
+  p.creases->ComputePointNormalsOff();
+  p.smooth->SetInputData(p.frame);
   p.smooth->ProcessAllArraysOff();
   p.smooth->AddCellDataArray("Radiosity");
   p.sceneMapper->SetInputData(p.shown);
@@ -143,7 +152,22 @@ void FrameRenderer::render(
   vtkPolyData* elements, const double lightTranslation[3], const std::filesystem::path& png)
 {
   Pipeline& p = *this->Internals;
-  p.scene->ShallowCopy(elements);
+  if (elements->GetPoints() != p.splitPoints || elements->GetPolys() != p.splitPolys ||
+    p.split->GetNumberOfCells() != elements->GetNumberOfCells())
+  {
+    // Splitting keeps the cells (all triangles) in their order: the frame's cell data fits.
+    p.scene->CopyStructure(elements);
+    p.creases->Update();
+    p.split->CopyStructure(p.creases->GetOutput());
+    p.splitPoints = elements->GetPoints();
+    p.splitPolys = elements->GetPolys();
+  }
+  p.frame->CopyStructure(p.split);
+  p.frame->GetCellData()->Initialize();
+  if (vtkDataArray* cellRadiosity = elements->GetCellData()->GetArray("Radiosity"))
+  {
+    p.frame->GetCellData()->AddArray(cellRadiosity);
+  }
   p.smooth->Update();
   p.shown->ShallowCopy(p.smooth->GetOutput());
   vtkDataArray* radiosity = p.shown->GetPointData()->GetArray("Radiosity");
@@ -173,6 +197,7 @@ void FrameRenderer::render(
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(p.window);
   grab->ReadFrontBufferOff();
+  grab->ShouldRerenderOff(); // rendered just above: a second render cost as much again
   vtkNew<vtkPNGWriter> writer;
   writer->SetInputConnection(grab->GetOutputPort());
   writer->SetFileName(png.string().c_str());
