@@ -205,7 +205,22 @@ int vtkMovingLightRadiosity::RequestInformation(
     {
       int producerPort = 0;
       vtkAlgorithm* producer = this->GetInputAlgorithm(port, 0, producerPort);
-      producer->Update(producerPort);
+      if (mlr::vtkparallel::controller())
+      {
+        // Whole on every rank, so that every rank declares the same time steps (a reader
+        // gives ranks other than 0 nothing when asked for their piece).
+        vtkNew<vtkInformationVector> requests;
+        requests->SetNumberOfInformationObjects(producer->GetNumberOfOutputPorts());
+        vtkInformation* whole = requests->GetInformationObject(producerPort);
+        whole->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+        whole->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+        whole->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+        producer->Update(producerPort, requests);
+      }
+      else
+      {
+        producer->Update(producerPort);
+      }
     }
   }
   std::vector<double> times;
