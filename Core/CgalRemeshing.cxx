@@ -9,6 +9,7 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
@@ -17,7 +18,12 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Projection_traits_xy_3.h>
+#include <CGAL/Projection_traits_xz_3.h>
+#include <CGAL/Projection_traits_yz_3.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/box_intersection_d.h>
 #include <CGAL/boost/graph/helpers.h>
 
@@ -592,6 +598,210 @@ std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<
   return covered;
 }
 
+/// Pieces in an order given by their point indices alone, each turned to start at its smallest
+/// index (which keeps its orientation).
+void sortPieces(std::vector<CgalTriangle>& pieces)
+{
+  for (CgalTriangle& t : pieces)
+  {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  }
+  std::sort(pieces.begin(), pieces.end());
+}
+
+/// See triangulateCanonically(). `Projection` drops the coordinate nearest the triangle's
+/// normal; its predicates are exact on the points' coordinates, so the result depends on
+/// nothing else.
+template <typename Projection>
+bool triangulateInProjection(const std::vector<Point>& points, const CgalTriangle& origin,
+  const std::vector<std::size_t>& used, const std::vector<std::pair<std::size_t, std::size_t>>& border,
+  const std::vector<std::pair<std::size_t, std::size_t>>& inner, std::vector<CgalTriangle>& result)
+{
+  using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<std::size_t, Projection>;
+  using FaceBase = CGAL::Constrained_triangulation_face_base_2<Projection,
+    CGAL::Triangulation_face_base_with_info_2<bool, Projection>>;
+  using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
+  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Projection, Tds, CGAL::No_constraint_intersection_tag>;
+  const Projection traits;
+  const CGAL::Orientation turn =
+    traits.orientation_2_object()(points[origin[0]], points[origin[1]], points[origin[2]]);
+  if (turn == CGAL::COLLINEAR)
+  {
+    return false;
+  }
+  Cdt cdt(traits);
+  // Where points are cocircular the triangulation depends on the insertion order: that of
+  // the point indices, which follow the input and, for points made by splitting, their
+  // coordinates.
+  std::vector<typename Cdt::Vertex_handle> vertex(used.size());
+  for (std::size_t i = 0; i < used.size(); ++i)
+  {
+    vertex[i] = cdt.insert(points[used[i]]);
+    vertex[i]->info() = used[i];
+  }
+  auto handle = [&](std::size_t point) {
+    return vertex[static_cast<std::size_t>(std::lower_bound(used.begin(), used.end(), point) - used.begin())];
+  };
+  for (const auto* edges : { &border, &inner })
+  {
+    for (const auto& [a, b] : *edges)
+    {
+      cdt.insert_constraint(handle(a), handle(b));
+    }
+  }
+  if (cdt.number_of_vertices() != used.size())
+  {
+    return false; // two points projected onto one, or a constraint crossed another
+  }
+  for (const auto* edges : { &border, &inner })
+  {
+    for (const auto& [a, b] : *edges)
+    {
+      if (!cdt.is_edge(handle(a), handle(b)))
+      {
+        return false; // a point lies on a constraint in projection
+      }
+    }
+  }
+  // Faces outside the triangle's border (where rounding made the border concave) are
+  // reached from the infinite face without crossing the border.
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+  {
+    f->info() = true;
+  }
+  std::vector<typename Cdt::Face_handle> front{ cdt.infinite_face() };
+  front.back()->info() = false;
+  while (!front.empty())
+  {
+    const typename Cdt::Face_handle f = front.back();
+    front.pop_back();
+    for (int i = 0; i < 3; ++i)
+    {
+      const typename Cdt::Vertex_handle a = f->vertex(Cdt::cw(i)), b = f->vertex(Cdt::ccw(i));
+      const bool onBorder = !cdt.is_infinite(a) && !cdt.is_infinite(b) &&
+        std::binary_search(border.begin(), border.end(),
+          std::make_pair(std::min(a->info(), b->info()), std::max(a->info(), b->info())));
+      const typename Cdt::Face_handle g = f->neighbor(i);
+      if (!onBorder && g->info())
+      {
+        g->info() = false;
+        front.push_back(g);
+      }
+    }
+  }
+  result.clear();
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+  {
+    if (f->info())
+    {
+      CgalTriangle t = { f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info() };
+      if (turn == CGAL::CLOCKWISE)
+      {
+        std::swap(t[1], t[2]);
+      }
+      result.push_back(t);
+    }
+  }
+  return true;
+}
+
+/**
+ * Triangulates again, from the point indices and coordinates alone, the triangle `origin`
+ * that autorefinement split into `faces` (its output, degenerate faces included), keeping the
+ * contact edges among them. `pieces` (the non-degenerate faces) is replaced when the new
+ * triangulation has the same points and area, and kept otherwise (rounding may leave the
+ * border too far from flat for a projection; then only their order is made canonical).
+ */
+void triangulateCanonically(const std::vector<Point>& points, const CgalTriangle& origin,
+  const std::vector<CgalTriangle>& faces, const std::vector<std::pair<std::size_t, std::size_t>>& contactEdges,
+  std::vector<CgalTriangle>& pieces)
+{
+  std::vector<std::size_t> used;
+  std::vector<std::pair<std::size_t, std::size_t>> edges;
+  for (const CgalTriangle& t : faces)
+  {
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      const std::size_t a = t[k], b = t[(k + 1) % 3];
+      used.push_back(a);
+      if (a != b)
+      {
+        edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
+    }
+  }
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  std::sort(edges.begin(), edges.end());
+  // Edges of one face only are the triangle's border; the others are inside, and kept when on
+  // a contact line.
+  std::vector<std::pair<std::size_t, std::size_t>> border, inner;
+  for (std::size_t i = 0; i < edges.size();)
+  {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j] == edges[i])
+    {
+      ++j;
+    }
+    if (j - i == 1)
+    {
+      border.push_back(edges[i]);
+    }
+    else if (std::binary_search(contactEdges.begin(), contactEdges.end(), edges[i]))
+    {
+      inner.push_back(edges[i]);
+    }
+    i = j;
+  }
+  const Vec3 normal = triangleAreaVector(toVec3(points[origin[0]]), toVec3(points[origin[1]]), toVec3(points[origin[2]]));
+  const double nx = std::abs(normal.x), ny = std::abs(normal.y), nz = std::abs(normal.z);
+  std::vector<CgalTriangle> result;
+  bool ok = false;
+  try
+  {
+    if (nz >= nx && nz >= ny)
+    {
+      ok = triangulateInProjection<CGAL::Projection_traits_xy_3<Kernel>>(points, origin, used, border, inner, result);
+    }
+    else if (nx >= ny)
+    {
+      ok = triangulateInProjection<CGAL::Projection_traits_yz_3<Kernel>>(points, origin, used, border, inner, result);
+    }
+    else
+    {
+      ok = triangulateInProjection<CGAL::Projection_traits_xz_3<Kernel>>(points, origin, used, border, inner, result);
+    }
+  }
+  catch (const std::exception&)
+  {
+    ok = false; // constraints crossing in projection: keep autorefinement's triangles
+  }
+  if (!ok || result.empty())
+  {
+    return;
+  }
+  auto area = [&points](const std::vector<CgalTriangle>& triangles) {
+    double sum = 0;
+    for (const CgalTriangle& t : triangles)
+    {
+      sum += triangleArea(points[t[0]], points[t[1]], points[t[2]]);
+    }
+    return sum;
+  };
+  std::vector<std::size_t> corners;
+  for (const CgalTriangle& t : result)
+  {
+    corners.insert(corners.end(), t.begin(), t.end());
+  }
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  const double before = area(pieces);
+  if (corners == used && std::abs(area(result) - before) <= 1e-9 * before)
+  {
+    pieces = std::move(result);
+  }
+}
+
 /// A limit the caller set was exceeded: not derived from std::exception, so that guarded()
 /// does not take it for a CGAL failure.
 struct OverLimit
@@ -810,23 +1020,6 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
       keep(soup.triangles[i], i);
     }
   }
-  std::vector<std::size_t> pieces(soup.triangles.size(), 0);
-  std::size_t degenerate = 0;
-  for (FaceIndex f : mesh.faces())
-  {
-    const HalfedgeIndex h = mesh.halfedge(f);
-    const CgalTriangle t = { pointOf[mesh.source(h)], pointOf[mesh.target(h)], pointOf[mesh.target(mesh.next(h))] };
-    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0] &&
-      !CGAL::collinear(split.points[t[0]], split.points[t[1]], split.points[t[2]]))
-    {
-      keep(t, tracking.origin[f]);
-      ++pieces[tracking.origin[f]];
-    }
-    else
-    {
-      ++degenerate;
-    }
-  }
   for (EdgeIndex e : mesh.edges())
   {
     const std::size_t a = pointOf[mesh.vertex(e, 0)], b = pointOf[mesh.vertex(e, 1)];
@@ -837,6 +1030,46 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   }
   std::sort(split.contactEdges.begin(), split.contactEdges.end());
   split.contactEdges.erase(std::unique(split.contactEdges.begin(), split.contactEdges.end()), split.contactEdges.end());
+
+  // Autorefinement's faces come in an order, and with a triangulation where points are
+  // cocircular, that follow heap addresses (its box intersection breaks ties by box
+  // address), so they change from run to run. Each split triangle is triangulated again,
+  // from values only, and its pieces sorted: the same input always gives the same patches.
+  std::vector<std::vector<CgalTriangle>> faceOf(set.size()), piecesOf(set.size());
+  std::size_t degenerate = 0;
+  for (FaceIndex f : mesh.faces())
+  {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    const CgalTriangle t = { pointOf[mesh.source(h)], pointOf[mesh.target(h)], pointOf[mesh.target(mesh.next(h))] };
+    const auto k = static_cast<std::size_t>(
+      std::lower_bound(set.begin(), set.end(), tracking.origin[f]) - set.begin());
+    faceOf[k].push_back(t);
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0] &&
+      !CGAL::collinear(split.points[t[0]], split.points[t[1]], split.points[t[2]]))
+    {
+      piecesOf[k].push_back(t);
+    }
+    else
+    {
+      ++degenerate;
+    }
+  }
+  std::vector<std::size_t> pieces(soup.triangles.size(), 0);
+  for (std::size_t k = 0; k < set.size(); ++k)
+  {
+    poll.tick();
+    std::vector<CgalTriangle>& p = piecesOf[k];
+    if (p.size() > 1)
+    {
+      triangulateCanonically(split.points, soup.triangles[set[k]], faceOf[k], split.contactEdges, p);
+    }
+    sortPieces(p);
+    pieces[set[k]] = p.size();
+    for (const CgalTriangle& t : p)
+    {
+      keep(t, set[k]);
+    }
+  }
 
   std::vector<ClosedSurface> closed = findClosedSurfaces(soup, surfaces, touching);
   const std::vector<bool> covered = coveredTriangles(split, surfaceOf, piece, soup, closed, poll);

@@ -127,6 +127,12 @@ using RemeshProgress = std::function<bool(double fraction)>;
  * the orientation of the polygon it lies on. A region whose remeshing fails or changes its
  * area by more than 0.5% keeps its input triangles (cut along the contact lines), only
  * refined.
+ *
+ * The same soup and options give the same patches, bit for bit, in any process: nothing
+ * depends on addresses, time or the heap. Autorefinement's pieces, whose order and
+ * triangulation follow box addresses inside CGAL, are triangulated again from their points
+ * and sorted (a split triangle whose pieces rounding bends too far to be triangulated in a
+ * plane keeps CGAL's triangulation, only sorted).
  */
 RemeshResult remesh(
   const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress = {});
