@@ -251,9 +251,15 @@ void stopServer(pid_t server)
   }
 }
 
-/// Reads what the server wrote to `fd` until a newline, its end or `seconds`; true when a
-/// display number came.
-bool readReadyLine(int fd, int seconds)
+enum class Startup
+{
+  Ready,   ///< the server wrote its display number
+  Exited,  ///< it closed the pipe without one: the number is taken, or it cannot start
+  TimedOut ///< still nothing after the time allowed
+};
+
+/// Reads what the server writes to `fd` until a newline, the pipe's end or `seconds`.
+Startup readReadyLine(int fd, int seconds)
 {
   std::string line;
   for (int waited = 0; waited < seconds * 10;)
@@ -277,11 +283,11 @@ bool readReadyLine(int fd, int seconds)
     }
     if (n <= 0 || c == '\n')
     {
-      return !line.empty();
+      return line.empty() ? Startup::Exited : Startup::Ready;
     }
     line += c;
   }
-  return false;
+  return Startup::TimedOut;
 }
 
 std::string fileText(int fd)
@@ -372,9 +378,9 @@ PictureDisplay::PictureDisplay()
       }
       throw std::runtime_error(std::string("cannot start Xvfb: ") + std::strerror(errno));
     }
-    const bool started = readReadyLine(ready[0], 30);
+    const Startup startup = readReadyLine(ready[0], 30);
     close(ready[0]);
-    if (started)
+    if (startup == Startup::Ready)
     {
       if (log >= 0)
       {
@@ -385,12 +391,16 @@ PictureDisplay::PictureDisplay()
       setenv("DISPLAY", display.c_str(), 1);
       return;
     }
-    // The number is taken (the server exits), or Xvfb cannot start at all.
     stopServer(child);
     failure = display + ": " + (log >= 0 ? fileText(log) : std::string("no log"));
     if (log >= 0)
     {
       close(log);
+    }
+    if (startup == Startup::TimedOut)
+    {
+      // Another number would not help a server that hangs.
+      throw std::runtime_error("--png: Xvfb did not accept connections within 30 s: " + failure);
     }
   }
   throw std::runtime_error("--png: Xvfb did not start: " + failure);

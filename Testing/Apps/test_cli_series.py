@@ -222,3 +222,13 @@ def test_frame_that_cannot_be_written_fails_the_run_and_leaves_nothing(tmp_path)
     assert result.returncode == 1
     assert "cannot write" in result.stderr and "s_0003.vtu" in result.stderr
     assert all_files(tmp_path) == ["out/.s_0003.vtu.partial/keep"]
+
+
+def test_xvfb_that_cannot_start_fails_the_run_with_its_message(tmp_path):
+    env, pids = fake_xvfb(tmp_path, server="sh -c 'echo \"Fatal server error: no screens\" >&2; exit 1'")
+    result = run(["--scene", SCENE, "--light", LIGHT, "--output", "out/s.pvd", "--png", "png",
+                  "--frames", "2"] + PATH + FAST, tmp_path, env=env)
+    assert result.returncode == 1
+    assert "--png: Xvfb did not start" in result.stderr and "no screens" in result.stderr
+    assert len(started_pids(pids)) == 20  # one display number after another
+    assert [f for f in all_files(tmp_path) if not f.startswith("bin/")] == ["xvfb.pids"]
