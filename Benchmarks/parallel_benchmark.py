@@ -49,8 +49,10 @@ def rank_script(args):
         NumberOfPaths=args.paths, GatheringRatio=1.0, FirstBounceSurvival=0.25,
         ReuseShooting=1, ReuseGathering=1, Seed=1, NumberOfThreads=args.threads)
     start = time.perf_counter()
+    cpu = time.process_time()
     radiosity.UpdatePipeline(time=0.0)
     update = time.perf_counter() - start
+    cpu = time.process_time() - cpu
     elements = radiosity.GetClientSideObject().GetOutputDataObject(0)
     fields = elements.GetFieldData()
 
@@ -58,6 +60,8 @@ def rank_script(args):
         array = fields.GetArray(name)
         return array.GetValue(0) if array is not None else 0.0
 
+    with open(f"{args.out}.cpu{rank}", "w") as f:
+        f.write(repr(cpu))
     if rank == 0:
         digest = hashlib.sha256(vtk_to_numpy(elements.GetCellData().GetArray("Radiosity")).tobytes())
         stats = {name: field(name) for name in (
@@ -78,7 +82,14 @@ def measure(args, ranks, threads, work):
                "--paths", str(args.paths), "--patch-size", str(args.patch_size)]
     subprocess.run(command, check=True, timeout=TIMEOUT, stdout=subprocess.DEVNULL)
     with open(out) as f:
-        return json.load(f)
+        stats = json.load(f)
+    # CPU seconds of each rank's update (its own work, plus MPI's polling while it waits).
+    cpus = []
+    for r in range(ranks):
+        with open(f"{out}.cpu{r}") as f:
+            cpus.append(float(f.read()))
+    stats["CpuSecondsPerRank"] = cpus
+    return stats
 
 
 def main():
@@ -115,13 +126,16 @@ def main():
           f"{int(first['Frames'])} frames, N = {args.paths}, k = 1, lambda = 0.25, full reuse; "
           f"remeshing {first['SecondsRemeshing']:.2f} s (not in the solve)")
     print(f"{'configuration':<22}{'solve s':>9}{'update s':>10}{'speed-up':>10}"
-          f"{'gather inputs':>15}{'sums over ranks':>17}")
+          f"{'gather inputs':>15}{'sums over ranks':>17}  CPU s per rank")
     for (ranks, threads), s in runs.items():
         solve = s["SecondsSolve"]
         print(f"{f'{ranks} rank x {threads} thread':<22}{solve:>9.2f}{s['SecondsUpdate']:>10.2f}"
               f"{first['SecondsSolve'] / solve:>9.2f}x"
               f"{100 * s['SecondsGatheringInputs'] / solve:>14.2f}%"
-              f"{100 * s['SecondsReducing'] / solve:>16.2f}%")
+              f"{100 * s['SecondsReducing'] / solve:>16.2f}%  "
+              + ", ".join(f"{c:.2f}" for c in s["CpuSecondsPerRank"]))
+    print(f"(machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}; the sums "
+          "include the waits for the slower rank)")
     digests = {s["RadiosityDigest"] for s in runs.values()}
     print("radiosity identical in every run: " + ("yes" if len(digests) == 1 else f"NO ({digests})"))
     if len(digests) != 1:
