@@ -10,7 +10,6 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
-#include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkUnsignedCharArray.h"
