@@ -72,6 +72,14 @@
  * `Reflectance`, a light without polygons, ...) gives an error naming what to fix and empty
  * outputs. An empty scene gives empty outputs and no error.
  *
+ * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
+ * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
+ * the pieces that arrive, in a canonical cell order (global or vtkOriginalCellIds, else rank
+ * then cell order), traces its share of the paths and gathering rays, and holds the serial
+ * solution bit for bit once the sums over ranks are done; each rank outputs the elements and
+ * patches whose nearest input cell is its own, rank 0 the Light. An abort or an error on any
+ * rank is reported on every rank. See README, "Running on a cluster".
+ *
  * @warning
  * The solve uses NumberOfThreads threads of its own (0: every core), whatever the
  * vtkSMPTools backend.

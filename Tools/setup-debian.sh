@@ -12,7 +12,7 @@ packages=(
   paraview paraview-dev python3-paraview
   libcgal-dev libembree-dev libtbb-dev libgtest-dev libbenchmark-dev libnova-dev nlohmann-json3-dev
   xvfb python3-numpy python3-pytest python3-matplotlib
-  libopenmpi-dev libglew-dev libx11-dev libgl-dev libpng-dev
+  libopenmpi-dev openmpi-bin libglew-dev libx11-dev libgl-dev libpng-dev
   clang libclang-rt-14-dev
 )
 
