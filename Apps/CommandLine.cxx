@@ -523,7 +523,7 @@ Output:
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)
   --stats FILE.json     also write the options, times and solver statistics as JSON
   --png DIR             also render one picture per frame into DIR (needs an X display;
-                        without DISPLAY the program runs itself under xvfb-run -a)
+                        without DISPLAY the program starts a private Xvfb)
   --help                show this text
 
 Files are written under temporary names and renamed once all are complete: a failure

@@ -71,7 +71,7 @@ struct FrameRenderer::Pipeline
   double exposure = 1.0;
 };
 
-FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6])
+FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6], const double* up)
   : Internals(new Pipeline)
 {
   Pipeline& p = *this->Internals;
@@ -120,6 +120,34 @@ FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6])
   camera->SetFocalPoint(centre);
   camera->SetPosition(centre[0], centre[1], centre[2] - std::max(distance, 1e-6));
   camera->SetViewUp(0, 1, 0);
+  if (up)
+  {
+    // An aerial view: from 35 degrees above the horizon, over a corner, framing the bounding
+    // sphere.
+    const double norm = std::sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    double u[3] = { up[0] / norm, up[1] / norm, up[2] / norm };
+    double a[3] = { 1, 0, 0 };
+    if (std::abs(u[0]) > 0.9)
+    {
+      a[0] = 0;
+      a[1] = 1;
+    }
+    double b[3] = { u[1] * a[2] - u[2] * a[1], u[2] * a[0] - u[0] * a[2], u[0] * a[1] - u[1] * a[0] };
+    const double bn = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double c[3] = { u[1] * b[2] - u[2] * b[1], u[2] * b[0] - u[0] * b[2], u[0] * b[1] - u[1] * b[0] };
+    const double radius = 0.5 * std::sqrt((bounds[1] - bounds[0]) * (bounds[1] - bounds[0]) +
+      (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) + (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
+    const double far = radius / std::sin(0.5 * ViewAngleDegrees * M_PI / 180.0);
+    const double elevation = 35 * M_PI / 180;
+    double from[3];
+    for (int i = 0; i < 3; ++i)
+    {
+      const double horizontal = (b[i] / bn + c[i] / bn) / std::sqrt(2.0);
+      from[i] = centre[i] + far * (std::cos(elevation) * horizontal + std::sin(elevation) * u[i]);
+    }
+    camera->SetPosition(from);
+    camera->SetViewUp(u);
+  }
 }
 
 FrameRenderer::~FrameRenderer() = default;

@@ -23,7 +23,9 @@ class FrameRenderer
 {
 public:
   /// `light` is the Light input; `bounds` those of the scene.
-  FrameRenderer(vtkPolyData* light, const double bounds[6]);
+  /// With `up` (the zenith of a scene lit by the sun), an aerial view instead: from above a
+  /// corner of the bounding box, looking at its centre, `up` pointing up in the picture.
+  FrameRenderer(vtkPolyData* light, const double bounds[6], const double* up = nullptr);
   ~FrameRenderer();
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;

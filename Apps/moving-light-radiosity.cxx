@@ -343,7 +343,9 @@ int run(int argc, char** argv)
     const Clock::time_point renderingStarted = Clock::now();
     const fs::path pictures = options.png;
     const PictureDisplay display; // outlives the renderer's connection to it
-    FrameRenderer renderer(light, scene->GetBounds());
+    // Scenes lit by the sun get an aerial view, their zenith up.
+    const Triple zenith = options.up.value_or(Triple{ 0, 0, 1 });
+    FrameRenderer renderer(light, scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
     renderer.setBrightLevel(brightLevel);
     for (std::size_t f = 0; f < times.size(); ++f)
     {
