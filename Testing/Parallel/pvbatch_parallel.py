@@ -33,7 +33,7 @@ args = parser.parse_args()
 from paraview.simple import (ExtractSurface, LoadPlugin, PassArrays, RedistributeDataSet,  # noqa: E402
                              XMLPolyDataReader)
 from vtkmodules.util.misc import calldata_type  # noqa: E402
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+from parallel_support import record_mesh  # noqa: E402
 from vtkmodules.util.vtkConstants import VTK_STRING  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator  # noqa: E402
 from vtkmodules.vtkParallelCore import vtkMultiProcessController  # noqa: E402
@@ -84,22 +84,7 @@ def record(prefix, time):
     results[prefix + "frame"] = np.array(field(elements, "FrameIndex"))
     results[prefix + "light_cells"] = np.array(algorithm.GetOutputDataObject(2).GetNumberOfCells())
     for name, data in (("e", elements), ("p", patches)):
-        cells = data.GetNumberOfCells()
-        results[f"{prefix}{name}_cells"] = np.array(cells)
-        if cells == 0:
-            continue
-        points = vtk_to_numpy(data.GetPoints().GetData()).astype(np.float64)
-        triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
-        results[f"{prefix}{name}_corners"] = points[triangles]
-        for i in range(data.GetCellData().GetNumberOfArrays()):
-            array = data.GetCellData().GetArray(i)
-            if array is not None:
-                results[f"{prefix}{name}_cell_{array.GetName()}"] = vtk_to_numpy(array)
-        for i in range(data.GetPointData().GetNumberOfArrays()):
-            array = data.GetPointData().GetArray(i)
-            if array is not None:
-                # Per cell corner, so that cells can be matched across ranks.
-                results[f"{prefix}{name}_corner_{array.GetName()}"] = vtk_to_numpy(array)[triangles]
+        record_mesh(results, prefix + name, data)
     return elements
 
 

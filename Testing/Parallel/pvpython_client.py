@@ -17,7 +17,7 @@ args = parser.parse_args()
 
 from paraview import servermanager  # noqa: E402
 from paraview.simple import Connect, LoadPlugin, XMLPolyDataReader  # noqa: E402
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+from parallel_support import record_mesh  # noqa: E402
 
 if not Connect("localhost", args.port):
     raise SystemExit(f"could not connect to the pvserver on port {args.port}")
@@ -35,24 +35,10 @@ radiosity.UpdatePipeline(time=0.0)
 results = {}
 for name, port in (("e", 0), ("p", 1)):
     data = servermanager.Fetch(radiosity, idx=port)
-    prefix = "f0_"
-    results[f"{prefix}{name}_cells"] = np.array(data.GetNumberOfCells())
     if name == "e":
-        results[prefix + "solves"] = np.array(data.GetFieldData().GetArray("SolveCount").GetValue(0))
-        results[prefix + "ranks"] = np.array(data.GetFieldData().GetArray("Ranks").GetValue(0)
-                                             if data.GetFieldData().GetArray("Ranks") else 1)
-    if data.GetNumberOfCells() == 0:
-        continue
-    points = vtk_to_numpy(data.GetPoints().GetData()).astype(np.float64)
-    triangles = vtk_to_numpy(data.GetPolys().GetConnectivityArray()).reshape(-1, 3)
-    results[f"{prefix}{name}_corners"] = points[triangles]
-    for i in range(data.GetCellData().GetNumberOfArrays()):
-        array = data.GetCellData().GetArray(i)
-        if array is not None:
-            results[f"{prefix}{name}_cell_{array.GetName()}"] = vtk_to_numpy(array)
-    for i in range(data.GetPointData().GetNumberOfArrays()):
-        array = data.GetPointData().GetArray(i)
-        if array is not None:
-            results[f"{prefix}{name}_corner_{array.GetName()}"] = vtk_to_numpy(array)[triangles]
+        results["f0_solves"] = np.array(data.GetFieldData().GetArray("SolveCount").GetValue(0))
+        results["f0_ranks"] = np.array(data.GetFieldData().GetArray("Ranks").GetValue(0)
+                                       if data.GetFieldData().GetArray("Ranks") else 1)
+    record_mesh(results, "f0_" + name, data)
 np.savez(f"{args.out}.rank0.npz", **results)
 print(f"client: wrote {args.out}.rank0.npz", flush=True)
