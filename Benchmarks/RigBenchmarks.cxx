@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <sys/resource.h>
 #include <vector>
 
 namespace mlr::bench
@@ -274,10 +275,30 @@ double meanRadiosity(const Scene& scene, const Reference& ref, std::size_t frame
   return sum / area;
 }
 
+/// CPU seconds (user + system, all threads) this process has used: unlike wall time, it
+/// hardly changes when other processes share the cores.
+double processCpuSeconds()
+{
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+    1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+/// A solve with the process CPU seconds it took.
+Solution timedSolve(const Scene& scene, const LightRig& rig, const SolverOptions& o, double& cpuSeconds)
+{
+  const double before = processCpuSeconds();
+  Solution s = solve(scene, rig, o);
+  cpuSeconds = processCpuSeconds() - before;
+  return s;
+}
+
 struct ModeRun
 {
   std::string name;
   SolverStatistics stats;
+  double cpuSeconds = 0; ///< median over the repeats
   std::vector<double> mse; ///< at each reported frame
   double meanMse = 0;      ///< over all frames
   int repeats = 1;
@@ -291,16 +312,22 @@ ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig
   o.reuseGathering = reuse;
   ModeRun run;
   run.name = name;
-  const Solution s = solve(scene, rig, o);
+  std::vector<double> cpu(1);
+  const Solution s = timedSolve(scene, rig, o, cpu[0]);
   std::vector<SolverStatistics> timings = { s.statistics };
   if (s.statistics.secondsTotal < 3.0)
   {
-    timings.push_back(solve(scene, rig, o).statistics);
-    timings.push_back(solve(scene, rig, o).statistics);
+    for (int r = 0; r < 2; ++r)
+    {
+      cpu.emplace_back();
+      timings.push_back(timedSolve(scene, rig, o, cpu.back()).statistics);
+    }
     std::sort(timings.begin(), timings.end(),
       [](const SolverStatistics& a, const SolverStatistics& b) { return a.secondsTotal < b.secondsTotal; });
+    std::sort(cpu.begin(), cpu.end());
   }
   run.stats = timings[timings.size() / 2];
+  run.cpuSeconds = cpu[cpu.size() / 2];
   run.repeats = static_cast<int>(timings.size());
   for (std::size_t f : frames)
   {
@@ -319,8 +346,8 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   const std::vector<std::string>& labels, const ModeRun& classic, const ModeRun& full,
   const std::string& extraJson)
 {
-  std::printf("\n%-12s %8s %8s %8s %8s %12s %12s %12s", "mode", "total s", "s/frame", "shoot s",
-    "gather s", "nearest-hit", "shadow", "gathering");
+  std::printf("\n%-12s %8s %8s %8s %8s %8s %12s %12s %12s", "mode", "total s", "s/frame", "shoot s",
+    "gather s", "CPU s", "nearest-hit", "shadow", "gathering");
   for (const std::string& label : labels)
   {
     std::printf(" %14s", ("MSE " + label).c_str());
@@ -329,8 +356,9 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   for (const ModeRun* m : { &classic, &full })
   {
     const SolverStatistics& s = m->stats;
-    std::printf("%-12s %8.2f %8.3f %8.2f %8.2f %12llu %12llu %12llu", m->name.c_str(),
+    std::printf("%-12s %8.2f %8.3f %8.2f %8.2f %8.2f %12llu %12llu %12llu", m->name.c_str(),
       s.secondsTotal, s.secondsTotal / double(frames), s.secondsShooting, s.secondsGathering,
+      m->cpuSeconds,
       static_cast<unsigned long long>(s.shootingRays), static_cast<unsigned long long>(s.shadowRays),
       static_cast<unsigned long long>(s.gatheringRays));
     for (double e : m->mse)
@@ -339,7 +367,7 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
     }
     std::printf(" %14.4g\n", m->meanMse);
   }
-  std::printf("%-12s %8s %8s %8s %8s %12s %12s %12s", "reference", "", "", "", "", "", "", "");
+  std::printf("%-12s %8s %8s %8s %8s %8s %12s %12s %12s", "reference", "", "", "", "", "", "", "", "");
   for (std::size_t f : at)
   {
     char text[32];
@@ -349,10 +377,12 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   std::printf("\n");
 
   const double speedup = classic.stats.secondsTotal / full.stats.secondsTotal;
+  const double cpuSpeedup = classic.cpuSeconds / full.cpuSeconds;
   std::printf("\n%s: full reuse is %.2fx faster than classic (%.2f s against %.2f s; %.3f s "
-              "against %.3f s per frame).\n",
+              "against %.3f s per frame); %.2fx in CPU time (%.2f s against %.2f s).\n",
     title.c_str(), speedup, full.stats.secondsTotal, classic.stats.secondsTotal,
-    full.stats.secondsTotal / double(frames), classic.stats.secondsTotal / double(frames));
+    full.stats.secondsTotal / double(frames), classic.stats.secondsTotal / double(frames),
+    cpuSpeedup, full.cpuSeconds, classic.cpuSeconds);
   std::printf("MSE of full reuse / classic:");
   for (std::size_t i = 0; i < at.size(); ++i)
   {
@@ -366,7 +396,8 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   }
   std::printf("MSE in (W/m^2)^2 against the reference, on its lit sides, area-weighted; it "
               "includes the reference's own error (about 1/%d of classic's). Solves under 3 s "
-              "show the median time of 3 runs.\n",
+              "show the median time of 3 runs. CPU s: the process's user + system seconds over all "
+              "threads, which other processes on the machine hardly change.\n",
     ref.paths / options.pathsPerFrame > 0 ? int(ref.paths / options.pathsPerFrame) : 1);
 
   std::ostringstream json;
@@ -376,6 +407,7 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
        << ",\n    \"reference_paths_per_frame\": " << ref.paths << ", \"reference_seconds\": "
        << ref.seconds << ", \"reference_cached\": " << (ref.cached ? "true" : "false")
        << ",\n    \"threads\": " << classic.stats.threads << ", \"speedup\": " << speedup
+       << ", \"speedup_cpu\": " << cpuSpeedup
        << ",\n    \"frames_reported\": [";
   for (std::size_t i = 0; i < at.size(); ++i)
   {
@@ -388,7 +420,8 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
     const SolverStatistics& s = m->stats;
     json << "      {\"name\": \"" << m->name << "\", \"seconds\": " << s.secondsTotal
          << ", \"seconds_shooting\": " << s.secondsShooting << ", \"seconds_gathering\": "
-         << s.secondsGathering << ", \"nearest_hit_rays\": " << s.shootingRays
+         << s.secondsGathering << ", \"cpu_seconds\": " << m->cpuSeconds
+         << ", \"nearest_hit_rays\": " << s.shootingRays
          << ", \"shadow_rays\": " << s.shadowRays << ", \"gathering_rays\": " << s.gatheringRays
          << ", \"mse\": [";
     for (std::size_t i = 0; i < m->mse.size(); ++i)
