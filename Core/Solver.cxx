@@ -490,32 +490,59 @@ std::size_t ShootingRun::areaKernel(const Vec3& x, const Vec3& n, const RayHit& 
     pose[i] = this->Pose[static_cast<std::size_t>(i)].data();
   }
   const double* active = this->PathsFromPosition.data();
-  for (std::size_t j = 0; j < this->Frames; ++j)
-  {
-    const double xj = pose[0][j] * x.x + pose[1][j] * x.y + pose[2][j] * x.z + pose[9][j];
-    const double yj = pose[3][j] * x.x + pose[4][j] * x.y + pose[5][j] * x.z + pose[10][j];
-    const double zj = pose[6][j] * x.x + pose[7][j] * x.y + pose[8][j] * x.z + pose[11][j];
-    const double nx = pose[0][j] * n.x + pose[1][j] * n.y + pose[2][j] * n.z;
-    const double nyj = pose[3][j] * n.x + pose[4][j] * n.y + pose[5][j] * n.z;
-    const double nz = pose[6][j] * n.x + pose[7][j] * n.y + pose[8][j] * n.z;
-    const double dx = y.x - xj, dy = y.y - yj, dz = y.z - zj;
-    const double cosX = nx * dx + nyj * dy + nz * dz;
-    const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
-    // Positions that are off cast no path and light nothing: their weight is never needed.
-    kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
-  }
   const double offset = this->Tracer.surfaceOffset();
   std::size_t count = 0;
-  for (std::size_t j = 0; j < this->Frames; ++j)
+  if (!this->SourceRef.area->rotates())
   {
-    if (kernel[j] > 0 && j != origin)
+    // Translations only (the common case): x_j = x + o_j and n_j = n, a third of the work.
+    const Vec3 toHit = y - x;
+    for (std::size_t j = 0; j < this->Frames; ++j)
     {
-      const Vec3 normal = this->SourceRef.area->turn(j, n);
-      scratch.targets[count] = this->SourceRef.area->place(j, x) + normal * offset;
-      scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
-      ++count;
+      const double dx = toHit.x - pose[9][j], dy = toHit.y - pose[10][j], dz = toHit.z - pose[11][j];
+      const double cosX = n.x * dx + n.y * dy + n.z * dz;
+      const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+      // Positions that are off cast no path and light nothing: their weight is never needed.
+      kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
+    }
+    const Vec3 lifted = x + n * offset;
+    for (std::size_t j = 0; j < this->Frames; ++j)
+    {
+      if (kernel[j] > 0 && j != origin)
+      {
+        scratch.targets[count] = Vec3(lifted.x + pose[9][j], lifted.y + pose[10][j], lifted.z + pose[11][j]);
+        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+        ++count;
+      }
+    }
+  }
+  else
+  {
+    for (std::size_t j = 0; j < this->Frames; ++j)
+    {
+      const double xj = pose[0][j] * x.x + pose[1][j] * x.y + pose[2][j] * x.z + pose[9][j];
+      const double yj = pose[3][j] * x.x + pose[4][j] * x.y + pose[5][j] * x.z + pose[10][j];
+      const double zj = pose[6][j] * x.x + pose[7][j] * x.y + pose[8][j] * x.z + pose[11][j];
+      const double nx = pose[0][j] * n.x + pose[1][j] * n.y + pose[2][j] * n.z;
+      const double nyj = pose[3][j] * n.x + pose[4][j] * n.y + pose[5][j] * n.z;
+      const double nz = pose[6][j] * n.x + pose[7][j] * n.y + pose[8][j] * n.z;
+      const double dx = y.x - xj, dy = y.y - yj, dz = y.z - zj;
+      const double cosX = nx * dx + nyj * dy + nz * dz;
+      const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+      kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
+    }
+    for (std::size_t j = 0; j < this->Frames; ++j)
+    {
+      if (kernel[j] > 0 && j != origin)
+      {
+        const Vec3 normal = this->SourceRef.area->turn(j, n);
+        scratch.targets[count] = this->SourceRef.area->place(j, x) + normal * offset;
+        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+        ++count;
+      }
     }
   }
   if (count > 0)
