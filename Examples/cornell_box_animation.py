@@ -101,11 +101,7 @@ print(f"wrote {series} and {len(times)} .vtu files in {os.path.join(args.output,
 # --- The pictures -----------------------------------------------------------------------------
 # Shown as Apply shows them: the filter's Elements in true colours (its point array Color, Map
 # Scalars off, unlit) and its Light output, the lamp where it is in each frame, in yellow.
-view = pv.CreateRenderView()
-view.ViewSize = [args.size, args.size]
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = [0.0, 0.0, 0.0]
+view = example_support.picture_view(pv, args.size, [0.0, 0.0, 0.0])
 room = pv.Show(radiosity, view)
 lamp = pv.Show(pv.OutputPort(radiosity, 2), view)
 
@@ -119,12 +115,6 @@ view.CameraPosition = [centre[0], centre[1],
                        bounds[4] - half / math.tan(math.radians(39.3 / 2))]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 
-animation = pv.GetAnimationScene()
-animation.UpdateAnimationUsingDataTimeSteps()
 pictures = os.path.join(args.output, "png")
-os.makedirs(pictures, exist_ok=True)
-for index, t in enumerate(times):
-    animation.AnimationTime = t
-    pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
-                      ImageResolution=[args.size, args.size])
+example_support.save_pictures(pv, view, times, pictures, args.size)
 print(f"wrote {len(times)} pictures in {pictures}")

@@ -66,3 +66,24 @@ def load_plugin(pv, parser, plugin=None):
         pv.LoadPlugin(plugin, remote=False)
         if not hasattr(pv, PLUGIN_NAME):
             sys.exit(f"{plugin} loaded, but it does not provide the {PLUGIN_NAME} filter")
+
+
+def picture_view(pv, size, background=(0.0, 0.0, 0.0)):
+    """A square render view without axes, for pictures of the animation."""
+    view = pv.CreateRenderView()
+    view.ViewSize = [size, size]
+    view.OrientationAxesVisibility = 0
+    view.UseColorPaletteForBackground = 0
+    view.Background = list(background)
+    return view
+
+
+def save_pictures(pv, view, times, folder, size):
+    """One picture per time step, folder/frame_0000.png ..., through the animation scene."""
+    animation = pv.GetAnimationScene()
+    animation.UpdateAnimationUsingDataTimeSteps()
+    os.makedirs(folder, exist_ok=True)
+    for index, t in enumerate(times):
+        animation.AnimationTime = t
+        pv.SaveScreenshot(os.path.join(folder, f"frame_{index:04d}.png"), view,
+                          ImageResolution=[size, size])

@@ -110,11 +110,7 @@ for name, file, material, start, end in SCENES:
     print(f"wrote {series}")
 
     # --- The pictures: the Elements in their display colours, the lamp in yellow --------------
-    view = pv.CreateRenderView()
-    view.ViewSize = [args.size, args.size]
-    view.OrientationAxesVisibility = 0
-    view.UseColorPaletteForBackground = 0
-    view.Background = [0.0, 0.0, 0.0]
+    view = example_support.picture_view(pv, args.size, [0.0, 0.0, 0.0])
     pv.Show(radiosity, view)
     pv.Show(pv.OutputPort(radiosity, 2), view)
     # Looking along -z into the open side, the front face filling the view.
@@ -127,14 +123,8 @@ for name, file, material, start, end in SCENES:
                            bounds[5] + half / math.tan(math.radians(VIEW_ANGLE / 2))]
     view.CameraViewUp = [0.0, 1.0, 0.0]
 
-    animation = pv.GetAnimationScene()
-    animation.UpdateAnimationUsingDataTimeSteps()
     pictures = os.path.join(args.output, "png", name)
-    os.makedirs(pictures, exist_ok=True)
-    for index, t in enumerate(times):
-        animation.AnimationTime = t
-        pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
-                          ImageResolution=[args.size, args.size])
+    example_support.save_pictures(pv, view, times, pictures, args.size)
     print(f"wrote {len(times)} pictures in {pictures}")
     # The next scene gets a pipeline and a view of its own, as a new ParaView state would.
     pv.Delete(view)

@@ -80,23 +80,13 @@ series = os.path.join(args.output, "spotlight.pvd")
 pv.SaveData(series, proxy=pv.MergeBlocks(Input=radiosity), WriteTimeSteps=1)
 print(f"wrote {series}")
 
-view = pv.CreateRenderView()
-view.ViewSize = [args.size, args.size]
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = [0.0, 0.0, 0.0]
+view = example_support.picture_view(pv, args.size, [0.0, 0.0, 0.0])
 pv.Show(radiosity, view)
 pv.Show(pv.OutputPort(radiosity, 2), view)
 view.CameraFocalPoint = [0.278, 0.274, 0.28]
 view.CameraPosition = [0.278, 0.274, -0.8]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 view.CameraViewAngle = 39.3
-animation = pv.GetAnimationScene()
-animation.UpdateAnimationUsingDataTimeSteps()
 pictures = os.path.join(args.output, "png")
-os.makedirs(pictures, exist_ok=True)
-for index, t in enumerate(times):
-    animation.AnimationTime = t
-    pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
-                      ImageResolution=[args.size, args.size])
+example_support.save_pictures(pv, view, times, pictures, args.size)
 print(f"wrote {len(times)} pictures in {pictures}")

@@ -84,22 +84,12 @@ series = os.path.join(args.output, "town.pvd")
 pv.SaveData(series, proxy=pv.MergeBlocks(Input=radiosity), WriteTimeSteps=1)
 print(f"wrote {series}")
 
-view = pv.CreateRenderView()
-view.ViewSize = [args.size, args.size]
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = [0.55, 0.7, 0.9]
+view = example_support.picture_view(pv, args.size, [0.55, 0.7, 0.9])
 pv.Show(radiosity, view)
 view.CameraPosition = [70, -90, 75]
 view.CameraFocalPoint = [0, 0, 4]
 view.CameraViewUp = [0, 0, 1]
 view.CameraViewAngle = 30
-animation = pv.GetAnimationScene()
-animation.UpdateAnimationUsingDataTimeSteps()
 pictures = os.path.join(args.output, "png")
-os.makedirs(pictures, exist_ok=True)
-for index, t in enumerate(times):
-    animation.AnimationTime = t
-    pv.SaveScreenshot(os.path.join(pictures, f"frame_{index:04d}.png"), view,
-                      ImageResolution=[args.size, args.size])
+example_support.save_pictures(pv, view, times, pictures, args.size)
 print(f"wrote {len(times)} pictures in {pictures}")
