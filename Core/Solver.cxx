@@ -1261,11 +1261,8 @@ std::vector<MovingLight> sceneEmitters(const Scene& scene)
   }
   for (std::size_t g = 0; g < emissions.size(); ++g)
   {
-    lights.emplace_back(polygons[g], emissions[g] * areas[g], std::vector<LightPose>{ LightPose() });
-    // The pose above is at the origin; a static light's only pose must leave it in place.
-    LightPose stay;
-    stay.position = lights.back().centroid();
-    lights.back() = MovingLight(polygons[g], emissions[g] * areas[g], std::vector<LightPose>{ stay });
+    // One pose, moved by nothing: the emitter stays where the scene has it.
+    lights.emplace_back(polygons[g], emissions[g] * areas[g], std::vector<Vec3>{ Vec3() });
   }
   return lights;
 }

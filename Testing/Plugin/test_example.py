@@ -14,22 +14,28 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 POSITIONS = 30  # Data/cornell_trajectory.vtp
 
 
-def test_example_writes_the_animation(tmp_path):
+def run_example(script, output, options):
+    """Runs Examples/<script> with pvpython on a private X display (the README runs it under an
+    X server too; a private one keeps parallel tests apart) and the built plugin, and returns
+    its report once it exited 0."""
     if not shutil.which("Xvfb"):
         pytest.skip("Xvfb is not installed")
     plugin = os.environ.get("MLR_PLUGIN")
     assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
-    output = tmp_path / "animation"
     env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
-    # The README runs it under xvfb-run -a; a private display keeps parallel tests apart.
     with virtual_display() as display:
         run = subprocess.run(
-            [os.environ.get("MLR_PVPYTHON", "pvpython"),
-             os.path.join(ROOT, "Examples", "cornell_box_animation.py"), "--plugin", plugin,
-             "--output", str(output), "--paths", "20000", "--size", "128"],
+            [os.environ.get("MLR_PVPYTHON", "pvpython"), os.path.join(ROOT, "Examples", script),
+             "--plugin", plugin, "--output", str(output)] + [str(o) for o in options],
             capture_output=True, text=True, timeout=300, env=dict(env, DISPLAY=display))
     report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
     assert run.returncode == 0, report
+    return report
+
+
+def test_example_writes_the_animation(tmp_path):
+    output = tmp_path / "animation"
+    report = run_example("cornell_box_animation.py", output, ["--paths", "20000", "--size", "128"])
 
     pvd = output / "cornell.pvd"
     assert pvd.is_file(), report
@@ -61,20 +67,8 @@ def test_sun_example_writes_a_day(tmp_path):
     The series' times are the clock hours; 05:00 is before sunrise (05:47), so that step is
     dark, and 13:00 (near solar noon) is lit, with the ground's direct light at the level of
     rho E sin(elevation)."""
-    if not shutil.which("Xvfb"):
-        pytest.skip("Xvfb is not installed")
-    plugin = os.environ.get("MLR_PLUGIN")
-    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
     output = tmp_path / "sun"
-    env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
-    with virtual_display() as display:
-        run = subprocess.run(
-            [os.environ.get("MLR_PVPYTHON", "pvpython"),
-             os.path.join(ROOT, "Examples", "sun_town_block.py"), "--plugin", plugin,
-             "--output", str(output), "--paths", "200000", "--step", "120", "--size", "96"],
-            capture_output=True, text=True, timeout=300, env=dict(env, DISPLAY=display))
-    report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
-    assert run.returncode == 0, report
+    run_example("sun_town_block.py", output, ["--paths", "200000", "--step", "120", "--size", "96"])
     entries = [(float(e.get("timestep")), e.get("file"))
                for e in ElementTree.parse(output / "town.pvd").getroot().iter("DataSet")]
     assert [t for t, _ in entries] == [5.0 + 2 * i for i in range(9)], entries
@@ -118,20 +112,8 @@ def test_spotlight_example_pans(tmp_path):
     """Examples/panning_spotlight.py: a Trajectory with a Normal array turns the lamp 90
     degrees; the green wall (x = 0) is lit more at the start and the red wall (x = 0.556) more
     at the end, and the Light output's polygon faces each step's Normal."""
-    if not shutil.which("Xvfb"):
-        pytest.skip("Xvfb is not installed")
-    plugin = os.environ.get("MLR_PLUGIN")
-    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
     output = tmp_path / "spotlight"
-    env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
-    with virtual_display() as display:
-        run = subprocess.run(
-            [os.environ.get("MLR_PVPYTHON", "pvpython"),
-             os.path.join(ROOT, "Examples", "panning_spotlight.py"), "--plugin", plugin,
-             "--output", str(output), "--paths", "100000", "--steps", "5", "--size", "96"],
-            capture_output=True, text=True, timeout=300, env=dict(env, DISPLAY=display))
-    report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
-    assert run.returncode == 0, report
+    run_example("panning_spotlight.py", output, ["--paths", "100000", "--steps", "5", "--size", "96"])
     entries = [e.get("file") for e in ElementTree.parse(output / "spotlight.pvd").getroot().iter("DataSet")]
     assert len(entries) == 5, entries
 
@@ -163,21 +145,9 @@ def test_material_scenes_example(tmp_path):
     pictures are in the scenes' own colours (the Cornell box's red and green walls, the room's
     red and blue walls and green box), not grey, and the lamp moves: the first and last
     frames differ."""
-    if not shutil.which("Xvfb"):
-        pytest.skip("Xvfb is not installed")
-    plugin = os.environ.get("MLR_PLUGIN")
-    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
     output = tmp_path / "materials"
     frames = 4
-    env = {k: v for k, v in os.environ.items() if k not in ("PV_PLUGIN_PATH", "PYTHONPATH")}
-    with virtual_display() as display:
-        run = subprocess.run(
-            [os.environ.get("MLR_PVPYTHON", "pvpython"),
-             os.path.join(ROOT, "Examples", "material_scenes.py"), "--plugin", plugin,
-             "--output", str(output), "--paths", "40000", "--frames", str(frames), "--size", "96"],
-            capture_output=True, text=True, timeout=300, env=dict(env, DISPLAY=display))
-    report = f"exit code {run.returncode}\n--- stdout\n{run.stdout}\n--- stderr\n{run.stderr}"
-    assert run.returncode == 0, report
+    report = run_example("material_scenes.py", output, ["--paths", "40000", "--frames", str(frames), "--size", "96"])
 
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkIOImage import vtkPNGReader
