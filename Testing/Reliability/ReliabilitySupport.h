@@ -53,8 +53,19 @@ public:
   DelayedCancel(const DelayedCancel&) = delete;
   DelayedCancel& operator=(const DelayedCancel&) = delete;
 
-  bool keepGoing() const { return !this->Requested.load(); }
+  bool keepGoing() const
+  {
+    const bool stop = this->Requested.load();
+    if (stop)
+    {
+      this->Refused.store(true);
+    }
+    return !stop;
+  }
   bool requested() const { return this->Requested.load(); }
+  /// True once a poll saw the request and said to stop: the work must then stop. A request
+  /// that came after the last poll (the work was finishing) is not a missed cancellation.
+  bool refused() const { return this->Refused.load(); }
   void finished() { this->End = Clock::now(); }
   /// Seconds from the request to finished(); negative when it was never requested.
   double latency() const;
@@ -62,6 +73,7 @@ public:
 private:
   std::atomic<bool> Requested{ false };
   std::atomic<bool> Stop{ false };
+  mutable std::atomic<bool> Refused{ false };
   Clock::time_point RequestedAt{};
   Clock::time_point End{};
   std::thread Timer;
