@@ -1,8 +1,11 @@
-// Per-worker power accumulators in 64-bit fixed point.
+// Power accumulators in 64-bit fixed point.
 //
-// Integer addition is associative, so the sum over workers does not depend on which worker
-// traced which path: with per-path random streams this makes the solve bit-identical for
-// any thread count, without atomics in the hot loop.
+// Integer addition is associative, so the sums do not depend on which worker traced which
+// path, nor in which order: with per-path random streams the solve is bit-identical for any
+// thread count. Workers add either to a copy of their own (plain adds: the fastest) or to
+// one copy shared by all (relaxed atomic adds, about a third slower in the hottest loop, but
+// the memory does not grow with the core count). The solver picks per-worker copies when
+// they fit in the memory limit (see Solver.cxx, AccumulatorCopies).
 #pragma once
 
 #include <algorithm>
@@ -32,31 +35,33 @@ enum class FrameLayout
 };
 
 /**
- * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), one copy per worker.
- * The caller picks the quantum: values are rounded to multiples of it, and a slot holds up
- * to 2^63 quanta.
+ * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), in one copy per
+ * worker or one shared copy. The caller picks the quantum: values are rounded to multiples
+ * of it, and a slot holds up to 2^63 quanta.
  */
 template <int Channels>
 class FixedPointAccumulator
 {
 public:
   /// One quantum for every channel.
-  FixedPointAccumulator(
-    int workers, std::size_t records, std::size_t frames, double quantum, FrameLayout layout)
-    : FixedPointAccumulator(workers, records, frames, filled(quantum), layout)
+  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records,
+    std::size_t frames, double quantum, FrameLayout layout)
+    : FixedPointAccumulator(workers, copyPerWorker, records, frames, filled(quantum), layout)
   {
   }
 
   /// One quantum per channel: a channel much weaker than the others keeps its precision.
-  FixedPointAccumulator(int workers, std::size_t records, std::size_t frames,
-    const std::array<double, Channels>& quantum, FrameLayout layout)
+  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records,
+    std::size_t frames, const std::array<double, Channels>& quantum, FrameLayout layout)
     : Frames(frames)
     , Stride(records * 2 * frames * Channels)
     , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
     , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
     , FrameStride(layout == FrameLayout::FramesInner ? Channels : records * 2 * Channels)
     , Quantum(quantum)
-    , Size(static_cast<std::size_t>(workers) * Stride)
+    , CopyStride(copyPerWorker ? Stride : 0)
+    , Shared(!copyPerWorker && workers > 1)
+    , Size(static_cast<std::size_t>(copyPerWorker ? workers : 1) * Stride)
     , Values(allocateZeroed(Size))
   {
     for (int c = 0; c < Channels; ++c)
@@ -65,10 +70,11 @@ public:
     }
   }
 
-  /// The slots of (record, side) at frame 0 for one worker; add() steps to other frames.
+  /// The slots of (record, side) at frame 0 that `worker` adds to; add() steps to other
+  /// frames.
   std::int64_t* slots(int worker, std::size_t record, int side)
   {
-    return this->Values.get() + static_cast<std::size_t>(worker) * this->Stride +
+    return this->Values.get() + static_cast<std::size_t>(worker) * this->CopyStride +
       this->offset(record, side, 0);
   }
 
@@ -79,7 +85,15 @@ public:
     for (int c = 0; c < Channels; ++c)
     {
       // Values are >= 0, so truncating x + 0.5 rounds to nearest.
-      s[c] += static_cast<std::int64_t>(values[c] * this->InverseQuantum[c] + 0.5);
+      const auto quanta = static_cast<std::int64_t>(values[c] * this->InverseQuantum[c] + 0.5);
+      if (!this->Shared)
+      {
+        s[c] += quanta;
+      }
+      else if (quanta != 0) // frames a path does not light cost no locked write
+      {
+        __atomic_fetch_add(&s[c], quanta, __ATOMIC_RELAXED);
+      }
     }
   }
 
@@ -143,8 +157,8 @@ public:
     return false;
   }
 
-  /// Adds every worker's copy into worker 0's and zeroes the others: the sums are unchanged,
-  /// and worker 0's copy (copySize() values) can then be summed over processes as a whole.
+  /// Adds every worker's copy into the first and zeroes the others: the sums are unchanged,
+  /// and the first copy (copySize() values) can then be summed over processes as a whole.
   std::int64_t* collapse()
   {
     std::int64_t* first = this->Values.get();
@@ -161,9 +175,10 @@ public:
   }
   std::size_t copySize() const { return this->Stride; }
 
-  static std::uint64_t bytes(int workers, std::size_t records, std::size_t frames)
+  /// Bytes of `copies` copies (the worker count, or 1 when shared).
+  static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
   {
-    return static_cast<std::uint64_t>(workers) * records * 2 * frames * Channels *
+    return static_cast<std::uint64_t>(copies) * records * 2 * frames * Channels *
       sizeof(std::int64_t);
   }
 
@@ -213,6 +228,8 @@ private:
   std::size_t FrameStride;
   std::array<double, Channels> Quantum;
   std::array<double, Channels> InverseQuantum;
+  std::size_t CopyStride; ///< 0 when the copy is shared
+  bool Shared;             ///< one copy for several workers: atomic adds
   std::size_t Size;
   std::unique_ptr<std::int64_t[], Free> Values;
 };

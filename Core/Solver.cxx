@@ -222,16 +222,16 @@ class ShootingRun
 {
 public:
   ShootingRun(const Scene& scene, const Source& source, const SolverOptions& options,
-    const RayTracer& tracer, int workers)
+    const RayTracer& tracer, int workers, bool copyPerWorker)
     : SceneRef(scene)
     , SourceRef(source)
     , Options(options)
     , Tracer(tracer)
     , Frames(source.positions)
     , Reuse(options.reuseShooting && source.positions > 1)
-    , ElementShare(workers, scene.elementCount(), source.positions, 0x1.0p-50,
+    , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions, 0x1.0p-50,
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
-    , PatchPower(workers, scene.patchCount(), source.positions,
+    , PatchPower(workers, copyPerWorker, scene.patchCount(), source.positions,
         { quantumFor(source.power.r), quantumFor(source.power.g), quantumFor(source.power.b) },
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
     , Counters(static_cast<std::size_t>(workers))
@@ -652,8 +652,8 @@ void ShootingRun::addTo(Solution& solution) const
   const std::size_t elements = this->SceneRef.elementCount();
   const std::size_t patches = this->SceneRef.patchCount();
   const std::size_t frames = solution.frameCount();
-  std::vector<Rgb>& direct = solution.directData();
-  std::vector<Rgb>& patch = solution.patchData();
+  std::vector<PackedRgb>& direct = solution.directData();
+  std::vector<PackedRgb>& patch = solution.patchData();
   const std::vector<Rgb>& factors = this->SourceRef.factors;
   auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
   for (std::size_t e = 0; e < elements; ++e)
@@ -913,7 +913,7 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   for (std::size_t pass = 0; pass < passes; ++pass)
   {
     Rgb* into = reuse ? sum.data() : &sum[pass];
-    const Rgb* pending = nullptr;
+    const PackedRgb* pending = nullptr;
     auto addPending = [&] {
       if (pending)
       {
@@ -943,9 +943,10 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       {
         continue;
       }
-      pending = &solution.patchRadiosity(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
+      pending = solution.patchData().data() +
+        solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
       const char* row = reinterpret_cast<const char*>(pending);
-      for (std::size_t byte = 0; byte < rowLength * sizeof(Rgb); byte += 64)
+      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
       {
         __builtin_prefetch(row + byte);
       }
@@ -955,7 +956,7 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   const Rgb scale = scene.elementReflectance(element) / static_cast<double>(rays);
   for (std::size_t f = 0; f < frames; ++f)
   {
-    solution.indirectData()[solution.elementIndex(f, element, side)] = scale * sum[f];
+    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(scale * sum[f]);
   }
 }
 
@@ -975,12 +976,12 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
           directPower += solution.direct(f, e, static_cast<Side>(s)) * scene.elementArea(e);
         }
         const Rgb patchDirect = directPower / scene.patchArea(p);
-        const Rgb& b = solution.patchRadiosity(f, p, static_cast<Side>(s));
+        const Rgb b = solution.patchRadiosity(f, p, static_cast<Side>(s));
         const Rgb rest(std::max(0.0, b.r - patchDirect.r), std::max(0.0, b.g - patchDirect.g),
           std::max(0.0, b.b - patchDirect.b));
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {
-          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] = rest;
+          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] = PackedRgb(rest);
         }
       }
     }
@@ -1008,7 +1009,6 @@ Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches
   , Elements(elements)
   , Patches(patches)
   , Direct(frames * elements * 2)
-  , Indirect(frames * elements * 2)
   , Patch(frames * patches * 2)
   , LitSide(elements, Side::Front)
 {
@@ -1120,7 +1120,7 @@ void agreeAcrossRanks(
   }
 }
 
-std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options)
 {
   const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
@@ -1132,21 +1132,43 @@ std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std
     }
     return product;
   };
-  // Results: direct and indirect per element side, shooting radiosity per patch side.
-  const std::uint64_t results = times({ frames,
-    saturatingSum(times({ elements, 2, 2 }), times({ patches, 2 })), sizeof(Rgb) });
-  // The fixed-point accumulators (FixedPointAccumulator::bytes), one copy per worker.
-  const std::uint64_t accumulators =
-    saturatingSum(times({ workers, elements, 2, frames, 1, sizeof(std::int64_t) }),
-      times({ workers, patches, 2, frames, 3, sizeof(std::int64_t) }));
-  const std::uint64_t scratch = times({ workers, frames, 2 * sizeof(Rgb) + sizeof(Vec3) + 16 });
-  // Embree's BVH and buffers, generously.
+  MemoryPlan plan;
+  const std::uint64_t direct = times({ frames, elements, 2, sizeof(PackedRgb) });
+  const std::uint64_t patch = times({ frames, patches, 2, sizeof(PackedRgb) });
+  const std::uint64_t indirect = direct;
+  plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
+  // One copy of the accumulators (FixedPointAccumulator::bytes): a scalar share per element
+  // side and RGB power per patch side, for every frame.
+  const std::uint64_t copy = saturatingSum(times({ elements, 2, frames, sizeof(std::int64_t) }),
+    times({ patches, 2, frames, 3, sizeof(std::int64_t) }));
+  // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
+  const std::uint64_t scratch = times({ workers, frames,
+    sizeof(double) + sizeof(Vec3) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
+  // Embree's BVH and buffers (generously), the emission and lit side of every element.
   const std::uint64_t tracing = saturatingSum(times({ elements, 256 }), times({ points, 16 }));
-  // Reachability: the probes' hits and their reverse edges.
+  const std::uint64_t perElement = times({ elements, sizeof(Rgb) + sizeof(Side) });
+  // Reachability: the probes' hits and their reverse edges (gone before gathering rays).
   const std::uint64_t reachability =
     times({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });
-  return saturatingSum(saturatingSum(results, accumulators),
-    saturatingSum(saturatingSum(scratch, tracing), reachability));
+  plan.other = saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, reachability));
+  const std::uint64_t base = saturatingSum(saturatingSum(scratch, tracing), perElement);
+  const std::uint64_t gathering =
+    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
+  const auto peakWith = [&](std::uint64_t copies) {
+    return saturatingSum(base,
+      std::max(saturatingSum(saturatingSum(direct, patch), times({ copies, copy })), gathering));
+  };
+  plan.accumulatorCopyPerWorker = workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
+  const std::uint64_t copies = plan.accumulatorCopyPerWorker ? workers : 1;
+  plan.accumulators = times({ copies, copy });
+  plan.peak = peakWith(copies);
+  return plan;
+}
+
+std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options)
+{
+  return planSolveMemory(patches, elements, points, frames, options).peak;
 }
 
 std::uint64_t estimateSolveMemory(
@@ -1332,6 +1354,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   std::size_t frames = 0;
   int workers = 1;
   std::uint64_t memory = 0;
+  MemoryPlan plan;
   std::vector<MovingLight> emitters;
   std::vector<Source> sources;
   std::vector<double> shootingCost;
@@ -1343,7 +1366,8 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   validateOptions(options);
   frames = frameCount(rig, scene.hasEmission());
   workers = resolveThreadCount(options.threads);
-  memory = estimateSolveMemory(scene, frames, options);
+  plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
+  memory = plan.peak;
   checkSolveMemory(memory, frames, scene.patchCount(), scene.elementCount(), options);
 
   emitters = sceneEmitters(scene);
@@ -1416,7 +1440,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   for (std::size_t i = 0; i < sources.size(); ++i)
   {
     const Source& source = sources[i];
-    ShootingRun run(scene, source, options, tracer, workers);
+    ShootingRun run(scene, source, options, tracer, workers, plan.accumulatorCopyPerWorker);
     const double share = shootingCost[i] / totalCost;
     const std::uint64_t paths = options.pathsPerFrame;
     std::uint64_t cast = 0;
@@ -1479,8 +1503,10 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   stats.sources = sources.size();
   stats.secondsShooting = secondsSince(shootingStart);
 
-  // Final gathering, once, on the sum of every source's patch solution.
+  // Final gathering, once, on the sum of every source's patch solution. The accumulators
+  // are gone: the indirect light takes their memory.
   const auto gatheringStart = Clock::now();
+  solution.allocateIndirect();
   if (options.gatheringRatio > 0)
   {
     const double share = reachabilityCost / totalCost;
@@ -1515,10 +1541,25 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     {
       // Each element side gathered on one rank and is exactly zero on the others, so the sum
       // over ranks is that rank's value, bit for bit.
-      static_assert(sizeof(Rgb) == 3 * sizeof(double), "Rgb is summed as doubles");
+      // Summed as doubles (exact for floats), a block at a time so that no copy of the whole
+      // array is needed.
+      static_assert(sizeof(PackedRgb) == 3 * sizeof(float), "PackedRgb is three floats");
       const auto sumStart = Clock::now();
-      std::vector<Rgb>& indirect = solution.indirectData();
-      options.sumDoublesAcrossRanks(reinterpret_cast<double*>(indirect.data()), 3 * indirect.size());
+      std::vector<PackedRgb>& indirect = solution.indirectData();
+      float* values = reinterpret_cast<float*>(indirect.data());
+      const std::size_t count = 3 * indirect.size();
+      constexpr std::size_t block = std::size_t(1) << 20;
+      std::vector<double> buffer(std::min(count, block));
+      for (std::size_t first = 0; first < count; first += block)
+      {
+        const std::size_t n = std::min(block, count - first);
+        std::copy(values + first, values + first + n, buffer.begin());
+        options.sumDoublesAcrossRanks(buffer.data(), n);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+          values[first + i] = static_cast<float>(buffer[i]);
+        }
+      }
       secondsReducing += secondsSince(sumStart);
     }
     for (const WorkerCounters& c : counters)
@@ -1560,6 +1601,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     ? 1.0 + (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) / lambda
     : 0.0;
   stats.memoryEstimateBytes = memory;
+  stats.accumulatorCopyPerWorker = plan.accumulatorCopyPerWorker;
   stats.threads = workers;
   stats.reuseShooting = options.reuseShooting;
   stats.reuseGathering = options.reuseGathering;

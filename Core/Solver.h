@@ -105,6 +105,8 @@ struct SolverStatistics
   double secondsReducing = 0;
   double secondsTotal = 0;
   std::uint64_t memoryEstimateBytes = 0;
+  /// The shooting accumulators had one copy per worker (else one shared copy, MemoryPlan).
+  bool accumulatorCopyPerWorker = true;
   int threads = 0;
   bool reuseShooting = false;
   bool reuseGathering = false;
@@ -133,13 +135,14 @@ public:
   std::size_t elementCount() const { return this->Elements; }
   std::size_t patchCount() const { return this->Patches; }
 
-  const Rgb& direct(std::size_t frame, std::size_t element, Side side) const
+  Rgb direct(std::size_t frame, std::size_t element, Side side) const
   {
     return this->Direct[this->elementIndex(frame, element, side)];
   }
-  const Rgb& indirect(std::size_t frame, std::size_t element, Side side) const
+  /// Zero until gathering has run.
+  Rgb indirect(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Indirect[this->elementIndex(frame, element, side)];
+    return this->Indirect.empty() ? Rgb() : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
   }
   /// Self-emission (W/m^2): the scene's emission on the front side, zero on the back.
   Rgb emitted(std::size_t element, Side side) const
@@ -148,11 +151,11 @@ public:
   }
   Rgb total(std::size_t frame, std::size_t element, Side side) const
   {
-    const std::size_t i = this->elementIndex(frame, element, side);
-    return this->emitted(element, side) + this->Direct[i] + this->Indirect[i];
+    return this->emitted(element, side) + this->direct(frame, element, side) +
+      this->indirect(frame, element, side);
   }
   /// The patch-level shooting solution (all bounces), which gathering reads.
-  const Rgb& patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
+  Rgb patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
   {
     return this->Patch[this->patchIndex(frame, patch, side)];
   }
@@ -172,28 +175,54 @@ public:
   {
     return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
   }
-  std::vector<Rgb>& directData() { return this->Direct; }
-  std::vector<Rgb>& indirectData() { return this->Indirect; }
-  std::vector<Rgb>& patchData() { return this->Patch; }
+  // Results are stored in single precision (PackedRgb); see MemoryPlan.
+  std::vector<PackedRgb>& directData() { return this->Direct; }
+  /// Empty until allocateIndirect(): the solver allocates it once the shooting accumulators
+  /// are freed, so that the two never take memory at once.
+  std::vector<PackedRgb>& indirectData() { return this->Indirect; }
+  void allocateIndirect() { this->Indirect.assign(this->Direct.size(), PackedRgb()); }
+  std::vector<PackedRgb>& patchData() { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   /// One per element, or empty when nothing emits.
   std::vector<Rgb>& emissionData() { return this->Emission; }
 
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
-  std::vector<Rgb> Direct, Indirect, Patch, Emission;
+  std::vector<PackedRgb> Direct, Indirect, Patch;
+  std::vector<Rgb> Emission;
   std::vector<Side> LitSide;
 };
 
 /// Receives the fraction done in [0, 1]; return false to cancel the solve.
 using ProgressCallback = std::function<bool(double fraction)>;
 
-/// Bytes a solve will allocate (results, per-thread accumulators, ray-tracing scene).
+/**
+ * How a solve uses memory: the one policy behind the estimate, the limit check and the
+ * allocations. Results are single precision (PackedRgb): direct light per element side,
+ * patch radiosity per patch side, and indirect light per element side, allocated when
+ * gathering starts, after the shooting accumulators are freed. The peak is the larger of the
+ * two phases. Shooting accumulators (64-bit fixed point) take one copy per worker (plain
+ * adds, the fastest) when that peak fits in half the memory limit, and otherwise one copy
+ * shared by the workers (atomic adds: shooting about a third slower, memory independent of
+ * the core count). Sizes saturate at UINT64_MAX instead of overflowing.
+ */
+struct MemoryPlan
+{
+  bool accumulatorCopyPerWorker = true;
+  std::uint64_t results = 0;      ///< direct, indirect and patch radiosity of every frame
+  std::uint64_t accumulators = 0; ///< the shooting accumulators of one source, all copies
+  std::uint64_t other = 0;        ///< per-thread scratch, the ray-tracing scene, reachability
+  std::uint64_t peak = 0;         ///< the estimate: the larger phase, shooting or gathering
+};
+
+MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options);
+
+/// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
 std::uint64_t estimateSolveMemory(
   const Scene& scene, std::size_t frames, const SolverOptions& options);
 
-/// The same estimate from counts alone, e.g. for a scene not remeshed yet. Saturates at
-/// UINT64_MAX instead of overflowing.
+/// The same estimate from counts alone, e.g. for a scene not remeshed yet.
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options);
 

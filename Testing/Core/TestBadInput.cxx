@@ -121,8 +121,10 @@ TEST(BadInput, MemoryEstimateOverLimitIsRefusedBeforeAllocating)
   // Refused up front: no time spent allocating or tracing (gigabytes would take far longer;
   // the bound is loose so that the machine's load cannot change the verdict).
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
-  // The estimate counts frames x (patches + elements) x 2 sides x RGB doubles at least.
-  const std::uint64_t floor = 10000ULL * (scene.patchCount() + scene.elementCount()) * 2 * 3 * 8;
+  // The estimate counts the results at least: frames x 2 sides x (patch radiosity + direct
+  // and indirect per element), RGB floats.
+  const std::uint64_t floor =
+    10000ULL * 2 * (scene.patchCount() + 2 * scene.elementCount()) * sizeof(PackedRgb);
   EXPECT_GT(estimate, floor);
 }
 

@@ -1,32 +1,37 @@
 // The same seed gives the same bits whatever the thread count; another seed does not.
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
 #include <gtest/gtest.h>
 
-#include <cstring>
-
 using namespace mlr;
 
 namespace
 {
-Solution solveWith(int threads, std::uint64_t seed, bool reuseShooting, bool reuseGathering)
+constexpr std::size_t Frames = 4;
+
+Scene box()
 {
-  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.6, 0.5, 0.4) }));
+  return Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.6, 0.5, 0.4) }));
+}
+
+/// `memoryLimit` 0 is the default limit, under which this small solve takes one accumulator
+/// copy per worker.
+Solution solveWith(int threads, std::uint64_t seed, bool reuseShooting, bool reuseGathering,
+  std::uint64_t memoryLimit = 0)
+{
+  const Scene scene = box();
   const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1, 2, 3),
-    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 4));
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, Frames));
   SolverOptions o;
   o.pathsPerFrame = 30000;
   o.threads = threads;
   o.seed = seed;
   o.reuseShooting = reuseShooting;
   o.reuseGathering = reuseGathering;
+  o.memoryLimitBytes = memoryLimit;
   return solve(scene, light, o);
-}
-
-bool sameBits(const std::vector<Rgb>& a, const std::vector<Rgb>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgb)) == 0;
 }
 }
 
@@ -40,15 +45,44 @@ TEST_P(Determinism, ThreadCountDoesNotChangeABit)
   Solution one = solveWith(1, 42, shooting, gathering);
   Solution two = solveWith(2, 42, shooting, gathering);
   Solution three = solveWith(3, 42, shooting, gathering);
-  EXPECT_TRUE(sameBits(one.directData(), two.directData()));
-  EXPECT_TRUE(sameBits(one.indirectData(), two.indirectData()));
-  EXPECT_TRUE(sameBits(one.patchData(), two.patchData()));
-  EXPECT_TRUE(sameBits(one.directData(), three.directData()));
-  EXPECT_TRUE(sameBits(one.indirectData(), three.indirectData()));
+  EXPECT_TRUE(checks::sameBits(one.directData(), two.directData()));
+  EXPECT_TRUE(checks::sameBits(one.indirectData(), two.indirectData()));
+  EXPECT_TRUE(checks::sameBits(one.patchData(), two.patchData()));
+  EXPECT_TRUE(checks::sameBits(one.directData(), three.directData()));
+  EXPECT_TRUE(checks::sameBits(one.indirectData(), three.indirectData()));
   EXPECT_EQ(one.statistics.shootingRays, two.statistics.shootingRays);
   EXPECT_EQ(one.statistics.shadowRays, two.statistics.shadowRays);
   EXPECT_EQ(one.statistics.gatheringRays, two.statistics.gatheringRays);
   EXPECT_EQ(two.statistics.threads, 2);
+}
+
+TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
+{
+  // A memory limit under twice the per-worker peak makes the solver share one accumulator
+  // copy between the workers (MemoryPlan); integer sums make that change no bit.
+  const auto [shooting, gathering] = GetParam();
+  const Scene scene = box();
+  SolverOptions o;
+  o.threads = 3;
+  o.memoryLimitBytes = std::uint64_t(1) << 40;
+  const MemoryPlan roomy = planSolveMemory(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  ASSERT_TRUE(roomy.accumulatorCopyPerWorker);
+  o.memoryLimitBytes = 2 * roomy.peak - 1;
+  const MemoryPlan tight = planSolveMemory(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  ASSERT_FALSE(tight.accumulatorCopyPerWorker);
+  EXPECT_EQ(3 * tight.accumulators, roomy.accumulators) << "one copy instead of three";
+  EXPECT_LT(tight.peak, roomy.peak);
+
+  Solution one = solveWith(1, 42, shooting, gathering);
+  Solution shared = solveWith(3, 42, shooting, gathering, o.memoryLimitBytes);
+  EXPECT_TRUE(one.statistics.accumulatorCopyPerWorker);
+  EXPECT_FALSE(shared.statistics.accumulatorCopyPerWorker);
+  EXPECT_EQ(shared.statistics.memoryEstimateBytes, tight.peak);
+  EXPECT_TRUE(checks::sameBits(one.directData(), shared.directData()));
+  EXPECT_TRUE(checks::sameBits(one.indirectData(), shared.indirectData()));
+  EXPECT_TRUE(checks::sameBits(one.patchData(), shared.patchData()));
 }
 
 TEST_P(Determinism, DifferentSeedsGiveDifferentResults)
@@ -56,8 +90,8 @@ TEST_P(Determinism, DifferentSeedsGiveDifferentResults)
   const auto [shooting, gathering] = GetParam();
   Solution a = solveWith(2, 1, shooting, gathering);
   Solution b = solveWith(2, 2, shooting, gathering);
-  EXPECT_FALSE(sameBits(a.directData(), b.directData()));
-  EXPECT_FALSE(sameBits(a.indirectData(), b.indirectData()));
+  EXPECT_FALSE(checks::sameBits(a.directData(), b.directData()));
+  EXPECT_FALSE(checks::sameBits(a.indirectData(), b.indirectData()));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllReuseModes, Determinism,

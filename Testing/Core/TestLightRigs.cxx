@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <iostream>
 
@@ -194,7 +196,10 @@ void expectScaled(const Rgb& scaled, const Rgb& reference, const Rgb& factor, co
 {
   for (int c = 0; c < 3; ++c)
   {
-    EXPECT_NEAR(scaled[c], factor[c] * reference[c], 1e-12 * std::abs(reference[c])) << what << " channel " << c;
+    // Results are stored in single precision: each side rounded once (PackedRgb).
+    EXPECT_NEAR(scaled[c], factor[c] * reference[c],
+      4 * std::numeric_limits<float>::epsilon() * std::abs(factor[c] * reference[c]))
+      << what << " channel " << c;
   }
 }
 }
@@ -416,12 +421,13 @@ TEST(LightRigs, StaticLightIsCastOnceAndLightsEveryFrameAlike)
       for (int c = 0; c < 3; ++c)
       {
         EXPECT_NEAR(lampDirect[f][c], staticPower[c], 1e-6 * staticPower[c]) << mode << " frame " << f;
-        EXPECT_NEAR(lampDirect[f][c], lampDirect[0][c], 1e-9 * staticPower[c]) << mode << " frame " << f;
+        // Alike up to the single-precision rounding of the stored results (PackedRgb).
+        EXPECT_NEAR(lampDirect[f][c], lampDirect[0][c], 1e-7 * staticPower[c]) << mode << " frame " << f;
         EXPECT_GT(lampIndirect[f][c], 0.0);
         if (reuse)
         {
           // One set of gathering rays serves every frame: the lamp's indirect light is the same.
-          EXPECT_NEAR(lampIndirect[f][c], lampIndirect[0][c], 1e-9 * lampIndirect[0][c]) << mode << " frame " << f;
+          EXPECT_NEAR(lampIndirect[f][c], lampIndirect[0][c], 1e-7 * lampIndirect[0][c]) << mode << " frame " << f;
         }
       }
     }

@@ -3,6 +3,7 @@
 // ranks are threads of this process here, their sums a barrier: Core knows no MPI, only
 // SolverOptions' sum hooks (the filter's tests run the same under mpiexec).
 #include "Error.h"
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -121,11 +122,6 @@ std::vector<RankResult> solveOnRanks(const Scene& scene, const LightRig& rig,
   return results;
 }
 
-bool sameBits(const std::vector<Rgb>& a, const std::vector<Rgb>& b)
-{
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgb)) == 0;
-}
-
 Scene boxScene()
 {
   return Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.6, 0.5, 0.4) }));
@@ -171,9 +167,9 @@ TEST_P(Ranks, EveryRankHoldsTheSerialSolutionBitForBit)
         std::to_string(threads) + " threads");
       ASSERT_TRUE(result.error.empty()) << result.error;
       Solution& s = result.solution;
-      EXPECT_TRUE(sameBits(serial.directData(), s.directData()));
-      EXPECT_TRUE(sameBits(serial.indirectData(), s.indirectData()));
-      EXPECT_TRUE(sameBits(serial.patchData(), s.patchData()));
+      EXPECT_TRUE(checks::sameBits(serial.directData(), s.directData()));
+      EXPECT_TRUE(checks::sameBits(serial.indirectData(), s.indirectData()));
+      EXPECT_TRUE(checks::sameBits(serial.patchData(), s.patchData()));
       EXPECT_EQ(serial.statistics.shootingRays, s.statistics.shootingRays);
       EXPECT_EQ(serial.statistics.shadowRays, s.statistics.shadowRays);
       EXPECT_EQ(serial.statistics.gatheringRays, s.statistics.gatheringRays);

@@ -11,12 +11,19 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace mlr::checks
 {
+
+/// The same results to the last bit (solutions whose sums must not depend on threads or ranks).
+inline bool sameBits(const std::vector<PackedRgb>& a, const std::vector<PackedRgb>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(PackedRgb)) == 0;
+}
 
 /// Runs `action`, expects mlr::Error, and checks that its message contains `words`.
 template <typename Action>
