@@ -2,12 +2,11 @@
 
 #include "vtkMovingLightRadiosity.h"
 
+#include <vtk_cli11.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <functional>
-#include <map>
-#include <set>
 #include <sstream>
 #include <vector>
 
@@ -56,22 +55,33 @@ long long parseInteger(const std::string& option, const std::string& text)
   return value;
 }
 
+/// The comma-separated fields of text, empty ones included.
+std::vector<std::string> split(const std::string& text)
+{
+  std::vector<std::string> fields(1);
+  for (char c : text)
+  {
+    if (c == ',')
+    {
+      fields.emplace_back();
+    }
+    else
+    {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
 Triple parseTriple(const std::string& option, const std::string& text)
 {
-  Triple values{};
-  std::size_t start = 0;
-  for (int i = 0; i < 3; ++i)
+  const std::vector<std::string> fields = split(text);
+  if (fields.size() != 3)
   {
-    const std::size_t comma = text.find(',', start);
-    const bool last = i == 2;
-    if (last != (comma == std::string::npos))
-    {
-      throw UsageError(option + " needs three numbers X,Y,Z, not '" + text + "'");
-    }
-    values[i] = parseNumber(option, text.substr(start, last ? std::string::npos : comma - start));
-    start = comma + 1;
+    throw UsageError(option + " needs three numbers X,Y,Z, not '" + text + "'");
   }
-  return values;
+  return { parseNumber(option, fields[0]), parseNumber(option, fields[1]),
+    parseNumber(option, fields[2]) };
 }
 
 /// HH:MM (00:00 to 24:00) as hours.
@@ -91,18 +101,7 @@ double parseClock(const std::string& option, const std::string& text)
 
 SunPathSpec parseSunPath(const std::string& option, const std::string& text)
 {
-  std::vector<std::string> fields;
-  std::size_t start = 0;
-  for (;;)
-  {
-    const std::size_t comma = text.find(',', start);
-    fields.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos)
-    {
-      break;
-    }
-    start = comma + 1;
-  }
+  const std::vector<std::string> fields = split(text);
   if (fields.size() != 6)
   {
     throw UsageError(option + " is '" + text +
@@ -127,92 +126,38 @@ SunPathSpec parseSunPath(const std::string& option, const std::string& text)
   return spec;
 }
 
-struct OptionSpec
+std::string asGiven(const std::string&, const std::string& text)
 {
-  const char* value; ///< what to give, for messages
-  std::function<void(Options&, const std::string& option, const std::string& value)> apply;
-};
+  return text;
+}
 
-const std::map<std::string, OptionSpec>& optionSpecs()
+/// R,G,B, or one number: a white light of that power per channel.
+Triple parsePower(const std::string& option, const std::string& text)
 {
-  static const std::map<std::string, OptionSpec> specs = {
-    { "--scene", { "FILE", [](Options& o, const auto&, const auto& v) { o.scene = v; } } },
-    { "--light", { "FILE", [](Options& o, const auto&, const auto& v) { o.light = v; } } },
-    { "--trajectory",
-      { "FILE", [](Options& o, const auto&, const auto& v) { o.trajectory = v; } } },
-    { "--from",
-      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.from = parseTriple(n, v); } } },
-    { "--to",
-      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.to = parseTriple(n, v); } } },
-    { "--frames",
-      { "N", [](Options& o, const auto& n, const auto& v) { o.frames = parseInteger(n, v); } } },
-    { "--light-material",
-      { "NAME", [](Options& o, const auto&, const auto& v) { o.lightMaterial = v; } } },
-    { "--aim",
-      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.aim = parseTriple(n, v); } } },
-    { "--sun-directions",
-      { "FILE", [](Options& o, const auto&, const auto& v) { o.sunDirections = v; } } },
-    { "--sun-path",
-      { "LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES",
-        [](Options& o, const auto& n, const auto& v) { o.sunPath = parseSunPath(n, v); } } },
-    { "--sun-irradiance",
-      { "W/m2",
-        [](Options& o, const auto& n, const auto& v) { o.sunIrradiance = parseNumber(n, v); } } },
-    { "--time-zone",
-      { "HOURS", [](Options& o, const auto& n, const auto& v) { o.timeZone = parseNumber(n, v); } } },
-    { "--north",
-      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.north = parseTriple(n, v); } } },
-    { "--up",
-      { "X,Y,Z", [](Options& o, const auto& n, const auto& v) { o.up = parseTriple(n, v); } } },
-    { "--light-power",
-      { "R,G,B",
-        [](Options& o, const auto& n, const auto& v) {
-          // One number is a white light of that power per channel.
-          if (v.find(',') != std::string::npos)
-          {
-            o.lightPower = parseTriple(n, v);
-            return;
-          }
-          const double power = parseNumber(n, v);
-          o.lightPower = Triple{ power, power, power };
-        } } },
-    { "--paths",
-      { "N", [](Options& o, const auto& n, const auto& v) { o.paths = parseInteger(n, v); } } },
-    { "--gather-ratio",
-      { "K", [](Options& o, const auto& n, const auto& v) { o.gatherRatio = parseNumber(n, v); } } },
-    { "--survival",
-      { "L", [](Options& o, const auto& n, const auto& v) { o.survival = parseNumber(n, v); } } },
-    { "--reuse",
-      { "none|gathering|shooting|both",
-        [](Options& o, const auto& n, const auto& v) {
-          if (v != "none" && v != "gathering" && v != "shooting" && v != "both")
-          {
-            throw UsageError(n + " is '" + v + "': give none, gathering, shooting or both");
-          }
-          o.reuse = v;
-        } } },
-    { "--patch-size",
-      { "H", [](Options& o, const auto& n, const auto& v) { o.patchSize = parseNumber(n, v); } } },
-    { "--seed",
-      { "S", [](Options& o, const auto& n, const auto& v) { o.seed = parseInteger(n, v); } } },
-    { "--threads",
-      { "T", [](Options& o, const auto& n, const auto& v) { o.threads = parseInteger(n, v); } } },
-    { "--memory-limit",
-      { "MIB",
-        [](Options& o, const auto& n, const auto& v) { o.memoryLimit = parseInteger(n, v); } } },
-    { "--output",
-      { "PATH.pvd",
-        [](Options& o, const auto& n, const auto& v) {
-          if (!endsWith(v, ".pvd") || v.size() <= 4 || endsWith(v, "/.pvd"))
-          {
-            throw UsageError(n + " is '" + v + "': give a file name ending in .pvd");
-          }
-          o.output = v;
-        } } },
-    { "--stats", { "FILE.json", [](Options& o, const auto&, const auto& v) { o.stats = v; } } },
-    { "--png", { "DIR", [](Options& o, const auto&, const auto& v) { o.png = v; } } },
-  };
-  return specs;
+  if (text.find(',') != std::string::npos)
+  {
+    return parseTriple(option, text);
+  }
+  const double power = parseNumber(option, text);
+  return { power, power, power };
+}
+
+std::string parseReuse(const std::string& option, const std::string& text)
+{
+  if (text != "none" && text != "gathering" && text != "shooting" && text != "both")
+  {
+    throw UsageError(option + " is '" + text + "': give none, gathering, shooting or both");
+  }
+  return text;
+}
+
+std::string parseOutput(const std::string& option, const std::string& text)
+{
+  if (!endsWith(text, ".pvd") || text.size() <= 4 || endsWith(text, "/.pvd"))
+  {
+    throw UsageError(option + " is '" + text + "': give a file name ending in .pvd");
+  }
+  return text;
 }
 
 std::string stem(const std::string& path)
@@ -239,48 +184,105 @@ Options parseCommandLine(int argc, const char* const* argv)
 {
   Options o;
   o.defaultRun = argc <= 1;
-  std::set<std::string> seen;
+  CLI::App app;
+  // --help prints helpText(), which says more about each option than CLI11's listing would.
+  app.set_help_flag();
+  const CLI::Option* help = app.add_flag("-h,--help", o.help);
+  // Unknown options, arguments and repeated options are reported below, in the project's words.
+  app.allow_extras();
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+
+  // Every option takes one value, read by `read(name, value)`. Numbers keep the project's readers:
+  // CLI11 2.0 takes nan, inf and 1e999 as numbers, reads whole numbers in base 0 (010 is 8,
+  // 0x10 is 16) and saturates those that overflow, and its conversion errors do not say which
+  // option failed.
+  const auto needsValue = [&app](const std::string& name) {
+    const CLI::Option* option = app.get_option_no_throw(name);
+    const std::string what = option ? option->get_type_name() : "";
+    return UsageError(name + " needs a value: " + name + " " + what);
+  };
+  const auto option = [&](const std::string& name, const char* value, auto& into, auto read) {
+    app
+      .add_option_function<std::string>(name,
+        [name, &into, read, &needsValue](const std::string& text) {
+          if (text.empty())
+          {
+            throw needsValue(name);
+          }
+          into = read(name, text);
+        })
+      ->type_name(value);
+  };
+  option("--scene", "FILE", o.scene, asGiven);
+  option("--light", "FILE", o.light, asGiven);
+  option("--trajectory", "FILE", o.trajectory, asGiven);
+  option("--from", "X,Y,Z", o.from, parseTriple);
+  option("--to", "X,Y,Z", o.to, parseTriple);
+  option("--frames", "N", o.frames, parseInteger);
+  option("--light-material", "NAME", o.lightMaterial, asGiven);
+  option("--aim", "X,Y,Z", o.aim, parseTriple);
+  option("--sun-directions", "FILE", o.sunDirections, asGiven);
+  option("--sun-path", "LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES", o.sunPath, parseSunPath);
+  option("--sun-irradiance", "W/m2", o.sunIrradiance, parseNumber);
+  option("--time-zone", "HOURS", o.timeZone, parseNumber);
+  option("--north", "X,Y,Z", o.north, parseTriple);
+  option("--up", "X,Y,Z", o.up, parseTriple);
+  option("--light-power", "R,G,B", o.lightPower, parsePower);
+  option("--paths", "N", o.paths, parseInteger);
+  option("--gather-ratio", "K", o.gatherRatio, parseNumber);
+  option("--survival", "L", o.survival, parseNumber);
+  option("--reuse", "none|gathering|shooting|both", o.reuse, parseReuse);
+  option("--patch-size", "H", o.patchSize, parseNumber);
+  option("--seed", "S", o.seed, parseInteger);
+  option("--threads", "T", o.threads, parseInteger);
+  option("--memory-limit", "MIB", o.memoryLimit, parseInteger);
+  option("--output", "PATH.pvd", o.output, parseOutput);
+  option("--stats", "FILE.json", o.stats, asGiven);
+  option("--png", "DIR", o.png, asGiven);
+
+  // CLI11 reads `--paths= 5` as `--paths 5` and `--help=no` as no --help: both stay errors.
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h")
+    const std::string name = arg.substr(0, arg.find('='));
+    const CLI::Option* given = app.get_option_no_throw(name);
+    if (given == help && name.size() < arg.size())
     {
-      o.help = true;
-      continue;
+      throw UsageError(name + " takes no value");
     }
+    if (given && name.size() + 1 == arg.size())
+    {
+      throw needsValue(name);
+    }
+  }
+  try
+  {
+    app.parse(argc, argv);
+  }
+  catch (const CLI::ArgumentMismatch&)
+  {
+    // Thrown when the arguments ran out before an option's value: the option is the last one.
+    throw needsValue(argv[argc - 1]);
+  }
+  catch (const CLI::ParseError& e)
+  {
+    throw UsageError(e.what());
+  }
+  if (!app.remaining().empty())
+  {
+    const std::string arg = app.remaining().front();
     if (arg.rfind("--", 0) != 0)
     {
       throw UsageError("unexpected argument '" + arg + "': every option starts with --");
     }
-    const std::size_t equals = arg.find('=');
-    const std::string name = arg.substr(0, equals);
-    const auto spec = optionSpecs().find(name);
-    if (spec == optionSpecs().end())
+    throw UsageError("unknown option " + arg.substr(0, arg.find('=')));
+  }
+  for (const CLI::Option* given : app.get_options())
+  {
+    if (given->count() > 1 && given != help)
     {
-      throw UsageError("unknown option " + name);
+      throw UsageError(given->get_name() + " is given twice");
     }
-    if (!seen.insert(name).second)
-    {
-      throw UsageError(name + " is given twice");
-    }
-    std::string value;
-    if (equals != std::string::npos)
-    {
-      value = arg.substr(equals + 1);
-    }
-    else if (i + 1 < argc)
-    {
-      value = argv[++i];
-    }
-    else
-    {
-      throw UsageError(name + " needs a value: " + name + " " + spec->second.value);
-    }
-    if (value.empty())
-    {
-      throw UsageError(name + " needs a value: " + name + " " + spec->second.value);
-    }
-    spec->second.apply(o, name, value);
   }
   if (o.help)
   {

@@ -6,6 +6,7 @@ ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
 """
 import json
 import os
+import re
 import sys
 import shutil
 import xml.etree.ElementTree as ElementTree
@@ -139,6 +140,56 @@ def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, mess
     assert result.returncode == 2
     assert message in result.stderr
     assert all_files(tmp_path) == []
+
+
+# The syntax CLI11 parses (issue 16), each line as given: no --output is appended.
+@pytest.mark.parametrize("args, message", [
+    (["--paths=many"], "--paths needs a whole number, not 'many'"),
+    (["--bogus=3"], "unknown option --bogus"),
+    (["scene.vtp"], "unexpected argument 'scene.vtp': every option starts with --"),
+    (["-x"], "unexpected argument '-x': every option starts with --"),
+    (["--paths"], "--paths needs a value: --paths N"),
+    (["--paths=", "5"], "--paths needs a value: --paths N"),
+    (["--scene", ""], "--scene needs a value: --scene FILE"),
+    (["--frames", "3", "--frames", "4"], "--frames is given twice"),
+    (["--help=no"], "--help takes no value"),
+    (["--seed", "-3"], "--seed is -3: give a value from 0"),  # a value, not an option
+    # CLI11 alone would read these as 16, as the largest whole number and as numbers.
+    (["--seed", "0x10"], "--seed needs a whole number, not '0x10'"),
+    (["--paths", "99999999999999999999"],
+     "--paths needs a whole number, not '99999999999999999999'"),
+    (["--survival", "inf"], "--survival needs a number, not 'inf'"),
+    (["--gather-ratio", "1e999"], "--gather-ratio needs a number, not '1e999'"),
+    (["--from", "1,2"], "--from needs three numbers X,Y,Z, not '1,2'"),
+    (["--aim", "1,2,3,"], "--aim needs three numbers X,Y,Z, not '1,2,3,'"),
+])
+def test_bad_syntax_fails_with_a_message_and_writes_nothing(tmp_path, args, message):
+    result = run(args, tmp_path)
+    assert result.returncode == 2
+    assert message in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_every_option_of_the_help_is_known(tmp_path):
+    """Every option the help lists is registered: alone, it asks for its value."""
+    options = sorted(set(re.findall(r"--[a-z][a-z-]+", run(["--help"], tmp_path).stdout)) -
+                     {"--help"})
+    assert len(options) == 26, options
+    for option in options:
+        result = run([option], tmp_path)
+        assert result.returncode == 2
+        assert f"{option} needs a value: {option} " in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_equals_syntax(tmp_path):
+    result = run(["--scene=" + SCENE, "--light=" + LIGHT, "--from=0.15,0.5478,0.15",
+                  "--to", "0.40,0.5478,0.40", "--frames=2", "--seed=3", "--paths=20000",
+                  "--patch-size=0.08", "--output=s.pvd", "--stats=s.json"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    settings = json.loads((tmp_path / "s.json").read_text())["settings"]
+    assert settings["paths"] == 20000 and settings["seed"] == 3
+    assert all_files(tmp_path) == ["s.json", "s.pvd", "s_0000.vtu", "s_0001.vtu"]
 
 
 def test_unreadable_files_fail_with_a_message_and_write_nothing(tmp_path):
