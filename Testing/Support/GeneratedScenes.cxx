@@ -265,4 +265,36 @@ PolygonSoup panelThroughWall(double thickness)
   return soup;
 }
 
+PolygonSoup sphereAndBoxOnTiledFloor(int floorCells, int sphereFrequency)
+{
+  PolygonSoup soup;
+  const auto n = static_cast<std::uint32_t>(floorCells);
+  for (std::uint32_t j = 0; j <= n; ++j)
+  {
+    for (std::uint32_t i = 0; i <= n; ++i)
+    {
+      soup.points.push_back({ -3 + 6.0 * i / n, -3 + 6.0 * j / n, 0 });
+    }
+  }
+  auto point = [n](std::uint32_t i, std::uint32_t j) { return j * (n + 1) + i; };
+  for (std::uint32_t j = 0; j < n; ++j)
+  {
+    for (std::uint32_t i = 0; i < n; ++i)
+    {
+      soup.polygons.push_back({ point(i, j), point(i + 1, j), point(i + 1, j + 1) });
+      soup.polygons.push_back({ point(i, j), point(i + 1, j + 1), point(i, j + 1) });
+    }
+  }
+  soup.materials.assign(soup.polygons.size(), Material{ Rgb(0.6) });
+  PolygonSoup sphere = icosphere(sphereFrequency, 1.5);
+  for (Vec3& p : sphere.points)
+  {
+    p.z += 0.9;
+  }
+  sphere.materials.assign(sphere.materials.size(), Material{ Rgb(0.7, 0.3, 0.3) });
+  append(soup, sphere);
+  append(soup, boxOfQuads({ 1.2345, 1.4321, 0 }, { 2.2345, 2.4321, 1 }, { Rgb(0.3, 0.3, 0.7) }));
+  return soup;
+}
+
 } // namespace mlr::scenes

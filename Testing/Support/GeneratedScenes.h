@@ -78,4 +78,13 @@ PolygonSoup blockOnFloor(double floorSize, const Vec3& blockLo, const Vec3& bloc
 /// thickness around it (normals out). The wall is the first polygon.
 PolygonSoup panelThroughWall(double thickness = 0);
 
+/**
+ * A large input for remeshing benchmarks, with contact lines and a covered face: a floor
+ * [-3, 3]^2 at z = 0 facing up, cut into floorCells^2 squares of 2 triangles sharing their
+ * points; an icosphere of `sphereFrequency` (radius 1.5, centre (0, 0, 0.9)) through it; and
+ * a closed box 1 x 1 x 1 of 6 quads (normals out) standing on it at (1.2345, 1.4321).
+ * 2 floorCells^2 + 20 sphereFrequency^2 + 6 polygons in three materials.
+ */
+PolygonSoup sphereAndBoxOnTiledFloor(int floorCells, int sphereFrequency);
+
 } // namespace mlr::scenes
