@@ -8,6 +8,7 @@
 #include "RemeshBenchmark.h"
 #include "Remeshing.h"
 #include "RigBenchmarks.h"
+#include "ScaleBenchmarks.h"
 #include "Solver.h"
 
 #include <algorithm>
@@ -33,14 +34,15 @@ struct Arguments
   std::string which = "all"; ///< --case: all, paper, rotating, sun or remesh
   int referenceFactor = 16;
   std::string cache = "output/benchmark-cache";
+  std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
 };
 
 void usage()
 {
   std::printf(
-    "usage: mlr-benchmark [--case all|paper|rotating|sun|remesh] [--paths N] [--frames n]\n"
+    "usage: mlr-benchmark [--case all|paper|rotating|sun|long|large|remesh] [--paths N] [--frames n]\n"
     "                     [--threads T] [--json FILE] [--reference-factor F] [--cache DIR]\n"
-    "                     [--only classic|gathering|shooting|full]\n"
+    "                     [--only classic|gathering|shooting|full] [--memory-limit-mib M]\n"
     "  paper:    the generated paper-scale room (about 2,800 patches, a small ceiling light on a\n"
     "            diagonal) in the four reuse modes, compared with bare Embree, and remeshing\n"
     "  rotating: a light turning 90 degrees in the same room (issue 12)\n"
@@ -50,7 +52,13 @@ void usage()
     "  all:      paper, rotating and sun in turn (the default)\n"
     "rotating and sun compare full reuse with classic, errors against a classic reference of\n"
     "F x N paths (default 16), cached in DIR (default output/benchmark-cache; '' keeps none).\n"
-    "--frames sets the frames of paper and rotating (30); --only profiles one paper mode.\n");
+    "--frames sets the frames of paper and rotating (30); --only profiles one paper mode.\n"
+    "  long:     the paper room over 300 frames, classic against full reuse, and where the\n"
+    "            shadow rays go (issue 16; about 2 minutes, not in all)\n"
+    "  large:    the room in about 100,000 patches, 120 frames, N = 4,000,000, full reuse: time\n"
+    "            and peak memory against the estimate (issue 16; about 3 minutes, not in all)\n"
+    "--memory-limit-mib M sets the solver's memory limit of long and large (default: half the\n"
+    "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n");
 }
 
 bool parse(int argc, char** argv, Arguments& a)
@@ -83,15 +91,19 @@ bool parse(int argc, char** argv, Arguments& a)
     {
       a.which = argv[++i];
       if (a.which != "all" && a.which != "paper" && a.which != "rotating" && a.which != "sun" &&
-        a.which != "remesh")
+        a.which != "remesh" && a.which != "long" && a.which != "large")
       {
-        std::fprintf(stderr, "mlr-benchmark: --case must be all, paper, rotating, sun or remesh\n");
+        std::fprintf(stderr, "mlr-benchmark: --case must be all, paper, rotating, sun, remesh, long or large\n");
         return false;
       }
     }
     else if (flag == "--reference-factor" && hasValue)
     {
       a.referenceFactor = std::atoi(argv[++i]);
+    }
+    else if (flag == "--memory-limit-mib" && hasValue)
+    {
+      a.memoryLimitMiB = std::strtoull(argv[++i], nullptr, 10);
     }
     else if (flag == "--cache" && hasValue)
     {
@@ -312,6 +324,17 @@ int main(int argc, char** argv)
     if (args.which == "remesh")
     {
       json.push_back("  \"remesh_large\": " + bench::runRemeshing(bench::RemeshCaseOptions{}));
+    }
+    bench::ScaleCaseOptions scaleOptions;
+    scaleOptions.threads = args.threads;
+    scaleOptions.memoryLimitBytes = args.memoryLimitMiB << 20;
+    if (args.which == "long")
+    {
+      json.push_back("  \"long_animation\": " + bench::runLongAnimation(scaleOptions));
+    }
+    if (args.which == "large")
+    {
+      json.push_back("  \"large_scene\": " + bench::runLargeScene(scaleOptions));
     }
     if (!args.json.empty())
     {

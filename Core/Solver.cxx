@@ -127,6 +127,7 @@ struct alignas(64) WorkerCounters
 {
   std::uint64_t shootingRays = 0;
   std::uint64_t shadowRays = 0;
+  std::uint64_t shadowRaysBlocked = 0;
   std::uint64_t gatheringRays = 0;
   std::uint64_t missedRays = 0;
   std::uint64_t firstHits = 0;
@@ -614,6 +615,7 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
     if (!scratch.visible[s])
     {
       kernel[scratch.targetFrames[s]] = 0;
+      ++counters.shadowRaysBlocked;
     }
   }
   double mixture = 0;
@@ -1494,6 +1496,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     {
       stats.shootingRays += c.shootingRays;
       stats.shadowRays += c.shadowRays;
+      stats.shadowRaysBlocked += c.shadowRaysBlocked;
       stats.gatheringRays += c.gatheringRays;
       stats.missedRays += c.missedRays;
       firstHits += c.firstHits;
@@ -1576,12 +1579,12 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   if (options.ranks > 1)
   {
     // The counters of the rays each rank traced (reachability's are every rank's own).
-    std::int64_t counts[6] = { static_cast<std::int64_t>(stats.shootingRays),
+    std::int64_t counts[7] = { static_cast<std::int64_t>(stats.shootingRays),
       static_cast<std::int64_t>(stats.shadowRays), static_cast<std::int64_t>(stats.gatheringRays),
       static_cast<std::int64_t>(stats.missedRays), static_cast<std::int64_t>(firstHits),
-      static_cast<std::int64_t>(backAbsorbed) };
+      static_cast<std::int64_t>(backAbsorbed), static_cast<std::int64_t>(stats.shadowRaysBlocked) };
     const auto sumStart = Clock::now();
-    options.sumAcrossRanks(counts, 6);
+    options.sumAcrossRanks(counts, 7);
     secondsReducing += secondsSince(sumStart);
     stats.shootingRays = static_cast<std::uint64_t>(counts[0]);
     stats.shadowRays = static_cast<std::uint64_t>(counts[1]);
@@ -1589,6 +1592,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     stats.missedRays = static_cast<std::uint64_t>(counts[3]);
     firstHits = static_cast<std::uint64_t>(counts[4]);
     backAbsorbed = static_cast<std::uint64_t>(counts[5]);
+    stats.shadowRaysBlocked = static_cast<std::uint64_t>(counts[6]);
   }
   stats.secondsReducing = secondsReducing;
   chooseLitSides(scene, solution);
@@ -1602,6 +1606,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     : 0.0;
   stats.memoryEstimateBytes = memory;
   stats.accumulatorCopyPerWorker = plan.accumulatorCopyPerWorker;
+  stats.firstHits = firstHits - backAbsorbed;
   stats.threads = workers;
   stats.reuseShooting = options.reuseShooting;
   stats.reuseGathering = options.reuseGathering;

@@ -86,6 +86,10 @@ struct SolverStatistics
   std::uint64_t pathsCast = 0;      ///< shooting paths actually traced, all frames
   std::uint64_t shootingRays = 0;   ///< nearest-hit rays of the shooting walks
   std::uint64_t shadowRays = 0;     ///< visibility rays for the reuse weights
+  std::uint64_t shadowRaysBlocked = 0; ///< of shadowRays, those an occluder stopped
+  /// Walks whose first ray hit the scene (and, one-sided, a front face): with reuse, each
+  /// asks for the visibility of every other position whose unoccluded kernel is not zero.
+  std::uint64_t firstHits = 0;
   std::uint64_t gatheringRays = 0;  ///< nearest-hit rays of the final gathering
   std::uint64_t missedRays = 0;     ///< nearest-hit rays that hit nothing
   std::uint64_t gatheringSides = 0; ///< element sides that gathered
