@@ -162,11 +162,11 @@ bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit
 
 namespace
 {
-/// Traces `count` occlusion rays from one origin in 16-wide packets. ray(i, dx, dy, dz, tfar)
-/// sets lane i's direction and far end.
-template <typename RayOf>
-void occludedPackets(RTCScene scene, const Vec3& origin, std::size_t count, std::uint8_t* visible,
-  const RayOf& rayOf)
+/// Traces `count` occlusion rays from one origin in 16-wide packets, lane i along
+/// (dx[i], dy[i], dz[i]) up to tfar; a lane whose offset is not longer than `shortest` is
+/// visible without tracing.
+void occludedPackets(RTCScene scene, const Vec3& origin, const float* dx, const float* dy,
+  const float* dz, std::size_t count, float tfar, float shortest, std::uint8_t* visible)
 {
   constexpr std::size_t width = 16;
   RTCIntersectContext context;
@@ -174,27 +174,32 @@ void occludedPackets(RTCScene scene, const Vec3& origin, std::size_t count, std:
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   alignas(64) RTCRay16 packet;
   alignas(64) int valid[width];
+  const float shortestSquared = shortest * shortest;
+  for (std::size_t i = 0; i < width; ++i)
+  {
+    // The same in every packet.
+    packet.org_x[i] = static_cast<float>(origin.x);
+    packet.org_y[i] = static_cast<float>(origin.y);
+    packet.org_z[i] = static_cast<float>(origin.z);
+    packet.time[i] = 0.0f;
+    packet.mask[i] = 0xFFFFFFFFu;
+    packet.id[i] = static_cast<unsigned>(i);
+    packet.flags[i] = 0;
+  }
   for (std::size_t first = 0; first < count; first += width)
   {
     const std::size_t lanes = std::min(width, count - first);
     // Branch-free lane set-up: idle lanes repeat the last ray and are switched off in `valid`.
     for (std::size_t i = 0; i < width; ++i)
     {
-      float dx, dy, dz, tfar;
-      const bool use = rayOf(first + std::min(i, lanes - 1), dx, dy, dz, tfar);
-      valid[i] = i < lanes && use ? -1 : 0;
-      packet.org_x[i] = static_cast<float>(origin.x);
-      packet.org_y[i] = static_cast<float>(origin.y);
-      packet.org_z[i] = static_cast<float>(origin.z);
-      packet.dir_x[i] = dx;
-      packet.dir_y[i] = dy;
-      packet.dir_z[i] = dz;
+      const std::size_t k = first + std::min(i, lanes - 1);
+      const float x = dx[k], y = dy[k], z = dz[k];
+      valid[i] = i < lanes && x * x + y * y + z * z > shortestSquared ? -1 : 0;
+      packet.dir_x[i] = x;
+      packet.dir_y[i] = y;
+      packet.dir_z[i] = z;
       packet.tnear[i] = 0.0f;
       packet.tfar[i] = tfar;
-      packet.time[i] = 0.0f;
-      packet.mask[i] = 0xFFFFFFFFu;
-      packet.id[i] = static_cast<unsigned>(i);
-      packet.flags[i] = 0;
     }
     rtcOccluded16(valid, scene, &context, &packet);
     for (std::size_t i = 0; i < lanes; ++i)
@@ -207,35 +212,20 @@ void occludedPackets(RTCScene scene, const Vec3& origin, std::size_t count, std:
 }
 }
 
-void RayTracer::visibleFrom(
-  const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const
+void RayTracer::visibleFrom(const Vec3& origin, const float* dx, const float* dy,
+  const float* dz, std::size_t count, std::uint8_t* visible) const
 {
   // The targets are lifted off their surfaces, as the rays that start there are: the whole
   // segment up to t = 1 is tested, with nothing to stop short of.
-  const Vec3 o = origin - this->Centre;
-  const float minimumSquared = static_cast<float>(this->Offset * this->Offset);
-  occludedPackets(this->Impl->Scene, o, count, visible,
-    [&](std::size_t i, float& dx, float& dy, float& dz, float& tfar) {
-      dx = static_cast<float>(targets[i].x - origin.x);
-      dy = static_cast<float>(targets[i].y - origin.y);
-      dz = static_cast<float>(targets[i].z - origin.z);
-      tfar = 1.0f;
-      return dx * dx + dy * dy + dz * dz > minimumSquared;
-    });
+  occludedPackets(this->Impl->Scene, origin - this->Centre, dx, dy, dz, count, 1.0f,
+    static_cast<float>(this->Offset), visible);
 }
 
-void RayTracer::visibleAlong(
-  const Vec3& origin, const Vec3* directions, std::size_t count, std::uint8_t* visible) const
+void RayTracer::visibleAlong(const Vec3& origin, const float* dx, const float* dy,
+  const float* dz, std::size_t count, std::uint8_t* visible) const
 {
-  const Vec3 o = origin - this->Centre;
-  occludedPackets(this->Impl->Scene, o, count, visible,
-    [&](std::size_t i, float& dx, float& dy, float& dz, float& tfar) {
-      dx = static_cast<float>(directions[i].x);
-      dy = static_cast<float>(directions[i].y);
-      dz = static_cast<float>(directions[i].z);
-      tfar = std::numeric_limits<float>::infinity();
-      return true;
-    });
+  occludedPackets(this->Impl->Scene, origin - this->Centre, dx, dy, dz, count,
+    std::numeric_limits<float>::infinity(), 0.0f, visible);
 }
 
 } // namespace mlr

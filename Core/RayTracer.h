@@ -41,18 +41,19 @@ public:
   bool intersect(const Vec3& origin, const Vec3& direction, RayHit& hit) const;
 
   /**
-   * Visibility of the segments origin -> targets[i] (endpoints excluded), for `count`
-   * targets, written to visible[i]. Coherent segments from one origin go through Embree's
-   * 16-wide packet query, not one call per segment. Callers pass points lifted off their
-   * surfaces (liftOff), the same points rays start from, so that a segment is blocked exactly
-   * when a ray between its ends would be.
+   * Visibility of the segments from `origin` to origin + (dx[i], dy[i], dz[i]) (endpoints
+   * excluded), for `count` segments, written to visible[i]. The offsets come as a structure
+   * of float arrays, the layout of Embree's 16-wide packets: coherent segments from one
+   * origin are traced a packet at a time. Callers give ends lifted off their surfaces
+   * (liftOff), the points rays start from, so that a segment is blocked exactly when a ray
+   * between its ends would be. A segment shorter than the lift is visible.
    */
-  void visibleFrom(
-    const Vec3& origin, const Vec3* targets, std::size_t count, std::uint8_t* visible) const;
+  void visibleFrom(const Vec3& origin, const float* dx, const float* dy, const float* dz,
+    std::size_t count, std::uint8_t* visible) const;
 
   /// Visibility to infinity from `origin` along each of `count` directions, as visibleFrom.
-  void visibleAlong(
-    const Vec3& origin, const Vec3* directions, std::size_t count, std::uint8_t* visible) const;
+  void visibleAlong(const Vec3& origin, const float* dx, const float* dy, const float* dz,
+    std::size_t count, std::uint8_t* visible) const;
 
   /// The distance rays leaving a surface start above it, so that they do not hit it again:
   /// 1e-5 of the scene's diagonal, whatever the scene's distance from the origin (rays are

@@ -138,7 +138,9 @@ struct alignas(64) WorkerCounters
 struct WorkerScratch
 {
   std::vector<double> kernel;
-  std::vector<Vec3> targets;
+  /// The shadow rays of one path, from the hit to each position still unknown: float
+  /// offsets in the layout of Embree's packets.
+  std::vector<float> dx, dy, dz;
   std::vector<std::uint32_t> targetFrames;
   std::vector<std::uint8_t> visible;
   std::vector<Rgb> gathered;
@@ -241,7 +243,9 @@ public:
     for (WorkerScratch& s : this->Scratch)
     {
       s.kernel.resize(this->Frames);
-      s.targets.resize(this->Frames);
+      s.dx.resize(this->Frames);
+      s.dy.resize(this->Frames);
+      s.dz.resize(this->Frames);
       s.targetFrames.resize(this->Frames);
       s.visible.resize(this->Frames);
     }
@@ -474,8 +478,8 @@ bool ShootingRun::emit(RandomStream& random, std::size_t position, int worker, V
 
 /**
  * The unoccluded kernel of an area light at every position, into scratch.kernel, and the
- * positions whose visibility is still unknown, into scratch.targets (lifted emission points)
- * and scratch.targetFrames. G_j = (n_j.d)(-n_y.d) / |d|^4 with d = y - x_j: the pi of G
+ * positions whose visibility is still unknown, into scratch.targetFrames, with the offsets
+ * from the lifted hit to their lifted emission points in scratch.dx, dy and dz. G_j = (n_j.d)(-n_y.d) / |d|^4 with d = y - x_j: the pi of G
  * cancels in the weights. The loop is branch-free over the positions (structure of arrays)
  * so that it vectorises.
  */
@@ -507,12 +511,15 @@ std::size_t ShootingRun::areaKernel(const Vec3& x, const Vec3& n, const RayHit& 
       // Positions that are off cast no path and light nothing: their weight is never needed.
       kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
     }
-    const Vec3 lifted = x + n * offset;
+    // From y lifted along n_y to x_j lifted along n: o_j - (y - x) + (n - n_y) offset.
+    const Vec3 base = (n - ny) * offset - toHit;
     for (std::size_t j = 0; j < this->Frames; ++j)
     {
       if (kernel[j] > 0 && j != origin)
       {
-        scratch.targets[count] = Vec3(lifted.x + pose[9][j], lifted.y + pose[10][j], lifted.z + pose[11][j]);
+        scratch.dx[count] = static_cast<float>(base.x + pose[9][j]);
+        scratch.dy[count] = static_cast<float>(base.y + pose[10][j]);
+        scratch.dz[count] = static_cast<float>(base.z + pose[11][j]);
         scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
         ++count;
       }
@@ -535,12 +542,16 @@ std::size_t ShootingRun::areaKernel(const Vec3& x, const Vec3& n, const RayHit& 
       const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
       kernel[j] = cosX > 0 && cosY > 0 && active[j] > 0 ? g : 0.0;
     }
+    const Vec3 from = this->Tracer.liftOff(y, ny);
     for (std::size_t j = 0; j < this->Frames; ++j)
     {
       if (kernel[j] > 0 && j != origin)
       {
         const Vec3 normal = this->SourceRef.area->turn(j, n);
-        scratch.targets[count] = this->SourceRef.area->place(j, x) + normal * offset;
+        const Vec3 d = this->SourceRef.area->place(j, x) + normal * offset - from;
+        scratch.dx[count] = static_cast<float>(d.x);
+        scratch.dy[count] = static_cast<float>(d.y);
+        scratch.dz[count] = static_cast<float>(d.z);
         scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
         ++count;
       }
@@ -548,8 +559,8 @@ std::size_t ShootingRun::areaKernel(const Vec3& x, const Vec3& n, const RayHit& 
   }
   if (count > 0)
   {
-    this->Tracer.visibleFrom(this->Tracer.liftOff(y, ny), scratch.targets.data(), count,
-      scratch.visible.data());
+    this->Tracer.visibleFrom(this->Tracer.liftOff(y, ny), scratch.dx.data(), scratch.dy.data(),
+      scratch.dz.data(), count, scratch.visible.data());
   }
   return count;
 }
@@ -575,15 +586,17 @@ std::size_t ShootingRun::directionalKernel(
   {
     if (kernel[j] > 0 && j != origin)
     {
-      scratch.targets[count] = Vec3(sx[j], sy[j], sz[j]);
+      scratch.dx[count] = static_cast<float>(sx[j]);
+      scratch.dy[count] = static_cast<float>(sy[j]);
+      scratch.dz[count] = static_cast<float>(sz[j]);
       scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
       ++count;
     }
   }
   if (count > 0)
   {
-    this->Tracer.visibleAlong(this->Tracer.liftOff(hit.point, ny), scratch.targets.data(), count,
-      scratch.visible.data());
+    this->Tracer.visibleAlong(this->Tracer.liftOff(hit.point, ny), scratch.dx.data(),
+      scratch.dy.data(), scratch.dz.data(), count, scratch.visible.data());
   }
   return count;
 }
@@ -1145,7 +1158,7 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     times({ patches, 2, frames, 3, sizeof(std::int64_t) }));
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = times({ workers, frames,
-    sizeof(double) + sizeof(Vec3) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
+    sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
   // Embree's BVH and buffers (generously), the emission and lit side of every element.
   const std::uint64_t tracing = saturatingSum(times({ elements, 256 }), times({ points, 16 }));
   const std::uint64_t perElement = times({ elements, sizeof(Rgb) + sizeof(Side) });
