@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -138,6 +140,10 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "secondsRendering", jsonNumber(stages.rendering) },
     { "secondsTotal", jsonNumber(stages.total) },
   };
+  // The peak resident memory of this process (the solve runs here; reading in a child).
+  struct rusage usage = {};
+  getrusage(RUSAGE_SELF, &usage);
+  json["memory"] = { { "peakResidentBytes", jsonNumber(1024.0 * usage.ru_maxrss, true) } };
 
   nlohmann::ordered_json records = nlohmann::ordered_json::array();
   for (const FrameRecord& frame : frames)

@@ -198,11 +198,17 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("PathsCast", statistics.pathsCast);
   count("ShootingRays", statistics.shootingRays);
   count("ShadowRays", statistics.shadowRays);
+  count("ShadowRaysBlocked", statistics.shadowRaysBlocked);
   count("GatheringRays", statistics.gatheringRays);
   count("MissedRays", statistics.missedRays);
   count("GatheringSides", statistics.gatheringSides);
   count("Threads", static_cast<std::uint64_t>(statistics.threads));
   count("MemoryEstimateBytes", statistics.memoryEstimateBytes);
+  // The cost that limits users: bytes per element and frame (MemoryPlan).
+  real("MemoryEstimateBytesPerElementFrame",
+    static_cast<double>(statistics.memoryEstimateBytes) /
+      std::max(1.0, static_cast<double>(statistics.elements) * static_cast<double>(statistics.frames)));
+  count("AccumulatorCopyPerWorker", statistics.accumulatorCopyPerWorker ? 1 : 0);
   count("ReuseShooting", statistics.reuseShooting ? 1 : 0);
   count("ReuseGathering", statistics.reuseGathering ? 1 : 0);
   count("TwoSided", statistics.twoSided ? 1 : 0);

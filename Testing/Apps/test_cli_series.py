@@ -115,6 +115,18 @@ def test_stats_time_the_stages(series):
     assert all(timing[key] >= 0 for key in STAGES)
     assert timing["secondsSolving"] > 0 and timing["secondsWriting"] > 0
     assert timing["secondsRendering"] == 0  # no --png
+    # Memory: the process's peak holds at least the solve's estimate of its results (the
+    # estimate covers every frame's radiosity; the peak is measured, so only its floor is
+    # checked), and the estimate per element-frame is stated.
+    statistics = stats["statistics"]
+    peak = stats["memory"]["peakResidentBytes"]
+    results = FRAMES * statistics["Elements"] * 2 * 2 * 12  # direct + indirect, 2 sides, RGB floats
+    assert statistics["MemoryEstimateBytes"] > results
+    assert peak > results
+    assert statistics["MemoryEstimateBytesPerElementFrame"] == pytest.approx(
+        statistics["MemoryEstimateBytes"] / (FRAMES * statistics["Elements"]))
+    assert statistics["AccumulatorCopyPerWorker"] in (0, 1)
+    assert 0 <= statistics["ShadowRaysBlocked"] <= statistics["ShadowRays"]
     # Disjoint stretches of the run, all within its total.
     assert sum(timing[key] for key in STAGES[:4]) <= timing["secondsTotal"]
     # The keys that were there before stay.
