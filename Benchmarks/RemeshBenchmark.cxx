@@ -92,6 +92,8 @@ struct CancelRun
 {
   double requestedAt = 0; ///< seconds into the run
   double latency = 0;     ///< from the request to mlr::Cancelled caught by the caller
+  double unwinding = 0;   ///< of which from the callback saying stop to the catch
+  double fraction = 0;    ///< the progress reported when the callback said stop
   bool cancelled = false; ///< false: the run ended before the request was seen
 };
 
@@ -100,12 +102,20 @@ CancelRun cancelAfter(const PolygonSoup& soup, const RemeshOptions& options, dou
 {
   std::atomic<bool> stop{ false };
   CancelRun run;
-  Clock::time_point ended;
+  Clock::time_point seen, ended;
   const Clock::time_point start = Clock::now();
   std::thread worker([&] {
     try
     {
-      remesh(soup, options, [&stop](double) { return !stop.load(std::memory_order_relaxed); });
+      remesh(soup, options, [&stop, &seen, &run](double f) {
+        if (!stop.load(std::memory_order_relaxed))
+        {
+          return true;
+        }
+        seen = Clock::now();
+        run.fraction = f;
+        return false;
+      });
     }
     catch (const Cancelled&)
     {
@@ -119,6 +129,7 @@ CancelRun cancelAfter(const PolygonSoup& soup, const RemeshOptions& options, dou
   worker.join();
   run.requestedAt = secondsBetween(start, requested);
   run.latency = secondsBetween(requested, ended);
+  run.unwinding = run.cancelled ? secondsBetween(seen, ended) : 0;
   return run;
 }
 
@@ -167,7 +178,7 @@ std::string runRemeshing(const RemeshCaseOptions& options)
     std::printf("\n");
 
     std::vector<CancelRun> runs;
-    std::vector<double> latencies;
+    std::vector<double> latencies, unwindings;
     for (int k = 0; k < options.cancelPoints; ++k)
     {
       // Deterministic request times, evenly spread over the uncancelled run.
@@ -176,6 +187,7 @@ std::string runRemeshing(const RemeshCaseOptions& options)
       if (runs.back().cancelled)
       {
         latencies.push_back(runs.back().latency);
+        unwindings.push_back(runs.back().unwinding);
       }
     }
     const auto worst = std::max_element(runs.begin(), runs.end(), [](const CancelRun& a, const CancelRun& b) {
@@ -185,15 +197,16 @@ std::string runRemeshing(const RemeshCaseOptions& options)
     const bool met = !latencies.empty() && maxLatency <= LatencyTarget;
     allMet = allMet && met;
     std::printf("  cancelled at %d evenly spaced times (%zu before the end): latency max %.3f s "
-                "(requested at %.2f s), median %.3f s\n",
+                "(requested at %.2f s), median %.3f s; of which unwinding (from the callback "
+                "saying stop to the catch) max %.3f s\n",
       options.cancelPoints, latencies.size(), maxLatency, worst != runs.end() ? worst->requestedAt : 0.0,
-      median(latencies));
-    std::printf("  latencies (requested at s: latency s):");
+      median(latencies), unwindings.empty() ? 0.0 : *std::max_element(unwindings.begin(), unwindings.end()));
+    std::printf("  latencies (requested at s: latency s, unwinding s, fraction):");
     for (const CancelRun& r : runs)
     {
       if (r.cancelled)
       {
-        std::printf(" %.2f: %.3f;", r.requestedAt, r.latency);
+        std::printf(" %.2f: %.3f, %.3f, %.3f;", r.requestedAt, r.latency, r.unwinding, r.fraction);
       }
       else
       {

@@ -573,3 +573,40 @@ TEST(Remeshing, RemeshedClosedBoxAbsorbsAllPower)
     }
   }
 }
+
+TEST(Remeshing, CancellingAtAnyProgressCallStopsWithCancelled)
+{
+  // A floor crossed by a sphere, with a box standing on it: repair, contact lines, covered
+  // faces and three components, each remeshed in five passes. Whatever call of the progress
+  // callback first says stop, in whichever phase (some come from inside guarded CGAL calls),
+  // remeshing ends with mlr::Cancelled: never a result, never a CGAL failure turned into a
+  // region refined only. Remeshing calls back at least 8 times (after repairing, after
+  // splitting, after each pass, at the end) however fast the machine, so every call
+  // number up to 8 is reached.
+  const PolygonSoup soup = sphereAndBoxOnTiledFloor(10, 12);
+  RemeshOptions options;
+  options.targetPatchCount = 1500;
+  std::size_t calls = 0;
+  const RemeshResult whole = remesh(soup, options, [&calls](double) {
+    ++calls;
+    return true;
+  });
+  ASSERT_GE(calls, 8u);
+  EXPECT_GT(whole.statistics.contactSplitTriangles, 0u);
+  EXPECT_GT(whole.statistics.coveredTriangles, 0u);
+  for (std::size_t stopAt = 1; stopAt <= 8; ++stopAt)
+  {
+    std::size_t call = 0;
+    bool cancelled = false;
+    try
+    {
+      remesh(soup, options, [&](double) { return ++call < stopAt; });
+    }
+    catch (const Cancelled&)
+    {
+      cancelled = true;
+    }
+    EXPECT_TRUE(cancelled) << "stopped at call " << stopAt;
+    EXPECT_EQ(call, stopAt) << "the callback was called again after saying stop";
+  }
+}
