@@ -347,13 +347,18 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     o.frames = 30;
   }
-  if (!o.usesEmbeddedScene() && !o.usesSun())
+  if (o.sceneLightsItself())
   {
-    if (o.light.empty() && !o.lightMaterial)
+    // Whether the scene emits is known once it is read (main checks it then).
+    if (!o.trajectory.empty() || o.from || o.aim || o.lightPower)
     {
-      throw UsageError("--scene needs --light FILE or --light-material NAME: the built-in light "
-                       "belongs to the Cornell box");
+      throw UsageError("--trajectory, --from, --to, --aim and --light-power are for a light: give "
+                       "--light FILE or --light-material NAME (without either, the scene's own "
+                       "emissive surfaces light it, in one frame)");
     }
+  }
+  else if (!o.usesEmbeddedScene() && !o.usesSun())
+  {
     if (o.trajectory.empty() && !o.from)
     {
       throw UsageError("--scene needs the light's path: --trajectory FILE or --from X,Y,Z "
@@ -474,8 +479,10 @@ Scene and light:
                         bring their materials: Kd or baseColorFactor is the reflectance
                         (1 or more clamped to 0.99 with a warning), Ke or emissiveFactor
                         the emission (default: the built-in Cornell box)
-  --light FILE          the light's polygons, emitting along their normals (required with
-                        --scene; default: the Cornell box's ceiling light)
+  --light FILE          the light's polygons, emitting along their normals (default: the
+                        Cornell box's ceiling light). A --scene given without --light,
+                        --light-material or the sun is lit by its own emissive surfaces
+                        alone, in one frame
   --light-material NAME the polygons of this material of the scene (an .obj's usemtl, a
                         glTF material) are the light, taken out of the scene; without
                         --light-power its power is the material's emission, pi Ke area

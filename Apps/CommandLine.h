@@ -69,6 +69,12 @@ struct Options
 
   bool usesEmbeddedScene() const { return this->scene.empty(); }
   bool usesSun() const { return !this->sunDirections.empty() || this->sunPath.has_value(); }
+  /// A scene given without any light: its own emissive surfaces light it, in one frame.
+  bool sceneLightsItself() const
+  {
+    return !this->usesEmbeddedScene() && !this->usesSun() && this->light.empty() &&
+      !this->lightMaterial;
+  }
 };
 
 /// Parses argv, fills the defaults that depend on other options and checks the combinations.

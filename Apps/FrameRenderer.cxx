@@ -101,13 +101,16 @@ FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6], const d
   p.sceneActor->GetProperty()->LightingOff();
   p.renderer->AddActor(p.sceneActor);
 
-  vtkNew<vtkPolyDataMapper> lightMapper;
-  lightMapper->SetInputData(light);
-  lightMapper->ScalarVisibilityOff();
-  p.lightActor->SetMapper(lightMapper);
-  p.lightActor->GetProperty()->SetColor(1, 1, 1);
-  p.lightActor->GetProperty()->LightingOff();
-  p.renderer->AddActor(p.lightActor);
+  if (light) // none when the scene's own surfaces emit
+  {
+    vtkNew<vtkPolyDataMapper> lightMapper;
+    lightMapper->SetInputData(light);
+    lightMapper->ScalarVisibilityOff();
+    p.lightActor->SetMapper(lightMapper);
+    p.lightActor->GetProperty()->SetColor(1, 1, 1);
+    p.lightActor->GetProperty()->LightingOff();
+    p.renderer->AddActor(p.lightActor);
+  }
 
   // Look along +z at the bounding box, from far enough for its front face to fill the view.
   const double centre[3] = { 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),

@@ -22,7 +22,8 @@ namespace mlr::cli
 class FrameRenderer
 {
 public:
-  /// `light` is the Light input; `bounds` those of the scene.
+  /// `light` is the Light input (none when the scene's own surfaces emit); `bounds` those of
+  /// the scene.
   /// With `up` (the zenith of a scene lit by the sun), an aerial view instead: from above a
   /// corner of the bounding box, looking at its centre, `up` pointing up in the picture.
   FrameRenderer(vtkPolyData* light, const double bounds[6], const double* up = nullptr);

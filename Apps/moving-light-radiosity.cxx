@@ -10,6 +10,7 @@
 #include "SeriesWriter.h"
 
 #include "vtkCallbackCommand.h"
+#include "vtkCellData.h"
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
@@ -114,6 +115,26 @@ void prepareDirectory(OutputTransaction& output, const fs::path& directory)
   fs::remove(probe, error);
 }
 
+/// True when the scene's emission array (the filter's EmissionArrayName) has a value above 0.
+bool emits(vtkPolyData* scene, const char* arrayName)
+{
+  vtkDataArray* emission = scene->GetCellData()->GetArray(arrayName);
+  if (!emission)
+  {
+    return false;
+  }
+  for (int c = 0; c < emission->GetNumberOfComponents(); ++c)
+  {
+    double range[2];
+    emission->GetRange(range, c);
+    if (range[1] > 0)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
 std::vector<double> timeSteps(vtkMovingLightRadiosity* filter)
 {
   vtkInformation* info = filter->GetOutputInformation(vtkMovingLightRadiosity::ELEMENTS_PORT);
@@ -208,8 +229,15 @@ int run(int argc, char** argv)
   const auto scene = options.usesEmbeddedScene()
     ? readEmbeddedFile("cornell_box.vtp")
     : readSceneFile(options.scene, memoryLimit);
+  if (options.sceneLightsItself() && !emits(scene, filter->GetEmissionArrayName()))
+  {
+    throw UsageError("--scene needs --light FILE or --light-material NAME, or surfaces that emit "
+                     "(a cell array '" + std::string(filter->GetEmissionArrayName()) +
+      "', or materials with Ke or an emissive colour): " + options.scene +
+      " emits nothing, and the built-in light belongs to the Cornell box");
+  }
   vtkSmartPointer<vtkPolyData> light;
-  if (!options.usesSun() && !options.lightMaterial)
+  if (!options.usesSun() && !options.lightMaterial && !options.sceneLightsItself())
   {
     light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
                                   : readSurfaceFile(options.light, "light", memoryLimit);
@@ -227,7 +255,7 @@ int run(int argc, char** argv)
   {
     trajectory = readSurfaceFile(options.trajectory, "trajectory", memoryLimit);
   }
-  else if (!options.from)
+  else if (!options.from && !options.sceneLightsItself())
   {
     trajectory = readEmbeddedFile("cornell_trajectory.vtp");
   }

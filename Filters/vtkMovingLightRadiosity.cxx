@@ -185,6 +185,15 @@ mlr::vtkinputs::Trajectory trajectoryOf(
     }
     const double* start = self->GetPathStart();
     const double* end = self->GetPathEnd();
+    if (self->GetLightType() == vtkMovingLightRadiosity::AREA_LIGHT &&
+      !*self->GetLightMaterial() &&
+      self->GetNumberOfInputConnections(vtkMovingLightRadiosity::LIGHT_PORT) == 0)
+    {
+      // No light: the scene's own emissive surfaces light it, and nothing moves: one frame,
+      // not NumberOfPositions copies of it.
+      return mlr::vtkinputs::straightTrajectory({ start[0], start[1], start[2] },
+        { start[0], start[1], start[2] }, 1);
+    }
     return mlr::vtkinputs::straightTrajectory({ start[0], start[1], start[2] },
       { end[0], end[1], end[2] }, self->GetNumberOfPositions());
   }

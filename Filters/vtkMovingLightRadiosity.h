@@ -34,7 +34,9 @@
  *   the light (the sun), one per frame, of any length but 0; `Power` scales SunIrradiance
  *   (clouds, night); `SunAzimuth` and `SunElevation` (degrees), if present, are passed to the
  *   outputs' field data. Without this input the light moves in a straight line from
- *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does).
+ *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does);
+ *   with neither a Light nor a LightMaterial, the scene's own emissive surfaces light it in
+ *   one frame.
  *
  * Outputs:
  * - port 0, Elements: the element mesh (triangles, four per patch) with the cell arrays
@@ -240,8 +242,8 @@ public:
 
   ///@{
   /**
-   * Light positions (frames) from PathStart to PathEnd when no Trajectory is connected.
-   * Default 10.
+   * Light positions (frames) from PathStart to PathEnd when no Trajectory is connected
+   * (one frame when there is no light at all, only emissive scene surfaces). Default 10.
    */
   vtkSetClampMacro(NumberOfPositions, int, 1, 100000);
   vtkGetMacro(NumberOfPositions, int);

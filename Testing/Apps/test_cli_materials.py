@@ -116,6 +116,42 @@ def test_without_light_material_the_lamp_emits_in_place(tmp_path):
     assert abs(emitted[lamp] - [math.pi * 17, math.pi * 12, math.pi * 4]).max() < 1e-3
 
 
+def test_scene_alone_is_lit_by_its_own_lamp_in_one_frame(tmp_path):
+    """--scene without a light: the lamp material (Ke) stays in place and lights the box; nothing
+    moves, so the series is one frame."""
+    result = run(["--scene", OBJ, "--output", "out/cornell.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert all_files(tmp_path / "out") == ["cornell.pvd", "cornell_0000.vtu"]
+    data = frame(tmp_path, 0)
+    emitted = vtk_to_numpy(data.GetCellData().GetArray("EmittedRadiosity"))
+    lamp = emitted[:, 0] > 0
+    assert lamp.any()
+    assert abs(emitted[lamp] - [math.pi * 17, math.pi * 12, math.pi * 4]).max() < 1e-3
+    # The lamp's first hits carry its power pi Ke A (less what leaves by the open front, about
+    # a fifth), channel by channel in the proportions of Ke: the same walks carry every channel.
+    rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))
+    area = vtk_to_numpy(data.GetCellData().GetArray("Area"))
+    direct = vtk_to_numpy(data.GetCellData().GetArray("DirectRadiosity"))
+    hit = (area[:, None] * direct / rho).sum(axis=0)
+    power = [math.pi * ke * lamp_area() for ke in (17, 12, 4)]
+    for channel in range(3):
+        assert 0.7 * power[channel] < hit[channel] < 1.01 * power[channel], (hit, power)
+        assert abs(hit[channel] / hit[0] - power[channel] / power[0]) < 1e-4, hit
+
+
+def test_scene_alone_that_emits_nothing_is_refused(tmp_path):
+    result = run(["--scene", os.path.join(DATA, "cornell_box.vtp"), "--output", "out/c.pvd"],
+                 tmp_path)
+    assert result.returncode == 2
+    assert "--scene needs --light FILE or --light-material NAME, or surfaces that emit" in \
+        result.stderr and "emits nothing" in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+    result = run(["--scene", OBJ, "--output", "out/c.pvd"] + PATH, tmp_path)
+    assert result.returncode == 2
+    assert "are for a light" in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+
+
 def test_unknown_material_lists_the_materials_and_writes_nothing(tmp_path):
     result = run(["--scene", OBJ, "--light-material", "lamp", "--output", "out/cornell.pvd"] + PATH + FAST,
                  tmp_path)
