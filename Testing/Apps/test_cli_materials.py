@@ -49,15 +49,22 @@ def test_light_material_is_the_moving_lamp_with_its_own_power(tmp_path):
     # The lamp left the geometry: no element carries its Kd 0.78, and nothing emits.
     assert not (abs(rho - 0.78).max(axis=1) < 1e-6).any()
     assert vtk_to_numpy(data.GetCellData().GetArray("EmittedRadiosity")).max() == 0.0
-    # Its power is pi Ke times its area. The box's front is open, so some of it leaves
-    # without a hit: the first-hit power sum A B_direct / rho is most of it (81% measured),
-    # never more (a lamp of a wrong power, e.g. LightPower's 100 W, fails either bound).
+    check_first_hits_carry_the_lamp_power(data)
+
+
+def check_first_hits_carry_the_lamp_power(data):
+    """The lamp's power is pi Ke times its area. The box's front is open, so some of it leaves
+    without a hit: the first-hit power sum A B_direct / rho is most of it (81% measured), never
+    more (a lamp of a wrong power, e.g. LightPower's 100 W, fails either bound); and it comes
+    in the proportions of Ke, as the same walks carry every channel."""
+    rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))
     area = vtk_to_numpy(data.GetCellData().GetArray("Area"))
     direct = vtk_to_numpy(data.GetCellData().GetArray("DirectRadiosity"))
     hit = (area[:, None] * direct / rho).sum(axis=0)
     power = [math.pi * ke * lamp_area() for ke in (17, 12, 4)]
     for channel in range(3):
         assert 0.7 * power[channel] < hit[channel] < 1.01 * power[channel], (hit, power)
+        assert abs(hit[channel] / hit[0] - power[channel] / power[0]) < 1e-4, hit
 
 
 def lamp_area():
@@ -127,16 +134,7 @@ def test_scene_alone_is_lit_by_its_own_lamp_in_one_frame(tmp_path):
     lamp = emitted[:, 0] > 0
     assert lamp.any()
     assert abs(emitted[lamp] - [math.pi * 17, math.pi * 12, math.pi * 4]).max() < 1e-3
-    # The lamp's first hits carry its power pi Ke A (less what leaves by the open front, about
-    # a fifth), channel by channel in the proportions of Ke: the same walks carry every channel.
-    rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))
-    area = vtk_to_numpy(data.GetCellData().GetArray("Area"))
-    direct = vtk_to_numpy(data.GetCellData().GetArray("DirectRadiosity"))
-    hit = (area[:, None] * direct / rho).sum(axis=0)
-    power = [math.pi * ke * lamp_area() for ke in (17, 12, 4)]
-    for channel in range(3):
-        assert 0.7 * power[channel] < hit[channel] < 1.01 * power[channel], (hit, power)
-        assert abs(hit[channel] / hit[0] - power[channel] / power[0]) < 1e-4, hit
+    check_first_hits_carry_the_lamp_power(data)
 
 
 def test_scene_alone_that_emits_nothing_is_refused(tmp_path):
