@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -33,6 +34,14 @@ void parallelFor(std::size_t taskCount, int threads,
   bool cancelled = false;
   std::exception_ptr failure;
   std::mutex failureMutex;
+  // The caller, out of tasks, waits for the others on this; it wakes when the last task ends
+  // or the loop stops, not a tick later (a sleep cost up to tickSeconds per loop).
+  std::mutex finishedMutex;
+  std::condition_variable finished;
+  auto notifyFinished = [&] {
+    std::lock_guard<std::mutex> lock(finishedMutex);
+    finished.notify_all();
+  };
 
   auto work = [&](int worker, bool isCaller) {
     using clock = std::chrono::steady_clock;
@@ -50,15 +59,21 @@ void parallelFor(std::size_t taskCount, int threads,
       }
       catch (...)
       {
-        std::lock_guard<std::mutex> lock(failureMutex);
-        if (!failure)
         {
-          failure = std::current_exception();
+          std::lock_guard<std::mutex> lock(failureMutex);
+          if (!failure)
+          {
+            failure = std::current_exception();
+          }
         }
         stop = true;
+        notifyFinished();
         break;
       }
-      done.fetch_add(1, std::memory_order_relaxed);
+      if (done.fetch_add(1) + 1 == taskCount)
+      {
+        notifyFinished();
+      }
       if (isCaller && tick)
       {
         const auto now = clock::now();
@@ -86,13 +101,19 @@ void parallelFor(std::size_t taskCount, int threads,
   // The caller ran out of tasks: keep reporting (and honouring cancel) while others finish.
   if (tick && !stop)
   {
+    std::unique_lock<std::mutex> lock(finishedMutex);
     while (done.load() < taskCount && !stop.load())
     {
-      std::this_thread::sleep_for(std::chrono::duration<double>(tickSeconds));
-      if (!tick(done.load()))
+      finished.wait_for(lock, std::chrono::duration<double>(tickSeconds));
+      if (done.load() < taskCount && !stop.load())
       {
-        cancelled = true;
-        stop = true;
+        lock.unlock();
+        if (!tick(done.load()))
+        {
+          cancelled = true;
+          stop = true;
+        }
+        lock.lock();
       }
     }
   }

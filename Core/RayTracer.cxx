@@ -124,15 +124,16 @@ RayTracer::RayTracer(const Scene& scene)
 
 RayTracer::~RayTracer() = default;
 
-bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit) const
+namespace
+{
+/// The nearest hit of one ray from `origin` (relative to the tracer's centre): false on a miss.
+bool traceNearest(RTCScene scene, const Vec3& origin, const Vec3& direction, RTCRayHit& query)
 {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit query;
-  const Vec3 o = origin - this->Centre;
-  query.ray.org_x = static_cast<float>(o.x);
-  query.ray.org_y = static_cast<float>(o.y);
-  query.ray.org_z = static_cast<float>(o.z);
+  query.ray.org_x = static_cast<float>(origin.x);
+  query.ray.org_y = static_cast<float>(origin.y);
+  query.ray.org_z = static_cast<float>(origin.z);
   query.ray.dir_x = static_cast<float>(direction.x);
   query.ray.dir_y = static_cast<float>(direction.y);
   query.ray.dir_z = static_cast<float>(direction.z);
@@ -144,8 +145,15 @@ bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit
   query.ray.flags = 0;
   query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   query.hit.primID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(this->Impl->Scene, &context, &query);
-  if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+  rtcIntersect1(scene, &context, &query);
+  return query.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+}
+
+bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit) const
+{
+  RTCRayHit query;
+  if (!traceNearest(this->Impl->Scene, origin - this->Centre, direction, query))
   {
     return false;
   }
@@ -157,6 +165,19 @@ bool RayTracer::intersect(const Vec3& origin, const Vec3& direction, RayHit& hit
   hit.point = p[t[0]] * (1.0 - u - v) + p[t[1]] * u + p[t[2]] * v;
   hit.side = dot(direction, this->SceneRef.elementNormal(element)) < 0 ? Side::Front : Side::Back;
   hit.distance = static_cast<double>(query.ray.tfar) * length(direction);
+  return true;
+}
+
+bool RayTracer::nearestSide(
+  const Vec3& origin, const Vec3& direction, std::uint32_t& element, Side& side) const
+{
+  RTCRayHit query;
+  if (!traceNearest(this->Impl->Scene, origin - this->Centre, direction, query))
+  {
+    return false;
+  }
+  element = query.hit.primID;
+  side = dot(direction, this->SceneRef.elementNormal(element)) < 0 ? Side::Front : Side::Back;
   return true;
 }
 

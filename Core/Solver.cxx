@@ -730,12 +730,12 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
   const std::size_t sides = 2 * patches;
   const bool twoSided = options.twoSided;
   constexpr std::uint32_t None = std::numeric_limits<std::uint32_t>::max();
-  auto sideOf = [&](const RayHit& hit) -> std::uint32_t {
-    if (!twoSided && hit.side == Side::Back)
+  auto sideOf = [&](std::uint32_t element, Side side) -> std::uint32_t {
+    if (!twoSided && side == Side::Back)
     {
       return None;
     }
-    return static_cast<std::uint32_t>(Scene::patchOfElement(hit.element) * 2 + static_cast<std::size_t>(hit.side));
+    return static_cast<std::uint32_t>(Scene::patchOfElement(element) * 2 + static_cast<std::size_t>(side));
   };
 
   // Seeds, one slot per probe so that the result does not depend on scheduling.
@@ -768,10 +768,11 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
           RandomStream random(ReachabilitySeed + l, StreamPurpose::Reachability, i, 0);
           Vec3 start, direction, x, n;
           source.emit(active[i / perPosition], random, tracer.surfaceOffset(), start, direction, x, n);
-          RayHit hit;
-          if (tracer.intersect(start, direction, hit))
+          std::uint32_t element = 0;
+          Side side = Side::Front;
+          if (tracer.nearestSide(start, direction, element, side))
           {
-            seeds[first + i] = sideOf(hit);
+            seeds[first + i] = sideOf(element, side);
           }
         }
       },
@@ -800,10 +801,11 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
             const double u1 = random.uniform(), u2 = random.uniform();
             const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
             const Vec3 direction = sampleCosineDirection(normal, random);
-            RayHit hit;
-            if (tracer.intersect(tracer.liftOff(origin, normal), direction, hit))
+            std::uint32_t element = 0;
+            Side hitSide = Side::Front;
+            if (tracer.nearestSide(tracer.liftOff(origin, normal), direction, element, hitSide))
             {
-              probe[side * K + r] = sideOf(hit);
+              probe[side * K + r] = sideOf(element, hitSide);
             }
           }
         }
@@ -946,20 +948,21 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
       const Vec3 direction = sampleCosineDirection(normal, random);
       ++counters.gatheringRays;
-      RayHit hit;
-      const bool found = tracer.intersect(tracer.liftOff(origin, normal), direction, hit);
+      std::uint32_t hitElement = 0;
+      Side hitSide = Side::Front;
+      const bool found = tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide);
       addPending();
       if (!found)
       {
         ++counters.missedRays;
         continue;
       }
-      if (!options.twoSided && hit.side == Side::Back)
+      if (!options.twoSided && hitSide == Side::Back)
       {
         continue;
       }
       pending = solution.patchData().data() +
-        solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hit.element), hit.side);
+        solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hitElement), hitSide);
       const char* row = reinterpret_cast<const char*>(pending);
       for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
       {
