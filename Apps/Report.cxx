@@ -90,10 +90,19 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   const std::string builtIn = "built-in Cornell box";
   nlohmann::ordered_json json;
   json["scene"] = options.scene.empty() ? builtIn : options.scene;
-  json["light"] = options.light.empty() ? builtIn : options.light;
+  // What lit the scene: a light file, a material of the scene, the sun, or the scene's own
+  // emissive surfaces.
+  json["light"] = !options.light.empty() ? options.light
+    : options.lightMaterial               ? "material " + *options.lightMaterial
+    : options.usesSun()                   ? std::string("sun")
+    : options.sceneLightsItself()         ? std::string("scene emission")
+                                          : builtIn;
   json["trajectory"] = !options.trajectory.empty()
     ? options.trajectory
-    : (options.from ? "straight line" : (options.scene.empty() ? builtIn : ""));
+    : (options.from ? "straight line"
+         : options.sunPath ? "sun path"
+         : !options.sunDirections.empty() ? options.sunDirections
+         : (options.scene.empty() ? builtIn : ""));
   json["output"] = options.output;
   json["settings"] = {
     { "lightPower", jsonTriple(filter->GetLightPower()) },

@@ -170,9 +170,12 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
     double(solvePeak) / GiB, double(solvePeak) / elementFrames, ratio);
   const bench::BareRates bare = bench::measureBareEmbree(scene, light, s.threads, 4000000);
   const double solverShadowRate = printShadowRays(s, frames, bare);
+  // Without the reset, VmHWM is the whole process's peak: the solve's own is not measured.
   std::printf("Targets: the process under 16 GiB: %s; the solve's peak within 15%% of the "
               "estimate: %s\n",
-    double(peak) < 16 * GiB ? "met" : "MISSED", ratio > 0.85 && ratio < 1.15 ? "met" : "MISSED");
+    double(peak) < 16 * GiB ? "met" : "MISSED",
+    !reset ? "not measured (the peak could not be reset)"
+           : ratio > 0.85 && ratio < 1.15 ? "met" : "MISSED");
 
   std::ostringstream out;
   out << "{\"frames\": " << frames << ", \"patches\": " << scene.patchCount()
@@ -181,8 +184,9 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
       << ", \"accumulator_copy_per_worker\": " << (plan.accumulatorCopyPerWorker ? "true" : "false")
       << ", \"estimate_bytes\": " << s.memoryEstimateBytes
       << ", \"resident_before_bytes\": " << before << ", \"peak_resident_bytes\": " << peak
-      << ", \"solve_peak_bytes\": " << solvePeak
-      << ", \"bytes_per_element_frame\": " << double(solvePeak) / elementFrames
+      << ", \"solve_peak_bytes\": " << (reset ? std::to_string(solvePeak) : std::string("null"))
+      << ", \"bytes_per_element_frame\": "
+      << (reset ? std::to_string(double(solvePeak) / elementFrames) : std::string("null"))
       << ", \"solver_shadow_rays_per_second\": " << solverShadowRate
       << ", \"bare_shadow_rays_per_second\": " << bare.shadowRays << "}";
   return out.str();

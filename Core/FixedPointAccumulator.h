@@ -5,7 +5,7 @@
 // thread count. Workers add either to a copy of their own (plain adds: the fastest) or to
 // one copy shared by all (relaxed atomic adds, about a third slower in the hottest loop, but
 // the memory does not grow with the core count). The solver picks per-worker copies when
-// they fit in the memory limit (see Solver.cxx, AccumulatorCopies).
+// they fit in half the memory limit (MemoryPlan, planSolveMemory in Solver.h).
 #pragma once
 
 #include <algorithm>

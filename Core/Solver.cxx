@@ -1226,7 +1226,7 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
     << about << patches << " patches + " << about << elements
     << " elements) x 2 sides x RGB, plus per-thread buffers), over the memory limit of "
     << gibibytes(limit)
-    << ": use fewer frames, a larger patch size or fewer threads, or raise the limit";
+    << ": use fewer frames or a larger patch size, or raise the limit";
   throw Error(s.str());
 }
 

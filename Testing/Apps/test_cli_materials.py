@@ -4,6 +4,7 @@ brings its colours and its lamp, and --light-material moves the lamp.
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps/test_cli_materials.py
 """
+import json
 import math
 import os
 import shutil
@@ -41,6 +42,7 @@ def test_light_material_is_the_moving_lamp_with_its_own_power(tmp_path):
     result = run(["--scene", OBJ, "--light-material", "light", "--output", "out/cornell.pvd",
                   "--stats", "out/stats.json"] + PATH + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
+    assert json.loads((tmp_path / "out" / "stats.json").read_text())["light"] == "material light"
     data = frame(tmp_path, 1)
     # The materials' Kd, not grey: the left wall red, the right wall green.
     rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))
@@ -126,9 +128,12 @@ def test_without_light_material_the_lamp_emits_in_place(tmp_path):
 def test_scene_alone_is_lit_by_its_own_lamp_in_one_frame(tmp_path):
     """--scene without a light: the lamp material (Ke) stays in place and lights the box; nothing
     moves, so the series is one frame."""
-    result = run(["--scene", OBJ, "--output", "out/cornell.pvd"] + FAST, tmp_path)
+    result = run(["--scene", OBJ, "--output", "out/cornell.pvd", "--stats", "out/s.json"] + FAST,
+                 tmp_path)
     assert result.returncode == 0, result.stderr
-    assert all_files(tmp_path / "out") == ["cornell.pvd", "cornell_0000.vtu"]
+    assert all_files(tmp_path / "out") == ["cornell.pvd", "cornell_0000.vtu", "s.json"]
+    stats = json.loads((tmp_path / "out" / "s.json").read_text())
+    assert stats["light"] == "scene emission" and stats["statistics"]["Frames"] == 1
     data = frame(tmp_path, 0)
     emitted = vtk_to_numpy(data.GetCellData().GetArray("EmittedRadiosity"))
     lamp = emitted[:, 0] > 0
