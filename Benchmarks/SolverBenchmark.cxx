@@ -57,7 +57,7 @@ void usage()
     "            shadow rays go (issue 16; about 2 minutes, not in all)\n"
     "  large:    the room in about 100,000 patches, 120 frames, N = 4,000,000, full reuse: time\n"
     "            and peak memory against the estimate (issue 16; about 3 minutes, not in all)\n"
-    "--memory-limit-mib M sets the solver's memory limit of long and large (default: half the\n"
+    "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half the\n"
     "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n");
 }
 
@@ -156,6 +156,7 @@ std::string runPaperCase(const Arguments& args)
   options.threads = args.threads;
   options.gatheringRatio = 1;
   options.firstBounceSurvival = 0.25;
+  options.memoryLimitBytes = args.memoryLimitMiB << 20;
 
   std::printf("Paper-scale room: %zu patches, %zu elements, %zu frames, N = %llu effective "
               "paths per frame, k = %g, lambda = %g\n",
