@@ -204,13 +204,296 @@ private:
 };
 
 // =========================================================================================
+// Textures: the mean colour of an image (glTF base colour and emissive textures, MTL map_Kd
+// and map_Ke), which multiplies the material's colour
+// =========================================================================================
+
+/// A texture's mean needs no more than this many texels: larger images are refused rather than
+/// risking memory on a damaged header.
+constexpr std::uint64_t MaxTexturePixels = std::uint64_t(1) << 26;
+/// The largest texture file read (MTL maps): a 64-Mpixel PNG seldom needs more, and a bigger
+/// file is refused before any of it is read.
+constexpr std::uintmax_t MaxTextureFileBytes = std::uintmax_t(256) << 20;
+
+bool isPng(const std::string& bytes)
+{
+  return bytes.size() >= 8 && bytes.compare(1, 3, "PNG") == 0;
+}
+
+bool isJpeg(const std::string& bytes)
+{
+  return bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xff &&
+    static_cast<unsigned char>(bytes[1]) == 0xd8;
+}
+
+double srgbToLinear(double value)
+{
+  return value <= 0.04045 ? value / 12.92 : std::pow((value + 0.055) / 1.055, 2.4);
+}
+
+/// Records what VTK's image readers report, so that a texture they cannot decode becomes one
+/// warning naming the material instead of errors without context.
+class ReaderMessages : public vtkCommand
+{
+public:
+  static ReaderMessages* New() { return new ReaderMessages; }
+  void Execute(vtkObject*, unsigned long event, void* data) override
+  {
+    std::string text = data ? static_cast<const char*>(data) : "";
+    // vtkOutputWindow-style text: "ERROR: In file, line N\nvtkClass (0x...): message"
+    const auto close = text.find("): ");
+    if (close != std::string::npos)
+    {
+      text = text.substr(close + 3);
+    }
+    if (event == vtkCommand::ErrorEvent)
+    {
+      this->Errors.push_back(trim(text));
+    }
+  }
+  std::vector<std::string> Errors;
+};
+
+/// A PNG file's texels as 8-bit sRGB RGBA, through libpng's simplified API, which reports a
+/// damaged file as an error (VTK 9.2's vtkPNGReader crashes on some damaged data).
+vtkSmartPointer<vtkImageData> decodePng(const std::string& bytes, std::string& problem)
+{
+  png_image png;
+  std::memset(&png, 0, sizeof(png));
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+  {
+    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
+    png_image_free(&png);
+    return nullptr;
+  }
+  if (static_cast<std::uint64_t>(png.width) * png.height > MaxTexturePixels)
+  {
+    problem = "its PNG image is larger than 64 Mpixels";
+    png_image_free(&png);
+    return nullptr;
+  }
+  png.format = PNG_FORMAT_RGBA;
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(static_cast<int>(png.width), static_cast<int>(png.height), 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 4);
+  if (!png_image_finish_read(&png, nullptr, image->GetScalarPointer(), 0, nullptr))
+  {
+    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
+    png_image_free(&png);
+    return nullptr;
+  }
+  return image;
+}
+
+/// The width x height of a JPEG's frame header (SOFn), read before vtkJPEGReader allocates the
+/// image it declares; 0 when no frame header is found (the reader then reports the damage).
+std::uint64_t jpegPixels(const std::string& bytes)
+{
+  auto byte = [&](std::size_t i) { return static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[i])); };
+  std::size_t at = 2;
+  while (at + 4 <= bytes.size() && byte(at) == 0xff)
+  {
+    const std::uint64_t marker = byte(at + 1);
+    if (marker == 0xff)
+    {
+      ++at; // fill byte
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd8))
+    {
+      at += 2; // markers without a length
+      continue;
+    }
+    if (marker == 0xd9 || marker == 0xda)
+    {
+      return 0; // end of image or scan data before any frame header
+    }
+    const bool frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (frame)
+    {
+      return at + 9 <= bytes.size() ? ((byte(at + 5) << 8) | byte(at + 6)) * ((byte(at + 7) << 8) | byte(at + 8)) : 0;
+    }
+    at += 2 + static_cast<std::size_t>((byte(at + 2) << 8) | byte(at + 3));
+  }
+  return 0;
+}
+
+/// The mean linear colour of an encoded PNG or JPEG image (sRGB, as colour textures are); no
+/// value, and `problem` saying why ("its image is ..."), when it cannot be decoded.
+std::optional<std::array<double, 3>> imageMean(const std::string& bytes, std::string& problem)
+{
+  vtkSmartPointer<vtkImageData> image;
+  if (isPng(bytes))
+  {
+    image = decodePng(bytes, problem);
+  }
+  else if (isJpeg(bytes))
+  {
+    if (jpegPixels(bytes) > MaxTexturePixels)
+    {
+      problem = "its JPEG image is larger than 64 Mpixels";
+      return std::nullopt;
+    }
+    vtkNew<vtkJPEGReader> reader;
+    vtkNew<ReaderMessages> messages;
+    reader->AddObserver(vtkCommand::ErrorEvent, messages);
+    reader->AddObserver(vtkCommand::WarningEvent, messages);
+    reader->SetMemoryBuffer(bytes.data());
+    reader->SetMemoryBufferLength(static_cast<vtkIdType>(bytes.size()));
+    reader->Update();
+    image = reader->GetOutput();
+    if (!messages->Errors.empty())
+    {
+      problem = "its image could not be decoded (" + messages->Errors.front() + ")";
+      image = nullptr;
+    }
+  }
+  else
+  {
+    problem = "its image is neither PNG nor JPEG";
+  }
+  vtkDataArray* texels = image ? image->GetPointData()->GetScalars() : nullptr;
+  if (problem.empty() && (!texels || texels->GetNumberOfTuples() == 0))
+  {
+    problem = "its image is empty";
+  }
+  if (!problem.empty())
+  {
+    return std::nullopt;
+  }
+  const int components = texels->GetNumberOfComponents();
+  const double scale = texels->GetDataTypeMax() > 1 ? texels->GetDataTypeMax() : 1.0;
+  std::array<double, 256> table{};
+  for (std::size_t i = 0; i < 256; ++i)
+  {
+    table[i] = srgbToLinear(static_cast<double>(i) / 255.0);
+  }
+  const bool eightBit = scale == 255.0;
+  std::array<double, 3> sum{ { 0, 0, 0 } };
+  const vtkIdType count = texels->GetNumberOfTuples();
+  for (vtkIdType t = 0; t < count; ++t)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      // Grey (and grey + alpha) images hold one colour component.
+      const double raw = texels->GetComponent(t, components >= 3 ? c : 0);
+      sum[static_cast<std::size_t>(c)] += eightBit
+        ? table[static_cast<std::size_t>(std::clamp(raw, 0.0, 255.0))]
+        : srgbToLinear(std::clamp(raw / scale, 0.0, 1.0));
+    }
+  }
+  for (double& s : sum)
+  {
+    s /= static_cast<double>(count);
+  }
+  return sum;
+}
+
+/// The bytes of a texture file an MTL map names, or false with `problem` ("its file ..."):
+/// only a regular file of at most MaxTextureFileBytes is read, and only when its first bytes
+/// are a PNG or JPEG signature, so that a folder, a device (/dev/zero), a FIFO or a large file
+/// of another kind is refused at once.
+bool readTextureFile(const std::filesystem::path& file, std::string& bytes, std::string& problem)
+{
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status))
+  {
+    problem = "its file does not exist";
+    return false;
+  }
+  if (!std::filesystem::is_regular_file(status))
+  {
+    problem = std::filesystem::is_directory(status) ? "its file is a folder" : "its file is not a regular file";
+    return false;
+  }
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error || size > MaxTextureFileBytes)
+  {
+    problem = error ? "its file's size cannot be read" : "its file is larger than 256 MiB";
+    return false;
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in)
+  {
+    problem = std::string("its file cannot be opened: ") + std::strerror(errno);
+    return false;
+  }
+  bytes.assign(std::min<std::uintmax_t>(size, 8), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!isPng(bytes) && !isJpeg(bytes))
+  {
+    problem = "its image is neither PNG nor JPEG";
+    return false;
+  }
+  const std::size_t start = bytes.size();
+  bytes.resize(static_cast<std::size_t>(size));
+  in.read(bytes.data() + start, static_cast<std::streamsize>(bytes.size() - start));
+  bytes.resize(start + static_cast<std::size_t>(in.gcount())); // a file that shrank meanwhile
+  if (in.bad())
+  {
+    problem = "its file could not be read";
+    return false;
+  }
+  return true;
+}
+
+// =========================================================================================
 // OBJ + MTL
 // =========================================================================================
 
 struct MtlMaterial
 {
   std::optional<std::array<double, 3>> kd, ke;
+  std::string mapKd, mapKe; ///< texture files (map_Kd, map_Ke), empty when none
 };
+
+/// The file a texture map statement names ("map_Kd [options] file"): what follows the options
+/// the MTL format defines, each with its number of values, so that a name with spaces stays
+/// whole; the last word when an option is unknown. Back slashes become slashes; a relative
+/// name is relative to the MTL file's folder. Empty when the statement names no file.
+std::string mtlMapFile(const std::string& rest, const std::filesystem::path& folder)
+{
+  // Option -> how many values it takes; 0: one to three numbers (-o, -s, -t: u [v [w]]).
+  static const std::map<std::string, int> options = { { "-blendu", 1 }, { "-blendv", 1 }, { "-bm", 1 },
+    { "-boost", 1 }, { "-cc", 1 }, { "-clamp", 1 }, { "-imfchan", 1 }, { "-mm", 2 }, { "-o", 0 },
+    { "-s", 0 }, { "-t", 0 }, { "-texres", 1 }, { "-type", 1 } };
+  std::vector<std::pair<std::size_t, std::size_t>> spans; // each word's start and length
+  for (std::size_t at = rest.find_first_not_of(" \t"); at != std::string::npos;)
+  {
+    const std::size_t end = std::min(rest.find_first_of(" \t", at), rest.size());
+    spans.emplace_back(at, end - at);
+    at = rest.find_first_not_of(" \t", end);
+  }
+  auto word = [&](std::size_t i) { return rest.substr(spans[i].first, spans[i].second); };
+  std::size_t i = 0;
+  // The last word is always the file (or part of it), never an option's value.
+  while (i + 1 < spans.size() && word(i).size() > 1 && word(i)[0] == '-')
+  {
+    const auto option = options.find(word(i));
+    if (option == options.end())
+    {
+      i = spans.size() - 1;
+      break;
+    }
+    ++i;
+    double number = 0;
+    for (int taken = 0; i + 1 < spans.size() && (option->second == 0 ? taken < 3 && parseNumber(word(i), number)
+                                                                      : taken < option->second);
+         ++taken)
+    {
+      ++i;
+    }
+  }
+  if (i >= spans.size())
+  {
+    return {};
+  }
+  std::string name = trim(rest.substr(spans[i].first));
+  std::replace(name.begin(), name.end(), '\\', '/');
+  return (folder / name).string();
+}
 
 /// "r [g b]" as MTL colour statements write it (g and b default to r).
 bool parseMtlColour(const std::string& rest, std::array<double, 3>& rgb)
@@ -260,6 +543,16 @@ std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::s
         warn(where + ": material " + named(rest) + " is defined again; its first definition is used");
       }
       current = known ? nullptr : &materials[rest];
+    }
+    else if ((keyword == "map_Kd" || keyword == "map_Ke") && current)
+    {
+      const std::string file = mtlMapFile(rest, std::filesystem::path(path).parent_path());
+      if (file.empty())
+      {
+        warn(where + ": '" + keyword + "' names no file; it is ignored");
+        continue;
+      }
+      (keyword == "map_Kd" ? current->mapKd : current->mapKe) = file;
     }
     else if ((keyword == "Kd" || keyword == "Ke") && current)
     {
@@ -498,6 +791,37 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     warn("the OBJ file " + named(path) + " names no material library ('mtllib' line): every surface is grey 0.5");
   }
 
+  // A map multiplies its colour by the texture's mean (each file decoded once); a texture that
+  // cannot be used is a warning and the colour alone stays.
+  std::map<std::string, std::pair<std::optional<std::array<double, 3>>, std::string>> textureMeans;
+  auto applyMap = [&](const std::string& file, const char* keyword, const std::string& what,
+                    std::optional<std::array<double, 3>>& colour) {
+    auto found = textureMeans.find(file);
+    if (found == textureMeans.end())
+    {
+      std::string bytes, problem;
+      std::optional<std::array<double, 3>> mean;
+      if (readTextureFile(file, bytes, problem))
+      {
+        mean = imageMean(bytes, problem);
+      }
+      found = textureMeans.emplace(file, std::make_pair(mean, problem)).first;
+    }
+    const auto& [mean, problem] = found->second;
+    if (!mean)
+    {
+      warn("the " + what + ": its " + keyword + " texture " + named(file) + ": " + problem + ", so " +
+        (keyword[5] == 'd' ? "Kd" : "Ke") + " alone is used");
+      return;
+    }
+    std::array<double, 3> product = colour.value_or(std::array<double, 3>{ { 1, 1, 1 } });
+    for (std::size_t c = 0; c < 3; ++c)
+    {
+      product[c] *= (*mean)[c];
+    }
+    colour = product;
+  };
+
   Scene scene;
   scene.format = "OBJ";
   for (const auto& name : usedMaterials)
@@ -508,9 +832,15 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     const std::string what = "material " + named(name) + " of " + named(path);
     if (found != library.end())
     {
-      if (found->second.kd)
+      // map_Kd without Kd: the texture alone is the colour (Kd 1), as viewers show it.
+      std::optional<std::array<double, 3>> kd = found->second.kd;
+      if (!found->second.mapKd.empty())
       {
-        material.reflectance = checkedReflectance(*found->second.kd, "the " + what, warn);
+        applyMap(found->second.mapKd, "map_Kd", what, kd);
+      }
+      if (kd)
+      {
+        material.reflectance = checkedReflectance(*kd, "the " + what, warn);
       }
       else
       {
@@ -525,6 +855,14 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
           {
             throw FileError("the " + what + " has a negative Ke: emission must be 0 or more");
           }
+        }
+        // map_Ke scales an emission Ke gives (as glTF's emissive texture its factor): without
+        // Ke, or with Ke 0, the material does not emit and the texture is not read.
+        if (!found->second.mapKe.empty() && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
+        {
+          std::optional<std::array<double, 3>> ke = material.radiance;
+          applyMap(found->second.mapKe, "map_Ke", what, ke);
+          material.radiance = *ke;
         }
       }
     }
@@ -567,29 +905,6 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
 
 namespace
 {
-/// Records what VTK's image readers report, so that a texture they cannot decode becomes one
-/// warning naming the material instead of errors without context.
-class ReaderMessages : public vtkCommand
-{
-public:
-  static ReaderMessages* New() { return new ReaderMessages; }
-  void Execute(vtkObject*, unsigned long event, void* data) override
-  {
-    std::string text = data ? static_cast<const char*>(data) : "";
-    // vtkOutputWindow-style text: "ERROR: In file, line N\nvtkClass (0x...): message"
-    const auto close = text.find("): ");
-    if (close != std::string::npos)
-    {
-      text = text.substr(close + 3);
-    }
-    if (event == vtkCommand::ErrorEvent)
-    {
-      this->Errors.push_back(trim(text));
-    }
-  }
-  std::vector<std::string> Errors;
-};
-
 std::int64_t componentBytes(std::int64_t componentType)
 {
   switch (componentType)
@@ -1128,11 +1443,6 @@ Json readGltfJson(const std::string& path, bool glb, std::string& bin, std::int6
   return {};
 }
 
-double srgbToLinear(double value)
-{
-  return value <= 0.04045 ? value / 12.92 : std::pow((value + 0.055) / 1.055, 2.4);
-}
-
 /// Decodes standard base64 (the payload of a data: URI); false on a character outside it.
 bool decodeBase64(const std::string& text, std::string& bytes)
 {
@@ -1212,40 +1522,6 @@ double component(const char* at, bool normalized)
     return static_cast<double>(value);
   }
   return std::max(static_cast<double>(value) / static_cast<double>(std::numeric_limits<T>::max()), -1.0);
-}
-
-/// A PNG file's texels as 8-bit sRGB RGBA, through libpng's simplified API, which reports a
-/// damaged file as an error (VTK 9.2's vtkPNGReader crashes on some damaged data).
-vtkSmartPointer<vtkImageData> decodePng(const std::string& bytes, std::string& problem)
-{
-  png_image png;
-  std::memset(&png, 0, sizeof(png));
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
-  {
-    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
-    png_image_free(&png);
-    return nullptr;
-  }
-  // A texture's mean needs no more than this: larger images are refused rather than risking
-  // memory on a damaged header.
-  if (static_cast<std::uint64_t>(png.width) * png.height > (std::uint64_t(1) << 26))
-  {
-    problem = "its PNG image is larger than 64 Mpixels";
-    png_image_free(&png);
-    return nullptr;
-  }
-  png.format = PNG_FORMAT_RGBA;
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(static_cast<int>(png.width), static_cast<int>(png.height), 1);
-  image->AllocateScalars(VTK_UNSIGNED_CHAR, 4);
-  if (!png_image_finish_read(&png, nullptr, image->GetScalarPointer(), 0, nullptr))
-  {
-    problem = std::string("its PNG image could not be decoded (") + png.message + ")";
-    png_image_free(&png);
-    return nullptr;
-  }
-  return image;
 }
 
 /// A glTF document whose indices and sizes GltfChecks has checked: buffers loaded, accessors
@@ -1374,7 +1650,7 @@ public:
   {
     const Json& entry = this->Root["textures"][texture];
     std::string problem;
-    vtkSmartPointer<vtkImageData> image;
+    std::optional<std::array<double, 3>> mean;
     if (!entry.contains("source"))
     {
       problem = "its texture has no image";
@@ -1382,84 +1658,23 @@ public:
     else
     {
       const Json& source = this->Root["images"][entry["source"].get<std::size_t>()];
-      std::string bytes, mime = source.value("mimeType", std::string());
+      std::string bytes;
       if (source.contains("bufferView"))
       {
         bytes = this->view(source["bufferView"].get<std::size_t>());
       }
       else
       {
-        const std::string uri = source["uri"].get<std::string>();
-        bytes = this->resource(uri, what + "'s image");
-        if (uri.rfind("data:image/", 0) == 0)
-        {
-          mime = uri.substr(5, uri.find(';') - 5);
-        }
+        bytes = this->resource(source["uri"].get<std::string>(), what + "'s image");
       }
-      const bool png = bytes.size() >= 8 && bytes.compare(1, 3, "PNG") == 0;
-      const bool jpeg = bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xff &&
-        static_cast<unsigned char>(bytes[1]) == 0xd8;
-      if (png)
-      {
-        image = decodePng(bytes, problem);
-      }
-      else if (jpeg)
-      {
-        vtkNew<vtkJPEGReader> reader;
-        vtkNew<ReaderMessages> messages;
-        reader->AddObserver(vtkCommand::ErrorEvent, messages);
-        reader->AddObserver(vtkCommand::WarningEvent, messages);
-        reader->SetMemoryBuffer(bytes.data());
-        reader->SetMemoryBufferLength(static_cast<vtkIdType>(bytes.size()));
-        reader->Update();
-        image = reader->GetOutput();
-        if (!messages->Errors.empty())
-        {
-          problem = "its image could not be decoded (" + messages->Errors.front() + ")";
-          image = nullptr;
-        }
-      }
-      else
-      {
-        problem = "its image is neither PNG nor JPEG";
-      }
+      mean = imageMean(bytes, problem);
     }
-    vtkDataArray* texels = image ? image->GetPointData()->GetScalars() : nullptr;
-    if (problem.empty() && (!texels || texels->GetNumberOfTuples() == 0))
-    {
-      problem = "its image is empty";
-    }
-    if (!problem.empty())
+    if (!mean)
     {
       warn(what + ": " + problem + ", so its factor alone is used");
       return { { 1, 1, 1 } };
     }
-    const int components = texels->GetNumberOfComponents();
-    const double scale = texels->GetDataTypeMax() > 1 ? texels->GetDataTypeMax() : 1.0;
-    std::array<double, 256> table{};
-    for (std::size_t i = 0; i < 256; ++i)
-    {
-      table[i] = srgbToLinear(static_cast<double>(i) / 255.0);
-    }
-    const bool eightBit = scale == 255.0;
-    std::array<double, 3> sum{ { 0, 0, 0 } };
-    const vtkIdType count = texels->GetNumberOfTuples();
-    for (vtkIdType t = 0; t < count; ++t)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        // Grey (and grey + alpha) images hold one colour component.
-        const double raw = texels->GetComponent(t, components >= 3 ? c : 0);
-        sum[static_cast<std::size_t>(c)] += eightBit
-          ? table[static_cast<std::size_t>(std::clamp(raw, 0.0, 255.0))]
-          : srgbToLinear(std::clamp(raw / scale, 0.0, 1.0));
-      }
-    }
-    for (double& s : sum)
-    {
-      s /= static_cast<double>(count);
-    }
-    return sum;
+    return *mean;
   }
 
   /// The local transform of node `index`: its matrix, or translation x rotation x scale.

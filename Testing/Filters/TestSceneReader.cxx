@@ -550,6 +550,110 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
   expectRgbNear(tuple3(broken.output, "Reflectance", 2), 0.99, 0.99, 0.99, 0, "damaged texture");
 }
 
+/// An OBJ file with one unit quad per material of `materials`, in that order, reading `mtl`.
+std::string quadPerMaterialObj(const std::string& mtl, const std::vector<std::string>& materials)
+{
+  std::string text = "mtllib " + mtl + "\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  for (const auto& name : materials)
+  {
+    text += "usemtl " + name + "\nf 1 2 3 4\n";
+  }
+  return text;
+}
+
+TEST(SceneReader, ObjMapKdMultipliesKdByTheTextureMeanInLinearColour)
+{
+  const TestFolder scratch("obj-texture");
+  const fs::path& folder = scratch.path;
+  // The glTF test's texture: red and blue half white, half black; green 128 (sRGB) everywhere.
+  writeFile(folder / "tex.png", pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } }));
+  fs::create_directories(folder / "textures");
+  writeFile(folder / "textures" / "wood grain.png",
+    pngImage({ { { 200, 100, 50 }, { 200, 100, 50 }, { 200, 100, 50 }, { 200, 100, 50 } } }));
+  // Options before the file name (each with its number of values), a name with a space, in a
+  // subfolder written with a back slash as Windows exporters do; map_Ke scales Ke.
+  writeFile(folder / "scene.mtl", R"(newmtl plain
+Kd 0.8 0.8 0.8
+map_Kd tex.png
+newmtl optioned
+Kd 1 0.5 1
+map_Kd -s 1 1 1 -o 0 0 -bm 0.5 -clamp on -mm 0 1 -blendu off -texres 512 -imfchan l textures\wood grain.png
+newmtl textureonly
+map_Kd tex.png
+newmtl glow
+Kd 0.5
+Ke 2 4 6
+map_Ke tex.png
+)");
+  writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "plain", "optioned", "textureonly", "glow" }));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.warnings(), "");
+  const double green = srgbToLinear(128 / 255.0);
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, 0.8 * green, 0.8 * 0.5, 1e-6, "Kd 0.8 x texture");
+  expectRgbNear(tuple3(result.output, "Reflectance", 1), srgbToLinear(200 / 255.0),
+    0.5 * srgbToLinear(100 / 255.0), srgbToLinear(50 / 255.0), 1e-6, "options before the file name");
+  expectRgbNear(tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-6, "map_Kd without Kd");
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 1e-6, "glow's Kd");
+  // Emission is the exitance, pi x radiance.
+  expectRgbNear(tuple3(result.output, "Emission", 3), 2 * 0.5 * Pi, 4 * green * Pi, 6 * 0.5 * Pi, 1e-6, "Ke x map_Ke");
+  expectRgbNear(tuple3(result.output, "Emission", 0), 0, 0, 0, 0, "no Ke");
+
+  // Kd 1 1 1 with a white texture is still clamped, with the clamping's warning.
+  writeFile(folder / "white.png", pngImage({ { { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 } } }));
+  writeFile(folder / "scene.mtl", "newmtl plain\nKd 1 1 1\nmap_Kd white.png\n");
+  writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "plain" }));
+  const ReadResult white = readScene(folder / "scene.obj");
+  ASSERT_TRUE(white.succeeded) << white.errors();
+  EXPECT_NE(white.warnings().find("clamped"), std::string::npos) << white.warnings();
+  expectRgbNear(tuple3(white.output, "Reflectance", 0), 0.99, 0.99, 0.99, 0, "clamped");
+}
+
+TEST(SceneReader, ObjTextureThatCannotBeUsedIsAWarningAndKdAloneIsUsed)
+{
+  const TestFolder scratch("obj-bad-texture");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "notes.txt", "not an image, though named in map_Kd\n");
+  std::string damaged = pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
+  damaged[damaged.size() - 20] = static_cast<char>(damaged[damaged.size() - 20] ^ 0x5a);
+  writeFile(folder / "damaged.png", damaged);
+  fs::create_directories(folder / "folder.png");
+  // Each refused quickly, without reading more than a signature: missing, not an image, a
+  // folder, a device that never ends, a damaged PNG; and a map_Kd without a file name.
+  const std::vector<std::pair<std::string, std::string>> cases = { { "missing", "absent.png" },
+    { "text", "notes.txt" }, { "folder", "folder.png" }, { "device", "/dev/zero" }, { "damaged", "damaged.png" } };
+  std::string mtl, names;
+  std::vector<std::string> materials;
+  for (const auto& [name, file] : cases)
+  {
+    mtl += "newmtl " + name + "\nKd 0.3 0.4 0.5\nmap_Kd -s 2 2 " + file + "\n";
+    materials.push_back(name);
+  }
+  mtl += "newmtl nofile\nKd 0.3 0.4 0.5\nmap_Kd\n";
+  materials.push_back("nofile");
+  writeFile(folder / "scene.mtl", mtl);
+  writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", materials));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  const std::string warnings = result.warnings();
+  for (std::size_t i = 0; i < cases.size(); ++i)
+  {
+    const auto& [name, file] = cases[i];
+    const fs::path path = file[0] == '/' ? fs::path(file) : folder / file;
+    const std::string expected = "material '" + name + "' of '" + (folder / "scene.obj").string() +
+      "': its map_Kd texture '" + path.string() + "': ";
+    EXPECT_NE(warnings.find(expected), std::string::npos) << expected << "\nin\n" << warnings;
+    expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(i)), 0.3, 0.4, 0.5, 1e-12, name);
+  }
+  EXPECT_NE(warnings.find("does not exist, so Kd alone is used"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("its image is neither PNG nor JPEG, so Kd alone is used"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("its file is a folder"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("its file is not a regular file"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("its PNG image could not be decoded"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("'map_Kd' names no file"), std::string::npos) << warnings;
+  expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(cases.size())), 0.3, 0.4, 0.5, 1e-12, "nofile");
+}
+
 TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
 {
   const TestFolder scratch("gltf-modes");
