@@ -179,3 +179,47 @@ def test_missing_mtl_falls_back_to_grey_with_a_warning(tmp_path):
                   "--output", "out/cornell.pvd"] + PATH + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
     assert "CornellBox-Original.mtl" in result.stderr, result.stderr
+
+
+def write_png(path, rgb):
+    """A 2 x 2 PNG of one sRGB colour `rgb` (0-255)."""
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+    from vtkmodules.vtkCommonCore import VTK_UNSIGNED_CHAR
+    image = vtkImageData()
+    image.SetDimensions(2, 2, 1)
+    image.AllocateScalars(VTK_UNSIGNED_CHAR, 3)
+    texels = image.GetPointData().GetScalars()
+    for t in range(4):
+        for c in range(3):
+            texels.SetComponent(t, c, rgb[c])
+    writer = vtkPNGWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(image)
+    writer.Write()
+
+
+def test_map_kd_texture_mean_multiplies_kd_and_a_bad_texture_is_a_warning(tmp_path):
+    """map_Kd: Kd times the texture's mean linear colour reaches the output; a texture that is no
+    image (here a device) is a warning naming the material and the file, and Kd alone stays."""
+    scene = copy_scene(tmp_path)
+    (tmp_path / "textures").mkdir()
+    write_png(tmp_path / "textures" / "bricks.png", (128, 64, 255))
+    mtl = (tmp_path / "CornellBox-Original.mtl").read_text()
+    mtl = mtl.replace("newmtl leftWall\n", "newmtl leftWall\nmap_Kd -s 2 2 1 -bm 1 textures\\bricks.png\n")
+    mtl = mtl.replace("newmtl rightWall\n", "newmtl rightWall\nmap_Kd /dev/zero\n")
+    (tmp_path / "CornellBox-Original.mtl").write_text(mtl)
+    result = run(["--scene", scene, "--light", os.path.join(DATA, "cornell_light.vtp"),
+                  "--output", "out/cornell.pvd"] + PATH + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "'rightWall'" in result.stderr and "'/dev/zero'" in result.stderr, result.stderr
+
+    def linear(value):
+        value /= 255
+        return value / 12.92 if value <= 0.04045 else ((value + 0.055) / 1.055) ** 2.4
+
+    rho = vtk_to_numpy(frame(tmp_path, 0).GetCellData().GetArray("Reflectance"))
+    textured = [kd * linear(v) for kd, v in zip((0.63, 0.065, 0.05), (128, 64, 255))]
+    assert (abs(rho - textured).max(axis=1) < 1e-6).any(), textured
+    assert not (abs(rho - (0.63, 0.065, 0.05)).max(axis=1) < 1e-6).any()
+    assert (abs(rho - (0.14, 0.45, 0.091)).max(axis=1) < 1e-6).any()

@@ -7,6 +7,7 @@
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
+#include "vtkJPEGWriter.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
 #include "vtkUnsignedCharArray.h"
@@ -17,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -652,6 +654,58 @@ TEST(SceneReader, ObjTextureThatCannotBeUsedIsAWarningAndKdAloneIsUsed)
   EXPECT_NE(warnings.find("its PNG image could not be decoded"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("'map_Kd' names no file"), std::string::npos) << warnings;
   expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(cases.size())), 0.3, 0.4, 0.5, 1e-12, "nofile");
+}
+
+TEST(SceneReader, ObjJpegTextureIsAveragedAndAHugeOneRefused)
+{
+  const TestFolder scratch("obj-jpeg");
+  const fs::path& folder = scratch.path;
+  // One colour over 8 x 8 texels (a whole JPEG block), at the best quality: decoded within a
+  // level or two of what was written.
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(8, 8, 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto* scalars = vtkUnsignedCharArray::SafeDownCast(image->GetPointData()->GetScalars());
+  const unsigned char colour[3] = { 200, 100, 50 };
+  for (vtkIdType t = 0; t < 64; ++t)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      scalars->SetTypedComponent(t, c, colour[c]);
+    }
+  }
+  auto writer = vtkSmartPointer<vtkJPEGWriter>::New();
+  writer->SetInputData(image);
+  writer->SetQuality(100);
+  writer->WriteToMemoryOn();
+  writer->Write();
+  vtkUnsignedCharArray* bytes = writer->GetResult();
+  std::string jpeg(reinterpret_cast<const char*>(bytes->GetPointer(0)), static_cast<std::size_t>(bytes->GetNumberOfValues()));
+  writeFile(folder / "tex.jpg", jpeg);
+  // The same file whose frame header (SOFn: FF C0, C1 or C2 (VTK writes progressive JPEG),
+  // length, precision, height, width) claims 65535 x 65535 texels: refused before the decoder
+  // allocates them.
+  std::size_t frame = std::string::npos;
+  for (const char* marker : { "\xff\xc0", "\xff\xc1", "\xff\xc2" })
+  {
+    frame = std::min(frame, jpeg.find(marker, 2));
+  }
+  ASSERT_NE(frame, std::string::npos);
+  for (std::size_t i = frame + 5; i < frame + 9; ++i)
+  {
+    jpeg[i] = '\xff';
+  }
+  writeFile(folder / "huge.jpg", jpeg);
+  writeFile(folder / "scene.mtl", "newmtl jpeg\nKd 0.5\nmap_Kd tex.jpg\nnewmtl huge\nKd 0.5\nmap_Kd huge.jpg\n");
+  writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "jpeg", "huge" }));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.5 * srgbToLinear(200 / 255.0),
+    0.5 * srgbToLinear(100 / 255.0), 0.5 * srgbToLinear(50 / 255.0), 0.005, "JPEG");
+  EXPECT_NE(result.warnings().find("'huge'"), std::string::npos) << result.warnings();
+  EXPECT_NE(result.warnings().find("its JPEG image is larger than 64 Mpixels, so Kd alone is used"), std::string::npos)
+    << result.warnings();
+  expectRgbNear(tuple3(result.output, "Reflectance", 1), 0.5, 0.5, 0.5, 0, "huge JPEG");
 }
 
 TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
