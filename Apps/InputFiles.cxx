@@ -38,14 +38,11 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
 vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes)
 {
   return guardedRead(path, "scene", memoryLimitBytes,
-    [](const std::string& file, const std::string& extension) -> vtkSmartPointer<vtkAlgorithm> {
-      if (extension != ".obj" && extension != ".gltf" && extension != ".glb" && extension != ".ply")
-      {
-        return nullptr;
-      }
+    [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm> {
+      // Formats with materials (.obj, .gltf, .glb, .ply): our reader; VTK's for the rest.
       auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
       reader->SetFileName(file.c_str());
-      return reader;
+      return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
     });
 }
 

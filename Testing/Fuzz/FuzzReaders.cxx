@@ -1,7 +1,8 @@
 // libFuzzer target: arbitrary bytes -> a scene file read as the command line reads it, through
 // the guarded reading (Apps/GuardedRead: .vtp .obj .ply .stl .vtu .vtk, chosen by the first
-// byte modulo 6, in that order) -> the vtkMovingLightRadiosity filter with a fixed light and a
-// 2-frame trajectory, few paths and a small memory limit.
+// byte modulo 6, in that order; .obj and .ply by our vtkRadiositySceneReader with their
+// materials, as the command line reads them) -> the vtkMovingLightRadiosity filter with a fixed
+// light and a 2-frame trajectory, few paths and a small memory limit.
 //
 // A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
 // out of time in its child process) or a filter error is a normal outcome. Findings are crashes,
@@ -19,6 +20,7 @@
 #include "vtkObject.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkRadiositySceneReader.h"
 #include "vtkCellArray.h"
 #include "vtkLogger.h"
 
@@ -101,7 +103,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   {
     mlr::guarded::ReadLimits limits;
     limits.time.baseSeconds = 1;
-    scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits);
+    scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits,
+      [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm> {
+        auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+        reader->SetFileName(file.c_str());
+        return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
+      });
   }
   catch (const mlr::guarded::InputError&)
   {
