@@ -214,6 +214,9 @@ constexpr std::uint64_t MaxTexturePixels = std::uint64_t(1) << 26;
 /// The largest texture file read (MTL maps): a 64-Mpixel PNG seldom needs more, and a bigger
 /// file is refused before any of it is read.
 constexpr std::uintmax_t MaxTextureFileBytes = std::uintmax_t(256) << 20;
+/// A glTF's external buffer or image file larger than this is refused before it is read:
+/// every byte is held in memory.
+constexpr std::uintmax_t MaxResourceFileBytes = std::uintmax_t(4) << 30;
 
 bool isPng(const std::string& bytes)
 {
@@ -1580,6 +1583,12 @@ public:
     if (!std::filesystem::is_regular_file(file, error))
     {
       this->fail(what + " names the file " + named(file.string()) + ", which does not exist");
+    }
+    const std::uintmax_t size = std::filesystem::file_size(file, error);
+    if (error || size > MaxResourceFileBytes)
+    {
+      this->fail(what + ": the file " + named(file.string()) +
+        (error ? " has a size that cannot be read" : " is over the 4 GiB this reader takes"));
     }
     std::ifstream in(file, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

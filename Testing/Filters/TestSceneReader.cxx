@@ -812,6 +812,7 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     { "draco.gltf", draco, "requires the extension KHR_draco_mesh_compression" },
     { "version1.gltf", version1, "glTF version 1.0, not 2.x" },
     { "nobin.gltf", gltfJson("missing.bin"), "missing.bin', which does not exist" },
+    { "huge.gltf", gltfJson("huge.bin"), "huge.bin' is over the 4 GiB this reader takes" },
     { "base64.gltf", notBase64, "not base64" },
     { "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4: a face names vertex 4" },
     { "negative.obj", "v 0 0 0\nf -1 -2 -3\n", "names vertex -2" },
@@ -832,6 +833,9 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     { "scene.stl", "solid x\nendsolid x\n", "extension '.stl'" },
   };
   writeFile(folder / "badkd.mtl", "newmtl m\nKd red\n");
+  // A sparse 5 GiB buffer: refused by its size, before a byte is read.
+  writeFile(folder / "huge.bin", "");
+  fs::resize_file(folder / "huge.bin", std::uintmax_t(5) << 30);
   for (const BadFile& file : files)
   {
     SCOPED_TRACE(file.name);
