@@ -54,8 +54,7 @@ public:
   /// One quantum per channel: a channel much weaker than the others keeps its precision.
   FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records,
     std::size_t frames, const std::array<double, Channels>& quantum, FrameLayout layout)
-    : Frames(frames)
-    , Stride(records * 2 * frames * Channels)
+    : Stride(records * 2 * frames * Channels)
     , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
     , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
     , FrameStride(layout == FrameLayout::FramesInner ? Channels : records * 2 * Channels)
@@ -138,26 +137,6 @@ public:
     }
   }
 
-  /// True if any worker scored anything on (record, side) in any frame.
-  bool received(std::size_t record, int side) const
-  {
-    for (std::size_t f = 0; f < this->Frames; ++f)
-    {
-      const std::int64_t* v = this->Values.get() + this->offset(record, side, f);
-      for (std::size_t w = 0; w * this->Stride < this->Size; ++w, v += this->Stride)
-      {
-        for (int c = 0; c < Channels; ++c)
-        {
-          if (v[c] != 0)
-          {
-            return true;
-          }
-        }
-      }
-    }
-    return false;
-  }
-
   /// Adds every worker's copy into the first and zeroes the others: the sums are unchanged,
   /// and the first copy (copySize() values) can then be summed over processes as a whole.
   std::int64_t* collapse()
@@ -222,7 +201,6 @@ private:
     return std::unique_ptr<std::int64_t[], Free>(static_cast<std::int64_t*>(memory));
   }
 
-  std::size_t Frames;
   std::size_t Stride;
   std::size_t RecordStride;
   std::size_t SideStride;

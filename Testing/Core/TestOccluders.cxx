@@ -18,23 +18,13 @@
 using namespace mlr;
 using mlr::checks::balanceOfFrame;
 using mlr::checks::expectError;
+using mlr::checks::modeOptions;
 using scenes::AxisBox;
 using scenes::FaceGroup;
 using scenes::OccludedRoom;
 
 namespace
 {
-SolverOptions optionsFor(bool reuse, std::uint64_t paths, std::uint64_t seed)
-{
-  SolverOptions options;
-  options.pathsPerFrame = paths;
-  options.reuseShooting = reuse;
-  options.reuseGathering = reuse;
-  options.seed = seed;
-  options.threads = 2;
-  return options;
-}
-
 MovingLight lightOf(const OccludedRoom& room)
 {
   return MovingLight(room.light, room.power, room.translations);
@@ -191,7 +181,7 @@ void expectEnergyBalance(bool reuse)
 {
   const OccludedRoom room = scenes::occludedRoom();
   const Scene scene = Scene::fromPatchMesh(room.mesh);
-  const Solution solution = solve(scene, lightOf(room), optionsFor(reuse, 400000, 5));
+  const Solution solution = solve(scene, lightOf(room), modeOptions(reuse, 400000, 5));
   expectBalance(room, scene, solution, 0.01);
 }
 
@@ -206,7 +196,7 @@ void expectDirectLightMatchesLambert(bool reuse)
 {
   const OccludedRoom room = scenes::occludedRoom();
   const Scene scene = Scene::fromPatchMesh(room.mesh);
-  const SolverOptions options = optionsFor(reuse, 400000, 17);
+  const SolverOptions options = modeOptions(reuse, 400000, 17);
   const Solution solution = solve(scene, lightOf(room), options);
   const double N = static_cast<double>(options.pathsPerFrame);
   const double lightArea = lightOf(room).area();
@@ -328,7 +318,7 @@ void expectLowAndHighPathCountsAgree(bool reuse, int seeds)
   std::vector<double> sum(faces, 0.0), sumSquares(faces, 0.0);
   for (int s = 0; s < seeds; ++s)
   {
-    const Solution solution = solve(scene, light, optionsFor(reuse, low, 100 + s));
+    const Solution solution = solve(scene, light, modeOptions(reuse, low, 100 + s));
     for (std::size_t i = 0; i < faces; ++i)
     {
       const double p = animationPower(scene, solution, room.faces[i]);
@@ -336,7 +326,7 @@ void expectLowAndHighPathCountsAgree(bool reuse, int seeds)
       sumSquares[i] += p * p;
     }
   }
-  const Solution reference = solve(scene, light, optionsFor(reuse, high, 99));
+  const Solution reference = solve(scene, light, modeOptions(reuse, high, 99));
   double meanSquareZ = 0;
   for (std::size_t i = 0; i < faces; ++i)
   {
@@ -408,7 +398,7 @@ TEST(OccludedRoom, ReachableSidesComeFromGeometryAlone)
   for (const Run& run : { Run{ false, 1000, 1, 1 }, Run{ true, 1000, 2, 2 }, Run{ true, 200000, 3, 2 },
          Run{ false, 200000, 4, 1 } })
   {
-    SolverOptions options = optionsFor(run.reuse, run.paths, run.seed);
+    SolverOptions options = modeOptions(run.reuse, run.paths, run.seed);
     options.threads = run.threads;
     const Solution solution = solve(scene, lightOf(room), options);
     EXPECT_EQ(solution.statistics.reachableSides, expected) << "N " << run.paths << " seed " << run.seed;
@@ -440,13 +430,13 @@ TEST(PathCount, ReuseWithFewerPathsThanPositionsIsRefusedNamingTheMinimum)
   const OccludedRoom room = scenes::occludedRoom(6);
   const Scene scene = Scene::fromPatchMesh(room.mesh);
   // Positions without a path would leave holes in the mixture density and unbounded weights.
-  expectError([&] { solve(scene, lightOf(room), optionsFor(true, 5, 1)); }, "give at least 6 paths per frame");
-  SolverOptions shootingOnly = optionsFor(true, 5, 1);
+  expectError([&] { solve(scene, lightOf(room), modeOptions(true, 5, 1)); }, "give at least 6 paths per frame");
+  SolverOptions shootingOnly = modeOptions(true, 5, 1);
   shootingOnly.reuseGathering = false;
   expectError([&] { solve(scene, lightOf(room), shootingOnly); }, "give at least 6");
   // Classic solves each frame on its own, and reuse at N = n has one path per position.
-  EXPECT_NO_THROW(solve(scene, lightOf(room), optionsFor(false, 5, 1)));
-  EXPECT_NO_THROW(solve(scene, lightOf(room), optionsFor(true, 6, 1)));
+  EXPECT_NO_THROW(solve(scene, lightOf(room), modeOptions(false, 5, 1)));
+  EXPECT_NO_THROW(solve(scene, lightOf(room), modeOptions(true, 6, 1)));
 }
 
 TEST(WeakChannel, AChannelAMillionTimesWeakerKeepsItsPrecision)
@@ -464,7 +454,7 @@ TEST(WeakChannel, AChannelAMillionTimesWeakerKeepsItsPrecision)
   const Scene scene = Scene::fromPatchMesh(room.mesh);
   for (bool reuse : { false, true })
   {
-    const Solution solution = solve(scene, lightOf(room), optionsFor(reuse, 20000, 3));
+    const Solution solution = solve(scene, lightOf(room), modeOptions(reuse, 20000, 3));
     double worst = 0;
     std::size_t lit = 0;
     for (std::size_t f = 0; f < solution.frameCount(); ++f)
@@ -506,7 +496,7 @@ TEST(FarFromOrigin, RoomTenKilometresAwayGivesTheSameResult)
   const Scene farScene = Scene::fromPatchMesh(far.mesh);
   for (bool reuse : { false, true })
   {
-    const SolverOptions options = optionsFor(reuse, 200000, 23);
+    const SolverOptions options = modeOptions(reuse, 200000, 23);
     const Solution a = solve(nearScene, lightOf(near), options);
     const Solution b = solve(farScene, lightOf(far), options);
     expectBalance(far, farScene, b, 0.01);
@@ -534,7 +524,7 @@ TEST(Lambda, BelowTheMinimumIsRefusedSayingWhy)
 {
   const OccludedRoom room = scenes::occludedRoom();
   const Scene scene = Scene::fromPatchMesh(room.mesh);
-  SolverOptions options = optionsFor(true, 1000, 1);
+  SolverOptions options = modeOptions(true, 1000, 1);
   options.firstBounceSurvival = 0.0009;
   expectError([&] { solve(scene, lightOf(room), options); }, "[0.001, 1]");
   expectError([&] { solve(scene, lightOf(room), options); }, "fixed-point sums could overflow");
@@ -554,7 +544,7 @@ TEST(EnergyBalance, ReflectanceNearOneIsNotTruncated)
     scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 2));
   for (bool reuse : { false, true })
   {
-    SolverOptions options = optionsFor(reuse, 8000, 31);
+    SolverOptions options = modeOptions(reuse, 8000, 31);
     options.firstBounceSurvival = 1;
     const Solution solution = solve(scene, light, options);
     for (std::size_t f = 0; f < 2; ++f)
