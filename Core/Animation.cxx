@@ -12,11 +12,6 @@ namespace
 /// Share of the progress given to remeshing; the solve takes the rest.
 constexpr double RemeshingShare = 0.05;
 
-std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
-{
-  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
-}
-
 std::uint64_t outputBytes(const AnimationOptions& options, std::size_t elements, std::size_t points)
 {
   const auto product = [](std::uint64_t a, std::uint64_t b) {

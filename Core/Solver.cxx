@@ -31,27 +31,6 @@ double secondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string gibibytes(std::uint64_t bytes)
-{
-  std::ostringstream s;
-  s.precision(3);
-  s << static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0) << " GiB";
-  return s.str();
-}
-
-/// a * b, saturating at UINT64_MAX.
-std::uint64_t saturatingProduct(std::uint64_t a, std::uint64_t b)
-{
-  std::uint64_t product = 0;
-  return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
-}
-
-std::uint64_t saturatingSum(std::uint64_t a, std::uint64_t b)
-{
-  std::uint64_t sum = 0;
-  return __builtin_add_overflow(a, b, &sum) ? UINT64_MAX : sum;
-}
-
 /// A walk longer than this is cut, which bounds the time between two cancellation checks.
 /// Roulette survives with the largest reflectance channel rho_max < 1, so a walk reaches
 /// this length with probability rho_max^(2^24): the power the cut loses is below 1e-7 of the
@@ -1194,17 +1173,6 @@ std::uint64_t estimateSolveMemory(
 {
   return estimateSolveMemory(
     scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
-}
-
-std::uint64_t defaultMemoryLimitBytes()
-{
-  const long pages = sysconf(_SC_PHYS_PAGES);
-  const long pageSize = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || pageSize <= 0)
-  {
-    return 4ULL << 30;
-  }
-  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 2;
 }
 
 std::uint64_t memoryLimitBytes(const SolverOptions& options)

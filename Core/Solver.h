@@ -3,6 +3,7 @@
 #pragma once
 
 #include "DirectionalLight.h"
+#include "MemoryBudget.h"
 #include "MovingLight.h"
 #include "Rgb.h"
 #include "Scene.h"
@@ -230,9 +231,6 @@ std::uint64_t estimateSolveMemory(
 /// The same estimate from counts alone, e.g. for a scene not remeshed yet.
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options);
-
-/// Half of the physical memory (4 GiB when it cannot be read): the default memory limit.
-std::uint64_t defaultMemoryLimitBytes();
 
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);
