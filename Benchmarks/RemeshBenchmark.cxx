@@ -19,7 +19,7 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 
-/// Cancellation must reach the caller within this many seconds (issue 16, target 4).
+/// Cancellation must reach the caller within this many seconds.
 constexpr double LatencyTarget = 0.5;
 
 double secondsBetween(Clock::time_point a, Clock::time_point b)

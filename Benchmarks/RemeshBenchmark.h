@@ -1,4 +1,4 @@
-// mlr-benchmark's remeshing case (issue 16, target 4): a 1,000,000-triangle input remeshed
+// mlr-benchmark's remeshing case: a 1,000,000-triangle input remeshed
 // to realistic patch counts, and how fast a cancellation stops it.
 #pragma once
 

@@ -483,7 +483,7 @@ std::string runTurningLight(const RigCaseOptions& c)
   rig.areaLights.emplace_back(scenes::squareLightFacingDown(centre, 1.15), Rgb(100, 100, 100), poses);
   const SolverOptions options = paperOptions(c);
 
-  std::printf("\n=== Turning light (issue 12) ===\nPaper-scale room: %zu patches, %zu elements; a "
+  std::printf("\n=== Turning light ===\nPaper-scale room: %zu patches, %zu elements; a "
               "1.15 m square light (100 W) fixed at (2.75, 2.75, 4.8) turning 90 degrees about y "
               "over %zu frames (facing 45 degrees towards -x, then towards +x); N = %llu, k = %g, "
               "lambda = %g\n",
@@ -538,7 +538,7 @@ std::string runSunOverTown(const RigCaseOptions& c)
     std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);
     return std::string(text);
   };
-  std::printf("\n=== Sun over a town block (issue 14) ===\nTown block: %zu buildings, %zu patches "
+  std::printf("\n=== Sun over a town block ===\nTown block: %zu buildings, %zu patches "
               "(%zu ground), %zu elements; %zu sun positions on 2024-06-21 at 48.85 N, 2.35 E, "
               "%s to %s (UTC+2) every 15 min, sun elevation %.1f, %.1f (highest, %s) and %.1f "
               "degrees; E = 1000 W/m^2; N = %llu, k = %g, lambda = %g\n",

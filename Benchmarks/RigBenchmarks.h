@@ -1,5 +1,5 @@
-// mlr-benchmark's light-rig cases: a turning light (issue 12) and the sun over a town block
-// (issue 14), each full reuse against classic with errors against a high-N classic reference.
+// mlr-benchmark's light-rig cases: a turning light and the sun over a town block
+//, each full reuse against classic with errors against a high-N classic reference.
 #pragma once
 
 #include <cstdint>

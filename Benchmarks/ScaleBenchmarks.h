@@ -1,4 +1,4 @@
-// mlr-benchmark's scale cases (issue 16): a long animation at the paper's scale, and a large
+// mlr-benchmark's scale cases: a long animation at the paper's scale, and a large
 // scene whose memory is measured against the solver's estimate.
 #pragma once
 

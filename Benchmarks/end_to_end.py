@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""End to end: the command line on the demo (issue 16, target 1), as a user runs it.
+"""End to end: the command line on the demo, as a user runs it.
 
 Runs moving-light-radiosity on the built-in Cornell box (30 light positions, the defaults of
 Tools/run-demo.sh: 600,000 paths per frame, about 3,000 patches) with --reuse none (classic)

@@ -7,7 +7,7 @@ paths per frame, k = 1 and lambda = 0.25:
 
 - a reference solution of every frame (classic, 16x the paths, cached on disk);
 - for classic, gathering-only reuse, shooting-only reuse and full reuse: seconds, rays by
-  kind, the MSE of every frame against the reference and the flicker (METHOD.md);
+  kind, the MSE of every frame against the reference and the flicker (Documentation/Method.md);
 - the time-vs-MSE curve of the middle frame (frame 17 of 30, the paper's Fig. 2) for the four
   modes at several path counts;
 - the speed-up of full reuse over classic beside the paper's eq. (4) with the measured l.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Scale-out on ParaView's MPI engine (issue 15): the paper's configuration (the shipped
+"""Scale-out on ParaView's MPI engine: the paper's configuration (the shipped
 Cornell box remeshed to 2,686 patches, 30 light positions, N = 600,000, k = 1, lambda = 0.25,
 full reuse) solved by pvbatch --symmetric under mpiexec as
 

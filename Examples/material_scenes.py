@@ -1,5 +1,5 @@
 """Scene files with their own materials in ParaView: the Cornell box OBJ + MTL and a glTF room,
-each lit by its own lamp moving along a straight path (issue 13).
+each lit by its own lamp moving along a straight path.
 
     xvfb-run -a pvpython Examples/material_scenes.py [--plugin PATH] [--output DIR] [--paths N]
 

@@ -57,7 +57,7 @@ void addFrameFieldData(vtkFieldData* fieldData, std::size_t frame, const Vec3& l
   const Vec3& lightTranslation, std::int64_t solveCount);
 
 // ------------------------------------------------------------------------------------------
-// Display (issue 17): colours a screen can show, smooth shading and the light itself.
+// Display: colours a screen can show, smooth shading and the light itself.
 
 /// Luminance of linear sRGB/Rec. 709 primaries.
 double luminance(const Rgb& rgb);

@@ -51,7 +51,7 @@ struct vtkMovingLightRadiosity::vtkInternals
   mlr::LightRig Rig;
   /// Per frame, passed on from the Trajectory when it has them (degrees).
   std::vector<double> SunAzimuth, SunElevation;
-  // Display (issue 17): what the colours of every frame need.
+  // Display: what the colours of every frame need.
   mlr::vtkoutputs::SmoothShading Shading;
   double AutoExposure = 0;
   /// Taken when the properties were last found to match the solve: Exposure moves it on, as
@@ -75,7 +75,7 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// The last solve stopped because AbortExecute was set (it stays set: see RequestData).
   bool Aborted = false;
 
-  // Several ranks (issue 15): this rank outputs only the elements and patches that come from
+  // Several ranks: this rank outputs only the elements and patches that come from
   // its own input cells, and rank 0 the Light.
   bool Distributed = false;
   std::vector<vtkIdType> OwnedElements, OwnedPatches;

@@ -87,7 +87,7 @@
  * vtkSMPTools backend.
  *
  * @sa
- * The method is described in shared/docs/METHOD.md of the MovingLightRadiosity project.
+ * The method is derived in Documentation/Method.md of the MovingLightRadiosity project.
  */
 
 #ifndef vtkMovingLightRadiosity_h
@@ -339,7 +339,7 @@ public:
   vtkGetMacro(MemoryLimit, int);
   ///@}
 
-  // ---------------------------------------------------------------- Display (issue 17)
+  // ---------------------------------------------------------------- Display
   ///@{
   /**
    * Exposure of the display colours, in EV (stops), on top of the automatic exposure: the

@@ -2,7 +2,7 @@
 # Installs what is missing, builds the command line in Release and measures it end to end on
 # the demo (Benchmarks/end_to_end.py): classic against full reuse, whole command and solve
 # alone, and writing the series as a share of the solve, with met / not met for the targets
-# of issue 16. Arguments go to end_to_end.py (e.g. --repeat 5).
+# (writing at most 25% of the solve). Arguments go to end_to_end.py (e.g. --repeat 5).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/Tools/build.sh" moving-light-radiosity

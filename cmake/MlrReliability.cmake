@@ -1,4 +1,4 @@
-# Sanitizer and fuzzing builds (issue 7). Included by the top-level CMakeLists.txt before any
+# Sanitizer and fuzzing builds. Included by the top-level CMakeLists.txt before any
 # target is defined, so that the flags reach Core, the CGAL translation unit, the filter module
 # and the tests alike. VTK, ParaView, Embree, TBB and CGAL's libraries stay uninstrumented
 # (they are Debian's builds): only our code is checked.

@@ -1,4 +1,4 @@
-// Contact lines (issue 11, item 4): surfaces are split where others touch or cross them, so
+// Contact lines: surfaces are split where others touch or cross them, so
 // that no patch straddles a contact and averages lit floor with the dark under a block.
 #include "CoreChecks.h"
 #include "Error.h"

@@ -1,4 +1,4 @@
-// Light rigs (issue 12): lights that turn, dim and multiply, static lights solved once, and
+// Light rigs: lights that turn, dim and multiply, static lights solved once, and
 // emissive scene surfaces.
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"

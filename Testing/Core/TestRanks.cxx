@@ -1,4 +1,4 @@
-// A solve shared by R ranks (issue 15) gives every rank the serial solution bit for bit, for
+// A solve shared by R ranks gives every rank the serial solution bit for bit, for
 // any number of ranks and threads, and a cancel or failure on one rank stops them all. The
 // ranks are threads of this process here, their sums a barrier: Core knows no MPI, only
 // SolverOptions' sum hooks (the filter's tests run the same under mpiexec).

@@ -1,4 +1,4 @@
-// The sun (issue 14): a directional light whose direction and irradiance change per frame.
+// The sun: a directional light whose direction and irradiance change per frame.
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"

@@ -1,4 +1,4 @@
-// What a viewer sees (issue 17): display colours, smooth-shading points and the light itself.
+// What a viewer sees: display colours, smooth-shading points and the light itself.
 #include "FilterTestSupport.h"
 
 #include "vtkCellData.h"

@@ -1,4 +1,4 @@
-// Light rigs (issue 12) and the sun (issue 14) through the filter's interface: the
+// Light rigs and the sun through the filter's interface: the
 // Trajectory's point arrays Normal, Orientation and Power, several lights by LightId, scene
 // Emission, LightType Directional, AimAtPoint and the Light output.
 #include "FilterTestSupport.h"

@@ -1,4 +1,4 @@
-// vtkRadiositySceneReader (issue 13): materials from OBJ+MTL, glTF and PLY files written here,
+// vtkRadiositySceneReader: materials from OBJ+MTL, glTF and PLY files written here,
 // the same reflectances from every format, and bad input with an error naming the file.
 #include "FilterTestSupport.h"
 

@@ -1,4 +1,4 @@
-// Units (issue 13): the outputs say what their numbers are, and a scene in
+// Units: the outputs say what their numbers are, and a scene in
 // millimetres gives what the same scene in metres gives, with radiosity in
 // W/mm^2 instead of W/m^2.
 #include "FilterTestSupport.h"

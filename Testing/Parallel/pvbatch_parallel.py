@@ -1,4 +1,4 @@
-"""One rank of the parallel tests (issue 15), run by run_parallel.py as
+"""One rank of the parallel tests, run by run_parallel.py as
 
     mpiexec -n R pvbatch --symmetric --force-offscreen-rendering pvbatch_parallel.py \
         --plugin MovingLightRadiosity.so --case CASE --out PREFIX

@@ -1,4 +1,4 @@
-"""The client of the client-server test (issue 15): pvpython connected to a pvserver running
+"""The client of the client-server test: pvpython connected to a pvserver running
 on several ranks, loading the plugin on the server as ParaView does, solving the Cornell box
 of pvbatch_parallel.py and fetching the Elements and Patches of frame 0 to the client (the
 ranks' pieces appended). Writes them to PREFIX.rank0.npz in pvbatch_parallel.py's format.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Runs one parallel test (issue 15): the serial reference in plain pvbatch, then the case on R
+"""Runs one parallel test: the serial reference in plain pvbatch, then the case on R
 ranks under mpiexec (pvbatch --symmetric), each bounded by a timeout, and compares what every
 rank wrote (pvbatch_parallel.py). Exits non-zero with one line per failed check.
 

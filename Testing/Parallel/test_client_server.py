@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Client-server test (issue 15): starts `mpiexec -n 2 pvserver` on a free loopback port,
+"""Client-server test: starts `mpiexec -n 2 pvserver` on a free loopback port,
 connects pvpython_client.py to it, and checks that the Elements and Patches the client
 fetches are the serial pvbatch result, array by array, bit for bit (cells matched by their
 corners). Every process is bounded by a timeout, and the server's process group is killed at

@@ -1,4 +1,4 @@
-"""What the first Apply shows (issue 17), checked in pvbatch with ParaView sources only:
+"""What the first Apply shows, checked in pvbatch with ParaView sources only:
 
 - every output port shown as the Apply button shows it (ShowInPreferredView): the Elements
   coloured by the point array Color with Map Scalars off and unlit (Ambient 1, Diffuse 0),

@@ -1,5 +1,5 @@
 """The plugin's scene reader and the filter's LightMaterial against the command line, on the
-shipped Data/CornellBox-Original.obj (issue 13):
+shipped Data/CornellBox-Original.obj:
 
 - RadiositySceneReader opens the OBJ + MTL; Moving Light Radiosity with LightMaterial "light"
   (no Light input), a straight path (PathStart, PathEnd, NumberOfPositions) and a fixed

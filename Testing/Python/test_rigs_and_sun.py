@@ -1,4 +1,4 @@
-"""Light rigs (issue 12) and the sun (issue 14) from Python: inputs built from vtkmodules
+"""Light rigs and the sun from Python: inputs built from vtkmodules
 sources, the arrays and time steps the filter gives back.
 
 Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.txt), or by hand:

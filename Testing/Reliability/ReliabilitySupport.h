@@ -24,7 +24,7 @@ constexpr bool UnderAddressSanitizer = false;
 constexpr bool UnderAddressSanitizer = false;
 #endif
 
-/// The bound the cancellation tests assert: ten times the 0.5 s that issue 7 promises on a
+/// The bound the cancellation tests assert: ten times the 0.5 s promised (Documentation/Reliability.md) on a
 /// quiet machine, so that the gate's verdict does not depend on the machine's load (the test
 /// command runs two tests at a time on two cores). The tests print the latency they measured;
 /// a stretch without a cancellation check shows there as a regression long before it fails.

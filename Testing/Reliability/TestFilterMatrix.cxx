@@ -1,4 +1,4 @@
-// The bad-input matrix of issue 7 for vtkMovingLightRadiosity: one row per kind of bad input,
+// The bad-input matrix for vtkMovingLightRadiosity: one row per kind of bad input,
 // each asserting the outcome (an error naming the problem, or a result with a warning), that
 // a failed update leaves both outputs empty (no partial result) and that it takes seconds at
 // most. The command line's rows (files, output folders, signals) are in test_cli_matrix.py.
@@ -229,7 +229,7 @@ std::vector<Row> rows()
         c.filter->SetMemoryLimit(8);
       },
       Outcome::Error, "the Scene has 200000 cells on 100002 points: taking them for remeshing needs an estimated", 2 },
-    // Clamped to one path, fewer than the light positions: reuse refuses it (issue 11).
+    // Clamped to one path, fewer than the light positions: reuse refuses it.
     { "PathsZeroIsClampedToOne", [](Case& c) { c.filter->SetNumberOfPaths(0); },
       Outcome::Error, "give at least", 10,
       [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 1); } },

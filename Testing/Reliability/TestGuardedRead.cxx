@@ -1,4 +1,4 @@
-// The guarded reading of input files (Apps/GuardedRead, issues 10 and 16): every format is
+// The guarded reading of input files (Apps/GuardedRead): every format is
 // read with its cell arrays; bad files are refused with a message naming them; a reader that
 // loops, blocks or crashes costs only its child process, which never outlives the caller.
 //

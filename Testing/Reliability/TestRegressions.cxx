@@ -1,4 +1,4 @@
-// Regression tests for what fuzzing found in Core (issue 7). The inputs that crashed are also
+// Regression tests for what fuzzing found in Core. The inputs that crashed are also
 // replayed as files: Testing/Fuzz/regressions/<target>/ (ctest Fuzz.*.Replay).
 #include "CoreChecks.h"
 #include "Error.h"

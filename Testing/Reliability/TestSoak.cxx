@@ -1,4 +1,4 @@
-// Soak (issue 7): 200 solves in one process through the filter, as ParaView runs them (change a
+// Soak: 200 solves in one process through the filter, as ParaView runs them (change a
 // property, Apply, look at other times), must not grow resident memory after warm-up.
 #include "FilterTestSupport.h"
 #include "ReliabilitySupport.h"

@@ -1,4 +1,4 @@
-"""The bad-input matrix of issue 7 for the command line moving-light-radiosity: one row per kind
+"""The bad-input matrix for the command line moving-light-radiosity: one row per kind
 of bad input, file or option. Every row asserts the exit status, the message and that no
 output file (nor a partial one) is left behind; rows that succeed assert what was written.
 The filter's rows are in TestFilterMatrix.cxx. No row may leave a process behind: this process

@@ -1,4 +1,4 @@
-// A room with occluders, for the tests of issue 11: a block standing on the floor and a
+// A room with occluders, for the occluder tests: a block standing on the floor and a
 // hanging two-sided panel, every surface grouped into named faces.
 #pragma once
 

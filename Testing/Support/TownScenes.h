@@ -1,4 +1,4 @@
-// A town block of box buildings on a ground plane, for the sun benchmark and tests (issue 14).
+// A town block of box buildings on a ground plane, for the sun benchmark and tests.
 #pragma once
 
 #include "OccluderScenes.h"
