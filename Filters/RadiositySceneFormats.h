@@ -1,6 +1,7 @@
 // The file formats vtkRadiositySceneReader reads: Wavefront OBJ with its MTL materials, glTF 2.0
 // (.gltf, .glb) and PLY with colours, each into one polygon soup with a material per cell.
-// Private to the Filters module.
+// Each format is read in its own file (ObjMtlFormat.cxx, GltfFormat.cxx, PlyFormat.cxx) with
+// the helpers of SceneText.h and SceneTextures.h. Private to the Filters module.
 #pragma once
 
 #include "vtkSmartPointer.h"

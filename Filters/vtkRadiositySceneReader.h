@@ -18,10 +18,12 @@
  * - `.obj`: Wavefront OBJ faces, with the materials of the MTL files its `mtllib` lines name
  *   (relative to the OBJ's folder). `Kd` is the reflectance, `Ke` the emitted radiance in
  *   W/(m^2 sr), as path tracers read it (the Cornell box's `Ke 17 12 4` light emits
- *   pi x (17, 12, 4) W/m^2). Faces before any `usemtl` have the material `none`. Texture maps
- *   (`map_Kd`) are not read: Kd alone gives the reflectance. Points and lines are skipped with
- *   a warning. A missing MTL file, or a material it does not define, is grey 0.5 and does not
- *   emit, with a warning naming the file or the material.
+ *   pi x (17, 12, 4) W/m^2). Faces before any `usemtl` have the material `none`. The PNG or
+ *   JPEG textures of `map_Kd` and `map_Ke` multiply Kd and Ke by their mean linear colour
+ *   (`map_Kd` without Kd: the mean alone is the reflectance; `map_Ke` only scales a non-zero
+ *   Ke); a texture that cannot be read or decoded is a warning, and the colour alone is used.
+ *   Points and lines are skipped with a warning. A missing MTL file, or a material it does not
+ *   define, is grey 0.5 and does not emit, with a warning naming the file or the material.
  * - `.gltf`, `.glb`: glTF 2.0 (buffers embedded, in a .glb BIN chunk or in files beside it),
  *   the default scene with its node transforms (glTF lengths are metres), skins and animations
  *   in the rest pose. Files that require geometry extensions (Draco, quantization, meshopt)

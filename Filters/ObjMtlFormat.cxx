@@ -1,0 +1,506 @@
+// Wavefront OBJ and the MTL material libraries it names (readObj).
+#include "RadiositySceneFormats.h"
+
+#include "SceneText.h"
+#include "SceneTextures.h"
+
+#include "vtkCellArray.h"
+#include "vtkPoints.h"
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace mlr::scenefile
+{
+
+namespace
+{
+/// The logical lines of an OBJ or MTL file: a line ending in a backslash continues on the next.
+class LogicalLines
+{
+public:
+  explicit LogicalLines(std::istream& in)
+    : In(in)
+  {
+  }
+
+  bool next(std::string& line)
+  {
+    line.clear();
+    std::string part;
+    bool any = false;
+    while (std::getline(this->In, part))
+    {
+      any = true;
+      ++this->Number;
+      if (!part.empty() && part.back() == '\r')
+      {
+        part.pop_back();
+      }
+      if (!part.empty() && part.back() == '\\')
+      {
+        part.back() = ' ';
+        line += part;
+        continue;
+      }
+      line += part;
+      return true;
+    }
+    return any;
+  }
+
+  std::size_t number() const { return this->Number; }
+  std::uintmax_t position() { return static_cast<std::uintmax_t>(std::max<std::streamoff>(0, this->In.tellg())); }
+
+private:
+  std::istream& In;
+  std::size_t Number = 0;
+};
+
+/// The keyword of a line and the rest of it, without a trailing comment.
+void splitKeyword(const std::string& line, std::string& keyword, std::string& rest)
+{
+  std::string text = line;
+  const auto hash = text.find('#');
+  if (hash != std::string::npos)
+  {
+    text.erase(hash);
+  }
+  text = trim(text);
+  const auto space = text.find_first_of(" \t");
+  keyword = text.substr(0, space);
+  rest = space == std::string::npos ? std::string() : trim(text.substr(space));
+}
+
+struct MtlMaterial
+{
+  std::optional<std::array<double, 3>> kd, ke;
+  std::string mapKd, mapKe; ///< texture files (map_Kd, map_Ke), empty when none
+};
+
+/// The file a texture map statement names ("map_Kd [options] file"): what follows the options
+/// the MTL format defines, each with its number of values, so that a name with spaces stays
+/// whole; the last word when an option is unknown. Back slashes become slashes; a relative
+/// name is relative to the MTL file's folder. Empty when the statement names no file.
+std::string mtlMapFile(const std::string& rest, const std::filesystem::path& folder)
+{
+  // Option -> how many values it takes; 0: one to three numbers (-o, -s, -t: u [v [w]]).
+  static const std::map<std::string, int> options = { { "-blendu", 1 }, { "-blendv", 1 }, { "-bm", 1 },
+    { "-boost", 1 }, { "-cc", 1 }, { "-clamp", 1 }, { "-imfchan", 1 }, { "-mm", 2 }, { "-o", 0 },
+    { "-s", 0 }, { "-t", 0 }, { "-texres", 1 }, { "-type", 1 } };
+  std::vector<std::pair<std::size_t, std::size_t>> spans; // each word's start and length
+  for (std::size_t at = rest.find_first_not_of(" \t"); at != std::string::npos;)
+  {
+    const std::size_t end = std::min(rest.find_first_of(" \t", at), rest.size());
+    spans.emplace_back(at, end - at);
+    at = rest.find_first_not_of(" \t", end);
+  }
+  auto word = [&](std::size_t i) { return rest.substr(spans[i].first, spans[i].second); };
+  std::size_t i = 0;
+  // The last word is always the file (or part of it), never an option's value.
+  while (i + 1 < spans.size() && word(i).size() > 1 && word(i)[0] == '-')
+  {
+    const auto option = options.find(word(i));
+    if (option == options.end())
+    {
+      i = spans.size() - 1;
+      break;
+    }
+    ++i;
+    double number = 0;
+    for (int taken = 0; i + 1 < spans.size() && (option->second == 0 ? taken < 3 && parseNumber(word(i), number)
+                                                                      : taken < option->second);
+         ++taken)
+    {
+      ++i;
+    }
+  }
+  if (i >= spans.size())
+  {
+    return {};
+  }
+  std::string name = trim(rest.substr(spans[i].first));
+  std::replace(name.begin(), name.end(), '\\', '/');
+  return (folder / name).string();
+}
+
+/// "r [g b]" as MTL colour statements write it (g and b default to r).
+bool parseMtlColour(const std::string& rest, std::array<double, 3>& rgb)
+{
+  const auto parts = words(rest);
+  if (parts.empty() || parts.size() > 3 || parts.size() == 2)
+  {
+    return false;
+  }
+  for (std::size_t i = 0; i < parts.size(); ++i)
+  {
+    if (!parseNumber(parts[i], rgb[i]))
+    {
+      return false;
+    }
+  }
+  if (parts.size() == 1)
+  {
+    rgb[1] = rgb[2] = rgb[0];
+  }
+  return true;
+}
+
+/// The materials of an MTL file by name; the first definition of a name wins.
+std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::string& objPath, const Warn& warn)
+{
+  std::ifstream in = openFile(path, "material library");
+  std::map<std::string, MtlMaterial> materials;
+  LogicalLines lines(in);
+  std::string line, keyword, rest;
+  MtlMaterial* current = nullptr;
+  std::set<std::string> repeated;
+  while (lines.next(line))
+  {
+    splitKeyword(line, keyword, rest);
+    const std::string where = "the material library " + named(path) + " of the OBJ file " + named(objPath) +
+      ", line " + std::to_string(lines.number());
+    if (keyword == "newmtl")
+    {
+      if (rest.empty())
+      {
+        throw FileError(where + ": 'newmtl' without a material name");
+      }
+      const bool known = materials.count(rest) != 0;
+      if (known && repeated.insert(rest).second)
+      {
+        warn(where + ": material " + named(rest) + " is defined again; its first definition is used");
+      }
+      current = known ? nullptr : &materials[rest];
+    }
+    else if ((keyword == "map_Kd" || keyword == "map_Ke") && current)
+    {
+      const std::string file = mtlMapFile(rest, std::filesystem::path(path).parent_path());
+      if (file.empty())
+      {
+        warn(where + ": '" + keyword + "' names no file; it is ignored");
+        continue;
+      }
+      (keyword == "map_Kd" ? current->mapKd : current->mapKe) = file;
+    }
+    else if ((keyword == "Kd" || keyword == "Ke") && current)
+    {
+      std::array<double, 3> rgb{};
+      if (!parseMtlColour(rest, rgb))
+      {
+        if (rest.rfind("spectral", 0) == 0 || rest.rfind("xyz", 0) == 0)
+        {
+          warn(where + ": '" + keyword + " " + printable(rest) + "' (spectral or CIE XYZ colours) is not supported; " +
+            (keyword == "Kd" ? "the material is grey" : "the material does not emit"));
+          continue;
+        }
+        throw FileError(where + ": '" + keyword + " " + printable(rest) + "' is not a colour (1 or 3 finite numbers)");
+      }
+      (keyword == "Kd" ? current->kd : current->ke) = rgb;
+    }
+  }
+  if (in.bad())
+  {
+    throw FileError("the material library " + named(path) + " could not be read to its end");
+  }
+  return materials;
+}
+
+/// The material library files an mtllib line names: the whole rest of the line when that is a
+/// file (names with spaces), else each word.
+std::vector<std::string> mtllibFiles(const std::string& rest, const std::filesystem::path& folder)
+{
+  std::error_code error;
+  const auto whole = folder / rest;
+  if (std::filesystem::is_regular_file(whole, error))
+  {
+    return { whole.string() };
+  }
+  std::vector<std::string> files;
+  for (const auto& word : words(rest))
+  {
+    files.push_back((folder / word).string());
+  }
+  return files;
+}
+} // namespace
+
+Scene readObj(const std::string& path, const Warn& warn, const Progress& progress)
+{
+  std::ifstream in = openFile(path, "OBJ file");
+  const std::uintmax_t size = std::max<std::uintmax_t>(1, fileSize(path));
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  ProgressPoll poll(progress, 0.0, 0.9);
+
+  std::vector<double> coordinates;
+  std::vector<long long> faceVertices;      // resolved, 0-based, checked at the end
+  std::vector<std::size_t> faceStart, faceLine;
+  std::vector<int> faceMaterial;
+  std::vector<std::string> usedMaterials;   // in order of first use
+  std::map<std::string, int> materialIds;
+  std::vector<std::pair<std::string, std::size_t>> libraries; // file, line of its mtllib
+  int currentMaterial = -1;
+  std::size_t skippedPoints = 0, skippedLines = 0;
+
+  auto materialId = [&](const std::string& name) {
+    const auto found = materialIds.find(name);
+    if (found != materialIds.end())
+    {
+      return found->second;
+    }
+    usedMaterials.push_back(name);
+    return materialIds[name] = static_cast<int>(usedMaterials.size() - 1);
+  };
+
+  LogicalLines lines(in);
+  std::string line, keyword, rest;
+  while (lines.next(line))
+  {
+    if (lines.number() % 65536 == 0)
+    {
+      poll(static_cast<double>(lines.position()) / static_cast<double>(size));
+    }
+    splitKeyword(line, keyword, rest);
+    auto where = [&]() { return "the OBJ file " + named(path) + ", line " + std::to_string(lines.number()); };
+    if (keyword == "v")
+    {
+      const auto parts = words(rest);
+      double xyz[3];
+      if (parts.size() < 3 || !parseNumber(parts[0], xyz[0]) || !parseNumber(parts[1], xyz[1]) ||
+        !parseNumber(parts[2], xyz[2]))
+      {
+        throw FileError(where() + ": 'v " + printable(rest) + "' is not a vertex (3 finite numbers x y z)");
+      }
+      coordinates.insert(coordinates.end(), xyz, xyz + 3);
+    }
+    else if (keyword == "f")
+    {
+      const auto references = words(rest);
+      if (references.size() < 3)
+      {
+        throw FileError(where() + ": a face needs at least 3 vertices, 'f " + printable(rest) + "' has " +
+          std::to_string(references.size()));
+      }
+      const long long defined = static_cast<long long>(coordinates.size() / 3);
+      faceStart.push_back(faceVertices.size());
+      faceLine.push_back(lines.number());
+      for (const auto& reference : references)
+      {
+        // v, v/vt, v/vt/vn or v//vn: only the vertex matters here.
+        const std::string vertex = reference.substr(0, reference.find('/'));
+        long long index = 0;
+        if (!parseInteger(vertex, index) || index == 0 ||
+          std::count(reference.begin(), reference.end(), '/') > 2)
+        {
+          throw FileError(where() + ": '" + printable(reference) +
+            "' is not a vertex reference (v, v/vt, v/vt/vn or v//vn, v a non-zero whole number)");
+        }
+        if (index < 0 && -index > defined)
+        {
+          throw FileError(where() + ": '" + printable(reference) + "' names vertex " + std::to_string(index) +
+            " but only " + std::to_string(defined) + " vertices are defined before it");
+        }
+        faceVertices.push_back(index < 0 ? defined + index : index - 1);
+      }
+      if (currentMaterial < 0)
+      {
+        currentMaterial = materialId("none");
+      }
+      faceMaterial.push_back(currentMaterial);
+    }
+    else if (keyword == "usemtl")
+    {
+      if (rest.empty())
+      {
+        throw FileError(where() + ": 'usemtl' without a material name");
+      }
+      currentMaterial = materialId(rest);
+    }
+    else if (keyword == "mtllib")
+    {
+      if (rest.empty())
+      {
+        throw FileError(where() + ": 'mtllib' without a file name");
+      }
+      for (const auto& file : mtllibFiles(rest, folder))
+      {
+        libraries.emplace_back(file, lines.number());
+      }
+    }
+    else if (keyword == "p")
+    {
+      ++skippedPoints;
+    }
+    else if (keyword == "l")
+    {
+      ++skippedLines;
+    }
+  }
+  if (in.bad())
+  {
+    throw FileError("the OBJ file " + named(path) + " could not be read to its end");
+  }
+  if (faceStart.empty())
+  {
+    throw FileError("the OBJ file " + named(path) + " has no faces ('f' lines): there is no surface to light");
+  }
+  const long long vertexCount = static_cast<long long>(coordinates.size() / 3);
+  for (std::size_t f = 0; f < faceStart.size(); ++f)
+  {
+    const std::size_t end = f + 1 < faceStart.size() ? faceStart[f + 1] : faceVertices.size();
+    for (std::size_t k = faceStart[f]; k < end; ++k)
+    {
+      if (faceVertices[k] >= vertexCount)
+      {
+        throw FileError("the OBJ file " + named(path) + ", line " + std::to_string(faceLine[f]) +
+          ": a face names vertex " + std::to_string(faceVertices[k] + 1) + " but the file defines " +
+          std::to_string(vertexCount) + " ('v' lines)");
+      }
+    }
+  }
+  if (skippedPoints + skippedLines > 0)
+  {
+    warn("the OBJ file " + named(path) + " has " + std::to_string(skippedPoints) + " point ('p') and " +
+      std::to_string(skippedLines) + " line ('l') elements: they are skipped, only faces are surfaces");
+  }
+
+  // Materials: Kd and Ke from the libraries.
+  std::map<std::string, MtlMaterial> library;
+  bool allLibrariesRead = !libraries.empty();
+  for (const auto& [file, lineNumber] : libraries)
+  {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(file, error))
+    {
+      allLibrariesRead = false;
+      warn("the material library " + named(file) + " named by the OBJ file " + named(path) + " (line " +
+        std::to_string(lineNumber) + ") does not exist: its materials are grey 0.5 and do not emit");
+      continue;
+    }
+    for (auto& [name, material] : readMtl(file, path, warn))
+    {
+      library.emplace(name, material);
+    }
+  }
+  if (libraries.empty())
+  {
+    warn("the OBJ file " + named(path) + " names no material library ('mtllib' line): every surface is grey 0.5");
+  }
+
+  // A map multiplies its colour by the texture's mean (each file decoded once); a texture that
+  // cannot be used is a warning and the colour alone stays.
+  std::map<std::string, std::pair<std::optional<std::array<double, 3>>, std::string>> textureMeans;
+  auto applyMap = [&](const std::string& file, const char* keyword, const std::string& what,
+                    std::optional<std::array<double, 3>>& colour) {
+    auto found = textureMeans.find(file);
+    if (found == textureMeans.end())
+    {
+      std::string bytes, problem;
+      std::optional<std::array<double, 3>> mean;
+      if (readTextureFile(file, bytes, problem))
+      {
+        mean = imageMean(bytes, problem);
+      }
+      found = textureMeans.emplace(file, std::make_pair(mean, problem)).first;
+    }
+    const auto& [mean, problem] = found->second;
+    if (!mean)
+    {
+      warn("the " + what + ": its " + keyword + " texture " + named(file) + ": " + problem + ", so " +
+        (keyword[5] == 'd' ? "Kd" : "Ke") + " alone is used");
+      return;
+    }
+    std::array<double, 3> product = colour.value_or(std::array<double, 3>{ { 1, 1, 1 } });
+    for (std::size_t c = 0; c < 3; ++c)
+    {
+      product[c] *= (*mean)[c];
+    }
+    colour = product;
+  };
+
+  Scene scene;
+  scene.format = "OBJ";
+  for (const auto& name : usedMaterials)
+  {
+    Material material;
+    material.name = name;
+    const auto found = library.find(name);
+    const std::string what = "material " + named(name) + " of " + named(path);
+    if (found != library.end())
+    {
+      // map_Kd without Kd: the texture alone is the colour (Kd 1), as viewers show it.
+      std::optional<std::array<double, 3>> kd = found->second.kd;
+      if (!found->second.mapKd.empty())
+      {
+        applyMap(found->second.mapKd, "map_Kd", what, kd);
+      }
+      if (kd)
+      {
+        material.reflectance = checkedReflectance(*kd, "the " + what, warn);
+      }
+      else
+      {
+        warn("the " + what + " has no Kd: it is grey 0.5");
+      }
+      if (found->second.ke)
+      {
+        material.radiance = *found->second.ke;
+        for (double value : material.radiance)
+        {
+          if (value < 0)
+          {
+            throw FileError("the " + what + " has a negative Ke: emission must be 0 or more");
+          }
+        }
+        // map_Ke scales an emission Ke gives (as glTF's emissive texture its factor): without
+        // Ke, or with Ke 0, the material does not emit and the texture is not read.
+        if (!found->second.mapKe.empty() && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
+        {
+          std::optional<std::array<double, 3>> ke = material.radiance;
+          applyMap(found->second.mapKe, "map_Ke", what, ke);
+          material.radiance = *ke;
+        }
+      }
+    }
+    else if (allLibrariesRead && name != "none")
+    {
+      warn("the " + what + " is not defined in its material libraries: it is grey 0.5");
+    }
+    else if (name == "none" && !libraries.empty())
+    {
+      warn("the OBJ file " + named(path) + " has faces before any 'usemtl': their material 'none' is grey 0.5");
+    }
+    scene.materials.push_back(material);
+  }
+
+  scene.points = vtkSmartPointer<vtkPoints>::New();
+  scene.points->SetDataTypeToDouble();
+  scene.points->SetNumberOfPoints(vertexCount);
+  for (long long i = 0; i < vertexCount; ++i)
+  {
+    scene.points->SetPoint(i, &coordinates[3 * i]);
+  }
+  scene.polygons = vtkSmartPointer<vtkCellArray>::New();
+  scene.polygons->AllocateExact(static_cast<vtkIdType>(faceStart.size()), static_cast<vtkIdType>(faceVertices.size()));
+  std::vector<vtkIdType> ids;
+  for (std::size_t f = 0; f < faceStart.size(); ++f)
+  {
+    const std::size_t end = f + 1 < faceStart.size() ? faceStart[f + 1] : faceVertices.size();
+    ids.assign(faceVertices.begin() + static_cast<std::ptrdiff_t>(faceStart[f]),
+      faceVertices.begin() + static_cast<std::ptrdiff_t>(end));
+    scene.polygons->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+  }
+  scene.materialOfCell = std::move(faceMaterial);
+  poll(1.0);
+  return scene;
+}
+
+} // namespace mlr::scenefile
