@@ -465,7 +465,9 @@ std::string helpText()
 Computes the radiosity of a scene lit by a light that moves along a path, all light
 positions at once with reuse of paths, and writes the animation as a .pvd + .vtu series
 (one unstructured grid per frame with the cell arrays Radiosity, DirectRadiosity,
-IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Reflectance and PatchId).
+IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Reflectance, PatchId and
+Color, the display colour, and the point arrays Radiosity, Color and ScenePointId on points
+split along creases for smooth shading).
 
 Without any option it runs the built-in example: the Cornell box with its ceiling light
 moving through 30 positions along a diagonal just below the ceiling, and writes
@@ -531,8 +533,10 @@ Output:
   --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)
   --stats FILE.json     also write the options, times and solver statistics as JSON
-  --png DIR             also render one picture per frame into DIR (needs an X display;
-                        without DISPLAY the program starts a private Xvfb)
+  --png DIR             also render one picture per frame into DIR, as ParaView shows the
+                        frame: the point array Color, unlit, and the light where it is in
+                        that frame (needs an X display; without DISPLAY the program starts
+                        a private Xvfb)
   --help                show this text
 
 Files are written under temporary names and renamed once all are complete: a failure

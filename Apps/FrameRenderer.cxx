@@ -2,22 +2,13 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
-#include "vtkCellArray.h"
-#include "vtkCellData.h"
-#include "vtkCellDataToPointData.h"
-#include "vtkDataArray.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
-#include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
-#include "vtkPolyDataNormals.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
-#include "vtkSmartPointer.h"
-#include "vtkUnsignedCharArray.h"
 #include "vtkWindowToImageFilter.h"
 
 #include <algorithm>
@@ -35,7 +26,6 @@
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <vector>
 
 namespace mlr::cli
 {
@@ -45,33 +35,24 @@ namespace
 constexpr int PictureSize = 640;
 /// The Cornell box camera's field of view: a 25 mm film at 35 mm focal length.
 constexpr double ViewAngleDegrees = 39.3;
-
-double luminance(const double rgb[3])
-{
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-}
+/// The plugin's Light representation (Plugin/MovingLightRadiosity.xml): the same lamp in
+/// ParaView and in the pictures.
+constexpr double LightColor[3] = { 1.0, 0.85, 0.2 };
 }
 
 struct FrameRenderer::Pipeline
 {
   vtkNew<vtkRenderWindow> window;
   vtkNew<vtkRenderer> renderer;
-  vtkNew<vtkPolyData> scene;
-  vtkNew<vtkPolyDataNormals> creases;
-  // The element mesh split along its creases, computed once: it is the same in every frame.
-  vtkNew<vtkPolyData> split;
-  vtkSmartPointer<vtkPoints> splitPoints; // held: a new mesh cannot take their addresses
-  vtkSmartPointer<vtkCellArray> splitPolys;
-  vtkNew<vtkPolyData> frame; ///< `split` with the frame's Radiosity
-  vtkNew<vtkCellDataToPointData> smooth;
-  vtkNew<vtkPolyData> shown;
-  vtkNew<vtkPolyDataMapper> sceneMapper;
-  vtkNew<vtkActor> sceneActor;
+  vtkNew<vtkPolyData> elements; ///< the frame's Elements, shallow copies
+  vtkNew<vtkPolyData> light;    ///< the frame's Light
+  vtkNew<vtkPolyDataMapper> elementsMapper;
+  vtkNew<vtkPolyDataMapper> lightMapper;
+  vtkNew<vtkActor> elementsActor;
   vtkNew<vtkActor> lightActor;
-  double exposure = 1.0;
 };
 
-FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6], const double* up)
+FrameRenderer::FrameRenderer(const double bounds[6], const double* up)
   : Internals(new Pipeline)
 {
   Pipeline& p = *this->Internals;
@@ -81,36 +62,23 @@ FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6], const d
   p.window->AddRenderer(p.renderer);
   p.renderer->SetBackground(0, 0, 0);
 
-  // Radiosity is smooth within a surface but jumps at its creases (a wall meets the floor):
-  // split the points along creases, then average the cells' radiosity at the points, which
-  // also softens the Monte Carlo noise of single elements.
-  p.creases->SetInputData(p.scene);
-  p.creases->SplittingOn();
-  p.creases->SetFeatureAngle(30);
-  p.creases->ConsistencyOff();
-  p.creases->AutoOrientNormalsOff();
-  p.creases->ComputeCellNormalsOff();
-  p.creases->ComputePointNormalsOff();
-  p.smooth->SetInputData(p.frame);
-  p.smooth->ProcessAllArraysOff();
-  p.smooth->AddCellDataArray("Radiosity");
-  p.sceneMapper->SetInputData(p.shown);
-  p.sceneMapper->SetScalarModeToUsePointData();
-  p.sceneMapper->SetColorModeToDirectScalars();
-  p.sceneActor->SetMapper(p.sceneMapper);
-  p.sceneActor->GetProperty()->LightingOff();
-  p.renderer->AddActor(p.sceneActor);
+  // The colours already are the lighting: shown as they are, unlit, as ParaView's Elements
+  // representation shows them (Map Scalars off).
+  p.elementsMapper->SetInputData(p.elements);
+  p.elementsMapper->SetScalarModeToUsePointFieldData();
+  p.elementsMapper->SelectColorArray("Color");
+  p.elementsMapper->SetColorModeToDirectScalars();
+  p.elementsMapper->ScalarVisibilityOn();
+  p.elementsActor->SetMapper(p.elementsMapper);
+  p.elementsActor->GetProperty()->LightingOff();
+  p.renderer->AddActor(p.elementsActor);
 
-  if (light) // none when the scene's own surfaces emit
-  {
-    vtkNew<vtkPolyDataMapper> lightMapper;
-    lightMapper->SetInputData(light);
-    lightMapper->ScalarVisibilityOff();
-    p.lightActor->SetMapper(lightMapper);
-    p.lightActor->GetProperty()->SetColor(1, 1, 1);
-    p.lightActor->GetProperty()->LightingOff();
-    p.renderer->AddActor(p.lightActor);
-  }
+  p.lightMapper->SetInputData(p.light);
+  p.lightMapper->ScalarVisibilityOff();
+  p.lightActor->SetMapper(p.lightMapper);
+  p.lightActor->GetProperty()->SetColor(LightColor[0], LightColor[1], LightColor[2]);
+  p.lightActor->GetProperty()->LightingOff();
+  p.renderer->AddActor(p.lightActor);
 
   // Look along +z at the bounding box, from far enough for its front face to fill the view.
   const double centre[3] = { 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),
@@ -155,73 +123,12 @@ FrameRenderer::FrameRenderer(vtkPolyData* light, const double bounds[6], const d
 
 FrameRenderer::~FrameRenderer() = default;
 
-double FrameRenderer::brightLevel(vtkPolyData* elements)
-{
-  vtkDataArray* radiosity = elements->GetCellData()->GetArray("Radiosity");
-  if (!radiosity || radiosity->GetNumberOfTuples() == 0)
-  {
-    return 0.0;
-  }
-  std::vector<double> values(static_cast<std::size_t>(radiosity->GetNumberOfTuples()));
-  for (vtkIdType i = 0; i < radiosity->GetNumberOfTuples(); ++i)
-  {
-    values[static_cast<std::size_t>(i)] = luminance(radiosity->GetTuple3(i));
-  }
-  const auto rank = values.begin() + static_cast<long>(0.99 * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), rank, values.end());
-  return *rank;
-}
-
-void FrameRenderer::setBrightLevel(double radiosity)
-{
-  // 1 - exp(-2) = 0.86: the bright level lands just below white and brighter spots
-  // (the hot spot under the light) still show some gradation instead of clipping.
-  this->Internals->exposure = radiosity > 0 ? 2.0 / radiosity : 1.0;
-}
-
 void FrameRenderer::render(
-  vtkPolyData* elements, const double lightTranslation[3], const std::filesystem::path& png)
+  vtkPolyData* elements, vtkPolyData* light, const std::filesystem::path& png)
 {
   Pipeline& p = *this->Internals;
-  if (elements->GetPoints() != p.splitPoints || elements->GetPolys() != p.splitPolys ||
-    p.split->GetNumberOfCells() != elements->GetNumberOfCells())
-  {
-    // Splitting keeps the cells (all triangles) in their order: the frame's cell data fits.
-    p.scene->CopyStructure(elements);
-    p.creases->Update();
-    p.split->CopyStructure(p.creases->GetOutput());
-    p.splitPoints = elements->GetPoints();
-    p.splitPolys = elements->GetPolys();
-  }
-  p.frame->CopyStructure(p.split);
-  p.frame->GetCellData()->Initialize();
-  if (vtkDataArray* cellRadiosity = elements->GetCellData()->GetArray("Radiosity"))
-  {
-    p.frame->GetCellData()->AddArray(cellRadiosity);
-  }
-  p.smooth->Update();
-  p.shown->ShallowCopy(p.smooth->GetOutput());
-  vtkDataArray* radiosity = p.shown->GetPointData()->GetArray("Radiosity");
-  const vtkIdType points = p.shown->GetNumberOfPoints();
-  vtkNew<vtkUnsignedCharArray> colours;
-  colours->SetNumberOfComponents(3);
-  colours->SetNumberOfTuples(points);
-  for (vtkIdType i = 0; i < points; ++i)
-  {
-    double rgb[3] = { 0, 0, 0 };
-    if (radiosity)
-    {
-      radiosity->GetTuple(i, rgb);
-    }
-    for (int c = 0; c < 3; ++c)
-    {
-      const double mapped = 1.0 - std::exp(-p.exposure * std::max(rgb[c], 0.0));
-      colours->SetTypedComponent(
-        i, c, static_cast<unsigned char>(std::lround(255.0 * std::pow(mapped, 1.0 / 2.2))));
-    }
-  }
-  p.shown->GetPointData()->SetScalars(colours);
-  p.lightActor->SetPosition(lightTranslation[0], lightTranslation[1], lightTranslation[2]);
+  p.elements->ShallowCopy(elements);
+  p.light->ShallowCopy(light);
   p.renderer->ResetCameraClippingRange();
   p.window->Render();
 

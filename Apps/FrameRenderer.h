@@ -12,36 +12,27 @@ namespace mlr::cli
 {
 
 /**
- * Renders the filter's Elements output as seen by a fixed camera on the -z side looking
- * along +z (y up), framing the front of the scene's bounding box like the Cornell box camera.
- * Surfaces are unlit: the radiosity of a diffuse surface is what the eye sees, interpolated
- * between elements within each smooth surface and mapped to colour with one exposure for the
- * whole animation so that frames compare. The light is drawn
- * white at its position in the frame. Needs an X display (ParaView's VTK renders with GLX).
+ * Draws the filter's outputs as seen by a fixed camera on the -z side looking along +z (y up),
+ * framing the front of the scene's bounding box like the Cornell box camera, as ParaView shows
+ * them on Apply: the Elements coloured by their point array `Color` as it is (the filter's
+ * exposure, tone curve and smooth-shading points), unlit, and the Light output's polygons
+ * where the filter posed them, in the plugin's unlit yellow. Needs an X display (ParaView's VTK
+ * renders with GLX).
  */
 class FrameRenderer
 {
 public:
-  /// `light` is the Light input (none when the scene's own surfaces emit); `bounds` those of
-  /// the scene.
-  /// With `up` (the zenith of a scene lit by the sun), an aerial view instead: from above a
-  /// corner of the bounding box, looking at its centre, `up` pointing up in the picture.
-  FrameRenderer(vtkPolyData* light, const double bounds[6], const double* up = nullptr);
+  /// `bounds` are those of the scene. With `up` (the zenith of a scene lit by the sun), an
+  /// aerial view instead: from above a corner of the bounding box, looking at its centre, `up`
+  /// pointing up in the picture.
+  explicit FrameRenderer(const double bounds[6], const double* up = nullptr);
   ~FrameRenderer();
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;
 
-  /// A bright but not extreme radiosity of the frame (W/m^2): the 99th percentile of the
-  /// luminance of `Radiosity` over its cells.
-  static double brightLevel(vtkPolyData* elements);
-
-  /// Maps `brightLevel` (the largest over all frames) to near white.
-  void setBrightLevel(double radiosity);
-
-  /// Renders one frame, the light moved by `lightTranslation`, into a PNG file.
-  /// Throws std::runtime_error when the picture cannot be written.
-  void render(vtkPolyData* elements, const double lightTranslation[3],
-    const std::filesystem::path& png);
+  /// Renders one frame, the filter's Elements and Light outputs of that frame, into a PNG
+  /// file. Throws std::runtime_error when the picture cannot be written.
+  void render(vtkPolyData* elements, vtkPolyData* light, const std::filesystem::path& png);
 
 private:
   struct Pipeline;

@@ -10,6 +10,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkUnsignedCharArray.h"
@@ -186,14 +187,16 @@ void FrameWriter::write(vtkPolyData* elements, double time, const std::filesyste
     cacheRange(this->Polys ? this->Polys->GetOffsetsArray() : nullptr);
     cacheRange(this->CellTypes);
   }
-  Job job{ this->Points, this->Polys, this->CellTypes, vtkSmartPointer<vtkCellData>::New(),
-    vtkSmartPointer<vtkFieldData>::New(), path };
+  Job job{ this->Points, this->Polys, this->CellTypes, vtkSmartPointer<vtkPointData>::New(),
+    vtkSmartPointer<vtkCellData>::New(), vtkSmartPointer<vtkFieldData>::New(), path };
+  job.pointData->ShallowCopy(elements->GetPointData());
   job.cellData->ShallowCopy(elements->GetCellData());
   job.fieldData->ShallowCopy(elements->GetFieldData());
   vtkNew<vtkDoubleArray> timeValue;
   timeValue->SetName("TimeValue");
   timeValue->InsertNextValue(time);
   job.fieldData->AddArray(timeValue);
+  cacheRanges(job.pointData);
   cacheRanges(job.cellData);
   cacheRanges(job.fieldData);
 
@@ -251,6 +254,7 @@ void FrameWriter::work()
         grid->SetPoints(job.points);
         grid->SetCells(job.cellTypes, job.polys);
       }
+      grid->GetPointData()->ShallowCopy(job.pointData);
       grid->GetCellData()->ShallowCopy(job.cellData);
       grid->GetFieldData()->ShallowCopy(job.fieldData);
       writer->SetFileName(job.path.string().c_str());

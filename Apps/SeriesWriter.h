@@ -17,6 +17,7 @@
 class vtkCellArray;
 class vtkCellData;
 class vtkFieldData;
+class vtkPointData;
 class vtkPoints;
 class vtkPolyData;
 class vtkUnsignedCharArray;
@@ -41,10 +42,10 @@ struct SeriesNaming
  * Writes the frames of a series, each the filter's Elements output as an unstructured grid of
  * triangles with its cell, point and field data and a field array TimeValue, LZ4-compressed
  * (VTK's vtkLZ4DataCompressor, which ParaView and VTK's readers read; zlib took as long as the
- * solve). The calling thread takes each frame's cell and field data; background threads, each
- * with one unstructured grid of the element mesh's points and cells (converted once while the
- * filter hands out the same mesh), swap them in, compress and write the frame meanwhile, so
- * that writing overlaps the next frame's update.
+ * solve). The calling thread takes each frame's point, cell and field data; background
+ * threads, each with one unstructured grid of the element mesh's points and cells (converted
+ * once while the filter hands out the same mesh), swap them in, compress and write the frame
+ * meanwhile, so that writing overlaps the next frame's update.
  */
 class FrameWriter
 {
@@ -64,12 +65,13 @@ public:
   void finish();
 
 private:
-  /// One frame: the shared mesh and the frame's own cell and field data.
+  /// One frame: the shared mesh and the frame's own point, cell and field data.
   struct Job
   {
     vtkSmartPointer<vtkPoints> points;
     vtkSmartPointer<vtkCellArray> polys;
     vtkSmartPointer<vtkUnsignedCharArray> cellTypes;
+    vtkSmartPointer<vtkPointData> pointData;
     vtkSmartPointer<vtkCellData> cellData;
     vtkSmartPointer<vtkFieldData> fieldData;
     std::filesystem::path path;

@@ -341,7 +341,6 @@ int run(int argc, char** argv)
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<FrameRecord> records;
-  double brightLevel = 0;
   {
     // Destroyed before `output`: no frame is still being written when a failure rolls back.
     FrameWriter writer(writerThreads());
@@ -354,10 +353,6 @@ int run(int argc, char** argv)
       record.file = naming.frameName(f, ".vtu");
       tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
       writer.write(elements, times[f], output.stage(naming.directory / record.file));
-      if (!options.png.empty())
-      {
-        brightLevel = std::max(brightLevel, FrameRenderer::brightLevel(elements));
-      }
       records.push_back(record);
       bar.show(double(f + 1) / double(times.size()), "writing frames");
     }
@@ -373,16 +368,15 @@ int run(int argc, char** argv)
     const PictureDisplay display; // outlives the renderer's connection to it
     // Scenes lit by the sun get an aerial view, their zenith up.
     const Triple zenith = options.up.value_or(Triple{ 0, 0, 1 });
-    FrameRenderer renderer(light, scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
-    renderer.setBrightLevel(brightLevel);
+    FrameRenderer renderer(scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
     for (std::size_t f = 0; f < times.size(); ++f)
     {
       throwIfInterrupted();
       vtkPolyData* elements = frameAt(filter, times[f]);
-      double translation[3];
-      tripleOf(elements->GetFieldData(), "LightTranslation", translation);
+      // The update of the Elements serves every output port at that time.
+      vtkPolyData* posedLight = filter->GetOutput(vtkMovingLightRadiosity::LIGHT_OUTPUT_PORT);
       records[f].picture = (pictures / naming.frameName(f, ".png")).string();
-      renderer.render(elements, translation, output.stage(records[f].picture));
+      renderer.render(elements, posedLight, output.stage(records[f].picture));
       bar.show(double(f + 1) / double(times.size()), "rendering pictures");
     }
     output.replaceSeries(pictures, naming.framePrefix(), ".png");

@@ -1,6 +1,6 @@
-"""How the command line writes its series and pictures (issue 16): LZ4-compressed frames
-written on background threads read back whole and consistent, --stats times the stages, and
-pictures without DISPLAY come from a private Xvfb that does not outlive the run.
+"""How the command line writes its series and pictures: LZ4-compressed frames written on
+background threads read back whole and consistent, --stats times the stages, and pictures
+without DISPLAY come from a private Xvfb that does not outlive the run.
 
 ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps/test_cli_series.py
@@ -83,6 +83,10 @@ def test_frames_read_back_with_their_times_and_one_mesh(series):
         # Float32 arrays: the sum agrees within a few units in the last place.
         assert numpy.allclose(total, parts, rtol=1e-5, atol=1e-6 * total.max())
         assert cell_data.GetArray("Radiosity").GetDataType() == 10  # VTK_FLOAT, as before
+        # The filter's point data too, what smooth shading and the pictures show.
+        for name in ("Radiosity", "Color", "ScenePointId"):
+            array = grid.GetPointData().GetArray(name)
+            assert array is not None and array.GetNumberOfTuples() == len(points), name
 
 
 def test_header_ranges_are_those_of_the_data(series):
@@ -92,20 +96,29 @@ def test_header_ranges_are_those_of_the_data(series):
     text = (series / "s_0002.vtu").read_bytes().split(b"<AppendedData")[0].decode()
     grid = read_grid(series / "s_0002.vtu")
     checked = 0
-    for match in re.finditer(r'<DataArray [^>]*Name="([^"]+)"[^>]*>', text):
-        tag, name = match.group(0), match.group(1)
+    # Point and cell data both have a Radiosity and a Color: each tag is read in its section.
+    sections = {"PointData": grid.GetPointData(), "CellData": grid.GetCellData(),
+                "FieldData": grid.GetFieldData()}
+    section = None
+    for match in re.finditer(r'<(PointData|CellData|FieldData|Points|Cells)\b|'
+                             r'<DataArray [^>]*Name="([^"]+)"[^>]*>', text):
+        if match.group(1):
+            section = match.group(1)
+            continue
+        tag, name = match.group(0), match.group(2)
         low = re.search(r'RangeMin="([^"]*)"', tag)
         high = re.search(r'RangeMax="([^"]*)"', tag)
         components = int(re.search(r'NumberOfComponents="(\d+)"', tag).group(1)) \
             if "NumberOfComponents" in tag else 1
-        array = (grid.GetCellData().GetArray(name) or grid.GetFieldData().GetArray(name)
-                 or (grid.GetPoints().GetData() if name == "Points" else None))
+        array = grid.GetPoints().GetData() if section == "Points" else (
+            sections[section].GetArray(name) if section in sections else None)
         if array is None or not low or not low.group(1):
             continue
         expected = array.GetRange(-1 if components > 1 else 0)
-        assert (float(low.group(1)), float(high.group(1))) == pytest.approx(expected, rel=1e-9), name
+        assert (float(low.group(1)), float(high.group(1))) == pytest.approx(expected, rel=1e-9), \
+            (section, name)
         checked += 1
-    assert checked >= 10
+    assert checked >= 14  # with the point data's Radiosity, Color and ScenePointId
 
 
 def test_stats_time_the_stages(series):
