@@ -142,7 +142,7 @@ def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, mess
     assert all_files(tmp_path) == []
 
 
-# The syntax CLI11 parses (issue 16), each line as given: no --output is appended.
+# The syntax CLI11 parses, each line as given: no --output is appended.
 @pytest.mark.parametrize("args, message", [
     (["--paths=many"], "--paths needs a whole number, not 'many'"),
     (["--bogus=3"], "unknown option --bogus"),

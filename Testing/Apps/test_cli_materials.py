@@ -1,4 +1,4 @@
-"""Scene files with materials on the command line (issue 13): the Cornell box OBJ+MTL of Data/
+"""Scene files with materials on the command line: the Cornell box OBJ+MTL of Data/
 brings its colours and its lamp, and --light-material moves the lamp.
 
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:

@@ -1,4 +1,4 @@
-"""The command line's light rigs and sun (issues 12 and 14): --sun-path, --sun-directions,
+"""The command line's light rigs and sun: --sun-path, --sun-directions,
 --sun-irradiance, --aim, the trajectory's Normal, Orientation and Power arrays, several lights
 (LightId, LightPower), emissive scene surfaces (Emission), and the bad inputs of both issues.
 
