@@ -297,7 +297,8 @@ TEST(RayTracer, VisibilityOfSegmentsAndDirections)
   std::vector<int> expected;
   while (dx.size() < 53)
   {
-    const Vec3 target(-0.2 + 1.4 * random.uniform(), -0.2 + 1.4 * random.uniform(), -0.3 + 1.3 * random.uniform());
+    const Vec3 target(
+      -0.2 + 1.4 * random.uniform(), -0.2 + 1.4 * random.uniform(), -0.3 + 1.3 * random.uniform());
     const Vec3 d = target - origin;
     bool ambiguous = false;
     const bool blocked = analyticallyBlocked(origin, d, ambiguous);

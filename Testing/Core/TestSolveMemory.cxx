@@ -223,7 +223,8 @@ namespace
 {
 /// Bytes FixedPointAccumulator adds to its two buffers by rounding each up to whole 2 MiB
 /// pages, which planSolveMemory leaves out (see DISABLED_ below).
-std::uint64_t accumulatorPageRounding(const MemoryPlan& plan, int threads, std::size_t records, std::size_t frames)
+std::uint64_t accumulatorPageRounding(
+  const MemoryPlan& plan, int threads, std::size_t records, std::size_t frames)
 {
   const int copies = plan.accumulatorCopyPerWorker ? threads : 1;
   const std::uint64_t page = std::uint64_t(2) << 20;

@@ -249,9 +249,10 @@ TEST(FilterTime, PredictedSpeedupIsEquationFourOfTheSolve)
   vtkPolyData* elements = filter->GetOutput(0);
   const double n = fieldValue(elements, "Frames"), l = fieldValue(elements, "MeanPathLength");
   ASSERT_EQ(n, 2);
-  EXPECT_GT(l, 1.5) << "walks in a closed box of reflectance 0.5 average two hits or more";
+  EXPECT_GT(l, 1.5) << "walks in a closed box of reflectance 0.5 average about two hits";
   const double walk = 0.6 * (l - 1);
-  EXPECT_NEAR(fieldValue(elements, "PredictedSpeedup"), (2 * (1 + walk) + 0.5 * 2) / (2 + walk + 0.5), 1e-12);
+  EXPECT_NEAR(fieldValue(elements, "PredictedSpeedup"),
+    (2 * (1 + walk) + 0.5 * 2) / (2 + walk + 0.5), 1e-12);
 }
 
 TEST(FilterTime, OutputsCarryTheDocumentedArrays)
