@@ -237,6 +237,24 @@ TEST(FilterTime, ChangingAPropertyOrAnInputSolvesAgain)
   EXPECT_EQ(filter->GetSolveCount(), 4);
 }
 
+TEST(FilterTime, PredictedSpeedupIsEquationFourOfTheSolve)
+{
+  // n (1 + lambda (l - 1)) + k n over n + lambda (l - 1) + k, for the solve's own n frames,
+  // k and lambda and the l it measured: not the defaults, and not another solve's.
+  BoxSetup setup = closedBoxSetup(2);
+  auto filter = fastFilter(setup);
+  filter->SetGatheringRatio(0.5);
+  filter->SetFirstBounceSurvival(0.6);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  vtkPolyData* elements = filter->GetOutput(0);
+  const double n = fieldValue(elements, "Frames"), l = fieldValue(elements, "MeanPathLength");
+  ASSERT_EQ(n, 2);
+  EXPECT_GT(l, 1.5) << "walks in a closed box of reflectance 0.5 average about two hits";
+  const double walk = 0.6 * (l - 1);
+  EXPECT_NEAR(fieldValue(elements, "PredictedSpeedup"),
+    (2 * (1 + walk) + 0.5 * 2) / (2 + walk + 0.5), 1e-12);
+}
+
 TEST(FilterTime, OutputsCarryTheDocumentedArrays)
 {
   BoxSetup setup = closedBoxSetup(2);
