@@ -59,7 +59,7 @@ struct SolverStatistics
  * B_total = E + B_direct + B_indirect for elements, E the self-emission of the front side.
  * B_direct comes from the shooting walks' first hits (from every light and emitter);
  * B_indirect from final gathering of the patches' shooting solution. Both sides are kept;
- * litSide() picks the one to show.
+ * litSide() and patchLitSide() pick the one to show, chosen once when the solve ends.
  */
 class Solution
 {
