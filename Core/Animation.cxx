@@ -1,8 +1,6 @@
 #include "Animation.h"
 
-#include "Error.h"
-
-#include <sstream>
+#include "MemoryBudget.h"
 
 namespace mlr
 {
@@ -14,29 +12,9 @@ constexpr double RemeshingShare = 0.05;
 
 std::uint64_t outputBytes(const AnimationOptions& options, std::size_t elements, std::size_t points)
 {
-  const auto product = [](std::uint64_t a, std::uint64_t b) {
-    std::uint64_t p = 0;
-    return __builtin_mul_overflow(a, b, &p) ? UINT64_MAX : p;
-  };
-  return saturatingSum(product(options.outputBytesPerElement, elements),
-    product(options.outputBytesPerPoint, points));
+  return saturatingSum(saturatingProduct(options.outputBytesPerElement, elements),
+    saturatingProduct(options.outputBytesPerPoint, points));
 }
-}
-
-void checkMemory(std::uint64_t bytes, std::uint64_t limitBytes, const std::string& what,
-  const std::string& advice)
-{
-  const std::uint64_t limit = limitBytes > 0 ? limitBytes : defaultMemoryLimitBytes();
-  if (bytes <= limit)
-  {
-    return;
-  }
-  std::ostringstream s;
-  s.precision(3);
-  s << what << " needs an estimated " << static_cast<double>(bytes) / (1 << 30)
-    << " GiB, over the memory limit of " << static_cast<double>(limit) / (1 << 30)
-    << " GiB: " << advice << ", or raise the limit";
-  throw Error(s.str());
 }
 
 Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,

@@ -45,9 +45,4 @@ struct Animation
 Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const AnimationOptions& options, const ProgressCallback& progress = {});
 
-/// Throws mlr::Error when `bytes` exceed the memory limit (0: the default), saying what they
-/// are for and what to reduce.
-void checkMemory(std::uint64_t bytes, std::uint64_t limitBytes, const std::string& what,
-  const std::string& advice);
-
 } // namespace mlr

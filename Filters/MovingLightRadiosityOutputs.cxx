@@ -153,18 +153,10 @@ void addElementRadiosity(
 
 std::vector<Side> patchLitSides(const Solution& solution)
 {
-  // The patch radiosity is rho/A times the power a side received, so the side with the
-  // larger sum over frames and channels is the one that received more power.
   std::vector<Side> sides(solution.patchCount(), Side::Front);
   for (std::size_t p = 0; p < solution.patchCount(); ++p)
   {
-    double front = 0, back = 0;
-    for (std::size_t f = 0; f < solution.frameCount(); ++f)
-    {
-      front += solution.patchRadiosity(f, p, Side::Front).sum();
-      back += solution.patchRadiosity(f, p, Side::Back).sum();
-    }
-    sides[p] = back > front ? Side::Back : Side::Front;
+    sides[p] = solution.patchLitSide(p);
   }
   return sides;
 }

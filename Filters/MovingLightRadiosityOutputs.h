@@ -36,8 +36,8 @@ vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCou
 void addElementRadiosity(
   const Solution& solution, std::size_t frame, bool twoSided, vtkCellData* cellData);
 
-/// The side of each patch that received more power over the animation (the patch-level
-/// counterpart of Solution::litSide).
+/// The side of each patch that received more power over the animation, as the solve chose
+/// it (Solution::patchLitSide), for every patch.
 std::vector<Side> patchLitSides(const Solution& solution);
 
 /// Adds `Radiosity`, the patch shooting solution of each patch's lit side in `frame`.

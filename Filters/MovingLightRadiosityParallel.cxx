@@ -361,16 +361,15 @@ void shareSolve(vtkMultiProcessController* controller, SolverOptions& options)
 Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
   const std::string& message, std::uint64_t digest)
 {
-  // Flags, and the digest as its low and high halves, negated for the minimum.
-  const long long low = static_cast<long long>(digest & 0xffffffffULL);
-  const long long high = static_cast<long long>(digest >> 32);
-  const long long mine[6] = { failed ? 1 : 0, cancelled ? 1 : 0, low, high, -low, -high };
-  long long all[6] = { 0, 0, 0, 0, 0, 0 };
-  controller->AllReduce(mine, all, 6, vtkCommunicator::MAX_OP);
+  long long mine[RankOutcome::Size];
+  RankOutcome::encode(failed, cancelled, digest, mine);
+  long long all[RankOutcome::Size] = {};
+  controller->AllReduce(mine, all, RankOutcome::Size, vtkCommunicator::MAX_OP);
+  const RankOutcome outcome = RankOutcome::decode(all);
   Verdict verdict;
-  verdict.failed = all[0] != 0;
-  verdict.cancelled = all[1] != 0;
-  if (!verdict.failed && !verdict.cancelled && (all[2] != -all[4] || all[3] != -all[5]))
+  verdict.failed = outcome.failed;
+  verdict.cancelled = outcome.cancelled;
+  if (!verdict.failed && !verdict.cancelled && outcome.digestsDiffer)
   {
     verdict.failed = true;
     verdict.message = "the ranks are not solving the same thing: their properties or inputs "

@@ -1,4 +1,4 @@
-// The filter on ParaView's MPI engine (issue 15): pvbatch --symmetric or pvserver under
+// The filter on ParaView's MPI engine: pvbatch --symmetric or pvserver under
 // mpiexec. Every rank gathers the whole inputs, remeshes them alike and solves its share of
 // the paths and gathering rays (Core sums the shares through the hooks set here); each rank
 // then outputs the elements that come from its own input cells.
@@ -55,25 +55,14 @@ struct Verdict
 };
 
 /// A collective agreement: every rank calls it at the same point with its own outcome. When
-/// none failed, `digest` (of what each rank is about to solve; 0 to skip) must be equal on
-/// every rank, or all fail: ranks that disagree would add up two different solves.
+/// none failed, `digest` (of what each rank is about to solve, digestOf(SolverOptions) among
+/// it; 0 to skip) must be equal on every rank, or all fail: ranks that disagree would add up
+/// two different solves. Core's RankOutcome decides; this only communicates.
 Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled,
   const std::string& message, std::uint64_t digest = 0);
 
-/// FNV-1a over the bytes of the values added.
-struct Digest
-{
-  std::uint64_t value = 14695981039346656037ULL;
-  template <typename T>
-  void add(const T& v)
-  {
-    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(&v);
-    for (std::size_t i = 0; i < sizeof(T); ++i)
-    {
-      this->value = (this->value ^ bytes[i]) * 1099511628211ULL;
-    }
-  }
-};
+/// FNV-1a over the bytes of the values added: Core's, which digests the solver options.
+using Digest = mlr::Digest;
 
 /**
  * The rank that owns each triangle (given by `triangles` on `points`): the rank of the input

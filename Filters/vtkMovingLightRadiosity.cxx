@@ -581,12 +581,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       // and gathered inputs, so that a rank that re-executed alone fails them all rather
       // than adding up two different solves.
       mlr::vtkparallel::Digest digest;
-      digest.add(solverOptions.pathsPerFrame);
-      digest.add(solverOptions.gatheringRatio);
-      digest.add(solverOptions.firstBounceSurvival);
-      digest.add(static_cast<std::uint64_t>(solverOptions.reuseShooting) * 2 + solverOptions.reuseGathering);
-      digest.add(static_cast<std::uint64_t>(solverOptions.twoSided));
-      digest.add(solverOptions.seed);
+      digest.add(mlr::digestOf(solverOptions));
       digest.add(options.remeshing.targetEdgeLength);
       digest.add(static_cast<std::uint64_t>(soup.points.size()));
       digest.add(static_cast<std::uint64_t>(soup.polygons.size()));

@@ -1,0 +1,184 @@
+#include "Gathering.h"
+
+#include "Random.h"
+#include "Ranks.h"
+#include "RayTracer.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mlr
+{
+
+namespace
+{
+constexpr std::size_t GatheringSidesPerTask = 32;
+
+/**
+ * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
+ * on it; each ray that reaches a patch side adds that side's shooting radiosity. With reuse
+ * one set of rays serves every frame; otherwise each frame casts its own.
+ */
+void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
+  std::uint32_t elementSide, std::uint64_t rays, Solution& solution, std::vector<Rgb>& sum,
+  WorkerCounters& counters)
+{
+  const std::size_t frames = solution.frameCount();
+  const bool reuse = options.reuseGathering;
+  const std::size_t element = elementSide / 2;
+  const Side side = static_cast<Side>(elementSide % 2);
+  const Triangle& t = scene.elementTriangles()[element];
+  const auto& points = scene.points();
+  const Vec3 normal = scene.elementSideNormal(element, side);
+  sum.assign(frames, Rgb());
+
+  // A hit's row of patch radiosity is added after the next ray is traced: the row was
+  // prefetched when the hit was found, so the trace hides its cache miss.
+  const std::size_t passes = reuse ? 1 : frames;
+  const std::size_t rowLength = reuse ? frames : 1;
+  for (std::size_t pass = 0; pass < passes; ++pass)
+  {
+    Rgb* into = reuse ? sum.data() : &sum[pass];
+    const PackedRgb* pending = nullptr;
+    auto addPending = [&] {
+      if (pending)
+      {
+        for (std::size_t f = 0; f < rowLength; ++f)
+        {
+          into[f] += pending[f];
+        }
+        pending = nullptr;
+      }
+    };
+    RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
+    for (std::uint64_t r = 0; r < rays; ++r)
+    {
+      const double u1 = random.uniform(), u2 = random.uniform();
+      const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
+      const Vec3 direction = sampleCosineDirection(normal, random);
+      ++counters.gatheringRays;
+      std::uint32_t hitElement = 0;
+      Side hitSide = Side::Front;
+      const bool found = tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide);
+      addPending();
+      if (!found)
+      {
+        ++counters.missedRays;
+        continue;
+      }
+      if (!options.twoSided && hitSide == Side::Back)
+      {
+        continue;
+      }
+      pending = solution.patchData().data() +
+        solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hitElement), hitSide);
+      const char* row = reinterpret_cast<const char*>(pending);
+      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
+      {
+        __builtin_prefetch(row + byte);
+      }
+    }
+    addPending();
+  }
+  const Rgb scale = scene.elementReflectance(element) / static_cast<double>(rays);
+  for (std::size_t f = 0; f < frames; ++f)
+  {
+    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(scale * sum[f]);
+  }
+}
+
+}
+
+std::vector<std::uint32_t> gatheringSides(const Scene& scene,
+  const std::vector<std::uint8_t>& reachable, std::uint64_t& rays, std::uint64_t total)
+{
+  std::vector<std::uint32_t> sides;
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    if (!(scene.patchReflectance(p).maxComponent() > 0))
+    {
+      continue;
+    }
+    for (int s = 0; s < 2; ++s)
+    {
+      if (reachable[2 * p + static_cast<std::size_t>(s)])
+      {
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        {
+          sides.push_back(static_cast<std::uint32_t>(e * 2 + static_cast<std::size_t>(s)));
+        }
+      }
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  rays = sides.empty()
+    ? 0
+    : static_cast<std::uint64_t>(std::max<long long>(
+        1, std::llround(static_cast<double>(total) / static_cast<double>(sides.size()))));
+  return sides;
+}
+
+GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
+  const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
+  Solution& solution)
+{
+  std::uint64_t raysPerSide = 0;
+  const auto total = static_cast<std::uint64_t>(
+    std::llround(options.gatheringRatio * static_cast<double>(options.pathsPerFrame)));
+  const std::vector<std::uint32_t> sides = gatheringSides(scene, reachable, raysPerSide, total);
+  std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
+  std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
+  const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
+  runOnRanks(tasks, workers, options,
+    [&](std::size_t task, int worker) {
+      const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
+      for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
+      {
+        gather(scene, tracer, options, sides[i], raysPerSide, solution,
+          sums[static_cast<std::size_t>(worker)], counters[static_cast<std::size_t>(worker)]);
+      }
+    },
+    fraction, secondsReducing);
+  // Each element side gathered on one rank and is exactly zero on the others, so the sum
+  // over ranks is that rank's value, bit for bit.
+  static_assert(sizeof(PackedRgb) == 3 * sizeof(float), "PackedRgb is three floats");
+  std::vector<PackedRgb>& indirect = solution.indirectData();
+  sumFloatsAcrossRanks(
+    options, reinterpret_cast<float*>(indirect.data()), 3 * indirect.size(), secondsReducing);
+  GatheringResult result;
+  result.sides = sides.size();
+  for (const WorkerCounters& c : counters)
+  {
+    result.counters += c;
+  }
+  return result;
+}
+
+void indirectFromPatches(const Scene& scene, Solution& solution)
+{
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < solution.frameCount(); ++f)
+      {
+        Rgb directPower;
+        for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
+        {
+          directPower += solution.direct(f, e, static_cast<Side>(s)) * scene.elementArea(e);
+        }
+        const Rgb patchDirect = directPower / scene.patchArea(p);
+        const Rgb b = solution.patchRadiosity(f, p, static_cast<Side>(s));
+        const Rgb rest(std::max(0.0, b.r - patchDirect.r), std::max(0.0, b.g - patchDirect.g),
+          std::max(0.0, b.b - patchDirect.b));
+        for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
+        {
+          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] = PackedRgb(rest);
+        }
+      }
+    }
+  }
+}
+
+} // namespace mlr

@@ -1,0 +1,48 @@
+// Final gathering: the indirect light of every element side from the patches' shooting
+// solution, with one set of rays for every frame (reuse) or one per frame.
+#pragma once
+
+#include "Solution.h"
+#include "SolverOptions.h"
+#include "WorkerCounters.h"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace mlr
+{
+
+class RayTracer;
+
+/**
+ * The element sides that gather: those of reachable patch sides whose reflectance is not
+ * zero (a black element reflects nothing it gathers). Returns them as element * 2 + side,
+ * in element order, and sets `rays` to the rays each casts so that together they cast about
+ * `total` (at least one each: equal counts keep every side's estimate equally accurate).
+ */
+std::vector<std::uint32_t> gatheringSides(const Scene& scene,
+  const std::vector<std::uint8_t>& reachable, std::uint64_t& rays, std::uint64_t total);
+
+/// What gathering traced on this rank.
+struct GatheringResult
+{
+  std::uint64_t sides = 0; ///< element sides that gathered (on every rank)
+  WorkerCounters counters;
+};
+
+/**
+ * Gathers k N rays (options.gatheringRatio) over the gathering sides of the `reachable` patch
+ * sides, shared by the ranks and summed over them, into solution's indirect light (which
+ * must be allocated). `fraction` gets the share done; false cancels.
+ */
+GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
+  const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
+  Solution& solution);
+
+/// Without gathering (k = 0) an element's indirect light is its patch's shooting solution
+/// minus the patch's direct part (the area-weighted direct of its four elements).
+void indirectFromPatches(const Scene& scene, Solution& solution);
+
+} // namespace mlr

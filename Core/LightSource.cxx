@@ -1,0 +1,350 @@
+#include "LightSource.h"
+
+#include "Error.h"
+#include "RayTracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+namespace mlr
+{
+
+std::size_t frameCount(const LightRig& rig, bool sceneEmits)
+{
+  std::size_t frames = 0;
+  std::string first;
+  auto take = [&](std::size_t n, const std::string& what) {
+    if (n <= 1)
+    {
+      return;
+    }
+    if (frames == 0)
+    {
+      frames = n;
+      first = what;
+    }
+    else if (n != frames)
+    {
+      throw Error(what + " has " + std::to_string(n) + " positions but " + first + " has " +
+        std::to_string(frames) + ": every moving light needs one position per frame");
+    }
+  };
+  for (std::size_t i = 0; i < rig.areaLights.size(); ++i)
+  {
+    take(rig.areaLights[i].frameCount(), "light " + std::to_string(i));
+  }
+  for (std::size_t i = 0; i < rig.directionalLights.size(); ++i)
+  {
+    take(rig.directionalLights[i].frameCount(), "directional light " + std::to_string(i));
+  }
+  if (rig.areaLights.empty() && rig.directionalLights.empty() && !sceneEmits)
+  {
+    throw Error("nothing emits light: give a light, a directional light or scene surfaces with "
+                "emission");
+  }
+  return std::max<std::size_t>(frames, 1);
+}
+
+void KernelScratch::resize(std::size_t positions)
+{
+  this->kernel.resize(positions);
+  this->dx.resize(positions);
+  this->dy.resize(positions);
+  this->dz.resize(positions);
+  this->targetFrames.resize(positions);
+  this->visible.resize(positions);
+}
+
+// --- Area lights -----------------------------------------------------------------------------
+
+AreaSource::AreaSource(const MovingLight& light)
+  : Light(&light)
+  , Pose(12, std::vector<double>(light.frameCount(), 0.0))
+{
+  for (std::size_t j = 0; j < light.frameCount(); ++j)
+  {
+    const LightPose& pose = light.pose(j);
+    const Rotation& r = pose.rotation;
+    const Vec3 o = pose.position - r.apply(light.centroid());
+    const double values[12] = { r.row0.x, r.row0.y, r.row0.z, r.row1.x, r.row1.y, r.row1.z,
+      r.row2.x, r.row2.y, r.row2.z, o.x, o.y, o.z };
+    for (int i = 0; i < 12; ++i)
+    {
+      this->Pose[i][j] = values[i];
+    }
+  }
+}
+
+void AreaSource::emit(
+  std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
+{
+  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+  this->Light->samplePoint(u0, u1, u2, path.ownPoint, path.ownNormal);
+  const Vec3 normal = this->Light->turn(position, path.ownNormal);
+  path.direction = sampleCosineDirection(normal, random);
+  path.start = this->Light->place(position, path.ownPoint) + normal * offset;
+}
+
+std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny,
+  std::size_t origin, const double* on, const RayTracer& tracer, KernelScratch& scratch) const
+{
+  const Vec3& x = path.ownPoint;
+  const Vec3& n = path.ownNormal;
+  const std::size_t positions = this->positions();
+  double* kernel = scratch.kernel.data();
+  const double* pose[12];
+  for (int i = 0; i < 12; ++i)
+  {
+    pose[i] = this->Pose[static_cast<std::size_t>(i)].data();
+  }
+  const double offset = tracer.surfaceOffset();
+  std::size_t count = 0;
+  if (!this->Light->rotates())
+  {
+    // Translations only (the common case): x_j = x + o_j and n_j = n, a third of the work.
+    const Vec3 toHit = y - x;
+    for (std::size_t j = 0; j < positions; ++j)
+    {
+      const double dx = toHit.x - pose[9][j], dy = toHit.y - pose[10][j], dz = toHit.z - pose[11][j];
+      const double cosX = n.x * dx + n.y * dy + n.z * dz;
+      const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+      // Positions that are off cast no path and light nothing: their weight is never needed.
+      kernel[j] = cosX > 0 && cosY > 0 && on[j] > 0 ? g : 0.0;
+    }
+    // From y lifted along n_y to x_j lifted along n: o_j - (y - x) + (n - n_y) offset.
+    const Vec3 base = (n - ny) * offset - toHit;
+    for (std::size_t j = 0; j < positions; ++j)
+    {
+      if (kernel[j] > 0 && j != origin)
+      {
+        scratch.dx[count] = static_cast<float>(base.x + pose[9][j]);
+        scratch.dy[count] = static_cast<float>(base.y + pose[10][j]);
+        scratch.dz[count] = static_cast<float>(base.z + pose[11][j]);
+        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+        ++count;
+      }
+    }
+  }
+  else
+  {
+    for (std::size_t j = 0; j < positions; ++j)
+    {
+      const double xj = pose[0][j] * x.x + pose[1][j] * x.y + pose[2][j] * x.z + pose[9][j];
+      const double yj = pose[3][j] * x.x + pose[4][j] * x.y + pose[5][j] * x.z + pose[10][j];
+      const double zj = pose[6][j] * x.x + pose[7][j] * x.y + pose[8][j] * x.z + pose[11][j];
+      const double nx = pose[0][j] * n.x + pose[1][j] * n.y + pose[2][j] * n.z;
+      const double nyj = pose[3][j] * n.x + pose[4][j] * n.y + pose[5][j] * n.z;
+      const double nz = pose[6][j] * n.x + pose[7][j] * n.y + pose[8][j] * n.z;
+      const double dx = y.x - xj, dy = y.y - yj, dz = y.z - zj;
+      const double cosX = nx * dx + nyj * dy + nz * dz;
+      const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const double g = cosX * cosY / std::max(r2 * r2, std::numeric_limits<double>::min());
+      kernel[j] = cosX > 0 && cosY > 0 && on[j] > 0 ? g : 0.0;
+    }
+    const Vec3 from = tracer.liftOff(y, ny);
+    for (std::size_t j = 0; j < positions; ++j)
+    {
+      if (kernel[j] > 0 && j != origin)
+      {
+        const Vec3 normal = this->Light->turn(j, n);
+        const Vec3 d = this->Light->place(j, x) + normal * offset - from;
+        scratch.dx[count] = static_cast<float>(d.x);
+        scratch.dy[count] = static_cast<float>(d.y);
+        scratch.dz[count] = static_cast<float>(d.z);
+        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+        ++count;
+      }
+    }
+  }
+  if (count > 0)
+  {
+    tracer.visibleFrom(tracer.liftOff(y, ny), scratch.dx.data(), scratch.dy.data(),
+      scratch.dz.data(), count, scratch.visible.data());
+  }
+  return count;
+}
+
+// --- Directional lights ----------------------------------------------------------------------
+
+DirectionalSource::DirectionalSource(const DirectionalLight& light, const Vec3& centre, double radius)
+  : Light(&light)
+  , Centre(centre)
+  , Radius(radius)
+  , Power(light.irradiance() * (M_PI * radius * radius))
+  , Pose(3, std::vector<double>(light.frameCount(), 0.0))
+{
+  for (std::size_t j = 0; j < light.frameCount(); ++j)
+  {
+    const Vec3& s = light.direction(j);
+    this->Pose[0][j] = s.x;
+    this->Pose[1][j] = s.y;
+    this->Pose[2][j] = s.z;
+  }
+}
+
+BoundingDisc DirectionalSource::boundingDisc(std::size_t position, double offset) const
+{
+  const Vec3& s = this->Light->direction(position);
+  return { this->Centre + s * (this->Radius + 2 * offset), s, this->Radius };
+}
+
+void DirectionalSource::emit(
+  std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
+{
+  const Vec3& s = this->Light->direction(position);
+  Vec3 t, b;
+  orthonormalBasis(s, t, b);
+  // A uniform point of the disc by rejection, as sampleCosineDirection does.
+  double u, v;
+  do
+  {
+    u = 2.0 * random.uniform() - 1.0;
+    v = 2.0 * random.uniform() - 1.0;
+  } while (u * u + v * v >= 1.0);
+  const double radius = this->Radius;
+  path.start = this->Centre + s * (radius + 2 * offset) + (t * u + b * v) * radius;
+  path.direction = -s;
+  path.ownPoint = path.start;
+  path.ownNormal = path.direction;
+}
+
+std::size_t DirectionalSource::kernel(const EmittedPath&, const Vec3& y, const Vec3& ny,
+  std::size_t origin, const double* on, const RayTracer& tracer, KernelScratch& scratch) const
+{
+  const std::size_t positions = this->positions();
+  double* kernel = scratch.kernel.data();
+  const double* sx = this->Pose[0].data();
+  const double* sy = this->Pose[1].data();
+  const double* sz = this->Pose[2].data();
+  for (std::size_t j = 0; j < positions; ++j)
+  {
+    const double c = ny.x * sx[j] + ny.y * sy[j] + ny.z * sz[j];
+    kernel[j] = c > 0 && on[j] > 0 ? c : 0.0;
+  }
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < positions; ++j)
+  {
+    if (kernel[j] > 0 && j != origin)
+    {
+      scratch.dx[count] = static_cast<float>(sx[j]);
+      scratch.dy[count] = static_cast<float>(sy[j]);
+      scratch.dz[count] = static_cast<float>(sz[j]);
+      scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+      ++count;
+    }
+  }
+  if (count > 0)
+  {
+    tracer.visibleAlong(tracer.liftOff(y, ny), scratch.dx.data(), scratch.dy.data(),
+      scratch.dz.data(), count, scratch.visible.data());
+  }
+  return count;
+}
+
+// --- The one interface -----------------------------------------------------------------------
+
+LightSource::LightSource(Kind kind, std::uint64_t stream)
+  : What(std::move(kind))
+  , Stream(stream)
+{
+  std::visit(
+    [&](const auto& light) {
+      this->Positions = light.positions();
+      this->Power = light.power();
+      for (std::size_t k = 0; k < this->Positions; ++k)
+      {
+        this->Factors.push_back(light.factor(k));
+      }
+    },
+    this->What);
+  for (std::size_t k = 0; k < this->Positions; ++k)
+  {
+    const bool on = this->Factors[k].maxComponent() > 0;
+    this->On.push_back(on ? 1.0 : 0.0);
+    if (on)
+    {
+      this->Active.push_back(k);
+    }
+  }
+}
+
+void LightSource::emit(
+  std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
+{
+  std::visit([&](const auto& light) { light.emit(position, random, offset, path); }, this->What);
+}
+
+std::size_t LightSource::kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny,
+  std::size_t origin, const RayTracer& tracer, KernelScratch& scratch) const
+{
+  return std::visit(
+    [&](const auto& light) { return light.kernel(path, y, ny, origin, this->On.data(), tracer, scratch); },
+    this->What);
+}
+
+std::vector<MovingLight> sceneEmitters(const Scene& scene)
+{
+  std::vector<MovingLight> lights;
+  if (!scene.hasEmission())
+  {
+    return lights;
+  }
+  std::vector<Rgb> emissions;
+  std::vector<std::vector<std::vector<Vec3>>> polygons;
+  std::vector<double> areas;
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    const Rgb e = scene.patchEmission(p);
+    if (!(e.maxComponent() > 0))
+    {
+      continue;
+    }
+    std::size_t group = std::find(emissions.begin(), emissions.end(), e) - emissions.begin();
+    if (group == emissions.size())
+    {
+      emissions.push_back(e);
+      polygons.emplace_back();
+      areas.push_back(0);
+    }
+    const Triangle& t = scene.patchTriangles()[p];
+    const auto& points = scene.points();
+    polygons[group].push_back({ points[t[0]], points[t[1]], points[t[2]] });
+    areas[group] += scene.patchArea(p);
+  }
+  for (std::size_t g = 0; g < emissions.size(); ++g)
+  {
+    // One pose, moved by nothing: the emitter stays where the scene has it.
+    lights.emplace_back(polygons[g], emissions[g] * areas[g], std::vector<Vec3>{ Vec3() });
+  }
+  return lights;
+}
+
+std::vector<LightSource> lightSources(
+  const Scene& scene, const LightRig& rig, const std::vector<MovingLight>& emitters)
+{
+  std::vector<LightSource> sources;
+  auto nextStream = [&] { return static_cast<std::uint64_t>(sources.size()) << 32; };
+  for (const MovingLight& light : rig.areaLights)
+  {
+    sources.emplace_back(AreaSource(light), nextStream());
+  }
+  for (const MovingLight& light : emitters)
+  {
+    sources.emplace_back(AreaSource(light), nextStream());
+  }
+  const Vec3 centre = (scene.boundsMin() + scene.boundsMax()) * 0.5;
+  const double radius = std::max(0.5 * scene.diagonal(), 1e-9 * std::max(1.0, length(centre)));
+  for (const DirectionalLight& light : rig.directionalLights)
+  {
+    sources.emplace_back(DirectionalSource(light, centre, radius), nextStream());
+  }
+  return sources;
+}
+
+} // namespace mlr

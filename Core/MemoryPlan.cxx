@@ -1,0 +1,79 @@
+#include "MemoryPlan.h"
+
+#include "Parallel.h"
+#include "Reachability.h"
+#include "Rgb.h"
+
+#include <algorithm>
+#include <string>
+
+namespace mlr
+{
+
+MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options)
+{
+  const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
+  MemoryPlan plan;
+  const std::uint64_t direct = saturatingProduct({ frames, elements, 2, sizeof(PackedRgb) });
+  const std::uint64_t patch = saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) });
+  const std::uint64_t indirect = direct;
+  plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
+  // One copy of the accumulators (FixedPointAccumulator::bytes): a scalar share per element
+  // side and RGB power per patch side, for every frame.
+  const std::uint64_t copy = saturatingSum(saturatingProduct({ elements, 2, frames, sizeof(std::int64_t) }),
+    saturatingProduct({ patches, 2, frames, 3, sizeof(std::int64_t) }));
+  // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
+  const std::uint64_t scratch = saturatingProduct({ workers, frames,
+    sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
+  // Embree's BVH and buffers (generously), the emission and lit side of every element.
+  const std::uint64_t tracing = saturatingSum(saturatingProduct({ elements, 256 }), saturatingProduct({ points, 16 }));
+  const std::uint64_t perElement = saturatingProduct({ elements, sizeof(Rgb) + sizeof(Side) });
+  // Reachability: the probes' hits and their reverse edges (gone before gathering rays).
+  const std::uint64_t reachability =
+    saturatingProduct({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });
+  plan.other = saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, reachability));
+  const std::uint64_t base = saturatingSum(saturatingSum(scratch, tracing), perElement);
+  const std::uint64_t gathering =
+    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
+  const auto peakWith = [&](std::uint64_t copies) {
+    return saturatingSum(base,
+      std::max(saturatingSum(saturatingSum(direct, patch), saturatingProduct({ copies, copy })), gathering));
+  };
+  plan.accumulatorCopyPerWorker = workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
+  const std::uint64_t copies = plan.accumulatorCopyPerWorker ? workers : 1;
+  plan.accumulators = saturatingProduct({ copies, copy });
+  plan.peak = peakWith(copies);
+  return plan;
+}
+
+std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options)
+{
+  return planSolveMemory(patches, elements, points, frames, options).peak;
+}
+
+std::uint64_t estimateSolveMemory(
+  const Scene& scene, std::size_t frames, const SolverOptions& options)
+{
+  return estimateSolveMemory(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
+}
+
+std::uint64_t memoryLimitBytes(const SolverOptions& options)
+{
+  return MemoryBudget(options.memoryLimitBytes).limitBytes();
+}
+
+void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
+  std::size_t elements, const SolverOptions& options, bool approximate)
+{
+  const std::string about = approximate ? "about " : "";
+  MemoryBudget(options.memoryLimitBytes)
+    .check(estimate, "the solve",
+      std::to_string(frames) + " frames x (" + about + std::to_string(patches) + " patches + " +
+        about + std::to_string(elements) + " elements) x 2 sides x RGB, plus per-thread buffers",
+      "use fewer frames or a larger patch size, or raise the limit");
+}
+
+} // namespace mlr

@@ -1,0 +1,443 @@
+#include "Shooting.h"
+
+#include "Error.h"
+#include "FixedPointAccumulator.h"
+#include "Random.h"
+#include "Ranks.h"
+#include "RayTracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace mlr
+{
+
+namespace
+{
+/// A walk longer than this is cut, which bounds the time between two cancellation checks.
+/// Roulette survives with the largest reflectance channel rho_max < 1, so a walk reaches
+/// this length with probability rho_max^(2^24): the power the cut loses is below 1e-7 of the
+/// walk's for every rho_max <= 1 - 1e-6 (TestOccluders checks rho = 0.999).
+constexpr int MaximumBounces = 1 << 24;
+
+/// Shooting paths per task: small enough that cancellation is noticed within
+/// milliseconds, large enough that scheduling costs nothing.
+constexpr std::uint64_t ReusedPathsPerTask = 256;
+constexpr std::uint64_t ClassicPathsPerTask = 2048;
+
+/// The rounding quantum of a fixed-point channel whose largest value per path is `scale`:
+/// one per channel, so that a channel 10^6 weaker than the others keeps its precision.
+double quantumFor(double scale)
+{
+  return scale > 0 && std::isfinite(scale) ? scale * 0x1.0p-40 : 1.0;
+}
+
+/// The shooting of one LightSource into its own accumulators, added to the solution at the end.
+class ShootingRun
+{
+public:
+  ShootingRun(const Scene& scene, const LightSource& source, const SolverOptions& options,
+    const RayTracer& tracer, int workers, bool copyPerWorker)
+    : SceneRef(scene)
+    , SourceRef(source)
+    , Options(options)
+    , Tracer(tracer)
+    , Frames(source.positions())
+    , Reuse(options.reuseShooting && source.positions() > 1)
+    , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions(), 0x1.0p-50,
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+    , PatchPower(workers, copyPerWorker, scene.patchCount(), source.positions(),
+        { quantumFor(source.power().r), quantumFor(source.power().g), quantumFor(source.power().b) },
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+    , Counters(static_cast<std::size_t>(workers))
+    , Scratch(static_cast<std::size_t>(workers))
+  {
+    for (KernelScratch& s : this->Scratch)
+    {
+      s.resize(this->Frames);
+    }
+    // M_k paths start from active position k; they add up to N exactly. Positions that are
+    // off cast nothing: their frames are zero, and every active frame j still has M_j > 0 in
+    // its weights' denominator, so no light is lost.
+    const std::vector<std::size_t>& positions = source.activePositions();
+    const std::uint64_t active = positions.size();
+    const std::uint64_t N = options.pathsPerFrame;
+    this->PathsFromPosition.assign(this->Frames, 0.0);
+    for (std::uint64_t a = 0; a < active; ++a)
+    {
+      this->PathsFromPosition[positions[a]] =
+        static_cast<double>(N / active + (a < N % active ? 1 : 0));
+    }
+  }
+
+  bool reuses() const { return this->Reuse; }
+
+  void shootReused(std::uint64_t path, int worker);
+  void shootClassic(std::size_t position, std::uint64_t path, int worker);
+  /// Adds this source's radiosity to `solution`: frame f gets position f, or the one
+  /// position of a static source, times that position's power factor.
+  void addTo(Solution& solution) const;
+
+  const std::vector<WorkerCounters>& counters() const { return this->Counters; }
+
+  /// Sums the scores over ranks (SolverOptions::sumAcrossRanks): integers, so every rank then
+  /// holds exactly the serial sums, whatever rank and worker traced each path.
+  void sumAcrossRanks(double& secondsReducing)
+  {
+    mlr::sumAcrossRanks(this->Options, this->ElementShare.collapse(), this->ElementShare.copySize(),
+      secondsReducing);
+    mlr::sumAcrossRanks(this->Options, this->PatchPower.collapse(), this->PatchPower.copySize(),
+      secondsReducing);
+  }
+
+  /// Which active position path `path` of a reuse solve starts from.
+  std::size_t positionOfPath(std::uint64_t path) const
+  {
+    const std::vector<std::size_t>& active = this->SourceRef.activePositions();
+    const std::uint64_t n = active.size();
+    const std::uint64_t base = this->Options.pathsPerFrame / n;
+    const std::uint64_t extra = this->Options.pathsPerFrame % n;
+    const std::uint64_t firstBlock = extra * (base + 1);
+    const std::uint64_t index = path < firstBlock ? path / (base + 1) : extra + (path - firstBlock) / base;
+    return active[static_cast<std::size_t>(index)];
+  }
+
+private:
+  bool emit(RandomStream& random, std::size_t position, int worker, EmittedPath& path, RayHit& hit);
+  void scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
+    std::size_t firstFrame, std::size_t frameCount, int worker);
+  // Always inlined, like the prefetch it calls: GCC would delete the call otherwise.
+  [[gnu::always_inline]] inline void prefetchFirstHit(
+    const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker);
+
+  const Scene& SceneRef;
+  const LightSource& SourceRef;
+  const SolverOptions& Options;
+  const RayTracer& Tracer;
+  std::size_t Frames;
+  bool Reuse;
+  // Direct light needs one scalar per element side and frame: the share of the source's
+  // power whose first hit lands there. Its colour rho_e Phi is the same for every hit, and
+  // a scalar is a third of the memory traffic of RGB in the hottest loop.
+  FixedPointAccumulator<1> ElementShare;
+  // The patch solution's reflected power (W), RGB, from the second hit of a walk on; the
+  // first hits come from ElementShare.
+  FixedPointAccumulator<3> PatchPower;
+  std::vector<WorkerCounters> Counters;
+  std::vector<KernelScratch> Scratch;
+  std::vector<double> PathsFromPosition;
+};
+
+/**
+ * Scores a walk's first hit on the element (direct) and patch, then follows it: continue
+ * with probability lambda, and at every later hit score the patch and play Russian
+ * roulette with the maximum reflectance channel. shares[f] is the fraction of the source's
+ * power the walk carries to its first hit in frame firstFrame + f: 1/N for a classic path,
+ * G_j(y) / sum_k M_k G_k(y) for a reused one. A walk's power in frame f is then
+ * colour * shares[f], with one RGB colour for all frames: the frames differ only by scalar
+ * weights (and the power factors, applied when the sums become radiosity).
+ *
+ * METHOD.md writes step 3 as P <- P / lambda; the power that leaves the first hit is the
+ * reflected power, so we carry rho * P / lambda (the energy balance test checks this).
+ */
+void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
+  std::size_t firstFrame, std::size_t frameCount, int worker)
+{
+  // The first hit scores only the element's share: the patch's first-hit power is
+  // rho_p Phi times the shares of its four elements, added when shooting ends. That keeps
+  // the RGB patch slots (3n values) out of the one write every path makes.
+  const int firstSide = static_cast<int>(firstHit.side);
+  const Rgb& firstRho = this->SceneRef.elementReflectance(firstHit.element);
+  Rgb colour = firstRho * this->SourceRef.power();
+  {
+    std::int64_t* elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
+    for (std::size_t f = 0; f < frameCount; ++f)
+    {
+      this->ElementShare.add(elementSlots, firstFrame + f, &shares[f]);
+    }
+    const double lambda = this->Options.firstBounceSurvival;
+    if (random.uniform() >= lambda)
+    {
+      return;
+    }
+    colour = colour / lambda;
+  }
+
+  // A bounce's score is written after the next ray is traced: its slots were prefetched
+  // when the hit was found, so the trace hides the cache miss.
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  std::int64_t* pendingSlots = nullptr;
+  Rgb pendingPower;
+  auto scorePending = [&] {
+    if (pendingSlots)
+    {
+      for (std::size_t f = 0; f < frameCount; ++f)
+      {
+        const double power[3] = { pendingPower.r * shares[f], pendingPower.g * shares[f],
+          pendingPower.b * shares[f] };
+        this->PatchPower.add(pendingSlots, firstFrame + f, power);
+      }
+      pendingSlots = nullptr;
+    }
+  };
+  RayHit hit = firstHit;
+  for (int bounce = 0; bounce < MaximumBounces; ++bounce)
+  {
+    const Vec3 normal = this->SceneRef.elementSideNormal(hit.element, hit.side);
+    const Vec3 direction = sampleCosineDirection(normal, random);
+    ++counters.shootingRays;
+    RayHit next;
+    const bool found = this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next);
+    scorePending();
+    if (!found)
+    {
+      ++counters.missedRays;
+      return;
+    }
+    if (!this->Options.twoSided && next.side == Side::Back)
+    {
+      return;
+    }
+    const std::size_t patch = Scene::patchOfElement(next.element);
+    const Rgb& rho = this->SceneRef.patchReflectance(patch);
+    pendingPower = rho * colour;
+    pendingSlots = this->PatchPower.slots(worker, patch, static_cast<int>(next.side));
+    this->PatchPower.prefetch(pendingSlots, firstFrame, frameCount);
+    const double survival = rho.maxComponent();
+    if (!(survival > 0) || random.uniform() >= survival)
+    {
+      scorePending();
+      return;
+    }
+    colour = pendingPower / survival;
+    hit = next;
+  }
+  scorePending();
+}
+
+/// Called as soon as a walk's first hit is known, so that the weights and shadow rays
+/// computed before scoring hide the cache misses of the slots it will score.
+inline void ShootingRun::prefetchFirstHit(
+  const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker)
+{
+  this->ElementShare.prefetch(
+    this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame, frameCount);
+}
+
+/// Starts a walk from the source at `position` and traces its first ray. False when the walk
+/// ends there: a miss (the power leaves the scene) or, with one-sided surfaces, a back face.
+bool ShootingRun::emit(
+  RandomStream& random, std::size_t position, int worker, EmittedPath& path, RayHit& hit)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  this->SourceRef.emit(position, random, this->Tracer.surfaceOffset(), path);
+  ++counters.shootingRays;
+  if (!this->Tracer.intersect(path.start, path.direction, hit))
+  {
+    ++counters.missedRays;
+    return false;
+  }
+  ++counters.firstHits;
+  if (!this->Options.twoSided && hit.side == Side::Back)
+  {
+    ++counters.firstHitsOnBack;
+    return false;
+  }
+  return true;
+}
+
+void ShootingRun::shootReused(std::uint64_t path, int worker)
+{
+  WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
+  KernelScratch& scratch = this->Scratch[static_cast<std::size_t>(worker)];
+  const std::size_t origin = this->positionOfPath(path);
+  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream());
+
+  EmittedPath emitted;
+  RayHit hit;
+  if (!this->emit(random, origin, worker, emitted, hit))
+  {
+    return;
+  }
+  this->prefetchFirstHit(hit, 0, this->Frames, worker);
+
+  // Mixture weights w_j = G_j(y) / sum_k M_k G_k(y), with real visibility: one shadow ray
+  // per other position whose unoccluded kernel is not zero (the origin's is known).
+  const std::size_t shadowCount = this->SourceRef.kernel(emitted, hit.point,
+    this->SceneRef.elementSideNormal(hit.element, hit.side), origin, this->Tracer, scratch);
+  double* kernel = scratch.kernel.data();
+  counters.shadowRays += shadowCount;
+  for (std::size_t s = 0; s < shadowCount; ++s)
+  {
+    if (!scratch.visible[s])
+    {
+      kernel[scratch.targetFrames[s]] = 0;
+      ++counters.shadowRaysBlocked;
+    }
+  }
+  double mixture = 0;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    mixture += this->PathsFromPosition[j] * kernel[j];
+  }
+  if (!(mixture > 0))
+  {
+    return; // grazing to the last bit: the path carries nothing
+  }
+  const double inverseMixture = 1.0 / mixture;
+  for (std::size_t j = 0; j < this->Frames; ++j)
+  {
+    kernel[j] *= inverseMixture;
+  }
+  this->scoreAndWalk(random, hit, kernel, 0, this->Frames, worker);
+}
+
+void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int worker)
+{
+  RandomStream random(
+    this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream() + position + 1);
+  EmittedPath emitted;
+  RayHit hit;
+  if (!this->emit(random, position, worker, emitted, hit))
+  {
+    return;
+  }
+  const double share = 1.0 / static_cast<double>(this->Options.pathsPerFrame);
+  this->scoreAndWalk(random, hit, &share, position, 1, worker);
+}
+
+void ShootingRun::addTo(Solution& solution) const
+{
+  const std::size_t elements = this->SceneRef.elementCount();
+  const std::size_t patches = this->SceneRef.patchCount();
+  const std::size_t frames = solution.frameCount();
+  std::vector<PackedRgb>& direct = solution.directData();
+  std::vector<PackedRgb>& patch = solution.patchData();
+  auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
+  for (std::size_t e = 0; e < elements; ++e)
+  {
+    const Rgb exitance =
+      this->SceneRef.elementReflectance(e) * this->SourceRef.power() / this->SceneRef.elementArea(e);
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        double share = 0;
+        this->ElementShare.total(e, s, positionOf(f), &share);
+        if (share != 0)
+        {
+          direct[solution.elementIndex(f, e, static_cast<Side>(s))] +=
+            exitance * this->SourceRef.factor(positionOf(f)) * share;
+        }
+      }
+    }
+  }
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
+    const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->SourceRef.power();
+    for (int s = 0; s < 2; ++s)
+    {
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        const std::size_t k = positionOf(f);
+        double power[3];
+        this->PatchPower.total(p, s, k, power);
+        double share = 0;
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        {
+          double elementShare = 0;
+          this->ElementShare.total(e, s, k, &elementShare);
+          share += elementShare;
+        }
+        patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
+          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * this->SourceRef.factor(k) * inverseArea;
+      }
+    }
+  }
+}
+
+} // namespace
+
+void checkPathsPerPosition(const LightSource& source, const SolverOptions& options)
+{
+  const std::size_t active = source.activePositions().size();
+  if (options.reuseShooting && source.positions() > 1 && options.pathsPerFrame < active)
+  {
+    // With M_k = 0 for some position k, the mixture has holes where only k lights: light
+    // would be lost, and the weights would be unbounded.
+    throw Error("reusing shooting paths needs at least one path per light position: " +
+      std::to_string(options.pathsPerFrame) + " paths per frame is fewer than the " +
+      std::to_string(active) + " light positions that emit; give at least " +
+      std::to_string(active) + " paths per frame, or turn shooting reuse off");
+  }
+}
+
+double shootingCost(const LightSource& source, const SolverOptions& options)
+{
+  const double N = static_cast<double>(options.pathsPerFrame);
+  const double lambda = options.firstBounceSurvival;
+  const double n = static_cast<double>(source.positions());
+  const bool reuse = options.reuseShooting && source.positions() > 1;
+  return reuse ? N * (1 + 1.5 * lambda + 0.2 * (n - 1)) : n * N * (1 + 1.5 * lambda);
+}
+
+ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
+  const RayTracer& tracer, int workers, bool copyPerWorker,
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
+  Solution& solution)
+{
+  ShootingRun run(scene, source, options, tracer, workers, copyPerWorker);
+  const std::uint64_t paths = options.pathsPerFrame;
+  const std::vector<std::size_t>& positions = source.activePositions();
+  ShootingResult result;
+  if (positions.empty())
+  {
+    // Off in every frame: nothing to add.
+  }
+  else if (run.reuses())
+  {
+    const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
+    runOnRanks(tasks, workers, options,
+      [&](std::size_t task, int worker) {
+        const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
+        for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
+        {
+          run.shootReused(p, worker);
+        }
+      },
+      fraction, secondsReducing);
+    result.pathsCast = paths;
+  }
+  else
+  {
+    const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
+    const std::uint64_t tasks = tasksPerFrame * positions.size();
+    runOnRanks(tasks, workers, options,
+      [&](std::size_t task, int worker) {
+        const std::size_t position = positions[task / tasksPerFrame];
+        const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
+        const std::uint64_t end = std::min<std::uint64_t>(paths, first + ClassicPathsPerTask);
+        for (std::uint64_t p = first; p < end; ++p)
+        {
+          run.shootClassic(position, p, worker);
+        }
+      },
+      fraction, secondsReducing);
+    result.pathsCast = paths * positions.size();
+  }
+  if (options.ranks > 1 && !positions.empty())
+  {
+    run.sumAcrossRanks(secondsReducing);
+  }
+  run.addTo(solution);
+  for (const WorkerCounters& c : run.counters())
+  {
+    result.counters += c;
+  }
+  return result;
+}
+
+} // namespace mlr

@@ -1,0 +1,42 @@
+// Shooting: random walks from one light source, scored into its own fixed-point sums and
+// added to the solution as direct light and the patches' shooting solution.
+#pragma once
+
+#include "LightSource.h"
+#include "Solution.h"
+#include "SolverOptions.h"
+#include "WorkerCounters.h"
+
+#include <cstdint>
+#include <functional>
+
+namespace mlr
+{
+
+class RayTracer;
+
+/// Throws mlr::Error when `source` reuses paths but N is fewer than its active positions.
+void checkPathsPerPosition(const LightSource& source, const SolverOptions& options);
+
+/// The expected ray casts of shooting `source`, which weigh the progress of its phase.
+double shootingCost(const LightSource& source, const SolverOptions& options);
+
+/// What shooting one source traced: its paths and this rank's rays.
+struct ShootingResult
+{
+  std::uint64_t pathsCast = 0;
+  WorkerCounters counters;
+};
+
+/**
+ * Shoots options.pathsPerFrame effective paths per frame from `source` (reused over its
+ * positions, or classic: each position its own), shared by the ranks and summed over them,
+ * and adds the source's radiosity to `solution`. `copyPerWorker`: one copy of the sums per
+ * worker (MemoryPlan). `fraction` gets the share done; false cancels.
+ */
+ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
+  const RayTracer& tracer, int workers, bool copyPerWorker,
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
+  Solution& solution);
+
+} // namespace mlr

@@ -1,0 +1,41 @@
+#include "Solution.h"
+
+namespace mlr
+{
+
+Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches)
+  : Frames(frames)
+  , Elements(elements)
+  , Patches(patches)
+  , Direct(frames * elements * 2)
+  , Patch(frames * patches * 2)
+  , LitSide(elements, Side::Front)
+  , PatchLitSide(patches, Side::Front)
+{
+}
+
+void Solution::chooseLitSides()
+{
+  for (std::size_t e = 0; e < this->Elements; ++e)
+  {
+    double front = 0, back = 0;
+    for (std::size_t f = 0; f < this->Frames; ++f)
+    {
+      front += this->total(f, e, Side::Front).sum();
+      back += this->total(f, e, Side::Back).sum();
+    }
+    this->LitSide[e] = back > front ? Side::Back : Side::Front;
+  }
+  for (std::size_t p = 0; p < this->Patches; ++p)
+  {
+    double front = 0, back = 0;
+    for (std::size_t f = 0; f < this->Frames; ++f)
+    {
+      front += this->patchRadiosity(f, p, Side::Front).sum();
+      back += this->patchRadiosity(f, p, Side::Back).sum();
+    }
+    this->PatchLitSide[p] = back > front ? Side::Back : Side::Front;
+  }
+}
+
+} // namespace mlr

@@ -1,0 +1,138 @@
+// What a solve gives: the radiosity of every element and patch side in every frame, the
+// side of each that is lit, and the statistics of the run.
+#pragma once
+
+#include "Rgb.h"
+#include "Scene.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mlr
+{
+
+struct SolverStatistics
+{
+  std::uint64_t frames = 0;
+  std::uint64_t patches = 0;
+  std::uint64_t elements = 0;
+  std::uint64_t effectivePathsPerFrame = 0;
+  std::uint64_t pathsCast = 0;      ///< shooting paths actually traced, all frames
+  std::uint64_t shootingRays = 0;   ///< nearest-hit rays of the shooting walks
+  std::uint64_t shadowRays = 0;     ///< visibility rays for the reuse weights
+  std::uint64_t shadowRaysBlocked = 0; ///< of shadowRays, those an occluder stopped
+  /// Walks whose first ray hit the scene (and, one-sided, a front face): with reuse, each
+  /// asks for the visibility of every other position whose unoccluded kernel is not zero.
+  std::uint64_t firstHits = 0;
+  std::uint64_t gatheringRays = 0;  ///< nearest-hit rays of the final gathering
+  std::uint64_t missedRays = 0;     ///< nearest-hit rays that hit nothing
+  std::uint64_t gatheringSides = 0; ///< element sides that gathered
+  std::uint64_t reachabilityRays = 0; ///< probes that decided which sides light can reach
+  std::uint64_t reachableSides = 0;   ///< patch sides light can reach (the others stay dark)
+  std::uint64_t sources = 0;          ///< lights shot: moving, static, directional, emitters
+  std::uint64_t staticPathsCast = 0;  ///< of pathsCast, from sources solved once for all frames
+  /// l of the paper: mean number of hits of a path without the lambda cut, from
+  /// shootingRays / pathsCast = 1 + lambda (l - 1).
+  double meanPathLength = 0;
+  double secondsRemeshing = 0; ///< set by callers that remesh before solving
+  double secondsSetup = 0;     ///< validation, allocation and building the BVH
+  double secondsShooting = 0;
+  double secondsGathering = 0;
+  /// Of shooting and gathering, the time spent in sums over ranks and the agreements
+  /// between phases (waiting for slower ranks included); 0 on one rank.
+  double secondsReducing = 0;
+  double secondsTotal = 0;
+  std::uint64_t memoryEstimateBytes = 0;
+  /// The shooting accumulators had one copy per worker (else one shared copy, MemoryPlan).
+  bool accumulatorCopyPerWorker = true;
+  int threads = 0;
+  bool reuseShooting = false;
+  bool reuseGathering = false;
+  bool twoSided = true;
+};
+
+/**
+ * Radiosity (W/m^2) of every element and patch side, for every frame.
+ *
+ * B_total = E + B_direct + B_indirect for elements, E the self-emission of the front side.
+ * B_direct comes from the shooting walks' first hits (from every light and emitter);
+ * B_indirect from final gathering of the patches' shooting solution. Both sides are kept;
+ * litSide() and patchLitSide() pick the one to show, chosen once when the solve ends.
+ */
+class Solution
+{
+public:
+  Solution() = default;
+  Solution(std::size_t frames, std::size_t elements, std::size_t patches);
+
+  std::size_t frameCount() const { return this->Frames; }
+  std::size_t elementCount() const { return this->Elements; }
+  std::size_t patchCount() const { return this->Patches; }
+
+  Rgb direct(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Direct[this->elementIndex(frame, element, side)];
+  }
+  /// Zero until gathering has run.
+  Rgb indirect(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Indirect.empty() ? Rgb() : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
+  }
+  /// Self-emission (W/m^2): the scene's emission on the front side, zero on the back.
+  Rgb emitted(std::size_t element, Side side) const
+  {
+    return side == Side::Front && !this->Emission.empty() ? this->Emission[element] : Rgb();
+  }
+  Rgb total(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->emitted(element, side) + this->direct(frame, element, side) +
+      this->indirect(frame, element, side);
+  }
+  /// The patch-level shooting solution (all bounces), which gathering reads.
+  Rgb patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
+  {
+    return this->Patch[this->patchIndex(frame, patch, side)];
+  }
+  /// The side of an element that received more power over the whole animation.
+  Side litSide(std::size_t element) const { return this->LitSide[element]; }
+  /// The same for a patch, from its shooting solution: the side whose radiosity (rho/A
+  /// times the power it received) has the larger sum over frames and channels.
+  Side patchLitSide(std::size_t patch) const { return this->PatchLitSide[patch]; }
+  /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete.
+  void chooseLitSides();
+
+  SolverStatistics statistics;
+  std::vector<std::string> warnings;
+
+  // Storage is element- (patch-) major with frames innermost: scoring one hit for all
+  // frames touches one contiguous run.
+  std::size_t elementIndex(std::size_t frame, std::size_t element, Side side) const
+  {
+    return (element * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+  }
+  std::size_t patchIndex(std::size_t frame, std::size_t patch, Side side) const
+  {
+    return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+  }
+  // Results are stored in single precision (PackedRgb); see MemoryPlan.
+  std::vector<PackedRgb>& directData() { return this->Direct; }
+  /// Empty until allocateIndirect(): the solver allocates it once the shooting accumulators
+  /// are freed, so that the two never take memory at once.
+  std::vector<PackedRgb>& indirectData() { return this->Indirect; }
+  void allocateIndirect() { this->Indirect.assign(this->Direct.size(), PackedRgb()); }
+  std::vector<PackedRgb>& patchData() { return this->Patch; }
+  std::vector<Side>& litSideData() { return this->LitSide; }
+  std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
+  /// One per element, or empty when nothing emits.
+  std::vector<Rgb>& emissionData() { return this->Emission; }
+
+private:
+  std::size_t Frames = 0, Elements = 0, Patches = 0;
+  std::vector<PackedRgb> Direct, Indirect, Patch;
+  std::vector<Rgb> Emission;
+  std::vector<Side> LitSide, PatchLitSide;
+};
+
+} // namespace mlr

@@ -1,0 +1,91 @@
+// What a solve is asked to do: the options, their bounds and the one list of their fields.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+namespace mlr
+{
+
+struct SolverOptions
+{
+  /// N: effective shooting paths per frame.
+  std::uint64_t pathsPerFrame = 600000;
+  /// k: gathering rays per frame = k * N, shared over the element sides that gather.
+  double gatheringRatio = 1.0;
+  /// lambda: probability that a path continues after its first hit, in [0.001, 1]. A walk
+  /// that survives carries 1/lambda of its power; the bound keeps the fixed-point sums (2^23
+  /// times the light's power per slot) far from overflow.
+  double firstBounceSurvival = 0.25;
+  /// Cast M = N/n paths from each position and weight them for every frame.
+  bool reuseShooting = true;
+  /// Cast one set of gathering rays and use every ray for every frame.
+  bool reuseGathering = true;
+  /// Surfaces scatter light on both sides; when false, back faces absorb everything.
+  bool twoSided = true;
+  std::uint64_t seed = 0;
+  /// Worker threads; 0 means every core. The result does not depend on it.
+  int threads = 0;
+  /// Refuse solves whose memory estimate exceeds this many bytes; 0 means half of the
+  /// physical memory.
+  std::uint64_t memoryLimitBytes = 0;
+
+  /// A solve shared by `ranks` processes (MPI ranks of pvbatch or pvserver), this one being
+  /// `rank`. Every rank gives the same scene, rig and options; each traces a disjoint share
+  /// of the shooting paths and gathering sides, keyed by their global index, and the sums are
+  /// added over ranks, so every rank ends with the serial solution, bit for bit.
+  int rank = 0;
+  int ranks = 1;
+  /// Sums `count` values over every rank, in place, on every rank (an MPI AllReduce): every
+  /// rank calls it at the same points of the solve. Required when ranks > 1; Core has no MPI.
+  std::function<void(std::int64_t* values, std::size_t count)> sumAcrossRanks;
+  std::function<void(double* values, std::size_t count)> sumDoublesAcrossRanks;
+};
+
+/// The largest pathsPerFrame accepted: past it a solve would run for months.
+constexpr std::uint64_t MaximumPathsPerFrame = 100000000000ULL;
+
+/// The smallest lambda accepted (SolverOptions::firstBounceSurvival).
+constexpr double MinimumFirstBounceSurvival = 0.001;
+
+/// Throws mlr::Error naming the first option that is out of range.
+void validateOptions(const SolverOptions& options);
+
+/// What an option decides, for the ranks' agreement (digestOf in Ranks.h).
+enum class OptionRole
+{
+  Result,  ///< changes the solution: every rank must give the same value
+  PerRank, ///< may differ between ranks without changing the solution (threads, rank)
+  Hook,    ///< a function the caller supplies (the sums over ranks)
+};
+
+/**
+ * Calls visit(name, value, role) for every field of `options`, in declaration order. The
+ * structured binding names every field, so adding one to SolverOptions without adding it
+ * here fails to compile: the ranks' digest cannot leave a new option out silently.
+ */
+template <typename Visitor>
+void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
+{
+  const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting,
+    reuseGathering, twoSided, seed, threads, memoryLimitBytes, rank, ranks, sumAcrossRanks,
+    sumDoublesAcrossRanks] = options;
+  visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
+  visit("gatheringRatio", gatheringRatio, OptionRole::Result);
+  visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
+  visit("reuseShooting", reuseShooting, OptionRole::Result);
+  visit("reuseGathering", reuseGathering, OptionRole::Result);
+  visit("twoSided", twoSided, OptionRole::Result);
+  visit("seed", seed, OptionRole::Result);
+  visit("threads", threads, OptionRole::PerRank);
+  // The limit decides whether a solve runs and how it holds its sums, never its result;
+  // every rank checks its own.
+  visit("memoryLimitBytes", memoryLimitBytes, OptionRole::PerRank);
+  visit("rank", rank, OptionRole::PerRank);
+  visit("ranks", ranks, OptionRole::Result);
+  visit("sumAcrossRanks", sumAcrossRanks, OptionRole::Hook);
+  visit("sumDoublesAcrossRanks", sumDoublesAcrossRanks, OptionRole::Hook);
+}
+
+} // namespace mlr
