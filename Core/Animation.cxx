@@ -27,6 +27,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     soupEmits = soupEmits || m.emission.maxComponent() > 0;
   }
   const std::size_t frames = frameCount(lights, soupEmits);
+  const std::size_t lightCount = lights.areaLights.size() + lights.directionalLights.size();
 
   RemeshOptions remeshing = options.remeshing;
   remeshing.memoryLimitBytes = options.solver.memoryLimitBytes;
@@ -37,7 +38,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   remeshing.checkExpectedPatches = [&](std::size_t expected) {
     const std::size_t patches = expected / 2;
     checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
-                                     options.solver),
+                                     options.solver, lightCount),
                        outputBytes(options, 4 * patches, 2 * patches)),
       frames, patches, 4 * patches, options.solver, true);
   };
@@ -57,7 +58,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   animation.scene = Scene::fromPatchMesh(remeshed.mesh);
   animation.patches = std::move(remeshed.mesh);
   const Scene& scene = animation.scene;
-  checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver),
+  checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
                      outputBytes(options, scene.elementCount(), scene.points().size())),
     frames, scene.patchCount(), scene.elementCount(), options.solver);
   });

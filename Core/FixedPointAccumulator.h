@@ -9,6 +9,8 @@
 // half the memory limit (MemoryPlan, planSolveMemory in Solver.h).
 #pragma once
 
+#include "MemoryBudget.h"
+
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -34,6 +36,18 @@ enum class FrameLayout
   /// stays in cache where the whole buffer would not.
   FramesOuter,
 };
+
+/// FixedPointAccumulator's buffers are aligned to and allocated in whole 2 MiB pages (see
+/// allocateZeroed). With transparent huge pages the last page is resident whole, so the
+/// memory plan counts the rounded size.
+constexpr std::uint64_t FixedPointPageBytes = std::uint64_t(2) << 20;
+
+/// The bytes a buffer of `bytes` takes once rounded up to whole pages (saturating).
+inline std::uint64_t fixedPointBufferBytes(std::uint64_t bytes)
+{
+  const std::uint64_t pages = bytes / FixedPointPageBytes + (bytes % FixedPointPageBytes != 0);
+  return pages > UINT64_MAX / FixedPointPageBytes ? UINT64_MAX : pages * FixedPointPageBytes;
+}
 
 /**
  * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), in one copy per
@@ -158,8 +172,14 @@ public:
   /// Bytes of `copies` copies (the worker count, or 1 when shared).
   static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
   {
-    return static_cast<std::uint64_t>(copies) * records * 2 * frames * Channels *
-      sizeof(std::int64_t);
+    return saturatingProduct({ static_cast<std::uint64_t>(copies), records, 2, frames,
+      Channels, sizeof(std::int64_t) });
+  }
+
+  /// What those copies allocate: bytes() rounded up to whole pages.
+  static std::uint64_t allocatedBytes(int copies, std::size_t records, std::size_t frames)
+  {
+    return fixedPointBufferBytes(bytes(copies, records, frames));
   }
 
 private:
@@ -186,10 +206,9 @@ private:
   /// those misses by 512.
   static std::unique_ptr<std::int64_t[], Free> allocateZeroed(std::size_t count)
   {
-    constexpr std::size_t hugePage = std::size_t(2) << 20;
     const std::size_t bytes = std::max<std::size_t>(count * sizeof(std::int64_t), 1);
-    const std::size_t rounded = (bytes + hugePage - 1) / hugePage * hugePage;
-    void* memory = std::aligned_alloc(hugePage, rounded);
+    const std::size_t rounded = static_cast<std::size_t>(fixedPointBufferBytes(bytes));
+    void* memory = std::aligned_alloc(FixedPointPageBytes, rounded);
     if (!memory)
     {
       throw std::bad_alloc();

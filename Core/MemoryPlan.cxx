@@ -1,5 +1,7 @@
 #include "MemoryPlan.h"
 
+#include "FixedPointAccumulator.h"
+
 #include "Parallel.h"
 #include "Reachability.h"
 #include "Rgb.h"
@@ -11,7 +13,7 @@ namespace mlr
 {
 
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options)
+  std::size_t frames, const SolverOptions& options, std::size_t lights)
 {
   const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
   MemoryPlan plan;
@@ -19,10 +21,13 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t patch = saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) });
   const std::uint64_t indirect = direct;
   plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
-  // One copy of the accumulators (FixedPointAccumulator::bytes): a scalar share per element
-  // side and RGB power per patch side, for every frame.
-  const std::uint64_t copy = saturatingSum(saturatingProduct({ elements, 2, frames, sizeof(std::int64_t) }),
-    saturatingProduct({ patches, 2, frames, 3, sizeof(std::int64_t) }));
+  // The accumulators of `copies` copies: a scalar share per element side and RGB power per
+  // patch side, for every frame, each buffer in whole pages.
+  const auto accumulators = [&](std::uint64_t copies) {
+    const int c = static_cast<int>(copies);
+    return saturatingSum(FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
+      FixedPointAccumulator<3>::allocatedBytes(c, patches, frames));
+  };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,
     sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
@@ -32,32 +37,36 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   // Reachability: the probes' hits and their reverse edges (gone before gathering rays).
   const std::uint64_t reachability =
     saturatingProduct({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });
-  plan.other = saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, reachability));
-  const std::uint64_t base = saturatingSum(saturatingSum(scratch, tracing), perElement);
+  // Per frame and light: its pose copied into the rig (120 bytes), its power factor (24) and
+  // the shooting run's pose coefficients and path counts (112), measured.
+  const std::uint64_t lightData = saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
+  const std::uint64_t base =
+    saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData));
+  plan.other = saturatingSum(base, reachability);
   const std::uint64_t gathering =
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
   const auto peakWith = [&](std::uint64_t copies) {
     return saturatingSum(base,
-      std::max(saturatingSum(saturatingSum(direct, patch), saturatingProduct({ copies, copy })), gathering));
+      std::max(saturatingSum(saturatingSum(direct, patch), accumulators(copies)), gathering));
   };
   plan.accumulatorCopyPerWorker = workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
   const std::uint64_t copies = plan.accumulatorCopyPerWorker ? workers : 1;
-  plan.accumulators = saturatingProduct({ copies, copy });
+  plan.accumulators = accumulators(copies);
   plan.peak = peakWith(copies);
   return plan;
 }
 
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options)
+  std::size_t frames, const SolverOptions& options, std::size_t lights)
 {
-  return planSolveMemory(patches, elements, points, frames, options).peak;
+  return planSolveMemory(patches, elements, points, frames, options, lights).peak;
 }
 
 std::uint64_t estimateSolveMemory(
-  const Scene& scene, std::size_t frames, const SolverOptions& options)
+  const Scene& scene, std::size_t frames, const SolverOptions& options, std::size_t lights)
 {
   return estimateSolveMemory(
-    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
+    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options, lights);
 }
 
 std::uint64_t memoryLimitBytes(const SolverOptions& options)

@@ -32,16 +32,18 @@ struct MemoryPlan
   std::uint64_t peak = 0;         ///< the estimate: the larger phase, shooting or gathering
 };
 
+/// The plan of a solve of `frames` frames lit by `lights` light sources (area lights, scene
+/// emitters and directional lights; their per-frame data is counted).
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options);
+  std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
 
 /// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
-std::uint64_t estimateSolveMemory(
-  const Scene& scene, std::size_t frames, const SolverOptions& options);
+std::uint64_t estimateSolveMemory(const Scene& scene, std::size_t frames,
+  const SolverOptions& options, std::size_t lights = 1);
 
 /// The same estimate from counts alone, e.g. for a scene not remeshed yet.
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options);
+  std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
 
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);

@@ -175,11 +175,11 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     validateOptions(options);
     frames = frameCount(rig, scene.hasEmission());
     workers = resolveThreadCount(options.threads);
-    plan = planSolveMemory(
-      scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
-    checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
     emitters = sceneEmitters(scene);
     sources = lightSources(scene, rig, emitters);
+    plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
+      frames, options, sources.size());
+    checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
     for (const LightSource& source : sources)
     {
       checkPathsPerPosition(source, options);

@@ -241,7 +241,7 @@ void addFrameFieldData(vtkFieldData* fieldData, std::size_t frame, const Vec3& l
 }
 
 // ------------------------------------------------------------------------------------------
-// Display (issue 17)
+// Display
 
 double luminance(const Rgb& rgb)
 {
