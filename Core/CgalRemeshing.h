@@ -1,5 +1,5 @@
 // Private to Core: the boundary between Remeshing.cxx and the translation units of
-// mlrCgalRemeshing, the only ones that include CGAL (each takes ~45 s and 1.6 GB to compile,
+// mlrCgalRemeshing, the only ones that include CGAL (up to ~45 s and 1.6 GB each to compile,
 // so nothing else sees CGAL's headers).
 #pragma once
 

@@ -234,8 +234,7 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
 bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, CgalRemeshOutput& out,
   CancellationPoll& poll);
 
-// Components and regions (CgalRegions.cxx). Each connected surface is remeshed in a mesh of
-// its own, so that a failure costs only that surface.
+// Components and regions (CgalRegions.cxx).
 
 /// The soup's connected components, each as the indices of its triangles.
 std::vector<std::vector<std::size_t>> connectedComponents(const RepairedSoup& soup, CancellationPoll& poll);
