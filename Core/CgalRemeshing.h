@@ -1,8 +1,10 @@
-// Private to Core: the boundary between Remeshing.cxx and the one translation unit that
-// includes CGAL (CGAL headers take ~45 s and 1.6 GB to compile, so nothing else sees them).
+// Private to Core: the boundary between Remeshing.cxx and the translation units of
+// mlrCgalRemeshing, the only ones that include CGAL (up to ~45 s and 1.6 GB each to compile,
+// so nothing else sees CGAL's headers).
 #pragma once
 
-#include "Remeshing.h"
+#include "PolygonSoup.h"
+#include "Scene.h"
 
 #include <cstddef>
 #include <cstdint>

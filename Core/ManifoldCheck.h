@@ -26,7 +26,7 @@ using SoupTriangle = std::array<std::size_t, 3>;
 bool isTriangleSoupAPolygonMesh(const std::vector<SoupTriangle>& triangles, CancellationPoll& poll);
 
 /// CGAL's own is_polygon_soup_a_polygon_mesh(), for the tests that compare the two
-/// (defined in CgalRemeshing.cxx, the translation unit that includes CGAL).
+/// (defined in CgalSoupRepair.cxx, among the translation units that include CGAL).
 bool cgalIsPolygonSoupAPolygonMesh(const std::vector<SoupTriangle>& triangles);
 
 } // namespace mlr::detail
