@@ -248,4 +248,19 @@ std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& pol
   return poses;
 }
 
+std::optional<std::size_t> aimAt(std::vector<PoseInput>& inputs, const Vec3& target)
+{
+  for (std::size_t k = 0; k < inputs.size(); ++k)
+  {
+    PoseInput& in = inputs[k];
+    in.hasNormal = true;
+    in.normal = target - in.position;
+    if (!in.hasOrientation && !(length(in.normal) > 1e-12))
+    {
+      return k;
+    }
+  }
+  return std::nullopt;
+}
+
 } // namespace mlr

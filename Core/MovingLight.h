@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,12 @@ public:
   const std::vector<LightPose>& poses() const { return this->Poses; }
   /// How far frame `frame` moves the centroid: p_k - c.
   Vec3 translation(std::size_t frame) const { return this->Poses[frame].position - this->Centroid; }
+  /// Frame `frame` as a rigid motion x -> R x + t of a point x of the light as given: this
+  /// t, p - R c.
+  Vec3 rigidTranslation(std::size_t frame) const
+  {
+    return this->Poses[frame].position - this->Poses[frame].rotation.apply(this->Centroid);
+  }
   /// True when some frame turns the light.
   bool rotates() const { return this->Rotates; }
 
@@ -113,5 +120,16 @@ Vec3 meanNormal(const std::vector<std::vector<Vec3>>& polygons);
  */
 std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& polygons,
   const std::vector<PoseInput>& inputs, std::vector<std::string>& warnings);
+
+/**
+ * Aims a light at `target` in every frame: each input's Normal becomes the direction from its
+ * position to the target, so that posesFromInputs turns the light about its centroid by the
+ * smallest rotation from meanNormal(polygons) to it (a target straight behind the light gets
+ * the half turn of Rotation::between). An Orientation still wins. A light at the target has
+ * no direction to face it: returns the first frame without an Orientation whose position is
+ * there (its Normal is then zero, which posesFromInputs refuses), none when every frame can
+ * face it.
+ */
+std::optional<std::size_t> aimAt(std::vector<PoseInput>& inputs, const Vec3& target);
 
 } // namespace mlr

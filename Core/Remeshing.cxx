@@ -3,8 +3,8 @@
 #include "CancellationPoll.h"
 #include "CgalRemeshing.h"
 #include "Error.h"
+#include "MemoryBudget.h"
 #include "PolygonTriangulation.h"
-#include "Solver.h"
 
 #include <algorithm>
 #include <array>
@@ -381,20 +381,17 @@ void checkPatchBudget(double expected, double h)
 /// the estimate exceeds the memory limit.
 void checkRemeshMemory(double inputTriangles, double patches, double h, const RemeshOptions& options)
 {
-  const double limit = static_cast<double>(
-    options.memoryLimitBytes > 0 ? options.memoryLimitBytes : defaultMemoryLimitBytes());
   const double estimate = inputTriangles * BytesPerInputTriangle + patches * BytesPerPatch;
-  if (estimate > limit)
-  {
-    std::ostringstream s;
-    s.precision(3);
-    s << "remeshing at patch size " << h << " needs an estimated "
-      << estimate / (1024.0 * 1024.0 * 1024.0) << " GiB (" << inputTriangles
-      << " input triangles into about " << patches << " patches), over the memory limit of "
-      << limit / (1024.0 * 1024.0 * 1024.0)
-      << " GiB: give a larger patch size or a smaller scene, or raise the limit";
-    throw Error(s.str());
-  }
+  // Rounded up to whole bytes, so that it is over the limit exactly when the estimate is.
+  const std::uint64_t bytes =
+    estimate < 0x1p64 ? static_cast<std::uint64_t>(std::ceil(estimate)) : UINT64_MAX;
+  std::ostringstream what, detail;
+  what.precision(3);
+  detail.precision(3);
+  what << "remeshing at patch size " << h;
+  detail << inputTriangles << " input triangles into about " << patches << " patches";
+  MemoryBudget(options.memoryLimitBytes)
+    .check(bytes, what.str(), detail.str(), "give a larger patch size or a smaller scene, or raise the limit");
 }
 
 /// Splits the given input triangles only; progress runs from `from` to 1.

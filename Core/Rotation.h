@@ -4,6 +4,7 @@
 #include "Vec3.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace mlr
@@ -15,6 +16,12 @@ struct Rotation
   Vec3 row0{ 1, 0, 0 }, row1{ 0, 1, 0 }, row2{ 0, 0, 1 };
 
   constexpr Vec3 apply(const Vec3& v) const { return { dot(row0, v), dot(row1, v), dot(row2, v) }; }
+
+  /// The matrix as rows of numbers, for code that holds rotations as arrays.
+  std::array<std::array<double, 3>, 3> rows() const
+  {
+    return { { { row0.x, row0.y, row0.z }, { row1.x, row1.y, row1.z }, { row2.x, row2.y, row2.z } } };
+  }
 
   bool isIdentity() const
   {

@@ -1,8 +1,8 @@
 #include "MovingLightRadiosityInputs.h"
 
 #include "Error.h"
+#include "MemoryBudget.h"
 #include "PolygonTriangulation.h"
-#include "Solver.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
@@ -236,24 +236,17 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     // Per point 24 bytes; per polygon its index vector (~56 bytes with the allocator's
     // overhead) and material (24), and 4 bytes per index. Strips become one polygon per
     // triangle.
-    const double cells = static_cast<double>(scene->GetNumberOfPolys()) +
-      static_cast<double>(scene->GetStrips()->GetNumberOfConnectivityIds());
-    const double ids = static_cast<double>(scene->GetPolys()->GetNumberOfConnectivityIds()) +
-      3.0 * static_cast<double>(scene->GetStrips()->GetNumberOfConnectivityIds());
-    const double estimate = 24.0 * static_cast<double>(scene->GetNumberOfPoints()) + 80.0 * cells + 4.0 * ids;
-    const double limit =
-      static_cast<double>(memoryLimitBytes > 0 ? memoryLimitBytes : defaultMemoryLimitBytes());
-    if (estimate > limit)
-    {
-      std::ostringstream s;
-      s.precision(3);
-      s << "the Scene has " << scene->GetNumberOfCells() << " cells on "
-        << scene->GetNumberOfPoints() << " points: taking them for remeshing needs an estimated "
-        << estimate / (1024.0 * 1024.0 * 1024.0) << " GiB, over the memory limit of "
-        << limit / (1024.0 * 1024.0 * 1024.0)
-        << " GiB: simplify the scene or raise MemoryLimit";
-      throw Error(s.str());
-    }
+    // The Scene is in memory, so these sums of its sizes cannot overflow.
+    const auto count = [](vtkIdType n) { return static_cast<std::uint64_t>(n); };
+    const std::uint64_t stripIds = count(scene->GetStrips()->GetNumberOfConnectivityIds());
+    const std::uint64_t cells = count(scene->GetNumberOfPolys()) + stripIds;
+    const std::uint64_t ids = count(scene->GetPolys()->GetNumberOfConnectivityIds()) + 3 * stripIds;
+    const std::uint64_t estimate = 24 * count(scene->GetNumberOfPoints()) + 80 * cells + 4 * ids;
+    MemoryBudget(memoryLimitBytes)
+      .check(estimate,
+        "the Scene has " + std::to_string(scene->GetNumberOfCells()) + " cells on " +
+          std::to_string(scene->GetNumberOfPoints()) + " points: taking them for remeshing",
+        "", "simplify the scene or raise MemoryLimit");
   }
   const vtkIdType ignored = scene->GetNumberOfVerts() + scene->GetNumberOfLines();
   if (ignored > 0)

@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdint>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -366,14 +367,11 @@ int vtkMovingLightRadiosity::RequestData(
         for (const mlr::MovingLight& light : cache.Rig.areaLights)
         {
           const std::size_t k = light.frameCount() > 1 ? frame : 0;
-          const mlr::LightPose& pose = light.pose(k);
-          const mlr::Rotation& r = pose.rotation;
           mlr::vtkoutputs::LightTransform transform;
-          transform.rotation = { { { r.row0.x, r.row0.y, r.row0.z }, { r.row1.x, r.row1.y, r.row1.z },
-            { r.row2.x, r.row2.y, r.row2.z } } };
-          transform.translation = pose.position - r.apply(light.centroid());
-          lights->AddInputData(
-            mlr::vtkoutputs::posedLight(light.polygons(), transform, light.power() * pose.power));
+          transform.rotation = light.pose(k).rotation.rows();
+          transform.translation = light.rigidTranslation(k);
+          lights->AddInputData(mlr::vtkoutputs::posedLight(
+            light.polygons(), transform, light.power() * light.pose(k).power));
         }
         if (lights->GetNumberOfInputConnections(0) > 0)
         {
@@ -533,18 +531,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         std::vector<mlr::PoseInput> inputs = trajectory.lights[i];
         if (this->AimAtPoint)
         {
-          for (std::size_t k = 0; k < inputs.size(); ++k)
+          // Core would blame a zero Normal, which the user never gave: name AimPoint.
+          if (const std::optional<std::size_t> k = mlr::aimAt(inputs, aim))
           {
-            mlr::PoseInput& in = inputs[k];
-            in.hasNormal = true;
-            in.normal = aim - in.position;
-            // Core would blame a zero Normal, which the user never gave: name AimPoint.
-            if (!in.hasOrientation && !(mlr::length(in.normal) > 1e-12))
-            {
-              throw mlr::Error("light " + std::to_string(i) + " (in LightId order) is at "
-                "AimPoint in frame " + std::to_string(k) + " and cannot face it: move "
-                "AimPoint off the light's Trajectory, or turn AimAtPoint off");
-            }
+            throw mlr::Error("light " + std::to_string(i) + " (in LightId order) is at "
+              "AimPoint in frame " + std::to_string(*k) + " and cannot face it: move "
+              "AimPoint off the light's Trajectory, or turn AimAtPoint off");
           }
         }
         const std::vector<mlr::LightPose> poses =

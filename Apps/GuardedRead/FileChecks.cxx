@@ -1,6 +1,7 @@
 #include "FileChecks.h"
 
 #include "GuardedRead.h"
+#include "MemoryBudget.h"
 
 #include <algorithm>
 #include <cctype>
@@ -351,12 +352,13 @@ void checkPlyFile(const std::string& path, const std::string& what)
   const std::uint64_t headerEnd = static_cast<std::uint64_t>(in.tellg());
   in.seekg(0, std::ios::end);
   const std::uint64_t rest = static_cast<std::uint64_t>(in.tellg()) - headerEnd;
-  long double needed = 0;
+  std::uint64_t needed = 0;
   for (const Element& e : elements)
   {
-    needed += static_cast<long double>(e.count) * (format == "ascii" ? 2.0L * e.values : e.fixedBytes);
+    needed = saturatingSum(needed,
+      saturatingProduct(e.count, format == "ascii" ? saturatingProduct(2, e.values) : e.fixedBytes));
   }
-  if (needed > static_cast<long double>(rest) + 1)
+  if (needed > saturatingSum(rest, 1))
   {
     std::ostringstream s;
     s << "its header counts elements that need at least " << static_cast<double>(needed)

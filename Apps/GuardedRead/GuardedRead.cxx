@@ -1,6 +1,7 @@
 #include "GuardedRead.h"
 
 #include "FileChecks.h"
+#include "MemoryBudget.h"
 
 #include "vtkDataSet.h"
 #include "vtkGenericDataObjectReader.h"
@@ -192,22 +193,6 @@ vtkSmartPointer<vtkAlgorithm> makeReader(
     throw InputError(what + " has an unknown extension: give a .vtp .vtu .vtk .obj .ply or .stl file");
   }
   return reader;
-}
-
-std::uint64_t physicalMemoryBytes()
-{
-  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && pageSize > 0
-    ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize)
-    : std::uint64_t(8) << 30;
-}
-
-std::string gibibytes(std::uint64_t bytes)
-{
-  std::ostringstream s;
-  s.precision(3);
-  s << static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0) << " GiB";
-  return s.str();
 }
 
 std::string secondsText(double seconds)
@@ -541,9 +526,9 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
     checkPlyFile(path, what);
   }
 
-  const std::uint64_t memory = limits.memoryBytes > 0 ? limits.memoryBytes : physicalMemoryBytes() / 2;
   // Readers need some room whatever the limit.
-  const std::uint64_t room = std::max<std::uint64_t>(memory, std::uint64_t(256) << 20);
+  const std::uint64_t room =
+    std::max<std::uint64_t>(MemoryBudget(limits.memoryBytes).limitBytes(), std::uint64_t(256) << 20);
   const double cpuSeconds = limits.time.cpuSeconds(size);
   const double wallSeconds = limits.time.wallSeconds(size);
 
