@@ -14,7 +14,7 @@ namespace mlr
  * A light at infinity. In frame k it shines from the unit direction s_k (pointing towards the
  * light) with irradiance s_k-scaled E (RGB, W/m^2 on a surface facing it). Paths of frame k
  * start uniformly on a disc perpendicular to s_k that covers the scene's bounding sphere
- * (METHOD.md, "Directional light"). A light with one direction lights every frame alike.
+ * (Documentation/Method.md, section 9). A light with one direction lights every frame alike.
  * The constructor throws mlr::Error naming what is wrong.
  */
 class DirectionalLight

@@ -139,8 +139,9 @@ private:
  * colour * shares[f], with one RGB colour for all frames: the frames differ only by scalar
  * weights (and the power factors, applied when the sums become radiosity).
  *
- * METHOD.md writes step 3 as P <- P / lambda; the power that leaves the first hit is the
- * reflected power, so we carry rho * P / lambda (the energy balance test checks this).
+ * A surviving walk carries rho * P / lambda, not P / lambda: the power that leaves the first
+ * hit is the reflected power (Documentation/Method.md, section 2; the energy balance test
+ * checks this).
  */
 void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
   std::size_t firstFrame, std::size_t frameCount, int worker)

@@ -1,6 +1,7 @@
 #include "vtkMovingLightRadiosity.h"
 
 #include "MovingLightRadiosityInputs.h"
+#include "MovingLightRadiosityDisplay.h"
 #include "MovingLightRadiosityOutputs.h"
 #include "MovingLightRadiosityParallel.h"
 

@@ -1,0 +1,302 @@
+#include "MovingLightRadiosityDisplay.h"
+
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace mlr::vtkoutputs
+{
+
+double luminance(const Rgb& rgb)
+{
+  return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b;
+}
+
+double acesFilmic(double x)
+{
+  if (!(x > 0))
+  {
+    return 0; // also NaN
+  }
+  const double mapped = x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
+  return std::min(mapped, 1.0);
+}
+
+unsigned char srgbByte(double linear)
+{
+  const double c = std::clamp(std::isnan(linear) ? 0.0 : linear, 0.0, 1.0);
+  const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  return static_cast<unsigned char>(std::lround(255.0 * encoded));
+}
+
+std::array<unsigned char, 3> displayColor(const Rgb& radiosity, double exposureScale)
+{
+  return { srgbByte(acesFilmic(exposureScale * radiosity.r)),
+    srgbByte(acesFilmic(exposureScale * radiosity.g)),
+    srgbByte(acesFilmic(exposureScale * radiosity.b)) };
+}
+
+double autoExposure(const Solution& solution)
+{
+  // A histogram of log2 luminance rather than a sort: frames x elements values may not fit
+  // in memory twice, and 1/64 EV is far below what the eye can tell.
+  constexpr int StepsPerEV = 64;
+  constexpr int LowestEV = -100, HighestEV = 100;
+  std::vector<std::uint64_t> histogram(
+    static_cast<std::size_t>((HighestEV - LowestEV) * StepsPerEV), 0);
+  std::uint64_t unlit = 0, total = 0;
+  for (std::size_t e = 0; e < solution.elementCount(); ++e)
+  {
+    const Side lit = solution.litSide(e);
+    for (std::size_t f = 0; f < solution.frameCount(); ++f)
+    {
+      const double l = luminance(solution.total(f, e, lit));
+      ++total;
+      if (!(l > 0) || !std::isfinite(l))
+      {
+        ++unlit;
+        continue;
+      }
+      const double bin = std::floor((std::log2(l) - LowestEV) * StepsPerEV);
+      const auto index = static_cast<std::size_t>(
+        std::clamp(bin, 0.0, static_cast<double>(histogram.size() - 1)));
+      ++histogram[index];
+    }
+  }
+  if (total == unlit)
+  {
+    return 0;
+  }
+  // The 99th percentile of all values, dark ones included; when more than 99% are dark, the
+  // brightest lit value instead, so that a small lit spot still gets a usable exposure.
+  const auto rank = static_cast<std::uint64_t>(std::ceil(0.99 * static_cast<double>(total)));
+  std::uint64_t seen = unlit;
+  std::size_t index = 0;
+  for (std::size_t i = 0; i < histogram.size(); ++i)
+  {
+    if (histogram[i] == 0)
+    {
+      continue;
+    }
+    index = i;
+    seen += histogram[i];
+    if (seen >= rank)
+    {
+      break;
+    }
+  }
+  const double log2Level = LowestEV + (static_cast<double>(index) + 0.5) / StepsPerEV;
+  return std::log2(AutoExposureTarget) - log2Level;
+}
+
+SmoothShading smoothShading(const Scene& scene, const Solution& solution)
+{
+  const std::vector<Triangle>& triangles = scene.elementTriangles();
+  const std::size_t corners = 3 * triangles.size();
+
+  // Union-find over element corners: two corners at the same scene point join when their
+  // elements share an edge through that point and meet smoothly there.
+  std::vector<std::size_t> parent(corners);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](std::size_t c) {
+    while (parent[c] != c)
+    {
+      parent[c] = parent[parent[c]];
+      c = parent[c];
+    }
+    return c;
+  };
+  auto join = [&](std::size_t a, std::size_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b)
+    {
+      parent[std::max(a, b)] = std::min(a, b);
+    }
+  };
+
+  std::vector<Vec3> litNormals(triangles.size());
+  for (std::size_t e = 0; e < triangles.size(); ++e)
+  {
+    litNormals[e] = scene.elementSideNormal(e, solution.litSide(e));
+  }
+  const double cosFeature = std::cos(FeatureAngle * M_PI / 180.0);
+  auto smooth = [&](std::size_t a, std::size_t b) {
+    return scene.elementReflectance(a) == scene.elementReflectance(b) &&
+      dot(litNormals[a], litNormals[b]) >= cosFeature;
+  };
+
+  // Every edge once per element, keyed by its two scene points (lower first), with the
+  // corners of the element at those points; sorted so that an edge's elements are adjacent.
+  struct EdgeUse
+  {
+    std::uint64_t key;
+    std::size_t lowCorner, highCorner;
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(corners);
+  for (std::size_t e = 0; e < triangles.size(); ++e)
+  {
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      std::size_t a = 3 * e + k, b = 3 * e + (k + 1) % 3;
+      if (triangles[e][k] > triangles[e][(k + 1) % 3])
+      {
+        std::swap(a, b);
+      }
+      const std::uint64_t key =
+        (static_cast<std::uint64_t>(triangles[a / 3][a % 3]) << 32) | triangles[b / 3][b % 3];
+      uses.push_back({ key, a, b });
+    }
+  }
+  std::sort(uses.begin(), uses.end(),
+    [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
+  for (std::size_t first = 0; first < uses.size();)
+  {
+    std::size_t last = first + 1;
+    while (last < uses.size() && uses[last].key == uses[first].key)
+    {
+      ++last;
+    }
+    // Usually 2 uses; more only at non-manifold edges, where every smooth pair joins.
+    for (std::size_t i = first; i < last; ++i)
+    {
+      for (std::size_t j = i + 1; j < last; ++j)
+      {
+        if (smooth(uses[i].lowCorner / 3, uses[j].lowCorner / 3))
+        {
+          join(uses[i].lowCorner, uses[j].lowCorner);
+          join(uses[i].highCorner, uses[j].highCorner);
+        }
+      }
+    }
+    first = last;
+  }
+
+  SmoothShading shading;
+  shading.elementAreas.resize(triangles.size());
+  for (std::size_t e = 0; e < triangles.size(); ++e)
+  {
+    shading.elementAreas[e] = scene.elementArea(e);
+  }
+  shading.cornerPoints.assign(corners, -1);
+  std::vector<double> area;
+  for (std::size_t c = 0; c < corners; ++c)
+  {
+    const std::size_t root = find(c);
+    if (shading.cornerPoints[root] < 0)
+    {
+      shading.cornerPoints[root] = static_cast<vtkIdType>(shading.scenePoints.size());
+      shading.scenePoints.push_back(triangles[c / 3][c % 3]);
+      area.push_back(0.0);
+    }
+    shading.cornerPoints[c] = shading.cornerPoints[root];
+    area[static_cast<std::size_t>(shading.cornerPoints[c])] += scene.elementArea(c / 3);
+  }
+  shading.inverseArea.resize(area.size());
+  for (std::size_t p = 0; p < area.size(); ++p)
+  {
+    shading.inverseArea[p] = area[p] > 0 ? 1.0 / area[p] : 0.0;
+  }
+  return shading;
+}
+
+vtkSmartPointer<vtkPolyData> smoothElementMesh(const Scene& scene, const SmoothShading& shading)
+{
+  const std::size_t pointCount = shading.scenePoints.size();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(pointCount));
+  vtkNew<vtkIdTypeArray> scenePointIds;
+  scenePointIds->SetName("ScenePointId");
+  scenePointIds->SetNumberOfTuples(static_cast<vtkIdType>(pointCount));
+  for (std::size_t i = 0; i < pointCount; ++i)
+  {
+    const Vec3& p = scene.points()[shading.scenePoints[i]];
+    points->SetPoint(static_cast<vtkIdType>(i), p.x, p.y, p.z);
+    scenePointIds->SetValue(static_cast<vtkIdType>(i), shading.scenePoints[i]);
+  }
+  vtkNew<vtkCellArray> cells;
+  const std::size_t n = scene.elementCount();
+  cells->AllocateExact(static_cast<vtkIdType>(n), static_cast<vtkIdType>(3 * n));
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    cells->InsertNextCell(3, shading.cornerPoints.data() + 3 * e);
+  }
+  auto mesh = vtkSmartPointer<vtkPolyData>::New();
+  mesh->SetPoints(points);
+  mesh->SetPolys(cells);
+  mesh->GetPointData()->AddArray(scenePointIds);
+
+  auto reflectance = rgbArray("Reflectance", n);
+  vtkNew<vtkIntArray> patchId;
+  patchId->SetName("PatchId");
+  patchId->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    setRgb(reflectance, e, scene.elementReflectance(e));
+    patchId->SetValue(static_cast<vtkIdType>(e), static_cast<int>(Scene::patchOfElement(e)));
+  }
+  mesh->GetCellData()->AddArray(reflectance);
+  mesh->GetCellData()->AddArray(patchId);
+  return mesh;
+}
+
+namespace
+{
+void setColor(vtkUnsignedCharArray* array, std::size_t i, const Rgb& radiosity, double scale)
+{
+  const std::array<unsigned char, 3> color = displayColor(radiosity, scale);
+  array->SetTypedTuple(static_cast<vtkIdType>(i), color.data());
+}
+}
+
+void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  double exposureScale, vtkPointData* pointData, vtkCellData* cellData)
+{
+  const std::size_t n = solution.elementCount();
+  const std::size_t pointCount = shading.scenePoints.size();
+  auto cellColor = rgbArray<vtkUnsignedCharArray>("Color", n);
+  std::vector<Rgb> pointSum(pointCount);
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    const Rgb radiosity = solution.total(frame, e, solution.litSide(e));
+    setColor(cellColor, e, radiosity, exposureScale);
+    const Rgb weighted = radiosity * shading.elementAreas[e];
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      pointSum[static_cast<std::size_t>(shading.cornerPoints[3 * e + k])] += weighted;
+    }
+  }
+  auto pointRadiosity = rgbArray("Radiosity", pointCount);
+  auto pointColor = rgbArray<vtkUnsignedCharArray>("Color", pointCount);
+  for (std::size_t p = 0; p < pointCount; ++p)
+  {
+    const Rgb radiosity = pointSum[p] * shading.inverseArea[p];
+    setRgb(pointRadiosity, p, radiosity);
+    setColor(pointColor, p, radiosity, exposureScale);
+  }
+  cellData->AddArray(cellColor);
+  cellData->SetActiveScalars("Color");
+  pointData->AddArray(pointRadiosity);
+  pointData->AddArray(pointColor);
+  pointData->SetActiveScalars("Color");
+}
+
+void addExposureFieldData(vtkFieldData* fieldData, double autoExposure, double exposure)
+{
+  addValue<vtkDoubleArray>(fieldData, "AutoExposure", autoExposure);
+  addValue<vtkDoubleArray>(fieldData, "Exposure", exposure);
+  addValue<vtkDoubleArray>(fieldData, "ExposureScale", std::exp2(autoExposure + exposure));
+}
+
+} // namespace mlr::vtkoutputs
