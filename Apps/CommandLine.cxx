@@ -35,8 +35,7 @@ double parseNumber(const std::string& option, const std::string& text)
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE ||
-    !std::isfinite(value))
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value))
   {
     throw UsageError(option + " needs a number, not '" + text + "'");
   }
@@ -196,15 +195,18 @@ Options parseCommandLine(int argc, const char* const* argv)
   // CLI11 2.0 takes nan, inf and 1e999 as numbers, reads whole numbers in base 0 (010 is 8,
   // 0x10 is 16) and saturates those that overflow, and its conversion errors do not say which
   // option failed.
-  const auto needsValue = [&app](const std::string& name) {
+  const auto needsValue = [&app](const std::string& name)
+  {
     const CLI::Option* option = app.get_option_no_throw(name);
     const std::string what = option ? option->get_type_name() : "";
     return UsageError(name + " needs a value: " + name + " " + what);
   };
-  const auto option = [&](const std::string& name, const char* value, auto& into, auto read) {
+  const auto option = [&](const std::string& name, const char* value, auto& into, auto read)
+  {
     app
       .add_option_function<std::string>(name,
-        [name, &into, read, &needsValue](const std::string& text) {
+        [name, &into, read, &needsValue](const std::string& text)
+        {
           if (text.empty())
           {
             throw needsValue(name);
@@ -367,7 +369,8 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   if (o.output.empty())
   {
-    o.output = "output/" + (o.usesEmbeddedScene() ? std::string("cornell") : stem(o.scene)) + ".pvd";
+    o.output =
+      "output/" + (o.usesEmbeddedScene() ? std::string("cornell") : stem(o.scene)) + ".pvd";
   }
   if (o.defaultRun)
   {
@@ -404,8 +407,8 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.paths)
   {
-    checkRange<long long>("--paths", *o.paths, filter->GetNumberOfPathsMinValue(),
-      filter->GetNumberOfPathsMaxValue());
+    checkRange<long long>(
+      "--paths", *o.paths, filter->GetNumberOfPathsMinValue(), filter->GetNumberOfPathsMaxValue());
     filter->SetNumberOfPaths(static_cast<vtkIdType>(*o.paths));
   }
   if (o.gatherRatio)
@@ -427,14 +430,13 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.patchSize)
   {
-    checkRange("--patch-size", *o.patchSize, filter->GetPatchSizeMinValue(),
-      filter->GetPatchSizeMaxValue());
+    checkRange(
+      "--patch-size", *o.patchSize, filter->GetPatchSizeMinValue(), filter->GetPatchSizeMaxValue());
     filter->SetPatchSize(*o.patchSize);
   }
   if (o.seed)
   {
-    checkRange<long long>(
-      "--seed", *o.seed, filter->GetSeedMinValue(), filter->GetSeedMaxValue());
+    checkRange<long long>("--seed", *o.seed, filter->GetSeedMinValue(), filter->GetSeedMaxValue());
     filter->SetSeed(static_cast<int>(*o.seed));
   }
   if (o.threads)

@@ -84,8 +84,8 @@ FrameRenderer::FrameRenderer(const double bounds[6], const double* up)
   const double centre[3] = { 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]),
     0.5 * (bounds[4] + bounds[5]) };
   const double halfSize = 0.5 * std::max(bounds[1] - bounds[0], bounds[3] - bounds[2]);
-  const double distance = halfSize / std::tan(0.5 * ViewAngleDegrees * M_PI / 180.0) +
-    (centre[2] - bounds[4]);
+  const double distance =
+    halfSize / std::tan(0.5 * ViewAngleDegrees * M_PI / 180.0) + (centre[2] - bounds[4]);
   vtkCamera* camera = p.renderer->GetActiveCamera();
   camera->SetViewAngle(ViewAngleDegrees);
   camera->SetFocalPoint(centre);
@@ -103,11 +103,15 @@ FrameRenderer::FrameRenderer(const double bounds[6], const double* up)
       a[0] = 0;
       a[1] = 1;
     }
-    double b[3] = { u[1] * a[2] - u[2] * a[1], u[2] * a[0] - u[0] * a[2], u[0] * a[1] - u[1] * a[0] };
+    double b[3] = { u[1] * a[2] - u[2] * a[1], u[2] * a[0] - u[0] * a[2],
+      u[0] * a[1] - u[1] * a[0] };
     const double bn = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    double c[3] = { u[1] * b[2] - u[2] * b[1], u[2] * b[0] - u[0] * b[2], u[0] * b[1] - u[1] * b[0] };
-    const double radius = 0.5 * std::sqrt((bounds[1] - bounds[0]) * (bounds[1] - bounds[0]) +
-      (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) + (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
+    double c[3] = { u[1] * b[2] - u[2] * b[1], u[2] * b[0] - u[0] * b[2],
+      u[0] * b[1] - u[1] * b[0] };
+    const double radius = 0.5 *
+      std::sqrt((bounds[1] - bounds[0]) * (bounds[1] - bounds[0]) +
+        (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) +
+        (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
     const double far = radius / std::sin(0.5 * ViewAngleDegrees * M_PI / 180.0);
     const double elevation = 35 * M_PI / 180;
     double from[3];

@@ -3,8 +3,8 @@
 #include "EmbeddedData.h"
 
 #include "vtkNew.h"
-#include "vtkRadiositySceneReader.h"
 #include "vtkPolyData.h"
+#include "vtkRadiositySceneReader.h"
 #include "vtkXMLPolyDataReader.h"
 
 namespace mlr::cli
@@ -38,7 +38,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
 vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes)
 {
   return guardedRead(path, "scene", memoryLimitBytes,
-    [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm> {
+    [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
+    {
       // Formats with materials (.obj, .gltf, .glb, .ply): our reader; VTK's for the rest.
       auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
       reader->SetFileName(file.c_str());

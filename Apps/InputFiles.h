@@ -32,7 +32,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
  * read with their materials by vtkRadiositySceneReader (cell arrays Reflectance, Emission,
  * MaterialId, field data MaterialNames), in the same guarded reading process.
  */
-vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes = 0);
+vtkSmartPointer<vtkPolyData> readSceneFile(
+  const std::string& path, std::uint64_t memoryLimitBytes = 0);
 
 /// A .vtp file of Data/ compiled into the program (cornell_box.vtp, cornell_light.vtp,
 /// cornell_trajectory.vtp).

@@ -83,9 +83,12 @@ void OutputTransaction::commit()
     for (const fs::directory_entry& entry : fs::directory_iterator(directory, error))
     {
       const std::string name = entry.path().filename().string();
-      const std::size_t digits = name.size() - std::min(name.size(), series.prefix.size() + series.suffix.size());
-      const bool matches = digits > 0 && name.compare(0, series.prefix.size(), series.prefix) == 0 &&
-        name.compare(name.size() - series.suffix.size(), series.suffix.size(), series.suffix) == 0 &&
+      const std::size_t digits =
+        name.size() - std::min(name.size(), series.prefix.size() + series.suffix.size());
+      const bool matches = digits > 0 &&
+        name.compare(0, series.prefix.size(), series.prefix) == 0 &&
+        name.compare(name.size() - series.suffix.size(), series.suffix.size(), series.suffix) ==
+          0 &&
         std::all_of(name.begin() + static_cast<long>(series.prefix.size()),
           name.end() - static_cast<long>(series.suffix.size()),
           [](unsigned char c) { return std::isdigit(c) != 0; });

@@ -32,7 +32,8 @@ void ProgressBar::show(double fraction, const std::string& label)
   const auto now = std::chrono::steady_clock::now();
   // Redraw on a new percent or label, at most 20 times a second.
   if ((percent == this->LastPercent && label == this->LastLabel) ||
-    (this->Drawn && label == this->LastLabel && now - this->LastDraw < std::chrono::milliseconds(50)))
+    (this->Drawn && label == this->LastLabel &&
+      now - this->LastDraw < std::chrono::milliseconds(50)))
   {
     return;
   }

@@ -69,9 +69,9 @@ std::string summaryLine(vtkFieldData* statistics)
   const double rays = value(statistics, "ShootingRays") + value(statistics, "ShadowRays") +
     value(statistics, "GatheringRays");
   std::ostringstream s;
-  s << value(statistics, "Frames") << " frames, " << value(statistics, "Elements")
-    << " elements (" << value(statistics, "Patches") << " patches), "
-    << value(statistics, "PathsPerFrame") << " paths/frame, " << millions(rays) << " rays ("
+  s << value(statistics, "Frames") << " frames, " << value(statistics, "Elements") << " elements ("
+    << value(statistics, "Patches") << " patches), " << value(statistics, "PathsPerFrame")
+    << " paths/frame, " << millions(rays) << " rays ("
     << millions(value(statistics, "ShootingRays")) << " shooting, "
     << millions(value(statistics, "ShadowRays")) << " shadow, "
     << millions(value(statistics, "GatheringRays")) << " gathering), "
@@ -84,8 +84,8 @@ std::string summaryLine(vtkFieldData* statistics)
 }
 
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
-  vtkMovingLightRadiosity* filter, vtkFieldData* statistics,
-  const std::vector<FrameRecord>& frames, const StageTimes& stages)
+  vtkMovingLightRadiosity* filter, vtkFieldData* statistics, const std::vector<FrameRecord>& frames,
+  const StageTimes& stages)
 {
   const std::string builtIn = "built-in Cornell box";
   nlohmann::ordered_json json;
@@ -93,16 +93,16 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   // What lit the scene: a light file, a material of the scene, the sun, or the scene's own
   // emissive surfaces.
   json["light"] = !options.light.empty() ? options.light
-    : options.lightMaterial               ? "material " + *options.lightMaterial
-    : options.usesSun()                   ? std::string("sun")
-    : options.sceneLightsItself()         ? std::string("scene emission")
-                                          : builtIn;
+    : options.lightMaterial              ? "material " + *options.lightMaterial
+    : options.usesSun()                  ? std::string("sun")
+    : options.sceneLightsItself()        ? std::string("scene emission")
+                                         : builtIn;
   json["trajectory"] = !options.trajectory.empty()
     ? options.trajectory
-    : (options.from ? "straight line"
-         : options.sunPath ? "sun path"
-         : !options.sunDirections.empty() ? options.sunDirections
-         : (options.scene.empty() ? builtIn : ""));
+    : (options.from                        ? "straight line"
+          : options.sunPath                ? "sun path"
+          : !options.sunDirections.empty() ? options.sunDirections
+                                           : (options.scene.empty() ? builtIn : ""));
   json["output"] = options.output;
   json["settings"] = {
     { "lightPower", jsonTriple(filter->GetLightPower()) },
@@ -118,8 +118,8 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   };
 
   // Every statistic the filter reports, except those that describe one frame.
-  static const std::set<std::string> perFrame = { "FrameIndex", "LightPosition",
-    "LightTranslation", "SolveCount", "TimeValue" };
+  static const std::set<std::string> perFrame = { "FrameIndex", "LightPosition", "LightTranslation",
+    "SolveCount", "TimeValue" };
   nlohmann::ordered_json values = nlohmann::ordered_json::object();
   for (int i = 0; statistics && i < statistics->GetNumberOfArrays(); ++i)
   {

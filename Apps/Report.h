@@ -42,7 +42,7 @@ std::string summaryLine(vtkFieldData* statistics);
 /// as JSON.
 /// Throws std::runtime_error.
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
-  vtkMovingLightRadiosity* filter, vtkFieldData* statistics,
-  const std::vector<FrameRecord>& frames, const StageTimes& stages);
+  vtkMovingLightRadiosity* filter, vtkFieldData* statistics, const std::vector<FrameRecord>& frames,
+  const StageTimes& stages);
 
 } // namespace mlr::cli

@@ -41,8 +41,7 @@ SeriesNaming::SeriesNaming(const std::filesystem::path& collection, std::size_t 
 std::string SeriesNaming::frameName(std::size_t frame, const std::string& extension) const
 {
   std::ostringstream name;
-  name << this->framePrefix() << std::setw(this->digits) << std::setfill('0') << frame
-       << extension;
+  name << this->framePrefix() << std::setw(this->digits) << std::setfill('0') << frame << extension;
   return name.str();
 }
 
@@ -202,7 +201,8 @@ void FrameWriter::write(vtkPolyData* elements, double time, const std::filesyste
 
   std::unique_lock<std::mutex> lock(this->Mutex);
   // Bounded: frames are produced faster than written on a slow disk.
-  this->Changed.wait(lock, [this] { return this->Queue.size() < this->MaxQueued || this->Failure; });
+  this->Changed.wait(
+    lock, [this] { return this->Queue.size() < this->MaxQueued || this->Failure; });
   if (this->Failure)
   {
     std::rethrow_exception(this->Failure);
@@ -288,19 +288,28 @@ std::string xmlEscaped(const std::string& text)
   {
     switch (c)
     {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
+      case '&':
+        escaped += "&amp;";
+        break;
+      case '<':
+        escaped += "&lt;";
+        break;
+      case '>':
+        escaped += "&gt;";
+        break;
+      case '"':
+        escaped += "&quot;";
+        break;
+      default:
+        escaped += c;
     }
   }
   return escaped;
 }
 }
 
-void writeCollection(const std::filesystem::path& path,
-  const std::vector<std::pair<double, std::string>>& frames)
+void writeCollection(
+  const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames)
 {
   std::ofstream out(path);
   out << std::setprecision(std::numeric_limits<double>::max_digits10);
@@ -309,8 +318,8 @@ void writeCollection(const std::filesystem::path& path,
          "  <Collection>\n";
   for (const auto& [time, file] : frames)
   {
-    out << "    <DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\"" << xmlEscaped(file)
-        << "\"/>\n";
+    out << "    <DataSet timestep=\"" << time << "\" group=\"\" part=\"0\" file=\""
+        << xmlEscaped(file) << "\"/>\n";
   }
   out << "  </Collection>\n</VTKFile>\n";
   out.close();

@@ -96,7 +96,7 @@ private:
 };
 
 /// Writes the .pvd collection: (time, file name relative to the .pvd) per frame.
-void writeCollection(const std::filesystem::path& path,
-  const std::vector<std::pair<double, std::string>>& frames);
+void writeCollection(
+  const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);
 
 } // namespace mlr::cli

@@ -26,8 +26,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -89,8 +89,8 @@ void checkNotADirectory(const fs::path& path, const std::string& what)
   std::error_code error;
   if (fs::is_directory(path, error))
   {
-    throw InputError("the " + what + " '" + path.string() +
-      "' is a directory: give the name of a file to write");
+    throw InputError(
+      "the " + what + " '" + path.string() + "' is a directory: give the name of a file to write");
   }
 }
 
@@ -189,9 +189,8 @@ vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
   std::string error;
   vtkNew<vtkCallbackCommand> onError;
   onError->SetClientData(&error);
-  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message) {
-    *static_cast<std::string*>(into) = static_cast<const char*>(message);
-  });
+  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message)
+    { *static_cast<std::string*>(into) = static_cast<const char*>(message); });
   source->AddObserver(vtkCommand::ErrorEvent, onError);
   source->Update();
   if (!error.empty())
@@ -226,13 +225,13 @@ int run(int argc, char** argv)
   const Clock::time_point readingStarted = Clock::now();
   const std::uint64_t memoryLimit =
     options.memoryLimit ? static_cast<std::uint64_t>(*options.memoryLimit) << 20 : 0;
-  const auto scene = options.usesEmbeddedScene()
-    ? readEmbeddedFile("cornell_box.vtp")
-    : readSceneFile(options.scene, memoryLimit);
+  const auto scene = options.usesEmbeddedScene() ? readEmbeddedFile("cornell_box.vtp")
+                                                 : readSceneFile(options.scene, memoryLimit);
   if (options.sceneLightsItself() && !emits(scene, filter->GetEmissionArrayName()))
   {
     throw UsageError("--scene needs --light FILE or --light-material NAME, or surfaces that emit "
-                     "(a cell array '" + std::string(filter->GetEmissionArrayName()) +
+                     "(a cell array '" +
+      std::string(filter->GetEmissionArrayName()) +
       "', or materials with Ke or an emissive colour): " + options.scene +
       " emits nothing, and the built-in light belongs to the Cornell box");
   }
@@ -274,30 +273,34 @@ int run(int argc, char** argv)
   ProgressBar bar;
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetClientData(&bar);
-  onProgress->SetCallback([](vtkObject* caller, unsigned long, void* bar, void*) {
-    auto* algorithm = static_cast<vtkMovingLightRadiosity*>(caller);
-    if (Interrupted)
+  onProgress->SetCallback(
+    [](vtkObject* caller, unsigned long, void* bar, void*)
     {
-      algorithm->SetAbortExecute(1);
-    }
-    static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
-  });
+      auto* algorithm = static_cast<vtkMovingLightRadiosity*>(caller);
+      if (Interrupted)
+      {
+        algorithm->SetAbortExecute(1);
+      }
+      static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
+    });
   const unsigned long solving = filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
   // Errors and warnings go below the bar, not into it.
   vtkNew<vtkCallbackCommand> onMessage;
   onMessage->SetClientData(&bar);
-  onMessage->SetCallback([](vtkObject*, unsigned long event, void* bar, void* message) {
-    static_cast<ProgressBar*>(bar)->finish();
-    const char* text = static_cast<const char*>(message);
-    if (event == vtkCommand::ErrorEvent)
+  onMessage->SetCallback(
+    [](vtkObject*, unsigned long event, void* bar, void* message)
     {
-      vtkOutputWindow::GetInstance()->DisplayErrorText(text);
-    }
-    else
-    {
-      vtkOutputWindow::GetInstance()->DisplayWarningText(text);
-    }
-  });
+      static_cast<ProgressBar*>(bar)->finish();
+      const char* text = static_cast<const char*>(message);
+      if (event == vtkCommand::ErrorEvent)
+      {
+        vtkOutputWindow::GetInstance()->DisplayErrorText(text);
+      }
+      else
+      {
+        vtkOutputWindow::GetInstance()->DisplayWarningText(text);
+      }
+    });
   filter->AddObserver(vtkCommand::ErrorEvent, onMessage);
   filter->AddObserver(vtkCommand::WarningEvent, onMessage);
 

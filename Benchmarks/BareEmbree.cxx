@@ -105,31 +105,33 @@ double timeParallel(std::size_t count, int threads, Work work)
 double traceNearest(RTCScene scene, const std::vector<Ray>& rays, int threads)
 {
   std::vector<unsigned> sink(static_cast<std::size_t>(threads) * 16, 0);
-  const double seconds = timeParallel(rays.size(), threads, [&](std::size_t begin, std::size_t end) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    unsigned hits = 0;
-    for (std::size_t i = begin; i < end; ++i)
+  const double seconds = timeParallel(rays.size(), threads,
+    [&](std::size_t begin, std::size_t end)
     {
-      RTCRayHit q;
-      q.ray.org_x = rays[i].org[0];
-      q.ray.org_y = rays[i].org[1];
-      q.ray.org_z = rays[i].org[2];
-      q.ray.dir_x = rays[i].dir[0];
-      q.ray.dir_y = rays[i].dir[1];
-      q.ray.dir_z = rays[i].dir[2];
-      q.ray.tnear = 0;
-      q.ray.tfar = 1e30f;
-      q.ray.time = 0;
-      q.ray.mask = ~0u;
-      q.ray.id = 0;
-      q.ray.flags = 0;
-      q.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(scene, &context, &q);
-      hits += q.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    }
-    sink[begin % sink.size()] = hits;
-  });
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      unsigned hits = 0;
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        RTCRayHit q;
+        q.ray.org_x = rays[i].org[0];
+        q.ray.org_y = rays[i].org[1];
+        q.ray.org_z = rays[i].org[2];
+        q.ray.dir_x = rays[i].dir[0];
+        q.ray.dir_y = rays[i].dir[1];
+        q.ray.dir_z = rays[i].dir[2];
+        q.ray.tnear = 0;
+        q.ray.tfar = 1e30f;
+        q.ray.time = 0;
+        q.ray.mask = ~0u;
+        q.ray.id = 0;
+        q.ray.flags = 0;
+        q.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &context, &q);
+        hits += q.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      }
+      sink[begin % sink.size()] = hits;
+    });
   return double(rays.size()) / seconds;
 }
 }
@@ -162,11 +164,14 @@ BareRates measureBareEmbree(
     area += scene.elementArea(e);
     cumulative[e] = area;
   }
-  auto surfacePoint = [&](RandomStream& r, Vec3& p, Vec3& n) {
+  auto surfacePoint = [&](RandomStream& r, Vec3& p, Vec3& n)
+  {
     const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), r.uniform() * area);
-    const std::size_t e = std::min<std::size_t>(std::size_t(it - cumulative.begin()), scene.elementCount() - 1);
+    const std::size_t e =
+      std::min<std::size_t>(std::size_t(it - cumulative.begin()), scene.elementCount() - 1);
     const Triangle& t = scene.elementTriangles()[e];
-    p = sampleTriangle(scene.points()[t[0]], scene.points()[t[1]], scene.points()[t[2]], r.uniform(), r.uniform());
+    p = sampleTriangle(
+      scene.points()[t[0]], scene.points()[t[1]], scene.points()[t[2]], r.uniform(), r.uniform());
     n = scene.elementNormal(e);
     p += n * offset;
   };
@@ -194,44 +199,46 @@ BareRates measureBareEmbree(
     }
   }
   std::vector<unsigned> sink(static_cast<std::size_t>(threads) * 16, 0);
-  const double seconds = timeParallel(origins, threads, [&](std::size_t begin, std::size_t end) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    alignas(64) RTCRay16 packet;
-    alignas(64) int valid[16];
-    unsigned visible = 0;
-    for (std::size_t i = begin; i < end; ++i)
+  const double seconds = timeParallel(origins, threads,
+    [&](std::size_t begin, std::size_t end)
     {
-      for (std::size_t first = 0; first < frames; first += 16)
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      alignas(64) RTCRay16 packet;
+      alignas(64) int valid[16];
+      unsigned visible = 0;
+      for (std::size_t i = begin; i < end; ++i)
       {
-        for (std::size_t l = 0; l < 16; ++l)
+        for (std::size_t first = 0; first < frames; first += 16)
         {
-          const bool on = first + l < frames;
-          const Ray& ray = targets[i * frames + std::min(first + l, frames - 1)];
-          valid[l] = on ? -1 : 0;
-          packet.org_x[l] = ray.org[0];
-          packet.org_y[l] = ray.org[1];
-          packet.org_z[l] = ray.org[2];
-          packet.dir_x[l] = ray.dir[0];
-          packet.dir_y[l] = ray.dir[1];
-          packet.dir_z[l] = ray.dir[2];
-          packet.tnear[l] = 0;
-          packet.tfar[l] = 0.9999f;
-          packet.time[l] = 0;
-          packet.mask[l] = ~0u;
-          packet.id[l] = unsigned(l);
-          packet.flags[l] = 0;
-        }
-        rtcOccluded16(valid, bare.handle(), &context, &packet);
-        for (std::size_t l = 0; l < 16; ++l)
-        {
-          visible += valid[l] && packet.tfar[l] >= 0;
+          for (std::size_t l = 0; l < 16; ++l)
+          {
+            const bool on = first + l < frames;
+            const Ray& ray = targets[i * frames + std::min(first + l, frames - 1)];
+            valid[l] = on ? -1 : 0;
+            packet.org_x[l] = ray.org[0];
+            packet.org_y[l] = ray.org[1];
+            packet.org_z[l] = ray.org[2];
+            packet.dir_x[l] = ray.dir[0];
+            packet.dir_y[l] = ray.dir[1];
+            packet.dir_z[l] = ray.dir[2];
+            packet.tnear[l] = 0;
+            packet.tfar[l] = 0.9999f;
+            packet.time[l] = 0;
+            packet.mask[l] = ~0u;
+            packet.id[l] = unsigned(l);
+            packet.flags[l] = 0;
+          }
+          rtcOccluded16(valid, bare.handle(), &context, &packet);
+          for (std::size_t l = 0; l < 16; ++l)
+          {
+            visible += valid[l] && packet.tfar[l] >= 0;
+          }
         }
       }
-    }
-    sink[begin % sink.size()] = visible;
-  });
+      sink[begin % sink.size()] = visible;
+    });
   rates.shadowRays = double(origins * frames) / seconds;
   return rates;
 }

@@ -31,7 +31,8 @@ double secondsBetween(Clock::time_point a, Clock::time_point b)
 std::uint64_t patchHash(const PatchMesh& mesh)
 {
   std::uint64_t hash = 14695981039346656037ULL;
-  auto bytes = [&hash](const void* data, std::size_t size) {
+  auto bytes = [&hash](const void* data, std::size_t size)
+  {
     const auto* p = static_cast<const unsigned char*>(data);
     for (std::size_t i = 0; i < size; ++i)
     {
@@ -68,10 +69,12 @@ PlainRun runWithoutCancelling(const PolygonSoup& soup, const RemeshOptions& opti
   calls.reserve(1 << 16);
   const Clock::time_point start = Clock::now();
   calls.emplace_back(start, 0.0);
-  const RemeshResult result = remesh(soup, options, [&calls](double f) {
-    calls.emplace_back(Clock::now(), f);
-    return true;
-  });
+  const RemeshResult result = remesh(soup, options,
+    [&calls](double f)
+    {
+      calls.emplace_back(Clock::now(), f);
+      return true;
+    });
   calls.emplace_back(Clock::now(), 1.0);
   PlainRun run;
   run.statistics = result.statistics;
@@ -104,26 +107,31 @@ CancelRun cancelAfter(const PolygonSoup& soup, const RemeshOptions& options, dou
   CancelRun run;
   Clock::time_point seen, ended;
   const Clock::time_point start = Clock::now();
-  std::thread worker([&] {
-    try
+  std::thread worker(
+    [&]
     {
-      remesh(soup, options, [&stop, &seen, &run](double f) {
-        if (!stop.load(std::memory_order_relaxed))
-        {
-          return true;
-        }
-        seen = Clock::now();
-        run.fraction = f;
-        return false;
-      });
-    }
-    catch (const Cancelled&)
-    {
-      run.cancelled = true;
-    }
-    ended = Clock::now();
-  });
-  std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after)));
+      try
+      {
+        remesh(soup, options,
+          [&stop, &seen, &run](double f)
+          {
+            if (!stop.load(std::memory_order_relaxed))
+            {
+              return true;
+            }
+            seen = Clock::now();
+            run.fraction = f;
+            return false;
+          });
+      }
+      catch (const Cancelled&)
+      {
+        run.cancelled = true;
+      }
+      ended = Clock::now();
+    });
+  std::this_thread::sleep_until(
+    start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after)));
   const Clock::time_point requested = Clock::now();
   stop = true;
   worker.join();
@@ -153,8 +161,7 @@ std::string runRemeshing(const RemeshCaseOptions& options)
               "triangles through it and a box standing on it: %zu polygons, %zu points "
               "(generated in %.1f s)\n",
     options.floorCells, options.floorCells, options.sphereFrequency, options.sphereFrequency,
-    soup.polygons.size(), soup.points.size(),
-    secondsBetween(generating, Clock::now()));
+    soup.polygons.size(), soup.points.size(), secondsBetween(generating, Clock::now()));
 
   std::ostringstream json;
   json << "{\"input_triangles\": " << soup.polygons.size() << ", \"cases\": [";
@@ -169,11 +176,13 @@ std::string runRemeshing(const RemeshCaseOptions& options)
                 "triangles split, %zu covered), %zu regions, %zu refined only; patch hash "
                 "%016llx\n",
       options.patchCounts[c], s.patches, s.seconds, s.secondsContacts, s.contactSplitTriangles,
-      s.coveredTriangles, s.regions, s.fallbackRegions, static_cast<unsigned long long>(plain.hash));
+      s.coveredTriangles, s.regions, s.fallbackRegions,
+      static_cast<unsigned long long>(plain.hash));
     std::printf("  progress callback: %zu calls; longest gaps between calls:", plain.calls);
     for (const Gap& g : plain.longestGaps)
     {
-      std::printf(" %.3f s at %.2f s (fraction %.4f -> %.4f);", g.seconds, g.at, g.fromFraction, g.toFraction);
+      std::printf(" %.3f s at %.2f s (fraction %.4f -> %.4f);", g.seconds, g.at, g.fromFraction,
+        g.toFraction);
     }
     std::printf("\n");
 
@@ -190,17 +199,19 @@ std::string runRemeshing(const RemeshCaseOptions& options)
         unwindings.push_back(runs.back().unwinding);
       }
     }
-    const auto worst = std::max_element(runs.begin(), runs.end(), [](const CancelRun& a, const CancelRun& b) {
-      return (a.cancelled ? a.latency : 0) < (b.cancelled ? b.latency : 0);
-    });
-    const double maxLatency = latencies.empty() ? 0 : *std::max_element(latencies.begin(), latencies.end());
+    const auto worst = std::max_element(runs.begin(), runs.end(),
+      [](const CancelRun& a, const CancelRun& b)
+      { return (a.cancelled ? a.latency : 0) < (b.cancelled ? b.latency : 0); });
+    const double maxLatency =
+      latencies.empty() ? 0 : *std::max_element(latencies.begin(), latencies.end());
     const bool met = !latencies.empty() && maxLatency <= LatencyTarget;
     allMet = allMet && met;
     std::printf("  cancelled at %d evenly spaced times (%zu before the end): latency max %.3f s "
                 "(requested at %.2f s), median %.3f s; of which unwinding (from the callback "
                 "saying stop to the catch) max %.3f s\n",
-      options.cancelPoints, latencies.size(), maxLatency, worst != runs.end() ? worst->requestedAt : 0.0,
-      median(latencies), unwindings.empty() ? 0.0 : *std::max_element(unwindings.begin(), unwindings.end()));
+      options.cancelPoints, latencies.size(), maxLatency,
+      worst != runs.end() ? worst->requestedAt : 0.0, median(latencies),
+      unwindings.empty() ? 0.0 : *std::max_element(unwindings.begin(), unwindings.end()));
     std::printf("  latencies (requested at s: latency s, unwinding s, fraction):");
     for (const CancelRun& r : runs)
     {
@@ -213,13 +224,15 @@ std::string runRemeshing(const RemeshCaseOptions& options)
         std::printf(" %.2f: finished;", r.requestedAt);
       }
     }
-    std::printf("\n  Target: cancellable within %.1f s: %s\n", LatencyTarget, met ? "met" : "MISSED");
+    std::printf(
+      "\n  Target: cancellable within %.1f s: %s\n", LatencyTarget, met ? "met" : "MISSED");
 
     json << (c > 0 ? ", " : "") << "{\"target_patches\": " << options.patchCounts[c]
          << ", \"patches\": " << s.patches << ", \"seconds\": " << s.seconds
-         << ", \"seconds_contacts\": " << s.secondsContacts
-         << ", \"longest_poll_gap_seconds\": " << (plain.longestGaps.empty() ? 0.0 : plain.longestGaps[0].seconds)
-         << ", \"cancel_requests\": " << options.cancelPoints << ", \"cancelled\": " << latencies.size()
+         << ", \"seconds_contacts\": " << s.secondsContacts << ", \"longest_poll_gap_seconds\": "
+         << (plain.longestGaps.empty() ? 0.0 : plain.longestGaps[0].seconds)
+         << ", \"cancel_requests\": " << options.cancelPoints
+         << ", \"cancelled\": " << latencies.size()
          << ", \"cancel_latency_max_seconds\": " << maxLatency
          << ", \"cancel_latency_median_seconds\": " << median(latencies)
          << ", \"target_met\": " << (met ? "true" : "false") << "}";

@@ -60,8 +60,8 @@ private:
   std::uint64_t Value = 14695981039346656037ULL;
 };
 
-std::uint64_t referenceKey(const std::string& name, const PatchMesh& mesh, const LightRig& rig,
-  const SolverOptions& options)
+std::uint64_t referenceKey(
+  const std::string& name, const PatchMesh& mesh, const LightRig& rig, const SolverOptions& options)
 {
   Hasher h;
   h.count(ReferenceVersion);
@@ -127,7 +127,8 @@ struct Reference
 
   double at(std::size_t frame, std::size_t element, int channel) const
   {
-    return this->radiosity[(frame * this->elements + element) * 3 + static_cast<std::size_t>(channel)];
+    return this
+      ->radiosity[(frame * this->elements + element) * 3 + static_cast<std::size_t>(channel)];
   }
 };
 
@@ -145,8 +146,8 @@ bool loadReference(const std::string& file, std::uint64_t key, std::size_t frame
   char magic[8];
   std::uint64_t header[4]; // key, frames, elements, paths
   if (!in || !readValues(in, magic, 8) || std::memcmp(magic, CacheMagic, 8) != 0 ||
-    !readValues(in, header, 4) || header[0] != key || header[1] != frames || header[2] != elements ||
-    !readValues(in, &ref.seconds, 1))
+    !readValues(in, header, 4) || header[0] != key || header[1] != frames ||
+    header[2] != elements || !readValues(in, &ref.seconds, 1))
   {
     return false;
   }
@@ -171,13 +172,15 @@ void storeReference(const std::string& file, std::uint64_t key, const Reference&
     out.write(CacheMagic, 8);
     out.write(reinterpret_cast<const char*>(header), sizeof header);
     out.write(reinterpret_cast<const char*>(&ref.seconds), sizeof ref.seconds);
-    out.write(reinterpret_cast<const char*>(ref.litSide.data()), static_cast<std::streamsize>(ref.litSide.size()));
+    out.write(reinterpret_cast<const char*>(ref.litSide.data()),
+      static_cast<std::streamsize>(ref.litSide.size()));
     out.write(reinterpret_cast<const char*>(ref.radiosity.data()),
       static_cast<std::streamsize>(ref.radiosity.size() * sizeof(double)));
     if (!out)
     {
-      throw Error("cannot write the reference cache " + partial + ": pass --cache DIR with a "
-                  "writable folder, or --cache '' to keep no cache");
+      throw Error("cannot write the reference cache " + partial +
+        ": pass --cache DIR with a "
+        "writable folder, or --cache '' to keep no cache");
     }
   }
   std::filesystem::rename(partial, path);
@@ -199,7 +202,8 @@ Reference referenceSolution(const std::string& name, const PatchMesh& mesh, cons
   {
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(key));
-    ref.file = (std::filesystem::path(caseOptions.cacheDirectory) / (name + "-" + hex + ".bin")).string();
+    ref.file =
+      (std::filesystem::path(caseOptions.cacheDirectory) / (name + "-" + hex + ".bin")).string();
     if (loadReference(ref.file, key, frames, scene.elementCount(), ref))
     {
       ref.cached = true;
@@ -245,7 +249,8 @@ Reference referenceSolution(const std::string& name, const PatchMesh& mesh, cons
 
 /// Area-weighted mean over elements and channels of (B - B_ref)^2 in `frame`, on the
 /// reference's lit sides (as the paper benchmark measures).
-double meanSquaredError(const Scene& scene, const Solution& s, const Reference& ref, std::size_t frame)
+double meanSquaredError(
+  const Scene& scene, const Solution& s, const Reference& ref, std::size_t frame)
 {
   double sum = 0, area = 0;
   for (std::size_t e = 0; e < scene.elementCount(); ++e)
@@ -269,7 +274,8 @@ double meanRadiosity(const Scene& scene, const Reference& ref, std::size_t frame
   double sum = 0, area = 0;
   for (std::size_t e = 0; e < scene.elementCount(); ++e)
   {
-    sum += scene.elementArea(e) * (ref.at(frame, e, 0) + ref.at(frame, e, 1) + ref.at(frame, e, 2)) / 3;
+    sum +=
+      scene.elementArea(e) * (ref.at(frame, e, 0) + ref.at(frame, e, 1) + ref.at(frame, e, 2)) / 3;
     area += scene.elementArea(e);
   }
   return sum / area;
@@ -286,7 +292,8 @@ double processCpuSeconds()
 }
 
 /// A solve with the process CPU seconds it took.
-Solution timedSolve(const Scene& scene, const LightRig& rig, const SolverOptions& o, double& cpuSeconds)
+Solution timedSolve(
+  const Scene& scene, const LightRig& rig, const SolverOptions& o, double& cpuSeconds)
 {
   const double before = processCpuSeconds();
   Solution s = solve(scene, rig, o);
@@ -298,15 +305,15 @@ struct ModeRun
 {
   std::string name;
   SolverStatistics stats;
-  double cpuSeconds = 0; ///< median over the repeats
+  double cpuSeconds = 0;   ///< median over the repeats
   std::vector<double> mse; ///< at each reported frame
   double meanMse = 0;      ///< over all frames
   int repeats = 1;
 };
 
 /// Solves in one mode; a solve under 3 s is timed as the median of three (same rays, same result).
-ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig,
-  SolverOptions o, bool reuse, const Reference& ref, const std::vector<std::size_t>& frames)
+ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig, SolverOptions o,
+  bool reuse, const Reference& ref, const std::vector<std::size_t>& frames)
 {
   o.reuseShooting = reuse;
   o.reuseGathering = reuse;
@@ -323,7 +330,8 @@ ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig
       timings.push_back(timedSolve(scene, rig, o, cpu.back()).statistics);
     }
     std::sort(timings.begin(), timings.end(),
-      [](const SolverStatistics& a, const SolverStatistics& b) { return a.secondsTotal < b.secondsTotal; });
+      [](const SolverStatistics& a, const SolverStatistics& b)
+      { return a.secondsTotal < b.secondsTotal; });
     std::sort(cpu.begin(), cpu.end());
   }
   run.stats = timings[timings.size() / 2];
@@ -358,8 +366,8 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
     const SolverStatistics& s = m->stats;
     std::printf("%-12s %8.2f %8.3f %8.2f %8.2f %8.2f %12llu %12llu %12llu", m->name.c_str(),
       s.secondsTotal, s.secondsTotal / double(frames), s.secondsShooting, s.secondsGathering,
-      m->cpuSeconds,
-      static_cast<unsigned long long>(s.shootingRays), static_cast<unsigned long long>(s.shadowRays),
+      m->cpuSeconds, static_cast<unsigned long long>(s.shootingRays),
+      static_cast<unsigned long long>(s.shadowRays),
       static_cast<unsigned long long>(s.gatheringRays));
     for (double e : m->mse)
     {
@@ -367,7 +375,8 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
     }
     std::printf(" %14.4g\n", m->meanMse);
   }
-  std::printf("%-12s %8s %8s %8s %8s %8s %12s %12s %12s", "reference", "", "", "", "", "", "", "", "");
+  std::printf(
+    "%-12s %8s %8s %8s %8s %8s %12s %12s %12s", "reference", "", "", "", "", "", "", "", "");
   for (std::size_t f : at)
   {
     char text[32];
@@ -386,13 +395,15 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   std::printf("MSE of full reuse / classic:");
   for (std::size_t i = 0; i < at.size(); ++i)
   {
-    std::printf(" %s %.2f%s", labels[i].c_str(), full.mse[i] / classic.mse[i], i + 1 < at.size() ? ";" : "");
+    std::printf(
+      " %s %.2f%s", labels[i].c_str(), full.mse[i] / classic.mse[i], i + 1 < at.size() ? ";" : "");
   }
-  std::printf("; mean over frames %.2f.\nTime x MSE gain of full reuse:", full.meanMse / classic.meanMse);
+  std::printf(
+    "; mean over frames %.2f.\nTime x MSE gain of full reuse:", full.meanMse / classic.meanMse);
   for (std::size_t i = 0; i < at.size(); ++i)
   {
-    std::printf(" %s %.1fx%s", labels[i].c_str(),
-      speedup * classic.mse[i] / full.mse[i], i + 1 < at.size() ? ";" : ".\n");
+    std::printf(" %s %.1fx%s", labels[i].c_str(), speedup * classic.mse[i] / full.mse[i],
+      i + 1 < at.size() ? ";" : ".\n");
   }
   std::printf("MSE in (W/m^2)^2 against the reference, on its lit sides, area-weighted; it "
               "includes the reference's own error (about 1/%d of classic's). Solves under 3 s "
@@ -404,11 +415,11 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   json << "{\n    \"patches\": " << scene.patchCount() << ", \"elements\": " << scene.elementCount()
        << ", \"frames\": " << frames << ",\n    \"paths_per_frame\": " << options.pathsPerFrame
        << ", \"k\": " << options.gatheringRatio << ", \"lambda\": " << options.firstBounceSurvival
-       << ",\n    \"reference_paths_per_frame\": " << ref.paths << ", \"reference_seconds\": "
-       << ref.seconds << ", \"reference_cached\": " << (ref.cached ? "true" : "false")
+       << ",\n    \"reference_paths_per_frame\": " << ref.paths
+       << ", \"reference_seconds\": " << ref.seconds
+       << ", \"reference_cached\": " << (ref.cached ? "true" : "false")
        << ",\n    \"threads\": " << classic.stats.threads << ", \"speedup\": " << speedup
-       << ", \"speedup_cpu\": " << cpuSpeedup
-       << ",\n    \"frames_reported\": [";
+       << ", \"speedup_cpu\": " << cpuSpeedup << ",\n    \"frames_reported\": [";
   for (std::size_t i = 0; i < at.size(); ++i)
   {
     json << (i ? ", " : "") << "{\"frame\": " << at[i] + 1 << ", \"label\": \"" << labels[i]
@@ -419,9 +430,9 @@ std::string report(const std::string& title, const Scene& scene, std::size_t fra
   {
     const SolverStatistics& s = m->stats;
     json << "      {\"name\": \"" << m->name << "\", \"seconds\": " << s.secondsTotal
-         << ", \"seconds_shooting\": " << s.secondsShooting << ", \"seconds_gathering\": "
-         << s.secondsGathering << ", \"cpu_seconds\": " << m->cpuSeconds
-         << ", \"nearest_hit_rays\": " << s.shootingRays
+         << ", \"seconds_shooting\": " << s.secondsShooting
+         << ", \"seconds_gathering\": " << s.secondsGathering
+         << ", \"cpu_seconds\": " << m->cpuSeconds << ", \"nearest_hit_rays\": " << s.shootingRays
          << ", \"shadow_rays\": " << s.shadowRays << ", \"gathering_rays\": " << s.gatheringRays
          << ", \"mse\": [";
     for (std::size_t i = 0; i < m->mse.size(); ++i)
@@ -480,7 +491,8 @@ std::string runTurningLight(const RigCaseOptions& c)
     poses.push_back(pose);
   }
   LightRig rig;
-  rig.areaLights.emplace_back(scenes::squareLightFacingDown(centre, 1.15), Rgb(100, 100, 100), poses);
+  rig.areaLights.emplace_back(
+    scenes::squareLightFacingDown(centre, 1.15), Rgb(100, 100, 100), poses);
   const SolverOptions options = paperOptions(c);
 
   std::printf("\n=== Turning light ===\nPaper-scale room: %zu patches, %zu elements; a "
@@ -532,7 +544,8 @@ std::string runSunOverTown(const RigCaseOptions& c)
   rig.directionalLights.emplace_back(directions, Rgb(1000, 1000, 1000));
   const SolverOptions options = paperOptions(c);
 
-  auto clock = [&](std::size_t f) {
+  auto clock = [&](std::size_t f)
+  {
     const int minutes = static_cast<int>(std::lround(sun[f].clockHours * 60));
     char text[8];
     std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);

@@ -61,10 +61,12 @@ double printShadowRays(const SolverStatistics& full, std::size_t frames, const B
               "%.1f%% skipped (zero unoccluded kernel), %.3g cast, %.1f%% of them blocked\n",
     double(full.firstHits), frames - 1, possible, 100 * (1 - shadow / possible), shadow,
     100 * double(full.shadowRaysBlocked) / shadow);
-  std::printf("Shadow rays are %.1f%% of full reuse's rays. Their rate in the solver: %.1f M/s "
-              "(shooting's %.2f s less %.2f s for its nearest-hit rays at bare speed, weights and "
-              "scoring included); bare Embree's rtcOccluded16 on the same scene: %.1f M/s (%.2fx)\n",
-    100 * shadow / double(full.shootingRays + full.shadowRays + full.gatheringRays + full.reachabilityRays),
+  std::printf(
+    "Shadow rays are %.1f%% of full reuse's rays. Their rate in the solver: %.1f M/s "
+    "(shooting's %.2f s less %.2f s for its nearest-hit rays at bare speed, weights and "
+    "scoring included); bare Embree's rtcOccluded16 on the same scene: %.1f M/s (%.2fx)\n",
+    100 * shadow /
+      double(full.shootingRays + full.shadowRays + full.gatheringRays + full.reachabilityRays),
     solverRate / 1e6, full.secondsShooting, nearestSeconds, bare.shadowRays / 1e6,
     bare.shadowRays / solverRate);
   return solverRate;
@@ -101,11 +103,13 @@ std::string runLongAnimation(const ScaleCaseOptions& scale)
 
   std::printf("Threads: %d\n%-12s %9s %9s %9s %9s %13s %13s %13s\n", full.threads, "mode",
     "total s", "ms/frame", "shoot s", "gather s", "nearest-hit", "shadow", "gathering");
-  for (const auto& [name, s] : { std::make_pair("classic", classic), std::make_pair("full reuse", full) })
+  for (const auto& [name, s] :
+    { std::make_pair("classic", classic), std::make_pair("full reuse", full) })
   {
     std::printf("%-12s %9.2f %9.2f %9.2f %9.2f %13llu %13llu %13llu\n", name, s.secondsTotal,
       1000 * s.secondsTotal / frames, s.secondsShooting, s.secondsGathering,
-      static_cast<unsigned long long>(s.shootingRays), static_cast<unsigned long long>(s.shadowRays),
+      static_cast<unsigned long long>(s.shootingRays),
+      static_cast<unsigned long long>(s.shadowRays),
       static_cast<unsigned long long>(s.gatheringRays + s.reachabilityRays));
   }
   const double speedup = classic.secondsTotal / full.secondsTotal;
@@ -138,8 +142,8 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   const Scene scene = Scene::fromPatchMesh(room.mesh);
   const MovingLight light(room.light, Rgb(100, 100, 100), room.translations);
   const SolverOptions options = optionsFor(scale, paths, true);
-  const MemoryPlan plan =
-    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
+  const MemoryPlan plan = planSolveMemory(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options);
   const double elementFrames = double(scene.elementCount()) * double(frames);
   std::printf("Large scene: the paper room in %zu patches, %zu elements, %zu frames, N = %llu, "
               "full reuse\n",
@@ -174,8 +178,9 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   std::printf("Targets: the process under 16 GiB: %s; the solve's peak within 15%% of the "
               "estimate: %s\n",
     double(peak) < 16 * GiB ? "met" : "MISSED",
-    !reset ? "not measured (the peak could not be reset)"
-           : ratio > 0.85 && ratio < 1.15 ? "met" : "MISSED");
+    !reset                           ? "not measured (the peak could not be reset)"
+      : ratio > 0.85 && ratio < 1.15 ? "met"
+                                     : "MISSED");
 
   std::ostringstream out;
   out << "{\"frames\": " << frames << ", \"patches\": " << scene.patchCount()

@@ -30,7 +30,7 @@ struct Arguments
   std::size_t frames = 30;
   int threads = 0;
   std::string json;
-  std::string only; ///< run just this mode (for profiling)
+  std::string only;          ///< run just this mode (for profiling)
   std::string which = "all"; ///< --case: all, paper, rotating, sun or remesh
   int referenceFactor = 16;
   std::string cache = "output/benchmark-cache";
@@ -40,7 +40,8 @@ struct Arguments
 void usage()
 {
   std::printf(
-    "usage: mlr-benchmark [--case all|paper|rotating|sun|long|large|remesh] [--paths N] [--frames n]\n"
+    "usage: mlr-benchmark [--case all|paper|rotating|sun|long|large|remesh] [--paths N] [--frames "
+    "n]\n"
     "                     [--threads T] [--json FILE] [--reference-factor F] [--cache DIR]\n"
     "                     [--only classic|gathering|shooting|full] [--memory-limit-mib M]\n"
     "  paper:    the generated paper-scale room (about 2,800 patches, a small ceiling light on a\n"
@@ -57,7 +58,8 @@ void usage()
     "            shadow rays go (about 2 minutes, not in all)\n"
     "  large:    the room in about 100,000 patches, 120 frames, N = 4,000,000, full reuse: time\n"
     "            and peak memory against the estimate (about 3 minutes, not in all)\n"
-    "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half the\n"
+    "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half "
+    "the\n"
     "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n");
 }
 
@@ -93,7 +95,8 @@ bool parse(int argc, char** argv, Arguments& a)
       if (a.which != "all" && a.which != "paper" && a.which != "rotating" && a.which != "sun" &&
         a.which != "remesh" && a.which != "long" && a.which != "large")
       {
-        std::fprintf(stderr, "mlr-benchmark: --case must be all, paper, rotating, sun, remesh, long or large\n");
+        std::fprintf(stderr,
+          "mlr-benchmark: --case must be all, paper, rotating, sun, remesh, long or large\n");
         return false;
       }
     }
@@ -119,7 +122,8 @@ bool parse(int argc, char** argv, Arguments& a)
 }
 
 /// Median remeshing seconds of `repeats` runs, with the last run's statistics.
-RemeshStatistics timeRemeshing(const PolygonSoup& soup, std::size_t patches, int repeats, double& median)
+RemeshStatistics timeRemeshing(
+  const PolygonSoup& soup, std::size_t patches, int repeats, double& median)
 {
   RemeshOptions options;
   options.targetPatchCount = patches;
@@ -191,7 +195,8 @@ std::string runPaperCase(const Arguments& args)
       runs.push_back(solve(scene, light, o).statistics);
       runs.push_back(solve(scene, light, o).statistics);
       std::sort(runs.begin(), runs.end(),
-        [](const SolverStatistics& a, const SolverStatistics& b) { return a.secondsTotal < b.secondsTotal; });
+        [](const SolverStatistics& a, const SolverStatistics& b)
+        { return a.secondsTotal < b.secondsTotal; });
     }
     m.stats = runs[runs.size() / 2];
     m.repeats = static_cast<int>(runs.size());
@@ -209,12 +214,13 @@ std::string runPaperCase(const Arguments& args)
     // the nearest-hit rays leave surfaces, and so do the reachability probes that gathering
     // casts first (counted with the gathering rays below).
     const double lightRays = double(s.pathsCast);
-    const double surfaceRays = double(s.shootingRays) - lightRays + double(s.gatheringRays) +
-      double(s.reachabilityRays);
+    const double surfaceRays =
+      double(s.shootingRays) - lightRays + double(s.gatheringRays) + double(s.reachabilityRays);
     m.bareSeconds = lightRays / bare.lightRays + surfaceRays / bare.surfaceRays +
       double(s.shadowRays) / bare.shadowRays;
     const double traced = s.secondsShooting + s.secondsGathering;
-    const double rays = double(s.shootingRays + s.shadowRays + s.gatheringRays + s.reachabilityRays);
+    const double rays =
+      double(s.shootingRays + s.shadowRays + s.gatheringRays + s.reachabilityRays);
     std::printf("%-16s %9.2f %9.2f %9.2f %12llu %12llu %12llu %10.1f %8.2fx\n", m.name,
       s.secondsTotal, s.secondsShooting, s.secondsGathering,
       static_cast<unsigned long long>(s.shootingRays),
@@ -251,18 +257,19 @@ std::string runPaperCase(const Arguments& args)
   double roomSeconds = 0, sphereSeconds = 0;
   const RemeshStatistics roomMesh = timeRemeshing(scenes::paperRoomOfQuads(), 2700, 5, roomSeconds);
   const RemeshStatistics sphereMesh = timeRemeshing(scenes::icosphere(100), 3000, 3, sphereSeconds);
-  std::printf("\nRemeshing (CGAL, median): paper room %zu quads -> %zu patches in %.3f s (%.1f%% of "
-              "the full-reuse solve); 200,000-triangle sphere -> %zu patches in %.2f s\n",
+  std::printf(
+    "\nRemeshing (CGAL, median): paper room %zu quads -> %zu patches in %.3f s (%.1f%% of "
+    "the full-reuse solve); 200,000-triangle sphere -> %zu patches in %.2f s\n",
     roomMesh.inputPolygons, roomMesh.patches, roomSeconds, 100 * roomSeconds / full.secondsTotal,
     sphereMesh.patches, sphereSeconds);
   std::printf("Target: remeshing the paper room under 25%% of the full-reuse solve: %s\n",
     roomSeconds < 0.25 * full.secondsTotal ? "met" : "MISSED");
 
   std::ostringstream out;
-  out << "  \"patches\": " << scene.patchCount() << ",\n  \"elements\": "
-      << scene.elementCount() << ",\n  \"frames\": " << light.frameCount()
-      << ",\n  \"paths_per_frame\": " << options.pathsPerFrame << ",\n  \"threads\": "
-      << threads << ",\n  \"mean_path_length\": " << classic.meanPathLength
+  out << "  \"patches\": " << scene.patchCount() << ",\n  \"elements\": " << scene.elementCount()
+      << ",\n  \"frames\": " << light.frameCount()
+      << ",\n  \"paths_per_frame\": " << options.pathsPerFrame << ",\n  \"threads\": " << threads
+      << ",\n  \"mean_path_length\": " << classic.meanPathLength
       << ",\n  \"remesh_room_seconds\": " << roomSeconds
       << ",\n  \"remesh_200k_seconds\": " << sphereSeconds
       << ",\n  \"speedup_measured\": " << measured << ",\n  \"speedup_eq4\": " << predicted

@@ -35,7 +35,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   // while), with the patch count remeshing expects once the polygons are triangulated,
   // halved so that an estimate on the high side never refuses a solve that fits (the exact
   // check follows remeshing).
-  remeshing.checkExpectedPatches = [&](std::size_t expected) {
+  remeshing.checkExpectedPatches = [&](std::size_t expected)
+  {
     const std::size_t patches = expected / 2;
     checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
                                      options.solver, lightCount),
@@ -50,18 +51,20 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   // Ranks of a distributed solve remesh the same scene alike; they agree before solving, so
   // that one cancelled or over its memory limit stops them all.
   Animation animation;
-  agreeAcrossRanks(options.solver, [&] {
-  RemeshResult remeshed = remesh(soup, remeshing, remeshProgress);
+  agreeAcrossRanks(options.solver,
+    [&]
+    {
+      RemeshResult remeshed = remesh(soup, remeshing, remeshProgress);
 
-  animation.warnings = std::move(remeshed.warnings);
-  animation.remeshing = remeshed.statistics;
-  animation.scene = Scene::fromPatchMesh(remeshed.mesh);
-  animation.patches = std::move(remeshed.mesh);
-  const Scene& scene = animation.scene;
-  checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
-                     outputBytes(options, scene.elementCount(), scene.points().size())),
-    frames, scene.patchCount(), scene.elementCount(), options.solver);
-  });
+      animation.warnings = std::move(remeshed.warnings);
+      animation.remeshing = remeshed.statistics;
+      animation.scene = Scene::fromPatchMesh(remeshed.mesh);
+      animation.patches = std::move(remeshed.mesh);
+      const Scene& scene = animation.scene;
+      checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
+                         outputBytes(options, scene.elementCount(), scene.points().size())),
+        frames, scene.patchCount(), scene.elementCount(), options.solver);
+    });
   const Scene& scene = animation.scene;
 
   ProgressCallback solveProgress;

@@ -15,8 +15,8 @@
 #include <CGAL/Projection_traits_yz_3.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/box_intersection_d.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <CGAL/box_intersection_d.h>
 
 #include <algorithm>
 #include <cmath>
@@ -66,7 +66,7 @@ struct Surfaces
 {
   std::vector<std::size_t> of; ///< surface of each triangle
   std::size_t count = 0;
-  std::vector<bool> closed;    ///< every edge shared by two triangles
+  std::vector<bool> closed; ///< every edge shared by two triangles
   /// (smaller point, larger point, triangle) for every triangle edge, sorted.
   std::vector<std::array<std::size_t, 3>> edges;
 };
@@ -76,7 +76,8 @@ Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
   // Union-find over points.
   std::vector<std::size_t> parent(soup.points.size());
   std::iota(parent.begin(), parent.end(), std::size_t(0));
-  auto root = [&parent](std::size_t p) {
+  auto root = [&parent](std::size_t p)
+  {
     while (parent[p] != p)
     {
       parent[p] = parent[parent[p]];
@@ -122,10 +123,12 @@ void findEdges(const RepairedSoup& soup, Surfaces& s, CancellationPoll& poll)
       s.edges.push_back({ std::min(a, b), std::max(a, b), i });
     }
   }
-  std::sort(s.edges.begin(), s.edges.end(), [&poll](const auto& a, const auto& b) {
-    poll.tick();
-    return a < b;
-  });
+  std::sort(s.edges.begin(), s.edges.end(),
+    [&poll](const auto& a, const auto& b)
+    {
+      poll.tick();
+      return a < b;
+    });
   for (std::size_t i = 0; i < s.edges.size();)
   {
     std::size_t j = i + 1;
@@ -145,7 +148,8 @@ using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::si
 
 /// Triangles that touch or cross a triangle of another surface: boxes first
 /// (box_intersection_d), then CGAL's exact triangle-triangle predicate.
-std::vector<bool> touchingTriangles(const RepairedSoup& soup, const Surfaces& surfaces, CancellationPoll& poll)
+std::vector<bool> touchingTriangles(
+  const RepairedSoup& soup, const Surfaces& surfaces, CancellationPoll& poll)
 {
   std::vector<bool> touching(soup.triangles.size(), false);
   if (surfaces.count < 2)
@@ -159,7 +163,8 @@ std::vector<bool> touchingTriangles(const RepairedSoup& soup, const Surfaces& su
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
     const CgalTriangle& t = soup.triangles[i];
-    boxes.emplace_back(soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox(), i);
+    boxes.emplace_back(
+      soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox(), i);
     const std::size_t s = surfaces.of[i];
     surfaceBox[s] = started[s] ? surfaceBox[s] + boxes.back().bbox() : boxes.back().bbox();
     started[s] = true;
@@ -173,26 +178,32 @@ std::vector<bool> touchingTriangles(const RepairedSoup& soup, const Surfaces& su
   }
   std::vector<bool> candidate(soup.triangles.size(), false);
   CGAL::box_intersection_d(boxes.begin(), boxes.end(), surfaceBoxes.begin(), surfaceBoxes.end(),
-    [&](const TriangleBox& triangle, const TriangleBox& surface) {
+    [&](const TriangleBox& triangle, const TriangleBox& surface)
+    {
       poll.tick();
-      candidate[triangle.info()] = candidate[triangle.info()] || surfaces.of[triangle.info()] != surface.info();
+      candidate[triangle.info()] =
+        candidate[triangle.info()] || surfaces.of[triangle.info()] != surface.info();
     });
-  boxes.erase(std::remove_if(boxes.begin(), boxes.end(), [&](const TriangleBox& b) { return !candidate[b.info()]; }),
+  boxes.erase(std::remove_if(boxes.begin(), boxes.end(),
+                [&](const TriangleBox& b) { return !candidate[b.info()]; }),
     boxes.end());
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const TriangleBox& a, const TriangleBox& b) {
-    poll.tick();
-    const std::size_t i = a.info(), j = b.info();
-    if (surfaces.of[i] == surfaces.of[j] || (touching[i] && touching[j]))
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(),
+    [&](const TriangleBox& a, const TriangleBox& b)
     {
-      return;
-    }
-    const CgalTriangle &s = soup.triangles[i], &t = soup.triangles[j];
-    if (CGAL::do_intersect(Kernel::Triangle_3(soup.points[s[0]], soup.points[s[1]], soup.points[s[2]]),
-          Kernel::Triangle_3(soup.points[t[0]], soup.points[t[1]], soup.points[t[2]])))
-    {
-      touching[i] = touching[j] = true;
-    }
-  });
+      poll.tick();
+      const std::size_t i = a.info(), j = b.info();
+      if (surfaces.of[i] == surfaces.of[j] || (touching[i] && touching[j]))
+      {
+        return;
+      }
+      const CgalTriangle &s = soup.triangles[i], &t = soup.triangles[j];
+      if (CGAL::do_intersect(
+            Kernel::Triangle_3(soup.points[s[0]], soup.points[s[1]], soup.points[s[2]]),
+            Kernel::Triangle_3(soup.points[t[0]], soup.points[t[1]], soup.points[t[2]])))
+      {
+        touching[i] = touching[j] = true;
+      }
+    });
   return touching;
 }
 
@@ -221,7 +232,8 @@ std::vector<ClosedSurface> findClosedSurfaces(
     if (surfaces.closed[s])
     {
       const CgalTriangle& t = soup.triangles[i];
-      const CGAL::Bbox_3 box = soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox();
+      const CGAL::Bbox_3 box =
+        soup.points[t[0]].bbox() + soup.points[t[1]].bbox() + soup.points[t[2]].bbox();
       whole[s] = started[s] ? whole[s] + box : box;
       started[s] = true;
       if (touching[i])
@@ -234,8 +246,8 @@ std::vector<ClosedSurface> findClosedSurfaces(
   for (std::size_t s = 0; s < surfaces.count; ++s)
   {
     const CGAL::Bbox_3& b = whole[s];
-    const double diagonal = std::sqrt(CGAL::square(b.xmax() - b.xmin()) + CGAL::square(b.ymax() - b.ymin()) +
-      CGAL::square(b.zmax() - b.zmin()));
+    const double diagonal = std::sqrt(CGAL::square(b.xmax() - b.xmin()) +
+      CGAL::square(b.ymax() - b.ymin()) + CGAL::square(b.zmax() - b.zmin()));
     // Contact points are rounded once to doubles: far above that, far below any real gap.
     closed[s].tolerance = 1e-9 * diagonal;
   }
@@ -266,9 +278,9 @@ const Tree& distanceTree(ClosedSurface& closed, const RepairedSoup& soup)
  * but not on it are kept: with two-sided surfaces a closed box may be a room as well as a
  * solid, and only the light's position could tell.
  */
-std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<std::size_t>& surfaceOf,
-  const std::vector<bool>& piece, const RepairedSoup& original, std::vector<ClosedSurface>& closed,
-  CancellationPoll& poll)
+std::vector<bool> coveredTriangles(const RepairedSoup& split,
+  const std::vector<std::size_t>& surfaceOf, const std::vector<bool>& piece,
+  const RepairedSoup& original, std::vector<ClosedSurface>& closed, CancellationPoll& poll)
 {
   std::vector<bool> covered(split.triangles.size(), false);
   std::vector<TriangleBox> closedBoxes;
@@ -278,8 +290,9 @@ std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<
     {
       const double t = closed[s].tolerance;
       const CGAL::Bbox_3& b = closed[s].box;
-      closedBoxes.emplace_back(
-        CGAL::Bbox_3(b.xmin() - t, b.ymin() - t, b.zmin() - t, b.xmax() + t, b.ymax() + t, b.zmax() + t), s);
+      closedBoxes.emplace_back(CGAL::Bbox_3(b.xmin() - t, b.ymin() - t, b.zmin() - t, b.xmax() + t,
+                                 b.ymax() + t, b.zmax() + t),
+        s);
     }
   }
   if (closedBoxes.empty())
@@ -298,14 +311,17 @@ std::vector<bool> coveredTriangles(const RepairedSoup& split, const std::vector<
       centroids.emplace_back(centroidOf[i].bbox(), i);
     }
   }
-  CGAL::box_intersection_d(centroids.begin(), centroids.end(), closedBoxes.begin(), closedBoxes.end(),
-    [&](const TriangleBox& triangle, const TriangleBox& closedBox) {
+  CGAL::box_intersection_d(centroids.begin(), centroids.end(), closedBoxes.begin(),
+    closedBoxes.end(),
+    [&](const TriangleBox& triangle, const TriangleBox& closedBox)
+    {
       poll.tick();
       const std::size_t i = triangle.info();
       ClosedSurface& surface = closed[closedBox.info()];
       if (surfaceOf[i] != closedBox.info() && !covered[i])
       {
-        covered[i] = distanceTree(surface, original).squared_distance(centroidOf[i]) <= CGAL::square(surface.tolerance);
+        covered[i] = distanceTree(surface, original).squared_distance(centroidOf[i]) <=
+          CGAL::square(surface.tolerance);
       }
     });
   return covered;
@@ -327,14 +343,16 @@ void sortPieces(std::vector<CgalTriangle>& pieces)
 /// nothing else.
 template <typename Projection>
 bool triangulateInProjection(const std::vector<Point>& points, const CgalTriangle& origin,
-  const std::vector<std::size_t>& used, const std::vector<std::pair<std::size_t, std::size_t>>& border,
+  const std::vector<std::size_t>& used,
+  const std::vector<std::pair<std::size_t, std::size_t>>& border,
   const std::vector<std::pair<std::size_t, std::size_t>>& inner, std::vector<CgalTriangle>& result)
 {
   using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<std::size_t, Projection>;
   using FaceBase = CGAL::Constrained_triangulation_face_base_2<Projection,
     CGAL::Triangulation_face_base_with_info_2<bool, Projection>>;
   using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
-  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Projection, Tds, CGAL::No_constraint_intersection_tag>;
+  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Projection, Tds,
+    CGAL::No_constraint_intersection_tag>;
   const Projection traits;
   const CGAL::Orientation turn =
     traits.orientation_2_object()(points[origin[0]], points[origin[1]], points[origin[2]]);
@@ -352,8 +370,10 @@ bool triangulateInProjection(const std::vector<Point>& points, const CgalTriangl
     vertex[i] = cdt.insert(points[used[i]]);
     vertex[i]->info() = used[i];
   }
-  auto handle = [&](std::size_t point) {
-    return vertex[static_cast<std::size_t>(std::lower_bound(used.begin(), used.end(), point) - used.begin())];
+  auto handle = [&](std::size_t point)
+  {
+    return vertex[static_cast<std::size_t>(
+      std::lower_bound(used.begin(), used.end(), point) - used.begin())];
   };
   for (const auto* edges : { &border, &inner })
   {
@@ -426,7 +446,8 @@ bool triangulateInProjection(const std::vector<Point>& points, const CgalTriangl
  * border too far from flat for a projection; then only their order is made canonical).
  */
 void triangulateCanonically(const std::vector<Point>& points, const CgalTriangle& origin,
-  const std::vector<CgalTriangle>& faces, const std::vector<std::pair<std::size_t, std::size_t>>& contactEdges,
+  const std::vector<CgalTriangle>& faces,
+  const std::vector<std::pair<std::size_t, std::size_t>>& contactEdges,
   std::vector<CgalTriangle>& pieces)
 {
   std::vector<std::size_t> used;
@@ -466,7 +487,8 @@ void triangulateCanonically(const std::vector<Point>& points, const CgalTriangle
     }
     i = j;
   }
-  const Vec3 normal = triangleAreaVector(toVec3(points[origin[0]]), toVec3(points[origin[1]]), toVec3(points[origin[2]]));
+  const Vec3 normal = triangleAreaVector(
+    toVec3(points[origin[0]]), toVec3(points[origin[1]]), toVec3(points[origin[2]]));
   const double nx = std::abs(normal.x), ny = std::abs(normal.y), nz = std::abs(normal.z);
   std::vector<CgalTriangle> result;
   bool ok = false;
@@ -474,15 +496,18 @@ void triangulateCanonically(const std::vector<Point>& points, const CgalTriangle
   {
     if (nz >= nx && nz >= ny)
     {
-      ok = triangulateInProjection<CGAL::Projection_traits_xy_3<Kernel>>(points, origin, used, border, inner, result);
+      ok = triangulateInProjection<CGAL::Projection_traits_xy_3<Kernel>>(
+        points, origin, used, border, inner, result);
     }
     else if (nx >= ny)
     {
-      ok = triangulateInProjection<CGAL::Projection_traits_yz_3<Kernel>>(points, origin, used, border, inner, result);
+      ok = triangulateInProjection<CGAL::Projection_traits_yz_3<Kernel>>(
+        points, origin, used, border, inner, result);
     }
     else
     {
-      ok = triangulateInProjection<CGAL::Projection_traits_xz_3<Kernel>>(points, origin, used, border, inner, result);
+      ok = triangulateInProjection<CGAL::Projection_traits_xz_3<Kernel>>(
+        points, origin, used, border, inner, result);
     }
   }
   catch (const std::exception&)
@@ -493,7 +518,8 @@ void triangulateCanonically(const std::vector<Point>& points, const CgalTriangle
   {
     return;
   }
-  auto area = [&points](const std::vector<CgalTriangle>& triangles) {
+  auto area = [&points](const std::vector<CgalTriangle>& triangles)
+  {
     double sum = 0;
     for (const CgalTriangle& t : triangles)
     {
@@ -615,8 +641,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     for (std::size_t i = 0; i < soup.triangles.size(); ++i)
     {
       const CgalTriangle& t = soup.triangles[i];
-      inSet[i] = growth >= 2 || inSet[i] || localIndex[t[0]] != NoOrigin || localIndex[t[1]] != NoOrigin ||
-        localIndex[t[2]] != NoOrigin;
+      inSet[i] = growth >= 2 || inSet[i] || localIndex[t[0]] != NoOrigin ||
+        localIndex[t[1]] != NoOrigin || localIndex[t[2]] != NoOrigin;
       if (inSet[i])
       {
         set.push_back(i);
@@ -691,14 +717,17 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
       added.push_back(v);
     }
   }
-  std::sort(added.begin(), added.end(), [&](VertexIndex a, VertexIndex b) {
-    return surfaceOfVertex[a] != surfaceOfVertex[b] ? surfaceOfVertex[a] < surfaceOfVertex[b]
-                                                    : mesh.point(a) < mesh.point(b);
-  });
+  std::sort(added.begin(), added.end(),
+    [&](VertexIndex a, VertexIndex b)
+    {
+      return surfaceOfVertex[a] != surfaceOfVertex[b] ? surfaceOfVertex[a] < surfaceOfVertex[b]
+                                                      : mesh.point(a) < mesh.point(b);
+    });
   for (std::size_t i = 0; i < added.size(); ++i)
   {
     const VertexIndex v = added[i];
-    if (i == 0 || surfaceOfVertex[v] != surfaceOfVertex[added[i - 1]] || mesh.point(v) != mesh.point(added[i - 1]))
+    if (i == 0 || surfaceOfVertex[v] != surfaceOfVertex[added[i - 1]] ||
+      mesh.point(v) != mesh.point(added[i - 1]))
     {
       split.points.push_back(mesh.point(v));
     }
@@ -707,7 +736,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
 
   std::vector<std::size_t> surfaceOf;
   std::vector<bool> piece;
-  auto keep = [&](const CgalTriangle& t, std::size_t origin) {
+  auto keep = [&](const CgalTriangle& t, std::size_t origin)
+  {
     piece.push_back(inSet[origin]);
     split.triangles.push_back(t);
     split.input.push_back(soup.input[origin]);
@@ -730,7 +760,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     }
   }
   std::sort(split.contactEdges.begin(), split.contactEdges.end());
-  split.contactEdges.erase(std::unique(split.contactEdges.begin(), split.contactEdges.end()), split.contactEdges.end());
+  split.contactEdges.erase(
+    std::unique(split.contactEdges.begin(), split.contactEdges.end()), split.contactEdges.end());
 
   // Autorefinement's faces come in an order, and with a triangulation where points are
   // cocircular, that follow heap addresses (its box intersection breaks ties by box
@@ -741,7 +772,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
   for (FaceIndex f : mesh.faces())
   {
     const HalfedgeIndex h = mesh.halfedge(f);
-    const CgalTriangle t = { pointOf[mesh.source(h)], pointOf[mesh.target(h)], pointOf[mesh.target(mesh.next(h))] };
+    const CgalTriangle t = { pointOf[mesh.source(h)], pointOf[mesh.target(h)],
+      pointOf[mesh.target(mesh.next(h))] };
     const auto k = static_cast<std::size_t>(
       std::lower_bound(set.begin(), set.end(), tracking.origin[f]) - set.begin());
     faceOf[k].push_back(t);
@@ -762,7 +794,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
     std::vector<CgalTriangle>& p = piecesOf[k];
     if (p.size() > 1)
     {
-      triangulateCanonically(split.points, soup.triangles[set[k]], faceOf[k], split.contactEdges, p);
+      triangulateCanonically(
+        split.points, soup.triangles[set[k]], faceOf[k], split.contactEdges, p);
     }
     sortPieces(p);
     pieces[set[k]] = p.size();
@@ -785,7 +818,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
       out.coveredArea += triangleArea(split.points[t[0]], split.points[t[1]], split.points[t[2]]);
     }
   }
-  if (out.coveredTriangles == 0 && split.contactEdges.empty() && mesh.number_of_faces() == set.size())
+  if (out.coveredTriangles == 0 && split.contactEdges.empty() &&
+    mesh.number_of_faces() == set.size())
   {
     return false; // touching at points or edges the surfaces already have
   }

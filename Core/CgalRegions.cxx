@@ -56,7 +56,8 @@ Mesh::Property_map<EdgeIndex, bool> markConstrainedEdges(Mesh& mesh, const Repai
   {
     const std::size_t p = pointOfVertex[mesh.vertex(e, 0)], q = pointOfVertex[mesh.vertex(e, 1)];
     if (mesh.is_border(e) ||
-      std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(), std::make_pair(std::min(p, q), std::max(p, q))))
+      std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(),
+        std::make_pair(std::min(p, q), std::max(p, q))))
     {
       constrained[e] = true;
       continue;
@@ -108,7 +109,8 @@ Mesh::Property_map<VertexIndex, bool> markCorners(
 
 } // namespace
 
-std::vector<std::vector<std::size_t>> connectedComponents(const RepairedSoup& soup, CancellationPoll& poll)
+std::vector<std::vector<std::size_t>> connectedComponents(
+  const RepairedSoup& soup, CancellationPoll& poll)
 {
   Mesh mesh;
   PMP::polygon_soup_to_polygon_mesh(soup.points, PolledTriangles(soup.triangles, poll), mesh);
@@ -166,14 +168,16 @@ ComponentLayout layOutComponent(Mesh& mesh, const RepairedSoup& soup, const Tria
   double sharpEdgeAngle, std::size_t firstRegionId)
 {
   ComponentLayout layout;
-  layout.constrained = markConstrainedEdges(mesh, soup, input, faces, pointOfVertex, sharpEdgeAngle);
+  layout.constrained =
+    markConstrainedEdges(mesh, soup, input, faces, pointOfVertex, sharpEdgeAngle);
   layout.corner = markCorners(mesh, layout.constrained);
   // Contact lines keep every point: both surfaces along a line keep the same polyline, so
   // remeshing opens no crack between them, and a curved line is not cut short.
   for (EdgeIndex e : mesh.edges())
   {
     const std::size_t p = pointOfVertex[mesh.vertex(e, 0)], q = pointOfVertex[mesh.vertex(e, 1)];
-    if (std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(), std::make_pair(std::min(p, q), std::max(p, q))))
+    if (std::binary_search(soup.contactEdges.begin(), soup.contactEdges.end(),
+          std::make_pair(std::min(p, q), std::max(p, q))))
     {
       layout.corner[mesh.vertex(e, 0)] = true;
       layout.corner[mesh.vertex(e, 1)] = true;

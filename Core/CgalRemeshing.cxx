@@ -48,8 +48,9 @@ std::string describe(const Rgb& c)
 std::string describeRegion(const Region& region, const std::vector<Material>& materials)
 {
   std::ostringstream s;
-  s << "region " << region.id << " (reflectance " << describe(materials[region.material].reflectance)
-    << ", " << countOf(region.triangles.size(), "input triangle") << ")";
+  s << "region " << region.id << " (reflectance "
+    << describe(materials[region.material].reflectance) << ", "
+    << countOf(region.triangles.size(), "input triangle") << ")";
   return s.str();
 }
 
@@ -162,8 +163,8 @@ std::vector<Refusal> checkRegions(const Mesh& mesh, const ComponentLayout& layou
     if (refusals[r].empty() && !(std::abs(change) <= tolerance))
     {
       std::ostringstream s;
-      s << "remeshing changed its area by " << 100 * change << "% (more than "
-        << 100 * tolerance << "%; the patch size may be too large for its curvature)";
+      s << "remeshing changed its area by " << 100 * change << "% (more than " << 100 * tolerance
+        << "%; the patch size may be too large for its curvature)";
       refusals[r] = s.str();
     }
   }
@@ -227,7 +228,8 @@ void refuseRegion(const Region& region, const RepairedSoup& soup, const Triangle
   }
   if (out.fallbackRegions <= MaximumRegionWarnings)
   {
-    out.warnings.push_back(describeRegion(region, materials) + " was only refined, not remeshed: " + why);
+    out.warnings.push_back(
+      describeRegion(region, materials) + " was only refined, not remeshed: " + why);
   }
 }
 
@@ -285,7 +287,8 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   bool valid = false;
   std::string failure;
   const bool built = guarded(
-    [&] {
+    [&]
+    {
       mesh = buildComponentMesh(soup, faces, localIndex, pointOfVertex, poll);
       valid = CGAL::is_valid_polygon_mesh(mesh) && CGAL::is_triangle_mesh(mesh);
     },
@@ -297,8 +300,10 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   poll.check();
   if (!built || !valid ||
     !guarded(
-      [&] {
-        layout = layOutComponent(mesh, soup, input, faces, pointOfVertex, settings.sharpEdgeAngle, out.regions);
+      [&]
+      {
+        layout = layOutComponent(
+          mesh, soup, input, faces, pointOfVertex, settings.sharpEdgeAngle, out.regions);
       },
       failure))
   {
@@ -310,17 +315,21 @@ void processComponent(const RepairedSoup& soup, const TriangleSoup& input,
   poll.check();
   std::unique_ptr<RegionProjection> projection;
   bool ok = guarded(
-    [&] { projection = std::make_unique<RegionProjection>(mesh, layout.region, layout.regions.size()); },
+    [&] {
+      projection = std::make_unique<RegionProjection>(mesh, layout.region, layout.regions.size());
+    },
     failure);
   for (unsigned pass = 0; ok && pass < Iterations; ++pass)
   {
     poll.check();
-    ok = guarded([&] { remeshPass(mesh, layout, settings.targetEdgeLength, *projection, poll); }, failure);
+    ok = guarded(
+      [&] { remeshPass(mesh, layout, settings.targetEdgeLength, *projection, poll); }, failure);
     afterPass(double(pass + 1) / Iterations);
   }
   poll.check();
   std::vector<Refusal> refusals(layout.regions.size(), failure);
-  if (ok && guarded([&] { refusals = checkRegions(mesh, layout, settings.areaTolerance); }, failure))
+  if (ok &&
+    guarded([&] { refusals = checkRegions(mesh, layout, settings.areaTolerance); }, failure))
   {
     emitRegions(mesh, layout, refusals, out);
   }
@@ -358,7 +367,8 @@ void addRepairWarnings(CgalRemeshOutput& out)
   }
   if (out.fallbackRegions > MaximumRegionWarnings)
   {
-    out.warnings.push_back("... and " + countOf(out.fallbackRegions - MaximumRegionWarnings, "more region") +
+    out.warnings.push_back("... and " +
+      countOf(out.fallbackRegions - MaximumRegionWarnings, "more region") +
       " only refined, not remeshed");
   }
 }
@@ -418,8 +428,10 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
       throw Error(e.message);
     }
     std::vector<std::vector<std::size_t>> splitComponents;
-    ok = ok && (!changed || guarded([&] { splitComponents = connectedComponents(split, poll); }, failure));
-    out.contactSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ok = ok &&
+      (!changed || guarded([&] { splitComponents = connectedComponents(split, poll); }, failure));
+    out.contactSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (ok && changed)
     {
       soup = std::move(split);
@@ -443,8 +455,10 @@ CgalRemeshOutput remeshWithCgal(const std::vector<Vec3>& points, const TriangleS
   // least 0.1% so that thousands of tiny components do not flood the caller.
   const double total = static_cast<double>(std::max<std::size_t>(1, soup.triangles.size()));
   double done = 0;
-  auto report = [&](double componentFraction) {
-    const double fraction = RepairShare + SplitShare + (1 - RepairShare - SplitShare) * componentFraction;
+  auto report = [&](double componentFraction)
+  {
+    const double fraction =
+      RepairShare + SplitShare + (1 - RepairShare - SplitShare) * componentFraction;
     if (fraction - reported >= 0.001)
     {
       reported = fraction;

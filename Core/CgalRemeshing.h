@@ -43,7 +43,7 @@ struct CgalRemeshOutput
   std::size_t contactEdges = 0;          ///< edges of the contact lines, once split
   std::size_t coveredTriangles = 0;      ///< pieces dropped, face to face on a closed surface
   double coveredArea = 0;
-  double contactSeconds = 0;             ///< finding contacts, splitting, dropping covered
+  double contactSeconds = 0; ///< finding contacts, splitting, dropping covered
   std::vector<std::string> warnings;
 };
 
@@ -64,8 +64,8 @@ struct CgalRemeshSettings
 
 /**
  * Repairs and orients the triangles, splits them along the lines where surfaces touch or
- * cross, drops the pieces lying face to face on closed surfaces, and isotropically remeshes region by region
- * with the contact lines as constraints. Never lets a CGAL exception escape: what CGAL
+ * cross, drops the pieces lying face to face on closed surfaces, and isotropically remeshes region
+ * by region with the contact lines as constraints. Never lets a CGAL exception escape: what CGAL
  * refuses is listed in refineOnly with a warning (if splitting fails, the surfaces are
  * remeshed unsplit, with a warning).
  * Throws mlr::Cancelled when `progress` returns false, mlr::Error when memory runs out.

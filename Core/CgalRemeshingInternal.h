@@ -191,7 +191,10 @@ public:
     return (*this->Triangles)[i];
   }
   const_iterator begin() const { return { this->Triangles->data(), this->Poll }; }
-  const_iterator end() const { return { this->Triangles->data() + this->Triangles->size(), this->Poll }; }
+  const_iterator end() const
+  {
+    return { this->Triangles->data() + this->Triangles->size(), this->Poll };
+  }
 
 private:
   const std::vector<CgalTriangle>* Triangles;
@@ -226,8 +229,8 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
 
 /**
  * Splits the soup along the lines where triangles of different surfaces touch or cross, and
- * drops the pieces lying face to face on closed surfaces. Only the triangles near a contact go through
- * CGAL's autorefinement (it takes seconds on 200,000 triangles); the rest are kept as they
+ * drops the pieces lying face to face on closed surfaces. Only the triangles near a contact go
+ * through CGAL's autorefinement (it takes seconds on 200,000 triangles); the rest are kept as they
  * are. Returns false, leaving the soup unchanged, when nothing touches. CGAL may throw: the
  * caller guards this.
  */
@@ -237,7 +240,8 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
 // Components and regions (CgalRegions.cxx).
 
 /// The soup's connected components, each as the indices of its triangles.
-std::vector<std::vector<std::size_t>> connectedComponents(const RepairedSoup& soup, CancellationPoll& poll);
+std::vector<std::vector<std::size_t>> connectedComponents(
+  const RepairedSoup& soup, CancellationPoll& poll);
 
 /// The component's triangles as a mesh of their own; face i is soup triangle faces[i], and
 /// vertex v is soup point used[v].

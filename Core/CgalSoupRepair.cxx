@@ -64,10 +64,12 @@ std::size_t removeDuplicateTriangles(RepairedSoup& soup, CancellationPoll& poll)
     std::sort(key.begin(), key.end());
     sorted[i] = { key, i };
   }
-  std::sort(sorted.begin(), sorted.end(), [&poll](const auto& a, const auto& b) {
-    poll.tick();
-    return a < b;
-  });
+  std::sort(sorted.begin(), sorted.end(),
+    [&poll](const auto& a, const auto& b)
+    {
+      poll.tick();
+      return a < b;
+    });
   std::vector<bool> keep(soup.triangles.size(), true);
   std::size_t removed = 0;
   for (std::size_t i = 1; i < sorted.size(); ++i)
@@ -129,7 +131,8 @@ std::size_t orientSoup(RepairedSoup& soup)
   soup.flipped.resize(soup.triangles.size(), false);
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
-    soup.flipped[i] = soup.flipped[i] != !sameCyclicOrder(before[i], soup.triangles[i], soup.points);
+    soup.flipped[i] =
+      soup.flipped[i] != !sameCyclicOrder(before[i], soup.triangles[i], soup.points);
   }
   return soup.points.size() - pointsBefore;
 }

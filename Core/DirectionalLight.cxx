@@ -7,8 +7,8 @@
 namespace mlr
 {
 
-DirectionalLight::DirectionalLight(
-  const std::vector<Vec3>& towardsLight, const Rgb& irradiance, const std::vector<Rgb>& powerFactors)
+DirectionalLight::DirectionalLight(const std::vector<Vec3>& towardsLight, const Rgb& irradiance,
+  const std::vector<Rgb>& powerFactors)
   : Irradiance(irradiance)
 {
   if (towardsLight.empty())
@@ -16,7 +16,8 @@ DirectionalLight::DirectionalLight(
     throw Error("the directional light has no direction: give one direction towards the light "
                 "per frame");
   }
-  if (!irradiance.isFinite() || !(irradiance.minComponent() >= 0) || !(irradiance.maxComponent() > 0))
+  if (!irradiance.isFinite() || !(irradiance.minComponent() >= 0) ||
+    !(irradiance.maxComponent() > 0))
   {
     std::ostringstream s;
     s << "the irradiance (" << irradiance.r << ", " << irradiance.g << ", " << irradiance.b
@@ -43,7 +44,8 @@ DirectionalLight::DirectionalLight(
     }
     this->Directions.push_back(d / norm);
   }
-  this->PowerFactors = powerFactors.empty() ? std::vector<Rgb>(towardsLight.size(), Rgb(1)) : powerFactors;
+  this->PowerFactors =
+    powerFactors.empty() ? std::vector<Rgb>(towardsLight.size(), Rgb(1)) : powerFactors;
   for (std::size_t k = 0; k < this->PowerFactors.size(); ++k)
   {
     const Rgb& f = this->PowerFactors[k];

@@ -59,15 +59,15 @@ class FixedPointAccumulator
 {
 public:
   /// One quantum for every channel.
-  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records,
-    std::size_t frames, double quantum, FrameLayout layout)
+  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records, std::size_t frames,
+    double quantum, FrameLayout layout)
     : FixedPointAccumulator(workers, copyPerWorker, records, frames, filled(quantum), layout)
   {
   }
 
   /// One quantum per channel: a channel much weaker than the others keeps its precision.
-  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records,
-    std::size_t frames, const std::array<double, Channels>& quantum, FrameLayout layout)
+  FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records, std::size_t frames,
+    const std::array<double, Channels>& quantum, FrameLayout layout)
     : Stride(records * 2 * frames * Channels)
     , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
     , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
@@ -114,7 +114,8 @@ public:
   /// Asks the cache for the slots add() will touch for frames [first, first + count), so
   /// that the miss overlaps work done before the add. Always inlined: GCC's IPA finds a
   /// function that only prefetches free of side effects and deletes calls to it.
-  [[gnu::always_inline]] void prefetch(const std::int64_t* recordSlots, std::size_t first, std::size_t count) const
+  [[gnu::always_inline]] void prefetch(
+    const std::int64_t* recordSlots, std::size_t first, std::size_t count) const
   {
     const std::int64_t* begin = recordSlots + first * this->FrameStride;
     if (this->FrameStride == Channels)
@@ -172,8 +173,8 @@ public:
   /// Bytes of `copies` copies (the worker count, or 1 when shared).
   static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
   {
-    return saturatingProduct({ static_cast<std::uint64_t>(copies), records, 2, frames,
-      Channels, sizeof(std::int64_t) });
+    return saturatingProduct(
+      { static_cast<std::uint64_t>(copies), records, 2, frames, Channels, sizeof(std::int64_t) });
   }
 
   /// What those copies allocate: bytes() rounded up to whole pages.
@@ -227,7 +228,7 @@ private:
   std::array<double, Channels> Quantum;
   std::array<double, Channels> InverseQuantum;
   std::size_t CopyStride; ///< 0 when the copy is shared
-  bool Shared;             ///< one copy for several workers: atomic adds
+  bool Shared;            ///< one copy for several workers: atomic adds
   std::size_t Size;
   std::unique_ptr<std::int64_t[], Free> Values;
 };

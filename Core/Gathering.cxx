@@ -40,7 +40,8 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   {
     Rgb* into = reuse ? sum.data() : &sum[pass];
     const PackedRgb* pending = nullptr;
-    auto addPending = [&] {
+    auto addPending = [&]
+    {
       if (pending)
       {
         for (std::size_t f = 0; f < rowLength; ++f)
@@ -59,7 +60,8 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       ++counters.gatheringRays;
       std::uint32_t hitElement = 0;
       Side hitSide = Side::Front;
-      const bool found = tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide);
+      const bool found =
+        tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide);
       addPending();
       if (!found)
       {
@@ -103,7 +105,8 @@ std::vector<std::uint32_t> gatheringSides(const Scene& scene,
     {
       if (reachable[2 * p + static_cast<std::size_t>(s)])
       {
-        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
+             ++e)
         {
           sides.push_back(static_cast<std::uint32_t>(e * 2 + static_cast<std::size_t>(s)));
         }
@@ -120,8 +123,7 @@ std::vector<std::uint32_t> gatheringSides(const Scene& scene,
 
 GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
-  Solution& solution)
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
 {
   std::uint64_t raysPerSide = 0;
   const auto total = static_cast<std::uint64_t>(
@@ -130,8 +132,10 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
   std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
   const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
-  runOnRanks(tasks, workers, options,
-    [&](std::size_t task, int worker) {
+  runOnRanks(
+    tasks, workers, options,
+    [&](std::size_t task, int worker)
+    {
       const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
       for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
       {
@@ -174,7 +178,8 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
           std::max(0.0, b.b - patchDirect.b));
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {
-          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] = PackedRgb(rest);
+          solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] =
+            PackedRgb(rest);
         }
       }
     }

@@ -16,7 +16,8 @@ std::size_t frameCount(const LightRig& rig, bool sceneEmits)
 {
   std::size_t frames = 0;
   std::string first;
-  auto take = [&](std::size_t n, const std::string& what) {
+  auto take = [&](std::size_t n, const std::string& what)
+  {
     if (n <= 1)
     {
       return;
@@ -108,7 +109,8 @@ std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec
     const Vec3 toHit = y - x;
     for (std::size_t j = 0; j < positions; ++j)
     {
-      const double dx = toHit.x - pose[9][j], dy = toHit.y - pose[10][j], dz = toHit.z - pose[11][j];
+      const double dx = toHit.x - pose[9][j], dy = toHit.y - pose[10][j],
+                   dz = toHit.z - pose[11][j];
       const double cosX = n.x * dx + n.y * dy + n.z * dz;
       const double cosY = -(ny.x * dx + ny.y * dy + ny.z * dz);
       const double r2 = dx * dx + dy * dy + dz * dz;
@@ -172,7 +174,8 @@ std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec
 
 // --- Directional lights ----------------------------------------------------------------------
 
-DirectionalSource::DirectionalSource(const DirectionalLight& light, const Vec3& centre, double radius)
+DirectionalSource::DirectionalSource(
+  const DirectionalLight& light, const Vec3& centre, double radius)
   : Light(&light)
   , Centre(centre)
   , Radius(radius)
@@ -254,7 +257,8 @@ LightSource::LightSource(Kind kind, std::uint64_t stream)
   , Stream(stream)
 {
   std::visit(
-    [&](const auto& light) {
+    [&](const auto& light)
+    {
       this->Positions = light.positions();
       this->Power = light.power();
       for (std::size_t k = 0; k < this->Positions; ++k)
@@ -283,8 +287,8 @@ void LightSource::emit(
 std::size_t LightSource::kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny,
   std::size_t origin, const RayTracer& tracer, KernelScratch& scratch) const
 {
-  return std::visit(
-    [&](const auto& light) { return light.kernel(path, y, ny, origin, this->On.data(), tracer, scratch); },
+  return std::visit([&](const auto& light)
+    { return light.kernel(path, y, ny, origin, this->On.data(), tracer, scratch); },
     this->What);
 }
 

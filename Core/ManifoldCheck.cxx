@@ -121,12 +121,14 @@ bool isTriangleSoupAPolygonMesh(const std::vector<SoupTriangle>& triangles, Canc
       byPrev.emplace_back(around[i].prev, i);
     }
     std::sort(byPrev.begin(), byPrev.end());
-    const auto successor = [&](std::size_t i) {
-      const auto it = std::lower_bound(byPrev.begin(), byPrev.end(),
-        std::make_pair(around[i].next, std::size_t(0)));
+    const auto successor = [&](std::size_t i)
+    {
+      const auto it = std::lower_bound(
+        byPrev.begin(), byPrev.end(), std::make_pair(around[i].next, std::size_t(0)));
       return it != byPrev.end() && it->first == around[i].next ? it->second : None;
     };
-    const auto predecessor = [&](std::size_t i) {
+    const auto predecessor = [&](std::size_t i)
+    {
       const Corner key{ around[i].prev, 0 };
       const Corner* it = std::lower_bound(around, around + count, key,
         [](const Corner& a, const Corner& b) { return a.next < b.next; });

@@ -23,33 +23,39 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
   // The accumulators of `copies` copies: a scalar share per element side and RGB power per
   // patch side, for every frame, each buffer in whole pages.
-  const auto accumulators = [&](std::uint64_t copies) {
+  const auto accumulators = [&](std::uint64_t copies)
+  {
     const int c = static_cast<int>(copies);
     return saturatingSum(FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
       FixedPointAccumulator<3>::allocatedBytes(c, patches, frames));
   };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,
-    sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) + sizeof(Rgb) });
+    sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) +
+      sizeof(Rgb) });
   // Embree's BVH and buffers (generously), the emission and lit side of every element.
-  const std::uint64_t tracing = saturatingSum(saturatingProduct({ elements, 256 }), saturatingProduct({ points, 16 }));
+  const std::uint64_t tracing =
+    saturatingSum(saturatingProduct({ elements, 256 }), saturatingProduct({ points, 16 }));
   const std::uint64_t perElement = saturatingProduct({ elements, sizeof(Rgb) + sizeof(Side) });
   // Reachability: the probes' hits and their reverse edges (gone before gathering rays).
   const std::uint64_t reachability =
     saturatingProduct({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });
   // Per frame and light: its pose copied into the rig (120 bytes), its power factor (24) and
   // the shooting run's pose coefficients and path counts (112), measured.
-  const std::uint64_t lightData = saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
+  const std::uint64_t lightData =
+    saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
   const std::uint64_t base =
     saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData));
   plan.other = saturatingSum(base, reachability);
   const std::uint64_t gathering =
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
-  const auto peakWith = [&](std::uint64_t copies) {
-    return saturatingSum(base,
-      std::max(saturatingSum(saturatingSum(direct, patch), accumulators(copies)), gathering));
+  const auto peakWith = [&](std::uint64_t copies)
+  {
+    return saturatingSum(
+      base, std::max(saturatingSum(saturatingSum(direct, patch), accumulators(copies)), gathering));
   };
-  plan.accumulatorCopyPerWorker = workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
+  plan.accumulatorCopyPerWorker =
+    workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
   const std::uint64_t copies = plan.accumulatorCopyPerWorker ? workers : 1;
   plan.accumulators = accumulators(copies);
   plan.peak = peakWith(copies);

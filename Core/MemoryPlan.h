@@ -38,8 +38,8 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
 
 /// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
-std::uint64_t estimateSolveMemory(const Scene& scene, std::size_t frames,
-  const SolverOptions& options, std::size_t lights = 1);
+std::uint64_t estimateSolveMemory(
+  const Scene& scene, std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
 
 /// The same estimate from counts alone, e.g. for a scene not remeshed yet.
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,

@@ -63,9 +63,10 @@ void MovingLight::setPoses(const std::vector<LightPose>& poses)
       throw Error(s.str());
     }
     const Rotation& r = pose.rotation;
-    const double orthogonality = std::max({ std::abs(dot(r.row0, r.row0) - 1),
-      std::abs(dot(r.row1, r.row1) - 1), std::abs(dot(r.row2, r.row2) - 1),
-      std::abs(dot(r.row0, r.row1)), std::abs(dot(r.row0, r.row2)), std::abs(dot(r.row1, r.row2)) });
+    const double orthogonality =
+      std::max({ std::abs(dot(r.row0, r.row0) - 1), std::abs(dot(r.row1, r.row1) - 1),
+        std::abs(dot(r.row2, r.row2) - 1), std::abs(dot(r.row0, r.row1)),
+        std::abs(dot(r.row0, r.row2)), std::abs(dot(r.row1, r.row2)) });
     if (!r.isFinite() || !(orthogonality < 1e-6) || !(dot(cross(r.row0, r.row1), r.row2) > 0))
     {
       throw Error("the orientation of light position " + std::to_string(k) +
@@ -132,8 +133,9 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
     {
       if (std::abs(dot(p - polygon[0], normal)) > 1e-3 * diameter)
       {
-        throw Error(which + " is not planar: its points lie off its plane by more than 0.1% of "
-                            "its size");
+        throw Error(which +
+          " is not planar: its points lie off its plane by more than 0.1% of "
+          "its size");
       }
     }
     const auto triangles = triangulatePolygon(polygon);
@@ -210,8 +212,8 @@ std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& pol
       if (!(norm > 1e-12) || !std::isfinite(norm))
       {
         std::ostringstream s;
-        s << "the Orientation of light position " << k << " is (" << q[0] << ", " << q[1]
-          << ", " << q[2] << ", " << q[3] << "): a quaternion (w, x, y, z) must be finite and "
+        s << "the Orientation of light position " << k << " is (" << q[0] << ", " << q[1] << ", "
+          << q[2] << ", " << q[3] << "): a quaternion (w, x, y, z) must be finite and "
           << "not zero ((1, 0, 0, 0) leaves the light as given)";
         throw Error(s.str());
       }
@@ -227,8 +229,8 @@ std::vector<LightPose> posesFromInputs(const std::vector<std::vector<Vec3>>& pol
       if (!(norm > 1e-12) || !std::isfinite(norm))
       {
         std::ostringstream s;
-        s << "the Normal of light position " << k << " is (" << in.normal.x << ", "
-          << in.normal.y << ", " << in.normal.z << "): give a finite direction of non-zero "
+        s << "the Normal of light position " << k << " is (" << in.normal.x << ", " << in.normal.y
+          << ", " << in.normal.z << "): give a finite direction of non-zero "
           << "length, the way the light emits in that frame";
         throw Error(s.str());
       }

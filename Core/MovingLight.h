@@ -104,7 +104,7 @@ struct PoseInput
   Vec3 normal; ///< the emission direction in this frame (any length but 0)
   bool hasOrientation = false;
   std::array<double, 4> orientation{ 1, 0, 0, 0 }; ///< quaternion w, x, y, z (any length but 0)
-  Rgb power{ 1, 1, 1 };                             ///< factor on the light's power
+  Rgb power{ 1, 1, 1 };                            ///< factor on the light's power
 };
 
 /// The area-weighted mean of the polygons' unit normals, normalised: the direction a light

@@ -38,12 +38,14 @@ void parallelFor(std::size_t taskCount, int threads,
   // or the loop stops, not a tick later (a sleep cost up to tickSeconds per loop).
   std::mutex finishedMutex;
   std::condition_variable finished;
-  auto notifyFinished = [&] {
+  auto notifyFinished = [&]
+  {
     std::lock_guard<std::mutex> lock(finishedMutex);
     finished.notify_all();
   };
 
-  auto work = [&](int worker, bool isCaller) {
+  auto work = [&](int worker, bool isCaller)
+  {
     using clock = std::chrono::steady_clock;
     auto lastTick = clock::now();
     while (!stop.load(std::memory_order_relaxed))

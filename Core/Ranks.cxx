@@ -85,13 +85,17 @@ void runOnRanks(std::size_t tasks, int workers, const SolverOptions& options,
   const std::size_t rank = static_cast<std::size_t>(options.rank);
   if (ranks <= 1)
   {
-    parallelFor(tasks, workers, body, [&](std::size_t done) {
-      return fraction(static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1)));
-    });
+    parallelFor(tasks, workers, body,
+      [&](std::size_t done)
+      {
+        return fraction(
+          static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1)));
+      });
     return;
   }
   const std::size_t rounds = std::min(RoundsPerPhase, std::max<std::size_t>(tasks, 1));
-  auto mineOf = [&](std::size_t length) { return length > rank ? (length - rank + ranks - 1) / ranks : 0; };
+  auto mineOf = [&](std::size_t length)
+  { return length > rank ? (length - rank + ranks - 1) / ranks : 0; };
   std::size_t mineTotal = 0;
   for (std::size_t q = 0; q < rounds; ++q)
   {
@@ -102,11 +106,15 @@ void runOnRanks(std::size_t tasks, int workers, const SolverOptions& options,
   {
     const std::size_t begin = tasks * q / rounds;
     const std::size_t mine = mineOf(tasks * (q + 1) / rounds - begin);
-    agreeAcrossRanks(options,
-      [&] {
-        parallelFor(mine, workers,
+    agreeAcrossRanks(
+      options,
+      [&]
+      {
+        parallelFor(
+          mine, workers,
           [&](std::size_t task, int worker) { body(begin + rank + task * ranks, worker); },
-          [&](std::size_t done) {
+          [&](std::size_t done)
+          {
             return fraction(static_cast<double>(doneBefore + done) /
               static_cast<double>(std::max<std::size_t>(mineTotal, 1)));
           });
@@ -167,16 +175,18 @@ void sumFloatsAcrossRanks(
 std::uint64_t digestOf(const SolverOptions& options)
 {
   Digest digest;
-  visitSolverOptions(options, [&](const char*, const auto& value, OptionRole role) {
-    using T = std::decay_t<decltype(value)>;
-    if constexpr (std::is_arithmetic<T>::value)
+  visitSolverOptions(options,
+    [&](const char*, const auto& value, OptionRole role)
     {
-      if (role == OptionRole::Result)
+      using T = std::decay_t<decltype(value)>;
+      if constexpr (std::is_arithmetic<T>::value)
       {
-        digest.add(value);
+        if (role == OptionRole::Result)
+        {
+          digest.add(value);
+        }
       }
-    }
-  });
+    });
   return digest.value;
 }
 

@@ -29,13 +29,15 @@ RTCDevice sharedDevice()
 {
   static std::once_flag once;
   static RTCDevice device = nullptr;
-  std::call_once(once, [] {
-    device = rtcNewDevice("verbose=0");
-    if (device)
+  std::call_once(once,
+    []
     {
-      rtcSetDeviceErrorFunction(device, onEmbreeError, nullptr);
-    }
-  });
+      device = rtcNewDevice("verbose=0");
+      if (device)
+      {
+        rtcSetDeviceErrorFunction(device, onEmbreeError, nullptr);
+      }
+    });
   if (!device)
   {
     throw Error("Embree could not create a device (does this CPU support SSE2?)");
@@ -89,11 +91,10 @@ RayTracer::RayTracer(const Scene& scene)
   rtcSetSceneBuildQuality(this->Impl->Scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   const auto& points = scene.points();
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX,
-    0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), points.size()));
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+    geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), points.size()));
   auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(geometry,
-    RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t),
-    scene.elementCount()));
+    RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), scene.elementCount()));
   raiseIfEmbreeFailed("building the ray-tracing scene");
   if (!vertices || !indices)
   {
@@ -233,8 +234,8 @@ void occludedPackets(RTCScene scene, const Vec3& origin, const float* dx, const 
 }
 }
 
-void RayTracer::visibleFrom(const Vec3& origin, const float* dx, const float* dy,
-  const float* dz, std::size_t count, std::uint8_t* visible) const
+void RayTracer::visibleFrom(const Vec3& origin, const float* dx, const float* dy, const float* dz,
+  std::size_t count, std::uint8_t* visible) const
 {
   // The targets are lifted off their surfaces, as the rays that start there are: the whole
   // segment up to t = 1 is tested, with nothing to stop short of.
@@ -242,8 +243,8 @@ void RayTracer::visibleFrom(const Vec3& origin, const float* dx, const float* dy
     static_cast<float>(this->Offset), visible);
 }
 
-void RayTracer::visibleAlong(const Vec3& origin, const float* dx, const float* dy,
-  const float* dz, std::size_t count, std::uint8_t* visible) const
+void RayTracer::visibleAlong(const Vec3& origin, const float* dx, const float* dy, const float* dz,
+  std::size_t count, std::uint8_t* visible) const
 {
   occludedPackets(this->Impl->Scene, origin - this->Centre, dx, dy, dz, count,
     std::numeric_limits<float>::infinity(), 0.0f, visible);

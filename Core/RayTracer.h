@@ -43,7 +43,8 @@ public:
   /// The element and side intersect() would report, without the hit point and distance:
   /// final gathering and the reachability probes need no more, and the point costs three
   /// scattered reads per ray.
-  bool nearestSide(const Vec3& origin, const Vec3& direction, std::uint32_t& element, Side& side) const;
+  bool nearestSide(
+    const Vec3& origin, const Vec3& direction, std::uint32_t& element, Side& side) const;
 
   /**
    * Visibility of the segments from `origin` to origin + (dx[i], dy[i], dz[i]) (endpoints

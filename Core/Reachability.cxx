@@ -29,12 +29,14 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
   const std::size_t sides = 2 * patches;
   const bool twoSided = options.twoSided;
   constexpr std::uint32_t None = std::numeric_limits<std::uint32_t>::max();
-  auto sideOf = [&](std::uint32_t element, Side side) -> std::uint32_t {
+  auto sideOf = [&](std::uint32_t element, Side side) -> std::uint32_t
+  {
     if (!twoSided && side == Side::Back)
     {
       return None;
     }
-    return static_cast<std::uint32_t>(Scene::patchOfElement(element) * 2 + static_cast<std::size_t>(side));
+    return static_cast<std::uint32_t>(
+      Scene::patchOfElement(element) * 2 + static_cast<std::size_t>(side));
   };
 
   // Seeds, one slot per probe so that the result does not depend on scheduling.
@@ -54,7 +56,8 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
     seeds.resize(first + total, None);
     const std::uint64_t perTask = 1024;
     parallelFor((total + perTask - 1) / perTask, workers,
-      [&](std::size_t task, int) {
+      [&](std::size_t task, int)
+      {
         for (std::uint64_t i = task * perTask; i < std::min(total, (task + 1) * perTask); ++i)
         {
           RandomStream random(ReachabilitySeed + l, StreamPurpose::Reachability, i, 0);
@@ -77,8 +80,10 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
   std::vector<std::uint32_t> probe(sides * K, None);
   const auto& points = scene.points();
   const std::size_t tasks = (patches + ReachabilityPatchesPerTask - 1) / ReachabilityPatchesPerTask;
-  parallelFor(tasks, workers,
-    [&](std::size_t task, int) {
+  parallelFor(
+    tasks, workers,
+    [&](std::size_t task, int)
+    {
       for (std::size_t p = task * ReachabilityPatchesPerTask;
            p < std::min(patches, (task + 1) * ReachabilityPatchesPerTask); ++p)
       {
@@ -103,7 +108,11 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
         }
       }
     },
-    [&](std::size_t done) { return keepGoing(static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1))); });
+    [&](std::size_t done)
+    {
+      return keepGoing(
+        static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(tasks, 1)));
+    });
   rays += patches * (twoSided ? 2 : 1) * K;
 
   // Reverse edges (compressed rows), then a breadth-first search from the seeds over both.
@@ -136,7 +145,8 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
   }
   std::vector<std::uint8_t> reached(sides, 0);
   std::vector<std::uint32_t> queue;
-  auto visit = [&](std::uint32_t side) {
+  auto visit = [&](std::uint32_t side)
+  {
     if (side != None && !reached[side])
     {
       reached[side] = 1;

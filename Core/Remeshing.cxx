@@ -32,8 +32,8 @@ constexpr double BytesPerPatch = 1000;
 
 /// Uniform 1:m^2 split of a triangle, m = ceil(longest edge / h). Neighbours split with
 /// different m meet at T-junctions, which are harmless to ray casting.
-void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const Material& material,
-  PatchMesh& out)
+void refineTriangle(
+  const Vec3& a, const Vec3& b, const Vec3& c, double h, const Material& material, PatchMesh& out)
 {
   const double longest = std::max({ length(b - a), length(c - b), length(a - c) });
   const int m = std::max(1, static_cast<int>(std::ceil(longest / h - 1e-9)));
@@ -50,7 +50,8 @@ void refineTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double h, const
       ++next;
     }
   }
-  auto at = [&](int i, int j) { return rowStart[static_cast<std::size_t>(i)] + static_cast<std::uint32_t>(j); };
+  auto at = [&](int i, int j)
+  { return rowStart[static_cast<std::size_t>(i)] + static_cast<std::uint32_t>(j); };
   for (int i = 0; i < m; ++i)
   {
     for (int j = 0; j < m - i; ++j)
@@ -192,7 +193,8 @@ struct Triangulation
 std::vector<bool> duplicatePolygons(const PolygonSoup& soup, detail::CancellationPoll& poll)
 {
   using Corner = std::array<double, 3>;
-  auto keyOf = [&soup](std::size_t i, std::vector<Corner>& key) {
+  auto keyOf = [&soup](std::size_t i, std::vector<Corner>& key)
+  {
     key.clear();
     for (std::uint32_t v : soup.polygons[i])
     {
@@ -225,10 +227,12 @@ std::vector<bool> duplicatePolygons(const PolygonSoup& soup, detail::Cancellatio
     }
     hashes.emplace_back(hash, i);
   }
-  std::sort(hashes.begin(), hashes.end(), [&poll](const auto& a, const auto& b) {
-    poll.tick();
-    return a < b;
-  });
+  std::sort(hashes.begin(), hashes.end(),
+    [&poll](const auto& a, const auto& b)
+    {
+      poll.tick();
+      return a < b;
+    });
 
   std::vector<bool> duplicate(soup.polygons.size(), false);
   std::vector<std::vector<Corner>> distinct; // the different keys of one run of equal hashes
@@ -280,8 +284,8 @@ bool isCollinear(const std::vector<Vec3>& corners)
   return true;
 }
 
-Triangulation triangulate(const PolygonSoup& soup, const std::vector<std::uint32_t>& materialOfPolygon,
-  detail::CancellationPoll& poll)
+Triangulation triangulate(const PolygonSoup& soup,
+  const std::vector<std::uint32_t>& materialOfPolygon, detail::CancellationPoll& poll)
 {
   Triangulation out;
   const std::vector<bool> duplicate = duplicatePolygons(soup, poll);
@@ -321,7 +325,8 @@ void addTriangulationWarnings(const Triangulation& t, std::vector<std::string>& 
 {
   if (t.linesAndPoints > 0)
   {
-    warnings.push_back("ignored " + countOf(t.linesAndPoints, "line or vertex", "lines or vertices") +
+    warnings.push_back("ignored " +
+      countOf(t.linesAndPoints, "line or vertex", "lines or vertices") +
       " (polygons with fewer than 3 points): only surfaces are remeshed");
   }
   if (t.duplicates > 0)
@@ -331,8 +336,8 @@ void addTriangulationWarnings(const Triangulation& t, std::vector<std::string>& 
   }
   if (t.zeroArea > 0)
   {
-    warnings.push_back("ignored " + countOf(t.zeroArea, "polygon") +
-      " with zero area (all points on one line)");
+    warnings.push_back(
+      "ignored " + countOf(t.zeroArea, "polygon") + " with zero area (all points on one line)");
   }
   if (t.selfCrossing > 0)
   {
@@ -379,7 +384,8 @@ void checkPatchBudget(double expected, double h)
 
 /// Refuses, before allocating, remeshing `inputTriangles` into about `patches` patches when
 /// the estimate exceeds the memory limit.
-void checkRemeshMemory(double inputTriangles, double patches, double h, const RemeshOptions& options)
+void checkRemeshMemory(
+  double inputTriangles, double patches, double h, const RemeshOptions& options)
 {
   const double estimate = inputTriangles * BytesPerInputTriangle + patches * BytesPerPatch;
   // Rounded up to whole bytes, so that it is over the limit exactly when the estimate is.
@@ -391,7 +397,8 @@ void checkRemeshMemory(double inputTriangles, double patches, double h, const Re
   what << "remeshing at patch size " << h;
   detail << inputTriangles << " input triangles into about " << patches << " patches";
   MemoryBudget(options.memoryLimitBytes)
-    .check(bytes, what.str(), detail.str(), "give a larger patch size or a smaller scene, or raise the limit");
+    .check(bytes, what.str(), detail.str(),
+      "give a larger patch size or a smaller scene, or raise the limit");
 }
 
 /// Splits the given input triangles only; progress runs from `from` to 1.
@@ -402,8 +409,8 @@ void refineOnly(const std::vector<Vec3>& points, const detail::TriangleSoup& sou
   for (std::size_t i = 0; i < which.size(); ++i)
   {
     const Triangle& t = soup.triangles[which[i]];
-    refineTriangle(points[t[0]], points[t[1]], points[t[2]], h,
-      materials[soup.material[which[i]]], out);
+    refineTriangle(
+      points[t[0]], points[t[1]], points[t[2]], h, materials[soup.material[which[i]]], out);
     if (i % 4096 == 0)
     {
       checkProgress(progress, from + (1 - from) * double(i) / double(which.size()));
@@ -426,8 +433,8 @@ void appendCgalPatches(
 }
 /// Remeshes with CGAL (unless told not to) and refines what it refused, or everything.
 void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles,
-  const std::vector<Material>& materials, double h, double expectedPatches, const RemeshOptions& options,
-  const RemeshProgress& progress, RemeshResult& result)
+  const std::vector<Material>& materials, double h, double expectedPatches,
+  const RemeshOptions& options, const RemeshProgress& progress, RemeshResult& result)
 {
   if (options.useCgal)
   {
@@ -436,9 +443,8 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     settings.sharpEdgeAngle = options.sharpEdgeAngle;
     settings.splitAtContacts = options.splitAtContacts;
     // Splitting at contacts adds triangles: the estimate checked before is checked again.
-    settings.checkTriangleCount = [&](std::size_t split) {
-      checkRemeshMemory(static_cast<double>(split), expectedPatches, h, options);
-    };
+    settings.checkTriangleCount = [&](std::size_t split)
+    { checkRemeshMemory(static_cast<double>(split), expectedPatches, h, options); };
     const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
       settings, [&](double f) { return !progress || progress(CgalShare * f); });
     appendCgalPatches(cgal, materials, result.mesh);
@@ -459,7 +465,8 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     result.statistics.coveredArea = cgal.coveredArea;
     result.statistics.secondsContacts = cgal.contactSeconds;
     result.warnings.insert(result.warnings.end(), cgal.warnings.begin(), cgal.warnings.end());
-    refineOnly(cgal.refinePoints, cgal.refineOnly, refined, materials, h, progress, CgalShare, result.mesh);
+    refineOnly(
+      cgal.refinePoints, cgal.refineOnly, refined, materials, h, progress, CgalShare, result.mesh);
   }
   else
   {
@@ -490,7 +497,8 @@ double edgeLengthForPatchCount(double area, std::size_t patches)
   return std::sqrt(4.0 * area * RemeshedPerEquilateral / (std::sqrt(3.0) * count));
 }
 
-RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress)
+RemeshResult remesh(
+  const PolygonSoup& soup, const RemeshOptions& options, const RemeshProgress& progress)
 {
   const auto start = std::chrono::steady_clock::now();
   validateOptions(options);
@@ -537,7 +545,8 @@ RemeshResult remesh(const PolygonSoup& soup, const RemeshOptions& options, const
   if (result.mesh.triangles.empty())
   {
     throw Error("the scene has no surface left after merging duplicate points (" +
-      std::to_string(stats.removedTriangles) + " triangles became degenerate or duplicates): "
+      std::to_string(stats.removedTriangles) +
+      " triangles became degenerate or duplicates): "
       "give at least one triangle with an area");
   }
   stats.patches = result.mesh.triangles.size();

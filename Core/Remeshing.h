@@ -39,8 +39,8 @@ struct RemeshOptions
 struct RemeshStatistics
 {
   std::size_t inputPolygons = 0;
-  std::size_t inputTriangles = 0; ///< after triangulating the polygons
-  std::size_t droppedPolygons = 0; ///< fewer than 3 points, duplicate, zero area or self-crossing
+  std::size_t inputTriangles = 0;   ///< after triangulating the polygons
+  std::size_t droppedPolygons = 0;  ///< fewer than 3 points, duplicate, zero area or self-crossing
   std::size_t removedTriangles = 0; ///< degenerate or duplicate once duplicate points merged
   /// Connected faces of one material and orientation, bounded by sharp edges (CGAL only).
   std::size_t regions = 0;
@@ -53,10 +53,10 @@ struct RemeshStatistics
   double coveredArea = 0;
   std::size_t patches = 0;
   double targetEdgeLength = 0; ///< the h actually used
-  double inputArea = 0;  ///< of the triangulated polygons that were kept
-  double outputArea = 0; ///< of the patches
-  double seconds = 0;    ///< wall-clock time of remesh(); callers copy it to secondsRemeshing
-  double secondsContacts = 0; ///< of which finding contacts, splitting and dropping covered pieces
+  double inputArea = 0;        ///< of the triangulated polygons that were kept
+  double outputArea = 0;       ///< of the patches
+  double seconds = 0;          ///< wall-clock time of remesh(); callers copy it to secondsRemeshing
+  double secondsContacts = 0;  ///< of which finding contacts, splitting and dropping covered pieces
 };
 
 struct RemeshResult

@@ -20,7 +20,8 @@ struct Rotation
   /// The matrix as rows of numbers, for code that holds rotations as arrays.
   std::array<std::array<double, 3>, 3> rows() const
   {
-    return { { { row0.x, row0.y, row0.z }, { row1.x, row1.y, row1.z }, { row2.x, row2.y, row2.z } } };
+    return { { { row0.x, row0.y, row0.z }, { row1.x, row1.y, row1.z },
+      { row2.x, row2.y, row2.z } } };
   }
 
   bool isIdentity() const
@@ -28,7 +29,10 @@ struct Rotation
     return row0 == Vec3(1, 0, 0) && row1 == Vec3(0, 1, 0) && row2 == Vec3(0, 0, 1);
   }
 
-  bool isFinite() const { return mlr::isFinite(row0) && mlr::isFinite(row1) && mlr::isFinite(row2); }
+  bool isFinite() const
+  {
+    return mlr::isFinite(row0) && mlr::isFinite(row1) && mlr::isFinite(row2);
+  }
 
   /// The rotation of the unit quaternion (w, x, y, z); the caller normalises it.
   static Rotation fromQuaternion(double w, double x, double y, double z)

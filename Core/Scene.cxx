@@ -28,7 +28,8 @@ void checkScenePoints(const std::vector<Vec3>& points)
   }
   if (nonFinite > 0)
   {
-    throw Error("the scene has " + std::to_string(nonFinite) + (nonFinite == 1 ? " point" : " points") +
+    throw Error("the scene has " + std::to_string(nonFinite) +
+      (nonFinite == 1 ? " point" : " points") +
       " with NaN or infinite coordinates: remove or fix them");
   }
   for (const Vec3& p : points)
@@ -142,7 +143,8 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
   // Split 1:4 at edge midpoints, sharing a midpoint between the patches of an edge.
   std::unordered_map<std::uint64_t, std::uint32_t> midpointOfEdge;
   midpointOfEdge.reserve(patches * 2);
-  auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
+  auto midpoint = [&](std::uint32_t a, std::uint32_t b)
+  {
     const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
     auto found = midpointOfEdge.find(key);
     if (found != midpointOfEdge.end())
@@ -166,8 +168,8 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
            Triangle{ ab, bc, ca } })
     {
       scene.ElementTriangles.push_back(e);
-      scene.ElementAreas.push_back(
-        0.5 * length(triangleAreaVector(scene.Points[e[0]], scene.Points[e[1]], scene.Points[e[2]])));
+      scene.ElementAreas.push_back(0.5 *
+        length(triangleAreaVector(scene.Points[e[0]], scene.Points[e[1]], scene.Points[e[2]])));
     }
   }
   return scene;

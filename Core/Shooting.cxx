@@ -49,7 +49,8 @@ public:
     , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions(), 0x1.0p-50,
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
     , PatchPower(workers, copyPerWorker, scene.patchCount(), source.positions(),
-        { quantumFor(source.power().r), quantumFor(source.power().g), quantumFor(source.power().b) },
+        { quantumFor(source.power().r), quantumFor(source.power().g),
+          quantumFor(source.power().b) },
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
     , Counters(static_cast<std::size_t>(workers))
     , Scratch(static_cast<std::size_t>(workers))
@@ -86,10 +87,10 @@ public:
   /// holds exactly the serial sums, whatever rank and worker traced each path.
   void sumAcrossRanks(double& secondsReducing)
   {
-    mlr::sumAcrossRanks(this->Options, this->ElementShare.collapse(), this->ElementShare.copySize(),
-      secondsReducing);
-    mlr::sumAcrossRanks(this->Options, this->PatchPower.collapse(), this->PatchPower.copySize(),
-      secondsReducing);
+    mlr::sumAcrossRanks(
+      this->Options, this->ElementShare.collapse(), this->ElementShare.copySize(), secondsReducing);
+    mlr::sumAcrossRanks(
+      this->Options, this->PatchPower.collapse(), this->PatchPower.copySize(), secondsReducing);
   }
 
   /// Which active position path `path` of a reuse solve starts from.
@@ -100,7 +101,8 @@ public:
     const std::uint64_t base = this->Options.pathsPerFrame / n;
     const std::uint64_t extra = this->Options.pathsPerFrame % n;
     const std::uint64_t firstBlock = extra * (base + 1);
-    const std::uint64_t index = path < firstBlock ? path / (base + 1) : extra + (path - firstBlock) / base;
+    const std::uint64_t index =
+      path < firstBlock ? path / (base + 1) : extra + (path - firstBlock) / base;
     return active[static_cast<std::size_t>(index)];
   }
 
@@ -171,7 +173,8 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
   std::int64_t* pendingSlots = nullptr;
   Rgb pendingPower;
-  auto scorePending = [&] {
+  auto scorePending = [&]
+  {
     if (pendingSlots)
     {
       for (std::size_t f = 0; f < frameCount; ++f)
@@ -190,7 +193,8 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
     const Vec3 direction = sampleCosineDirection(normal, random);
     ++counters.shootingRays;
     RayHit next;
-    const bool found = this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next);
+    const bool found =
+      this->Tracer.intersect(this->Tracer.liftOff(hit.point, normal), direction, next);
     scorePending();
     if (!found)
     {
@@ -224,7 +228,8 @@ inline void ShootingRun::prefetchFirstHit(
   const RayHit& hit, std::size_t firstFrame, std::size_t frameCount, int worker)
 {
   this->ElementShare.prefetch(
-    this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame, frameCount);
+    this->ElementShare.slots(worker, hit.element, static_cast<int>(hit.side)), firstFrame,
+    frameCount);
 }
 
 /// Starts a walk from the source at `position` and traces its first ray. False when the walk
@@ -319,8 +324,8 @@ void ShootingRun::addTo(Solution& solution) const
   auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
   for (std::size_t e = 0; e < elements; ++e)
   {
-    const Rgb exitance =
-      this->SceneRef.elementReflectance(e) * this->SourceRef.power() / this->SceneRef.elementArea(e);
+    const Rgb exitance = this->SceneRef.elementReflectance(e) * this->SourceRef.power() /
+      this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
       for (std::size_t f = 0; f < frames; ++f)
@@ -347,14 +352,16 @@ void ShootingRun::addTo(Solution& solution) const
         double power[3];
         this->PatchPower.total(p, s, k, power);
         double share = 0;
-        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
+             ++e)
         {
           double elementShare = 0;
           this->ElementShare.total(e, s, k, &elementShare);
           share += elementShare;
         }
         patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
-          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * this->SourceRef.factor(k) * inverseArea;
+          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * this->SourceRef.factor(k) *
+          inverseArea;
       }
     }
   }
@@ -387,8 +394,7 @@ double shootingCost(const LightSource& source, const SolverOptions& options)
 
 ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
   const RayTracer& tracer, int workers, bool copyPerWorker,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
-  Solution& solution)
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
 {
   ShootingRun run(scene, source, options, tracer, workers, copyPerWorker);
   const std::uint64_t paths = options.pathsPerFrame;
@@ -401,8 +407,10 @@ ShootingResult shoot(const Scene& scene, const LightSource& source, const Solver
   else if (run.reuses())
   {
     const std::uint64_t tasks = (paths + ReusedPathsPerTask - 1) / ReusedPathsPerTask;
-    runOnRanks(tasks, workers, options,
-      [&](std::size_t task, int worker) {
+    runOnRanks(
+      tasks, workers, options,
+      [&](std::size_t task, int worker)
+      {
         const std::uint64_t end = std::min<std::uint64_t>(paths, (task + 1) * ReusedPathsPerTask);
         for (std::uint64_t p = task * ReusedPathsPerTask; p < end; ++p)
         {
@@ -416,8 +424,10 @@ ShootingResult shoot(const Scene& scene, const LightSource& source, const Solver
   {
     const std::uint64_t tasksPerFrame = (paths + ClassicPathsPerTask - 1) / ClassicPathsPerTask;
     const std::uint64_t tasks = tasksPerFrame * positions.size();
-    runOnRanks(tasks, workers, options,
-      [&](std::size_t task, int worker) {
+    runOnRanks(
+      tasks, workers, options,
+      [&](std::size_t task, int worker)
+      {
         const std::size_t position = positions[task / tasksPerFrame];
         const std::uint64_t first = (task % tasksPerFrame) * ClassicPathsPerTask;
         const std::uint64_t end = std::min<std::uint64_t>(paths, first + ClassicPathsPerTask);

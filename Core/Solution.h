@@ -19,16 +19,16 @@ struct SolverStatistics
   std::uint64_t patches = 0;
   std::uint64_t elements = 0;
   std::uint64_t effectivePathsPerFrame = 0;
-  std::uint64_t pathsCast = 0;      ///< shooting paths actually traced, all frames
-  std::uint64_t shootingRays = 0;   ///< nearest-hit rays of the shooting walks
-  std::uint64_t shadowRays = 0;     ///< visibility rays for the reuse weights
+  std::uint64_t pathsCast = 0;         ///< shooting paths actually traced, all frames
+  std::uint64_t shootingRays = 0;      ///< nearest-hit rays of the shooting walks
+  std::uint64_t shadowRays = 0;        ///< visibility rays for the reuse weights
   std::uint64_t shadowRaysBlocked = 0; ///< of shadowRays, those an occluder stopped
   /// Walks whose first ray hit the scene (and, one-sided, a front face): with reuse, each
   /// asks for the visibility of every other position whose unoccluded kernel is not zero.
   std::uint64_t firstHits = 0;
-  std::uint64_t gatheringRays = 0;  ///< nearest-hit rays of the final gathering
-  std::uint64_t missedRays = 0;     ///< nearest-hit rays that hit nothing
-  std::uint64_t gatheringSides = 0; ///< element sides that gathered
+  std::uint64_t gatheringRays = 0;    ///< nearest-hit rays of the final gathering
+  std::uint64_t missedRays = 0;       ///< nearest-hit rays that hit nothing
+  std::uint64_t gatheringSides = 0;   ///< element sides that gathered
   std::uint64_t reachabilityRays = 0; ///< probes that decided which sides light can reach
   std::uint64_t reachableSides = 0;   ///< patch sides light can reach (the others stay dark)
   std::uint64_t sources = 0;          ///< lights shot: moving, static, directional, emitters
@@ -78,7 +78,8 @@ public:
   /// Zero until gathering has run.
   Rgb indirect(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Indirect.empty() ? Rgb() : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
+    return this->Indirect.empty() ? Rgb()
+                                  : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
   }
   /// Self-emission (W/m^2): the scene's emission on the front side, zero on the back.
   Rgb emitted(std::size_t element, Side side) const

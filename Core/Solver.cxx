@@ -3,8 +3,8 @@
 #include "Error.h"
 #include "Gathering.h"
 #include "Parallel.h"
-#include "Reachability.h"
 #include "RayTracer.h"
+#include "Reachability.h"
 #include "Shooting.h"
 
 #include <algorithm>
@@ -41,8 +41,7 @@ struct ProgressPlan
       total += this->shooting.back();
     }
     this->reachability = static_cast<double>(scene.patchCount() * 2 * ReachabilityProbesPerSide);
-    const double gathering = options.gatheringRatio *
-      static_cast<double>(options.pathsPerFrame) *
+    const double gathering = options.gatheringRatio * static_cast<double>(options.pathsPerFrame) *
       (options.reuseGathering ? 1.0 : static_cast<double>(frames));
     total += this->reachability + gathering;
     for (double& share : this->shooting)
@@ -63,10 +62,10 @@ void finish(const Scene& scene, const SolverOptions& options, std::size_t frames
   stats.patches = scene.patchCount();
   stats.elements = scene.elementCount();
   stats.effectivePathsPerFrame = options.pathsPerFrame;
-  stats.meanPathLength = stats.pathsCast > 0
-    ? 1.0 + (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) /
+  stats.meanPathLength = stats.pathsCast > 0 ? 1.0 +
+      (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) /
         options.firstBounceSurvival
-    : 0.0;
+                                             : 0.0;
   stats.memoryEstimateBytes = plan.peak;
   stats.accumulatorCopyPerWorker = plan.accumulatorCopyPerWorker;
   stats.firstHits = firstHits - backAbsorbed;
@@ -171,43 +170,47 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   std::optional<RayTracer> tracerStorage;
   Solution solution;
   double secondsReducing = 0;
-  agreeAcrossRanks(options, [&] {
-    validateOptions(options);
-    frames = frameCount(rig, scene.hasEmission());
-    workers = resolveThreadCount(options.threads);
-    emitters = sceneEmitters(scene);
-    sources = lightSources(scene, rig, emitters);
-    plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
-      frames, options, sources.size());
-    checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
-    for (const LightSource& source : sources)
+  agreeAcrossRanks(
+    options,
+    [&]
     {
-      checkPathsPerPosition(source, options);
-    }
-    shares.emplace(scene, sources, frames, options);
-    if (progress && !progress(0.0))
-    {
-      throw Cancelled();
-    }
-    tracerStorage.emplace(scene);
-    solution = Solution(frames, scene.elementCount(), scene.patchCount());
-    if (scene.hasEmission())
-    {
-      solution.emissionData().resize(scene.elementCount());
-      for (std::size_t e = 0; e < scene.elementCount(); ++e)
+      validateOptions(options);
+      frames = frameCount(rig, scene.hasEmission());
+      workers = resolveThreadCount(options.threads);
+      emitters = sceneEmitters(scene);
+      sources = lightSources(scene, rig, emitters);
+      plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
+        frames, options, sources.size());
+      checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
+      for (const LightSource& source : sources)
       {
-        solution.emissionData()[e] = scene.elementEmission(e);
+        checkPathsPerPosition(source, options);
       }
-    }
-  }, &secondsReducing);
+      shares.emplace(scene, sources, frames, options);
+      if (progress && !progress(0.0))
+      {
+        throw Cancelled();
+      }
+      tracerStorage.emplace(scene);
+      solution = Solution(frames, scene.elementCount(), scene.patchCount());
+      if (scene.hasEmission())
+      {
+        solution.emissionData().resize(scene.elementCount());
+        for (std::size_t e = 0; e < scene.elementCount(); ++e)
+        {
+          solution.emissionData()[e] = scene.elementEmission(e);
+        }
+      }
+    },
+    &secondsReducing);
   const RayTracer& tracer = *tracerStorage;
   double progressBase = 0;
-  auto phaseTick = [&](double share) {
+  auto phaseTick = [&](double share)
+  {
     const double base = progressBase;
     progressBase += share;
-    return [&progress, base, share](double fraction) {
-      return !progress || progress(base + share * fraction);
-    };
+    return [&progress, base, share](double fraction)
+    { return !progress || progress(base + share * fraction); };
   };
   SolverStatistics& stats = solution.statistics;
   stats.secondsSetup = secondsSince(start);
@@ -235,11 +238,16 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     // Deterministic and cheap: every rank probes every side.
     std::vector<std::uint8_t> reachable;
     const auto reachabilityTick = phaseTick(shares->reachability);
-    agreeAcrossRanks(options, [&] {
-      reachable = reachableSides(
-        scene, tracer, sources, options, workers, reachabilityTick, stats.reachabilityRays);
-    }, &secondsReducing);
-    stats.reachableSides = static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
+    agreeAcrossRanks(
+      options,
+      [&]
+      {
+        reachable = reachableSides(
+          scene, tracer, sources, options, workers, reachabilityTick, stats.reachabilityRays);
+      },
+      &secondsReducing);
+    stats.reachableSides =
+      static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
     const GatheringResult gathered = gatherIndirect(scene, tracer, options, reachable, workers,
       phaseTick(1.0 - progressBase), secondsReducing, solution);
     stats.gatheringSides = gathered.sides;

@@ -24,8 +24,8 @@ namespace mlr
 {
 
 /// Paper eq. (4): predicted speed-up of full reuse over classic, in ray casts.
-double predictedSpeedup(std::size_t frames, double gatheringRatio, double lambda,
-  double meanPathLength);
+double predictedSpeedup(
+  std::size_t frames, double gatheringRatio, double lambda, double meanPathLength);
 
 /// Receives the fraction done in [0, 1]; return false to cancel the solve.
 using ProgressCallback = std::function<bool(double fraction)>;

@@ -68,9 +68,9 @@ enum class OptionRole
 template <typename Visitor>
 void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
-  const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting,
-    reuseGathering, twoSided, seed, threads, memoryLimitBytes, rank, ranks, sumAcrossRanks,
-    sumDoublesAcrossRanks] = options;
+  const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, reuseGathering,
+    twoSided, seed, threads, memoryLimitBytes, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks] =
+    options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);

@@ -106,7 +106,8 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
 
   std::vector<SunPosition> path;
   const double step = r.stepMinutes / 60.0;
-  const auto frames = static_cast<long long>(std::floor((r.endHour - r.startHour) / step + 1e-9)) + 1;
+  const auto frames =
+    static_cast<long long>(std::floor((r.endHour - r.startHour) / step + 1e-9)) + 1;
   for (long long i = 0; i < frames; ++i)
   {
     SunPosition p;

@@ -96,7 +96,8 @@ public:
   }
 
   /// An optional integer member; `fallback` when absent.
-  std::int64_t integer(const Json& object, const char* key, const std::string& where, std::int64_t fallback = -1) const
+  std::int64_t integer(
+    const Json& object, const char* key, const std::string& where, std::int64_t fallback = -1) const
   {
     const auto found = object.find(key);
     if (found == object.end())
@@ -111,10 +112,12 @@ public:
   }
 
   /// An optional index into the top-level array `into`; -1 when absent.
-  std::int64_t index(const Json& object, const char* key, const char* into, const std::string& where) const
+  std::int64_t index(
+    const Json& object, const char* key, const char* into, const std::string& where) const
   {
     const std::int64_t value = this->integer(object, key, where);
-    if (object.contains(key) && (value < 0 || value >= static_cast<std::int64_t>(this->array(into).size())))
+    if (object.contains(key) &&
+      (value < 0 || value >= static_cast<std::int64_t>(this->array(into).size())))
     {
       this->fail(where + "." + key + " = " + std::to_string(value) + " but the file has " +
         std::to_string(this->array(into).size()) + " " + into);
@@ -134,8 +137,8 @@ public:
   void run(bool glb, std::int64_t binBytes)
   {
     const auto asset = this->Root.find("asset");
-    const std::string version = asset != this->Root.end() && asset->is_object() && asset->contains("version") &&
-        (*asset)["version"].is_string()
+    const std::string version = asset != this->Root.end() && asset->is_object() &&
+        asset->contains("version") && (*asset)["version"].is_string()
       ? (*asset)["version"].get<std::string>()
       : std::string();
     if (version.rfind("2.", 0) != 0)
@@ -147,10 +150,12 @@ public:
     // here (or the emission strength, which is read); geometry compression is not supported.
     for (const auto& required : this->array("extensionsRequired"))
     {
-      const std::string name = required.is_string() ? required.get<std::string>() : std::string("?");
+      const std::string name =
+        required.is_string() ? required.get<std::string>() : std::string("?");
       if (name.rfind("KHR_materials_", 0) != 0 && name != "KHR_texture_transform")
       {
-        this->fail("it requires the extension " + printable(name) + ", which this reader does not support");
+        this->fail(
+          "it requires the extension " + printable(name) + ", which this reader does not support");
       }
     }
     // Buffers and their views.
@@ -174,8 +179,9 @@ public:
         }
         if (binBytes < length)
         {
-          this->fail(where + ".byteLength is " + std::to_string(length) + " but the BIN chunk holds " +
-            std::to_string(std::max<std::int64_t>(0, binBytes)) + " bytes");
+          this->fail(where + ".byteLength is " + std::to_string(length) +
+            " but the BIN chunk holds " + std::to_string(std::max<std::int64_t>(0, binBytes)) +
+            " bytes");
         }
       }
       else if (!uri->is_string())
@@ -196,11 +202,12 @@ public:
       const std::int64_t offset = this->integer(view, "byteOffset", where, 0);
       const std::int64_t length = this->integer(view, "byteLength", where);
       const std::int64_t stride = this->integer(view, "byteStride", where, 0);
-      if (offset < 0 || length < 0 || offset + length > this->BufferBytes[static_cast<std::size_t>(buffer)])
+      if (offset < 0 || length < 0 ||
+        offset + length > this->BufferBytes[static_cast<std::size_t>(buffer)])
       {
-        this->fail(where + " (bytes " + std::to_string(offset) + " to " + std::to_string(offset + length) +
-          ") does not fit in buffer " + std::to_string(buffer) + " (" +
-          std::to_string(this->BufferBytes[static_cast<std::size_t>(buffer)]) + " bytes)");
+        this->fail(where + " (bytes " + std::to_string(offset) + " to " +
+          std::to_string(offset + length) + ") does not fit in buffer " + std::to_string(buffer) +
+          " (" + std::to_string(this->BufferBytes[static_cast<std::size_t>(buffer)]) + " bytes)");
       }
       if (view.contains("byteStride") && (stride < 4 || stride > 252))
       {
@@ -221,10 +228,12 @@ public:
       {
         this->fail(where + " has no bufferView: accessors without data are not supported");
       }
-      const Json& view = views[static_cast<std::size_t>(this->index(accessor, "bufferView", "bufferViews", where))];
+      const Json& view =
+        views[static_cast<std::size_t>(this->index(accessor, "bufferView", "bufferViews", where))];
       const std::int64_t bytes = componentBytes(this->integer(accessor, "componentType", where, 0));
       const auto type = accessor.find("type");
-      const std::int64_t components = type != accessor.end() && type->is_string() ? typeComponents(*type) : 0;
+      const std::int64_t components =
+        type != accessor.end() && type->is_string() ? typeComponents(*type) : 0;
       const std::int64_t count = this->integer(accessor, "count", where, 0);
       const std::int64_t offset = this->integer(accessor, "byteOffset", where, 0);
       if (bytes == 0 || components == 0 || count < 1 || offset < 0)
@@ -237,9 +246,9 @@ public:
       const std::int64_t available = view["byteLength"].get<std::int64_t>();
       if (count > INT32_MAX / stride || end > available)
       {
-        this->fail(where + " (" + std::to_string(count) + " elements of " + std::to_string(element) +
-          " bytes from byte " + std::to_string(offset) + ") does not fit in its bufferView (" +
-          std::to_string(available) + " bytes)");
+        this->fail(where + " (" + std::to_string(count) + " elements of " +
+          std::to_string(element) + " bytes from byte " + std::to_string(offset) +
+          ") does not fit in its bufferView (" + std::to_string(available) + " bytes)");
       }
       this->AccessorType.push_back(*type);
       this->AccessorComponent.push_back(this->integer(accessor, "componentType", where, 0));
@@ -259,15 +268,18 @@ public:
         const std::string where = mesh + ".primitives[" + std::to_string(p) + "]";
         const Json& primitive = this->object(*primitives, p, where);
         const auto attributes = primitive.find("attributes");
-        if (attributes == primitive.end() || !attributes->is_object() || !attributes->contains("POSITION"))
+        if (attributes == primitive.end() || !attributes->is_object() ||
+          !attributes->contains("POSITION"))
         {
           this->fail(where + " has no POSITION attribute");
         }
         for (const auto& attribute : attributes->items())
         {
-          const std::int64_t a = this->index(*attributes, attribute.key().c_str(), "accessors", where + ".attributes");
+          const std::int64_t a =
+            this->index(*attributes, attribute.key().c_str(), "accessors", where + ".attributes");
           if (attribute.key() == "POSITION" &&
-            (this->AccessorType[static_cast<std::size_t>(a)] != "VEC3" || this->AccessorComponent[static_cast<std::size_t>(a)] != 5126))
+            (this->AccessorType[static_cast<std::size_t>(a)] != "VEC3" ||
+              this->AccessorComponent[static_cast<std::size_t>(a)] != 5126))
           {
             this->fail(where + ".attributes.POSITION is not a VEC3 of floats");
           }
@@ -285,7 +297,8 @@ public:
         const std::int64_t mode = this->integer(primitive, "mode", where, 4);
         if (mode < 0 || mode > 6)
         {
-          this->fail(where + ".mode = " + std::to_string(mode) + " is not a glTF primitive mode (0 to 6)");
+          this->fail(
+            where + ".mode = " + std::to_string(mode) + " is not a glTF primitive mode (0 to 6)");
         }
         const auto targets = primitive.find("targets");
         if (targets != primitive.end())
@@ -314,7 +327,8 @@ public:
     {
       const std::string where = "materials[" + std::to_string(i) + "]";
       const Json& material = this->object(materials, i, where);
-      auto textureOf = [&](const Json& holder, const char* key, const std::string& at) {
+      auto textureOf = [&](const Json& holder, const char* key, const std::string& at)
+      {
         const auto info = holder.find(key);
         if (info != holder.end())
         {
@@ -351,7 +365,8 @@ public:
       if (this->index(image, "bufferView", "bufferViews", where) >= 0)
       {
         const auto mime = image.find("mimeType");
-        if (mime == image.end() || !mime->is_string() || (*mime != "image/png" && *mime != "image/jpeg"))
+        if (mime == image.end() || !mime->is_string() ||
+          (*mime != "image/png" && *mime != "image/jpeg"))
         {
           this->fail(where + " is in a bufferView but its mimeType is not image/png or image/jpeg");
         }
@@ -390,7 +405,8 @@ public:
         auto& childParent = parent[child.get<std::size_t>()];
         if (childParent >= 0 || child.get<std::size_t>() == i)
         {
-          this->fail("node " + std::to_string(child.get<std::int64_t>()) + " has two parents or is its own child");
+          this->fail("node " + std::to_string(child.get<std::int64_t>()) +
+            " has two parents or is its own child");
         }
         childParent = static_cast<std::int64_t>(i);
       }
@@ -475,7 +491,8 @@ public:
       }
       for (const auto& channel : *channels)
       {
-        const std::int64_t sampler = channel.is_object() ? this->integer(channel, "sampler", where, -1) : -1;
+        const std::int64_t sampler =
+          channel.is_object() ? this->integer(channel, "sampler", where, -1) : -1;
         if (sampler < 0 || sampler >= static_cast<std::int64_t>(samplers->size()))
         {
           this->fail(where + " has a channel without a valid sampler");
@@ -513,9 +530,8 @@ Json readGltfJson(const std::string& path, bool glb, std::string& bin, std::int6
   std::ifstream in = openFile(path, "glTF file");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   binBytes = -1;
-  auto fail = [&](const std::string& problem) {
-    throw FileError("the glTF file " + named(path) + " " + problem);
-  };
+  auto fail = [&](const std::string& problem)
+  { throw FileError("the glTF file " + named(path) + " " + problem); };
   if (glb)
   {
     const auto* bytes = reinterpret_cast<const unsigned char*>(text.data());
@@ -629,7 +645,8 @@ std::string uriPath(const std::string& uri)
   std::string path;
   for (std::size_t i = 0; i < uri.size(); ++i)
   {
-    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+    if (uri[i] == '%' && i + 2 < uri.size() &&
+      std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
       std::isxdigit(static_cast<unsigned char>(uri[i + 2])))
     {
       path += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
@@ -653,7 +670,8 @@ double component(const char* at, bool normalized)
   {
     return static_cast<double>(value);
   }
-  return std::max(static_cast<double>(value) / static_cast<double>(std::numeric_limits<T>::max()), -1.0);
+  return std::max(
+    static_cast<double>(value) / static_cast<double>(std::numeric_limits<T>::max()), -1.0);
 }
 
 /// A glTF document whose indices and sizes GltfChecks has checked: buffers loaded, accessors
@@ -677,7 +695,8 @@ public:
       }
       else
       {
-        bytes = this->resource(buffers[i]["uri"].get<std::string>(), "buffers[" + std::to_string(i) + "]");
+        bytes = this->resource(
+          buffers[i]["uri"].get<std::string>(), "buffers[" + std::to_string(i) + "]");
       }
       if (bytes.size() < length)
       {
@@ -745,9 +764,11 @@ public:
     const std::size_t bytes = static_cast<std::size_t>(componentBytes(type));
     components = static_cast<std::size_t>(typeComponents(accessor["type"].get<std::string>()));
     const std::size_t count = accessor["count"].get<std::size_t>();
-    const std::size_t stride = std::max<std::size_t>(view.value("byteStride", std::size_t(0)), bytes * components);
+    const std::size_t stride =
+      std::max<std::size_t>(view.value("byteStride", std::size_t(0)), bytes * components);
     const std::string& buffer = this->Buffers[view["buffer"].get<std::size_t>()];
-    const std::size_t start = view.value("byteOffset", std::size_t(0)) + accessor.value("byteOffset", std::size_t(0));
+    const std::size_t start =
+      view.value("byteOffset", std::size_t(0)) + accessor.value("byteOffset", std::size_t(0));
     const bool normalized = accessor.value("normalized", false);
     std::vector<double> values(count * components);
     for (std::size_t e = 0; e < count; ++e)
@@ -784,7 +805,8 @@ public:
 
   /// The mean linear colour of texture `texture` (sRGB-encoded, as base colour and emissive
   /// textures are); (1, 1, 1) with a warning when its image cannot be decoded.
-  std::array<double, 3> textureMean(std::size_t texture, const std::string& what, const Warn& warn) const
+  std::array<double, 3> textureMean(
+    std::size_t texture, const std::string& what, const Warn& warn) const
   {
     const Json& entry = this->Root["textures"][texture];
     std::string problem;
@@ -820,7 +842,8 @@ public:
   {
     const Json& node = this->Root["nodes"][index];
     const std::string where = "nodes[" + std::to_string(index) + "]";
-    auto numbers = [&](const char* key, std::size_t size, std::vector<double> fallback) {
+    auto numbers = [&](const char* key, std::size_t size, std::vector<double> fallback)
+    {
       const auto found = node.find(key);
       if (found == node.end())
       {
@@ -943,7 +966,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   if (surfaces == 0)
   {
     throw FileError("the glTF file " + named(path) + " has no triangles" +
-      (others > 0 ? " (only points or lines: " + std::to_string(others) + " primitives)" : std::string()) +
+      (others > 0 ? " (only points or lines: " + std::to_string(others) + " primitives)"
+                  : std::string()) +
       ": there is no surface to light");
   }
   poll(0.1);
@@ -955,7 +979,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   const Json& scenes = checks.array("scenes");
   if (!scenes.empty())
   {
-    const std::size_t scene = static_cast<std::size_t>(std::max<std::int64_t>(0, checks.integer(root, "scene", "the file", 0)));
+    const std::size_t scene = static_cast<std::size_t>(
+      std::max<std::int64_t>(0, checks.integer(root, "scene", "the file", 0)));
     for (const auto& node : scenes[scene].value("nodes", Json::array()))
     {
       roots.push_back(node.get<std::int64_t>());
@@ -998,7 +1023,9 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   {
     const auto [nodeIndex, parent] = stack.back();
     stack.pop_back();
-    poll(0.3 + 0.6 * static_cast<double>(visited++) / static_cast<double>(std::max<std::size_t>(1, nodes.size())));
+    poll(0.3 +
+      0.6 * static_cast<double>(visited++) /
+        static_cast<double>(std::max<std::size_t>(1, nodes.size())));
     const Json& node = nodes[nodeIndex];
     const std::array<double, 16> matrix = multiply(parent, document.localTransform(nodeIndex));
     const Json children = node.value("children", Json::array());
@@ -1021,7 +1048,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       }
       const Json& attributes = primitive["attributes"];
       std::size_t components = 0;
-      const std::vector<double> positions = document.accessor(attributes["POSITION"].get<std::size_t>(), components);
+      const std::vector<double> positions =
+        document.accessor(attributes["POSITION"].get<std::size_t>(), components);
       const std::size_t vertexCount = positions.size() / 3;
       std::vector<std::size_t> indices;
       if (primitive.contains("indices"))
@@ -1053,8 +1081,9 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         }
         else if (mode == 5) // strip: every other triangle turns the other way
         {
-          triangles.push_back(i % 2 == 0 ? std::array<std::size_t, 3>{ { indices[i], indices[i + 1], indices[i + 2] } }
-                                         : std::array<std::size_t, 3>{ { indices[i + 1], indices[i], indices[i + 2] } });
+          triangles.push_back(i % 2 == 0
+              ? std::array<std::size_t, 3>{ { indices[i], indices[i + 1], indices[i + 2] } }
+              : std::array<std::size_t, 3>{ { indices[i + 1], indices[i], indices[i + 2] } });
         }
         else // fan
         {
@@ -1096,14 +1125,16 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         }
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
         {
-          document.fail("meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
+          document.fail(
+            "meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
         }
         scene.points->InsertNextPoint(p);
       }
       for (const auto& triangle : triangles)
       {
         const vtkIdType ids[3] = { offset + static_cast<vtkIdType>(triangle[0]),
-          offset + static_cast<vtkIdType>(triangle[1]), offset + static_cast<vtkIdType>(triangle[2]) };
+          offset + static_cast<vtkIdType>(triangle[1]),
+          offset + static_cast<vtkIdType>(triangle[2]) };
         scene.polygons->InsertNextCell(3, ids);
         scene.materialOfCell.push_back(material);
         std::array<double, 3> mean{ { 1, 1, 1 } };
@@ -1112,8 +1143,10 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
           anyColour = true;
           for (std::size_t c = 0; c < 3; ++c)
           {
-            mean[c] = (colours[triangle[0] * colourComponents + c] + colours[triangle[1] * colourComponents + c] +
-                        colours[triangle[2] * colourComponents + c]) / 3.0;
+            mean[c] = (colours[triangle[0] * colourComponents + c] +
+                        colours[triangle[1] * colourComponents + c] +
+                        colours[triangle[2] * colourComponents + c]) /
+              3.0;
           }
         }
         vertexColourOfCell.push_back(mean);
@@ -1123,7 +1156,9 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   if (scene.polygons->GetNumberOfCells() == 0)
   {
     throw FileError("the glTF file " + named(path) + " has no triangles in its scene" +
-      (skippedPrimitives > 0 ? " (only points or lines: " + std::to_string(skippedPrimitives) + " primitives)" : std::string()) +
+      (skippedPrimitives > 0
+          ? " (only points or lines: " + std::to_string(skippedPrimitives) + " primitives)"
+          : std::string()) +
       ": there is no surface to light");
   }
   if (skippedPrimitives > 0)
@@ -1136,7 +1171,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
     // Morph targets, skins and animations move vertices; the rest pose is what is read.
     if (!checks.array("skins").empty() || !checks.array("animations").empty())
     {
-      warn("the glTF file " + named(path) + " has skins or animations: the meshes are read in their rest pose");
+      warn("the glTF file " + named(path) +
+        " has skins or animations: the meshes are read in their rest pose");
     }
   }
 
@@ -1163,10 +1199,12 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         : "material_" + std::to_string(gltfIndex);
       const std::string what = "the glTF material " + named(material.name) + " of " + named(path);
       const Json pbr = source.value("pbrMetallicRoughness", Json::object());
-      std::array<double, 3> base = colourFactor(pbr, "baseColorFactor", 4, 1.0, where + ".pbrMetallicRoughness", failMaterial);
+      std::array<double, 3> base =
+        colourFactor(pbr, "baseColorFactor", 4, 1.0, where + ".pbrMetallicRoughness", failMaterial);
       if (pbr.contains("baseColorTexture"))
       {
-        const auto mean = document.textureMean(pbr["baseColorTexture"]["index"].get<std::size_t>(), what, warn);
+        const auto mean =
+          document.textureMean(pbr["baseColorTexture"]["index"].get<std::size_t>(), what, warn);
         for (std::size_t c = 0; c < 3; ++c)
         {
           base[c] *= mean[c];
@@ -1174,13 +1212,16 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       }
       material.reflectance = checkedReflectance(base, what, warn);
       double strength = 1.0;
-      const Json extension = source.value("extensions", Json::object()).value("KHR_materials_emissive_strength", Json::object());
+      const Json extension = source.value("extensions", Json::object())
+                               .value("KHR_materials_emissive_strength", Json::object());
       if (extension.contains("emissiveStrength"))
       {
         const Json& value = extension["emissiveStrength"];
         if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0)
         {
-          document.fail(where + ".extensions.KHR_materials_emissive_strength.emissiveStrength must be a number, 0 or more");
+          document.fail(where +
+            ".extensions.KHR_materials_emissive_strength.emissiveStrength must be a number, 0 or "
+            "more");
         }
         strength = value.get<double>();
       }
@@ -1189,9 +1230,11 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       {
         value *= strength;
       }
-      if (source.contains("emissiveTexture") && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
+      if (source.contains("emissiveTexture") &&
+        material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
       {
-        const auto mean = document.textureMean(source["emissiveTexture"]["index"].get<std::size_t>(), what, warn);
+        const auto mean =
+          document.textureMean(source["emissiveTexture"]["index"].get<std::size_t>(), what, warn);
         for (std::size_t c = 0; c < 3; ++c)
         {
           material.radiance[c] *= mean[c];
@@ -1212,7 +1255,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
     scene.cellReflectance.resize(vertexColourOfCell.size());
     for (std::size_t cell = 0; cell < vertexColourOfCell.size(); ++cell)
     {
-      const auto& base = scene.materials[static_cast<std::size_t>(scene.materialOfCell[cell])].reflectance;
+      const auto& base =
+        scene.materials[static_cast<std::size_t>(scene.materialOfCell[cell])].reflectance;
       for (std::size_t c = 0; c < 3; ++c)
       {
         const double value = std::max(0.0, base[c] * vertexColourOfCell[cell][c]);

@@ -67,8 +67,8 @@ double autoExposure(const Solution& solution)
         continue;
       }
       const double bin = std::floor((std::log2(l) - LowestEV) * StepsPerEV);
-      const auto index = static_cast<std::size_t>(
-        std::clamp(bin, 0.0, static_cast<double>(histogram.size() - 1)));
+      const auto index =
+        static_cast<std::size_t>(std::clamp(bin, 0.0, static_cast<double>(histogram.size() - 1)));
       ++histogram[index];
     }
   }
@@ -107,7 +107,8 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
   // elements share an edge through that point and meet smoothly there.
   std::vector<std::size_t> parent(corners);
   std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&parent](std::size_t c) {
+  auto find = [&parent](std::size_t c)
+  {
     while (parent[c] != c)
     {
       parent[c] = parent[parent[c]];
@@ -115,7 +116,8 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
     }
     return c;
   };
-  auto join = [&](std::size_t a, std::size_t b) {
+  auto join = [&](std::size_t a, std::size_t b)
+  {
     a = find(a);
     b = find(b);
     if (a != b)
@@ -130,7 +132,8 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
     litNormals[e] = scene.elementSideNormal(e, solution.litSide(e));
   }
   const double cosFeature = std::cos(FeatureAngle * M_PI / 180.0);
-  auto smooth = [&](std::size_t a, std::size_t b) {
+  auto smooth = [&](std::size_t a, std::size_t b)
+  {
     return scene.elementReflectance(a) == scene.elementReflectance(b) &&
       dot(litNormals[a], litNormals[b]) >= cosFeature;
   };
@@ -158,8 +161,8 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
       uses.push_back({ key, a, b });
     }
   }
-  std::sort(uses.begin(), uses.end(),
-    [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
+  std::sort(
+    uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
   for (std::size_t first = 0; first < uses.size();)
   {
     std::size_t last = first + 1;

@@ -8,13 +8,13 @@
 #include "vtkCellArrayIterator.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkFieldData.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
-#include "vtkFieldData.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,8 +28,8 @@ namespace
 {
 /// Calls visit(cellId, pointIds) for every polygon of `data`, then for every triangle of its
 /// strips, with the cell ids vtkPolyData gives them (vertices, lines, polygons, strips).
-void forEachSurfaceCell(vtkPolyData* data,
-  const std::function<void(vtkIdType, const std::vector<std::uint32_t>&)>& visit)
+void forEachSurfaceCell(
+  vtkPolyData* data, const std::function<void(vtkIdType, const std::vector<std::uint32_t>&)>& visit)
 {
   vtkIdType cellId = data->GetNumberOfVerts() + data->GetNumberOfLines();
   std::vector<std::uint32_t> ids;
@@ -82,7 +82,8 @@ std::vector<Vec3> pointsOf(vtkPointSet* data)
 /// The Scene's cell array `name` (numeric, 1 or 3 components), or nullptr when absent.
 vtkDataArray* colourArray(vtkPolyData* scene, const std::string& name, const char* values)
 {
-  vtkAbstractArray* array = name.empty() ? nullptr : scene->GetCellData()->GetAbstractArray(name.c_str());
+  vtkAbstractArray* array =
+    name.empty() ? nullptr : scene->GetCellData()->GetAbstractArray(name.c_str());
   if (!array)
   {
     return nullptr;
@@ -114,8 +115,8 @@ Rgb colourOfCell(vtkDataArray* array, vtkIdType cellId)
   {
     return Rgb(array->GetComponent(cellId, 0));
   }
-  return Rgb(array->GetComponent(cellId, 0), array->GetComponent(cellId, 1),
-    array->GetComponent(cellId, 2));
+  return Rgb(
+    array->GetComponent(cellId, 0), array->GetComponent(cellId, 1), array->GetComponent(cellId, 2));
 }
 
 Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& name)
@@ -177,7 +178,8 @@ vtkDataArray* pointArray(vtkPointSet* data, const char* name, int components, in
 vtkDataArray* materialIdArray(vtkPolyData* scene)
 {
   auto* ids = vtkDataArray::SafeDownCast(scene->GetCellData()->GetAbstractArray("MaterialId"));
-  if (!ids || ids->GetNumberOfComponents() != 1 || ids->GetNumberOfTuples() < scene->GetNumberOfCells())
+  if (!ids || ids->GetNumberOfComponents() != 1 ||
+    ids->GetNumberOfTuples() < scene->GetNumberOfCells())
   {
     return nullptr;
   }
@@ -193,7 +195,8 @@ vtkDataArray* lightIdArray(vtkPolyData* light)
     return nullptr;
   }
   auto* ids = vtkDataArray::SafeDownCast(array);
-  if (!ids || ids->GetNumberOfComponents() != 1 || ids->GetNumberOfTuples() < light->GetNumberOfCells())
+  if (!ids || ids->GetNumberOfComponents() != 1 ||
+    ids->GetNumberOfTuples() < light->GetNumberOfCells())
   {
     throw Error("the Light's cell array LightId must be numeric with one integer per cell: fix "
                 "it or remove it to make every polygon one light");
@@ -251,8 +254,8 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   const vtkIdType ignored = scene->GetNumberOfVerts() + scene->GetNumberOfLines();
   if (ignored > 0)
   {
-    warnings.push_back("ignored " + std::to_string(scene->GetNumberOfVerts()) +
-      " vertices and " + std::to_string(scene->GetNumberOfLines()) +
+    warnings.push_back("ignored " + std::to_string(scene->GetNumberOfVerts()) + " vertices and " +
+      std::to_string(scene->GetNumberOfLines()) +
       " lines of the Scene: only polygons and triangle strips are surfaces");
   }
   if (scene->GetNumberOfPolys() + scene->GetNumberOfStrips() == 0)
@@ -265,29 +268,32 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   if (!reflectance)
   {
     std::ostringstream s;
-    s << "the Scene has no cell array " << (reflectanceName.empty() ? "for reflectance" : reflectanceName)
+    s << "the Scene has no cell array "
+      << (reflectanceName.empty() ? "for reflectance" : reflectanceName)
       << ": every surface is grey " << Material{}.reflectance.g;
     warnings.push_back(s.str());
   }
   soup.points = pointsOf(scene);
   vtkDataArray* materialIds = skipMaterial >= 0 ? materialIdArray(scene) : nullptr;
-  forEachSurfaceCell(scene, [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids) {
-    if (materialIds && materialIds->GetComponent(cellId, 0) == skipMaterial)
+  forEachSurfaceCell(scene,
+    [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids)
     {
-      return;
-    }
-    soup.polygons.push_back(ids);
-    Material material;
-    if (reflectance)
-    {
-      material.reflectance = reflectanceOfCell(reflectance, cellId, reflectanceName);
-    }
-    if (emission)
-    {
-      material.emission = emissionOfCell(emission, cellId, emissionName);
-    }
-    soup.materials.push_back(material);
-  });
+      if (materialIds && materialIds->GetComponent(cellId, 0) == skipMaterial)
+      {
+        return;
+      }
+      soup.polygons.push_back(ids);
+      Material material;
+      if (reflectance)
+      {
+        material.reflectance = reflectanceOfCell(reflectance, cellId, reflectanceName);
+      }
+      if (emission)
+      {
+        material.emission = emissionOfCell(emission, cellId, emissionName);
+      }
+      soup.materials.push_back(material);
+    });
   return soup;
 }
 
@@ -302,7 +308,8 @@ MaterialLight materialLight(
   {
     throw Error("the Scene has no materials (field data MaterialNames and cell array "
                 "MaterialId, as the radiosity scene reader gives for OBJ+MTL, glTF and PLY "
-                "files), so no light can be taken from its material '" + material + "'");
+                "files), so no light can be taken from its material '" +
+      material + "'");
   }
   MaterialLight result;
   std::string found;
@@ -322,31 +329,36 @@ MaterialLight materialLight(
   vtkDataArray* emission = colourArray(scene, emissionName, "in W/m^2, >= 0");
   const std::vector<Vec3> points = pointsOf(scene);
   Rgb power;
-  forEachSurfaceCell(scene, [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds) {
-    if (ids->GetComponent(cellId, 0) != result.materialId)
+  forEachSurfaceCell(scene,
+    [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds)
     {
-      return;
-    }
-    std::vector<Vec3> polygon;
-    for (std::uint32_t id : pointIds)
-    {
-      if (id >= points.size())
+      if (ids->GetComponent(cellId, 0) != result.materialId)
       {
-        throw Error("a Scene polygon uses point " + std::to_string(id) + " but the Scene has " +
-          std::to_string(points.size()) + " points: fix its connectivity");
+        return;
       }
-      polygon.push_back(points[id]);
-    }
-    if (emission)
-    {
-      power += emissionOfCell(emission, cellId, emissionName) * (0.5 * length(newellNormal(polygon)));
-    }
-    result.light.polygons.push_back(std::move(polygon));
-  });
+      std::vector<Vec3> polygon;
+      for (std::uint32_t id : pointIds)
+      {
+        if (id >= points.size())
+        {
+          throw Error("a Scene polygon uses point " + std::to_string(id) + " but the Scene has " +
+            std::to_string(points.size()) + " points: fix its connectivity");
+        }
+        polygon.push_back(points[id]);
+      }
+      if (emission)
+      {
+        power +=
+          emissionOfCell(emission, cellId, emissionName) * (0.5 * length(newellNormal(polygon)));
+      }
+      result.light.polygons.push_back(std::move(polygon));
+    });
   if (result.light.polygons.empty())
   {
-    throw Error("the Scene's material '" + material + "' has no polygon: choose a material "
-      "with surfaces (its materials are " + found + ")");
+    throw Error("the Scene's material '" + material +
+      "' has no polygon: choose a material "
+      "with surfaces (its materials are " +
+      found + ")");
   }
   if (power.maxComponent() > 0)
   {
@@ -370,7 +382,8 @@ std::vector<LightInput> lightInputs(vtkPolyData* light)
     return lights;
   }
   vtkDataArray* ids = lightIdArray(light);
-  const std::vector<long long> distinct = ids ? distinctLightIds(light, ids) : std::vector<long long>{ 0 };
+  const std::vector<long long> distinct =
+    ids ? distinctLightIds(light, ids) : std::vector<long long>{ 0 };
   lights.resize(distinct.size());
   vtkDataArray* power = nullptr;
   if (vtkAbstractArray* array = light->GetCellData()->GetAbstractArray("LightPower"))
@@ -384,43 +397,47 @@ std::vector<LightInput> lightInputs(vtkPolyData* light)
     }
   }
   const std::vector<Vec3> points = pointsOf(light);
-  forEachSurfaceCell(light, [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds) {
-    std::vector<Vec3> polygon;
-    polygon.reserve(pointIds.size());
-    for (std::uint32_t id : pointIds)
+  forEachSurfaceCell(light,
+    [&](vtkIdType cellId, const std::vector<std::uint32_t>& pointIds)
     {
-      if (id >= points.size())
+      std::vector<Vec3> polygon;
+      polygon.reserve(pointIds.size());
+      for (std::uint32_t id : pointIds)
       {
-        throw Error("a Light polygon uses point " + std::to_string(id) + " but the Light has " +
-          std::to_string(points.size()) + " points: fix its connectivity");
+        if (id >= points.size())
+        {
+          throw Error("a Light polygon uses point " + std::to_string(id) + " but the Light has " +
+            std::to_string(points.size()) + " points: fix its connectivity");
+        }
+        polygon.push_back(points[id]);
       }
-      polygon.push_back(points[id]);
-    }
-    const std::size_t which = ids
-      ? static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(),
-                                   static_cast<long long>(ids->GetComponent(cellId, 0))) -
-          distinct.begin())
-      : 0;
-    LightInput& target = lights[which];
-    target.polygons.push_back(std::move(polygon));
-    if (power)
-    {
-      const Rgb p = colourOfCell(power, cellId);
-      if (target.hasPower && p != target.power)
+      const std::size_t which = ids
+        ? static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(),
+                                     static_cast<long long>(ids->GetComponent(cellId, 0))) -
+            distinct.begin())
+        : 0;
+      LightInput& target = lights[which];
+      target.polygons.push_back(std::move(polygon));
+      if (power)
       {
-        throw Error("the Light's cell array LightPower differs between the polygons of light " +
-          std::to_string(distinct[which]) + ": give every polygon of a light the same power");
+        const Rgb p = colourOfCell(power, cellId);
+        if (target.hasPower && p != target.power)
+        {
+          throw Error("the Light's cell array LightPower differs between the polygons of light " +
+            std::to_string(distinct[which]) + ": give every polygon of a light the same power");
+        }
+        target.power = p;
+        target.hasPower = true;
       }
-      target.power = p;
-      target.hasPower = true;
-    }
-  });
+    });
   for (std::size_t i = 0; i < lights.size(); ++i)
   {
     if (lights[i].polygons.empty())
     {
-      throw Error((ids ? "light " + std::to_string(distinct[i]) + " of the Light" : std::string("the light")) +
-        " has no polygon (only vertices or lines): give at least one polygon with 3 or more points");
+      throw Error((ids ? "light " + std::to_string(distinct[i]) + " of the Light"
+                       : std::string("the light")) +
+        " has no polygon (only vertices or lines): give at least one polygon with 3 or more "
+        "points");
     }
   }
   return lights;
@@ -445,7 +462,8 @@ std::vector<PoseInput> poseInputsOf(vtkPointSet* trajectory, const std::vector<v
     if (normal)
     {
       in.hasNormal = true;
-      in.normal = { normal->GetComponent(id, 0), normal->GetComponent(id, 1), normal->GetComponent(id, 2) };
+      in.normal = { normal->GetComponent(id, 0), normal->GetComponent(id, 1),
+        normal->GetComponent(id, 2) };
     }
     if (orientation)
     {
@@ -463,8 +481,8 @@ std::vector<PoseInput> poseInputsOf(vtkPointSet* trajectory, const std::vector<v
       if (!in.power.isFinite() || in.power.minComponent() < 0)
       {
         std::ostringstream s;
-        s << "the Trajectory's point array Power has (" << in.power.r << ", " << in.power.g
-          << ", " << in.power.b << ") at point " << id
+        s << "the Trajectory's point array Power has (" << in.power.r << ", " << in.power.g << ", "
+          << in.power.b << ") at point " << id
           << ": a power factor must be finite and >= 0 (0 turns the light off)";
         throw Error(s.str());
       }
@@ -539,8 +557,11 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
     const vtkIdType lines = poly ? poly->GetNumberOfLines() : 0;
     if (static_cast<std::size_t>(lines) != lights)
     {
-      throw Error("the Light holds " + std::to_string(lights) + " lights (LightId) but the "
-        "Trajectory has " + std::to_string(lines) + " polylines: give one polyline per light, "
+      throw Error("the Light holds " + std::to_string(lights) +
+        " lights (LightId) but the "
+        "Trajectory has " +
+        std::to_string(lines) +
+        " polylines: give one polyline per light, "
         "in LightId order (a single point for a light that does not move)");
     }
     auto it = vtkSmartPointer<vtkCellArrayIterator>::Take(poly->GetLines()->NewIterator());

@@ -35,8 +35,8 @@ vtkSmartPointer<vtkPolyData> triangleMesh(
     vtkPoints->SetPoint(static_cast<vtkIdType>(i), points[i].x, points[i].y, points[i].z);
   }
   vtkNew<vtkCellArray> cells;
-  cells->AllocateExact(static_cast<vtkIdType>(triangles.size()),
-    static_cast<vtkIdType>(3 * triangles.size()));
+  cells->AllocateExact(
+    static_cast<vtkIdType>(triangles.size()), static_cast<vtkIdType>(3 * triangles.size()));
   for (const Triangle& t : triangles)
   {
     const vtkIdType ids[3] = { t[0], t[1], t[2] };
@@ -153,12 +153,10 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   const SolverStatistics& statistics, const SolverOptions& options)
 {
   auto fieldData = vtkSmartPointer<vtkFieldData>::New();
-  auto count = [&](const char* name, std::uint64_t value) {
-    addValue<vtkIdTypeArray>(fieldData, name, static_cast<vtkIdType>(value));
-  };
-  auto real = [&](const char* name, double value) {
-    addValue<vtkDoubleArray>(fieldData, name, value);
-  };
+  auto count = [&](const char* name, std::uint64_t value)
+  { addValue<vtkIdTypeArray>(fieldData, name, static_cast<vtkIdType>(value)); };
+  auto real = [&](const char* name, double value)
+  { addValue<vtkDoubleArray>(fieldData, name, value); };
   count("Frames", statistics.frames);
   count("Patches", statistics.patches);
   count("Elements", statistics.elements);
@@ -175,7 +173,8 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   // The cost that limits users: bytes per element and frame (MemoryPlan).
   real("MemoryEstimateBytesPerElementFrame",
     static_cast<double>(statistics.memoryEstimateBytes) /
-      std::max(1.0, static_cast<double>(statistics.elements) * static_cast<double>(statistics.frames)));
+      std::max(
+        1.0, static_cast<double>(statistics.elements) * static_cast<double>(statistics.frames)));
   count("AccumulatorCopyPerWorker", statistics.accumulatorCopyPerWorker ? 1 : 0);
   count("ReuseShooting", statistics.reuseShooting ? 1 : 0);
   count("ReuseGathering", statistics.reuseGathering ? 1 : 0);
@@ -216,11 +215,12 @@ void addFrameFieldData(vtkFieldData* fieldData, std::size_t frame, const Vec3& l
   addValue<vtkIdTypeArray>(fieldData, "SolveCount", static_cast<vtkIdType>(solveCount));
 }
 
-vtkSmartPointer<vtkPolyData> posedLight(const std::vector<std::vector<Vec3>>& polygons,
-  const LightTransform& transform, const Rgb& power)
+vtkSmartPointer<vtkPolyData> posedLight(
+  const std::vector<std::vector<Vec3>>& polygons, const LightTransform& transform, const Rgb& power)
 {
   const auto& r = transform.rotation;
-  auto pose = [&](const Vec3& x) {
+  auto pose = [&](const Vec3& x)
+  {
     return Vec3(r[0][0] * x.x + r[0][1] * x.y + r[0][2] * x.z,
              r[1][0] * x.x + r[1][1] * x.y + r[1][2] * x.z,
              r[2][0] * x.x + r[2][1] * x.y + r[2][2] * x.z) +

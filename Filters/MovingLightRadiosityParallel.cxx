@@ -89,8 +89,8 @@ vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
         if (difference.empty() && (it == found.end() || it->second != components))
         {
           difference = "cell array '" + name + "' (" + std::to_string(components) +
-            " components) is on rank " + std::to_string(pieceRanks.front()) + "'s piece but not on rank " +
-            std::to_string(pieceRanks[p]) + "'s";
+            " components) is on rank " + std::to_string(pieceRanks.front()) +
+            "'s piece but not on rank " + std::to_string(pieceRanks[p]) + "'s";
         }
       }
       for (const auto& [name, components] : found)
@@ -99,8 +99,8 @@ vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
         if (difference.empty() && (it == expected.end() || it->second != components))
         {
           difference = "cell array '" + name + "' (" + std::to_string(components) +
-            " components) is on rank " + std::to_string(pieceRanks[p]) + "'s piece but not on rank " +
-            std::to_string(pieceRanks.front()) + "'s";
+            " components) is on rank " + std::to_string(pieceRanks[p]) +
+            "'s piece but not on rank " + std::to_string(pieceRanks.front()) + "'s";
         }
       }
       throw Error("the " + port + " arrives in pieces over the ranks that disagree: the " +
@@ -139,7 +139,8 @@ vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
   }
   // Cells of one id on several ranks must be one cell (a ghost copy): ids that are only
   // local (0, 1, ... on every rank) name different cells, and then rank order is used.
-  auto sameCell = [&](const Cell& a, const Cell& b) {
+  auto sameCell = [&](const Cell& a, const Cell& b)
+  {
     vtkPolyData* pa = pieces[a.piece];
     vtkPolyData* pb = pieces[b.piece];
     if (a.piece == b.piece || pa->GetCellSize(a.id) != pb->GetCellSize(b.id))
@@ -164,7 +165,8 @@ vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
   if (byIds)
   {
     std::vector<Cell> sorted = cells;
-    std::stable_sort(sorted.begin(), sorted.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
+    std::stable_sort(
+      sorted.begin(), sorted.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
     bool global = true;
     for (std::size_t i = 1; i < sorted.size() && global; ++i)
     {
@@ -183,8 +185,10 @@ vtkSmartPointer<vtkPolyData> joinPieces(const std::vector<vtkPolyData*>& pieces,
   vtkNew<vtkPoints> points;
   points->SetDataType(pieces.front()->GetPoints()->GetDataType());
   joined->SetPoints(points);
-  joined->AllocateExact(static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 4);
-  joined->GetCellData()->CopyAllocate(pieces.front()->GetCellData(), static_cast<vtkIdType>(cells.size()));
+  joined->AllocateExact(
+    static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 4);
+  joined->GetCellData()->CopyAllocate(
+    pieces.front()->GetCellData(), static_cast<vtkIdType>(cells.size()));
   joined->GetPointData()->CopyAllocate(pieces.front()->GetPointData());
   joined->GetFieldData()->ShallowCopy(pieces.front()->GetFieldData());
   // Points at equal coordinates are one point, as they were before the split.
@@ -281,11 +285,13 @@ vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controlle
       continue;
     }
     vtkNew<vtkCharArray> buffer;
-    buffer->SetArray(all.data() + offsets[static_cast<std::size_t>(r)], lengths[static_cast<std::size_t>(r)], 1);
+    buffer->SetArray(
+      all.data() + offsets[static_cast<std::size_t>(r)], lengths[static_cast<std::size_t>(r)], 1);
     vtkSmartPointer<vtkDataObject> decoded = vtkCommunicator::UnMarshalDataObject(buffer);
     if (!decoded)
     {
-      throw Error("the " + port + " piece of rank " + std::to_string(r) + " could not be read back");
+      throw Error(
+        "the " + port + " piece of rank " + std::to_string(r) + " could not be read back");
     }
     pieces.push_back(decoded);
     pieceRanks.push_back(r);
@@ -304,7 +310,8 @@ vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controlle
   {
     if (cellRanks)
     {
-      cellRanks->assign(static_cast<std::size_t>(pieces.front()->GetNumberOfElements(vtkDataObject::CELL)),
+      cellRanks->assign(
+        static_cast<std::size_t>(pieces.front()->GetNumberOfElements(vtkDataObject::CELL)),
         pieceRanks.front());
     }
     return pieces.front();
@@ -330,27 +337,31 @@ void shareSolve(vtkMultiProcessController* controller, SolverOptions& options)
 {
   options.rank = controller->GetLocalProcessId();
   options.ranks = controller->GetNumberOfProcesses();
-  options.sumAcrossRanks = [controller](std::int64_t* values, std::size_t count) {
+  options.sumAcrossRanks = [controller](std::int64_t* values, std::size_t count)
+  {
     std::vector<long long> send, receive;
     for (std::size_t first = 0; first < count; first += Chunk)
     {
       const std::size_t n = std::min(Chunk, count - first);
       send.assign(values + first, values + first + n);
       receive.resize(n);
-      if (!controller->AllReduce(send.data(), receive.data(), static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
+      if (!controller->AllReduce(
+            send.data(), receive.data(), static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
       {
         throw Error("the sum over ranks failed");
       }
       std::copy(receive.begin(), receive.end(), values + first);
     }
   };
-  options.sumDoublesAcrossRanks = [controller](double* values, std::size_t count) {
+  options.sumDoublesAcrossRanks = [controller](double* values, std::size_t count)
+  {
     std::vector<double> send;
     for (std::size_t first = 0; first < count; first += Chunk)
     {
       const std::size_t n = std::min(Chunk, count - first);
       send.assign(values + first, values + first + n);
-      if (!controller->AllReduce(send.data(), values + first, static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
+      if (!controller->AllReduce(
+            send.data(), values + first, static_cast<vtkIdType>(n), vtkCommunicator::SUM_OP))
       {
         throw Error("the sum over ranks failed");
       }
@@ -397,7 +408,8 @@ Verdict agree(vtkMultiProcessController* controller, bool failed, bool cancelled
   std::vector<char> text(static_cast<std::size_t>(std::max<vtkIdType>(total, 1)));
   std::vector<char> sent(own.begin(), own.end());
   sent.push_back('\0');
-  controller->AllGatherV(sent.data(), text.data(), static_cast<vtkIdType>(own.size()), counts.data(), offsets.data());
+  controller->AllGatherV(
+    sent.data(), text.data(), static_cast<vtkIdType>(own.size()), counts.data(), offsets.data());
   if (failed)
   {
     verdict.message = message;
@@ -460,7 +472,8 @@ vtkSmartPointer<vtkPolyData> extractCells(vtkPolyData* full, const std::vector<v
   out->GetFieldData()->ShallowCopy(full->GetFieldData());
   out->GetPointData()->CopyAllocate(full->GetPointData());
   out->GetCellData()->CopyAllocate(full->GetCellData(), static_cast<vtkIdType>(cells.size()));
-  out->AllocateExact(static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 3);
+  out->AllocateExact(
+    static_cast<vtkIdType>(cells.size()), static_cast<vtkIdType>(cells.size()) * 3);
   std::vector<vtkIdType> newId(static_cast<std::size_t>(full->GetNumberOfPoints()), -1);
   std::vector<vtkIdType> ids;
   vtkNew<vtkIdList> scratch;

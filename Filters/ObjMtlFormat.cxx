@@ -58,7 +58,10 @@ public:
   }
 
   std::size_t number() const { return this->Number; }
-  std::uintmax_t position() { return static_cast<std::uintmax_t>(std::max<std::streamoff>(0, this->In.tellg())); }
+  std::uintmax_t position()
+  {
+    return static_cast<std::uintmax_t>(std::max<std::streamoff>(0, this->In.tellg()));
+  }
 
 private:
   std::istream& In;
@@ -93,9 +96,9 @@ struct MtlMaterial
 std::string mtlMapFile(const std::string& rest, const std::filesystem::path& folder)
 {
   // Option -> how many values it takes; 0: one to three numbers (-o, -s, -t: u [v [w]]).
-  static const std::map<std::string, int> options = { { "-blendu", 1 }, { "-blendv", 1 }, { "-bm", 1 },
-    { "-boost", 1 }, { "-cc", 1 }, { "-clamp", 1 }, { "-imfchan", 1 }, { "-mm", 2 }, { "-o", 0 },
-    { "-s", 0 }, { "-t", 0 }, { "-texres", 1 }, { "-type", 1 } };
+  static const std::map<std::string, int> options = { { "-blendu", 1 }, { "-blendv", 1 },
+    { "-bm", 1 }, { "-boost", 1 }, { "-cc", 1 }, { "-clamp", 1 }, { "-imfchan", 1 }, { "-mm", 2 },
+    { "-o", 0 }, { "-s", 0 }, { "-t", 0 }, { "-texres", 1 }, { "-type", 1 } };
   std::vector<std::pair<std::size_t, std::size_t>> spans; // each word's start and length
   for (std::size_t at = rest.find_first_not_of(" \t"); at != std::string::npos;)
   {
@@ -116,8 +119,8 @@ std::string mtlMapFile(const std::string& rest, const std::filesystem::path& fol
     }
     ++i;
     double number = 0;
-    for (int taken = 0; i + 1 < spans.size() && (option->second == 0 ? taken < 3 && parseNumber(word(i), number)
-                                                                      : taken < option->second);
+    for (int taken = 0; i + 1 < spans.size() &&
+         (option->second == 0 ? taken < 3 && parseNumber(word(i), number) : taken < option->second);
          ++taken)
     {
       ++i;
@@ -155,7 +158,8 @@ bool parseMtlColour(const std::string& rest, std::array<double, 3>& rgb)
 }
 
 /// The materials of an MTL file by name; the first definition of a name wins.
-std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::string& objPath, const Warn& warn)
+std::map<std::string, MtlMaterial> readMtl(
+  const std::string& path, const std::string& objPath, const Warn& warn)
 {
   std::ifstream in = openFile(path, "material library");
   std::map<std::string, MtlMaterial> materials;
@@ -166,8 +170,8 @@ std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::s
   while (lines.next(line))
   {
     splitKeyword(line, keyword, rest);
-    const std::string where = "the material library " + named(path) + " of the OBJ file " + named(objPath) +
-      ", line " + std::to_string(lines.number());
+    const std::string where = "the material library " + named(path) + " of the OBJ file " +
+      named(objPath) + ", line " + std::to_string(lines.number());
     if (keyword == "newmtl")
     {
       if (rest.empty())
@@ -177,7 +181,8 @@ std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::s
       const bool known = materials.count(rest) != 0;
       if (known && repeated.insert(rest).second)
       {
-        warn(where + ": material " + named(rest) + " is defined again; its first definition is used");
+        warn(
+          where + ": material " + named(rest) + " is defined again; its first definition is used");
       }
       current = known ? nullptr : &materials[rest];
     }
@@ -198,11 +203,13 @@ std::map<std::string, MtlMaterial> readMtl(const std::string& path, const std::s
       {
         if (rest.rfind("spectral", 0) == 0 || rest.rfind("xyz", 0) == 0)
         {
-          warn(where + ": '" + keyword + " " + printable(rest) + "' (spectral or CIE XYZ colours) is not supported; " +
+          warn(where + ": '" + keyword + " " + printable(rest) +
+            "' (spectral or CIE XYZ colours) is not supported; " +
             (keyword == "Kd" ? "the material is grey" : "the material does not emit"));
           continue;
         }
-        throw FileError(where + ": '" + keyword + " " + printable(rest) + "' is not a colour (1 or 3 finite numbers)");
+        throw FileError(where + ": '" + keyword + " " + printable(rest) +
+          "' is not a colour (1 or 3 finite numbers)");
       }
       (keyword == "Kd" ? current->kd : current->ke) = rgb;
     }
@@ -241,16 +248,17 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
   ProgressPoll poll(progress, 0.0, 0.9);
 
   std::vector<double> coordinates;
-  std::vector<long long> faceVertices;      // resolved, 0-based, checked at the end
+  std::vector<long long> faceVertices; // resolved, 0-based, checked at the end
   std::vector<std::size_t> faceStart, faceLine;
   std::vector<int> faceMaterial;
-  std::vector<std::string> usedMaterials;   // in order of first use
+  std::vector<std::string> usedMaterials; // in order of first use
   std::map<std::string, int> materialIds;
   std::vector<std::pair<std::string, std::size_t>> libraries; // file, line of its mtllib
   int currentMaterial = -1;
   std::size_t skippedPoints = 0, skippedLines = 0;
 
-  auto materialId = [&](const std::string& name) {
+  auto materialId = [&](const std::string& name)
+  {
     const auto found = materialIds.find(name);
     if (found != materialIds.end())
     {
@@ -269,7 +277,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
       poll(static_cast<double>(lines.position()) / static_cast<double>(size));
     }
     splitKeyword(line, keyword, rest);
-    auto where = [&]() { return "the OBJ file " + named(path) + ", line " + std::to_string(lines.number()); };
+    auto where = [&]()
+    { return "the OBJ file " + named(path) + ", line " + std::to_string(lines.number()); };
     if (keyword == "v")
     {
       const auto parts = words(rest);
@@ -277,7 +286,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
       if (parts.size() < 3 || !parseNumber(parts[0], xyz[0]) || !parseNumber(parts[1], xyz[1]) ||
         !parseNumber(parts[2], xyz[2]))
       {
-        throw FileError(where() + ": 'v " + printable(rest) + "' is not a vertex (3 finite numbers x y z)");
+        throw FileError(
+          where() + ": 'v " + printable(rest) + "' is not a vertex (3 finite numbers x y z)");
       }
       coordinates.insert(coordinates.end(), xyz, xyz + 3);
     }
@@ -286,8 +296,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
       const auto references = words(rest);
       if (references.size() < 3)
       {
-        throw FileError(where() + ": a face needs at least 3 vertices, 'f " + printable(rest) + "' has " +
-          std::to_string(references.size()));
+        throw FileError(where() + ": a face needs at least 3 vertices, 'f " + printable(rest) +
+          "' has " + std::to_string(references.size()));
       }
       const long long defined = static_cast<long long>(coordinates.size() / 3);
       faceStart.push_back(faceVertices.size());
@@ -305,8 +315,9 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
         }
         if (index < 0 && -index > defined)
         {
-          throw FileError(where() + ": '" + printable(reference) + "' names vertex " + std::to_string(index) +
-            " but only " + std::to_string(defined) + " vertices are defined before it");
+          throw FileError(where() + ": '" + printable(reference) + "' names vertex " +
+            std::to_string(index) + " but only " + std::to_string(defined) +
+            " vertices are defined before it");
         }
         faceVertices.push_back(index < 0 ? defined + index : index - 1);
       }
@@ -350,7 +361,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
   }
   if (faceStart.empty())
   {
-    throw FileError("the OBJ file " + named(path) + " has no faces ('f' lines): there is no surface to light");
+    throw FileError(
+      "the OBJ file " + named(path) + " has no faces ('f' lines): there is no surface to light");
   }
   const long long vertexCount = static_cast<long long>(coordinates.size() / 3);
   for (std::size_t f = 0; f < faceStart.size(); ++f)
@@ -361,15 +373,16 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
       if (faceVertices[k] >= vertexCount)
       {
         throw FileError("the OBJ file " + named(path) + ", line " + std::to_string(faceLine[f]) +
-          ": a face names vertex " + std::to_string(faceVertices[k] + 1) + " but the file defines " +
-          std::to_string(vertexCount) + " ('v' lines)");
+          ": a face names vertex " + std::to_string(faceVertices[k] + 1) +
+          " but the file defines " + std::to_string(vertexCount) + " ('v' lines)");
       }
     }
   }
   if (skippedPoints + skippedLines > 0)
   {
-    warn("the OBJ file " + named(path) + " has " + std::to_string(skippedPoints) + " point ('p') and " +
-      std::to_string(skippedLines) + " line ('l') elements: they are skipped, only faces are surfaces");
+    warn("the OBJ file " + named(path) + " has " + std::to_string(skippedPoints) +
+      " point ('p') and " + std::to_string(skippedLines) +
+      " line ('l') elements: they are skipped, only faces are surfaces");
   }
 
   // Materials: Kd and Ke from the libraries.
@@ -381,8 +394,9 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     if (!std::filesystem::is_regular_file(file, error))
     {
       allLibrariesRead = false;
-      warn("the material library " + named(file) + " named by the OBJ file " + named(path) + " (line " +
-        std::to_string(lineNumber) + ") does not exist: its materials are grey 0.5 and do not emit");
+      warn("the material library " + named(file) + " named by the OBJ file " + named(path) +
+        " (line " + std::to_string(lineNumber) +
+        ") does not exist: its materials are grey 0.5 and do not emit");
       continue;
     }
     for (auto& [name, material] : readMtl(file, path, warn))
@@ -392,14 +406,16 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
   }
   if (libraries.empty())
   {
-    warn("the OBJ file " + named(path) + " names no material library ('mtllib' line): every surface is grey 0.5");
+    warn("the OBJ file " + named(path) +
+      " names no material library ('mtllib' line): every surface is grey 0.5");
   }
 
   // A map multiplies its colour by the texture's mean (each file decoded once); a texture that
   // cannot be used is a warning and the colour alone stays.
   std::map<std::string, std::pair<std::optional<std::array<double, 3>>, std::string>> textureMeans;
   auto applyMap = [&](const std::string& file, const char* keyword, const std::string& what,
-                    std::optional<std::array<double, 3>>& colour) {
+                    std::optional<std::array<double, 3>>& colour)
+  {
     auto found = textureMeans.find(file);
     if (found == textureMeans.end())
     {
@@ -414,8 +430,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     const auto& [mean, problem] = found->second;
     if (!mean)
     {
-      warn("the " + what + ": its " + keyword + " texture " + named(file) + ": " + problem + ", so " +
-        (keyword[5] == 'd' ? "Kd" : "Ke") + " alone is used");
+      warn("the " + what + ": its " + keyword + " texture " + named(file) + ": " + problem +
+        ", so " + (keyword[5] == 'd' ? "Kd" : "Ke") + " alone is used");
       return;
     }
     std::array<double, 3> product = colour.value_or(std::array<double, 3>{ { 1, 1, 1 } });
@@ -462,7 +478,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
         }
         // map_Ke scales an emission Ke gives (as glTF's emissive texture its factor): without
         // Ke, or with Ke 0, the material does not emit and the texture is not read.
-        if (!found->second.mapKe.empty() && material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
+        if (!found->second.mapKe.empty() &&
+          material.radiance != std::array<double, 3>{ { 0, 0, 0 } })
         {
           std::optional<std::array<double, 3>> ke = material.radiance;
           applyMap(found->second.mapKe, "map_Ke", what, ke);
@@ -476,7 +493,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     }
     else if (name == "none" && !libraries.empty())
     {
-      warn("the OBJ file " + named(path) + " has faces before any 'usemtl': their material 'none' is grey 0.5");
+      warn("the OBJ file " + named(path) +
+        " has faces before any 'usemtl': their material 'none' is grey 0.5");
     }
     scene.materials.push_back(material);
   }
@@ -489,7 +507,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
     scene.points->SetPoint(i, &coordinates[3 * i]);
   }
   scene.polygons = vtkSmartPointer<vtkCellArray>::New();
-  scene.polygons->AllocateExact(static_cast<vtkIdType>(faceStart.size()), static_cast<vtkIdType>(faceVertices.size()));
+  scene.polygons->AllocateExact(
+    static_cast<vtkIdType>(faceStart.size()), static_cast<vtkIdType>(faceVertices.size()));
   std::vector<vtkIdType> ids;
   for (std::size_t f = 0; f < faceStart.size(); ++f)
   {

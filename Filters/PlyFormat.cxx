@@ -99,8 +99,8 @@ public:
       }
       if (!parseNumber(word, value))
       {
-        throw FileError("the PLY file " + named(this->Path) + ": '" + printable(word) + "' (" + what +
-          ") is not a finite number");
+        throw FileError("the PLY file " + named(this->Path) + ": '" + printable(word) + "' (" +
+          what + ") is not a finite number");
       }
       return value;
     }
@@ -131,7 +131,8 @@ public:
     else if (plyIsSigned(type))
     {
       const std::uint64_t sign = std::uint64_t(1) << (8 * bytes - 1);
-      value = static_cast<double>(static_cast<std::int64_t>((bits ^ sign)) - static_cast<std::int64_t>(sign));
+      value = static_cast<double>(
+        static_cast<std::int64_t>((bits ^ sign)) - static_cast<std::int64_t>(sign));
     }
     else
     {
@@ -139,7 +140,8 @@ public:
     }
     if (!std::isfinite(value))
     {
-      throw FileError("the PLY file " + named(this->Path) + ": " + what + " is not a finite number");
+      throw FileError(
+        "the PLY file " + named(this->Path) + ": " + what + " is not a finite number");
     }
     return value;
   }
@@ -170,9 +172,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
 {
   std::ifstream in = openFile(path, "PLY file");
   ProgressPoll poll(progress, 0.0, 0.9);
-  auto fail = [&](const std::string& problem) {
-    throw FileError("the PLY file " + named(path) + " " + problem);
-  };
+  auto fail = [&](const std::string& problem)
+  { throw FileError("the PLY file " + named(path) + " " + problem); };
   std::string line;
   if (!std::getline(in, line) || trim(line) != "ply")
   {
@@ -195,12 +196,15 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
     }
     if (parts[0] == "format")
     {
-      if (parts.size() < 2 || (parts[1] != "ascii" && parts[1] != "binary_little_endian" && parts[1] != "binary_big_endian"))
+      if (parts.size() < 2 ||
+        (parts[1] != "ascii" && parts[1] != "binary_little_endian" &&
+          parts[1] != "binary_big_endian"))
       {
         fail("has an unknown format, " + where);
       }
-      format = parts[1] == "ascii" ? PlyFormat::Ascii
-                                   : (parts[1] == "binary_little_endian" ? PlyFormat::BinaryLittle : PlyFormat::BinaryBig);
+      format = parts[1] == "ascii"
+        ? PlyFormat::Ascii
+        : (parts[1] == "binary_little_endian" ? PlyFormat::BinaryLittle : PlyFormat::BinaryBig);
       hasFormat = true;
     }
     else if (parts[0] == "element")
@@ -219,7 +223,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
         fail("declares a property before any element, " + where);
       }
       PlyProperty property;
-      if (parts.size() == 5 && parts[1] == "list" && plyBytes(parts[2]) && plyBytes(parts[3]) && !plyIsFloat(parts[2]))
+      if (parts.size() == 5 && parts[1] == "list" && plyBytes(parts[2]) && plyBytes(parts[3]) &&
+        !plyIsFloat(parts[2]))
       {
         property = { parts[4], parts[3], true, parts[2] };
       }
@@ -263,11 +268,14 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
   {
     indexProperty = face->find("vertex_index");
   }
-  if (!face || face->count == 0 || indexProperty < 0 || !face->properties[static_cast<std::size_t>(indexProperty)].list)
+  if (!face || face->count == 0 || indexProperty < 0 ||
+    !face->properties[static_cast<std::size_t>(indexProperty)].list)
   {
-    fail("has no faces (an element 'face' with a list property vertex_indices): there is no surface to light");
+    fail("has no faces (an element 'face' with a list property vertex_indices): there is no "
+         "surface to light");
   }
-  auto colourOf = [](const PlyElement& element, std::array<int, 3>& rgb) {
+  auto colourOf = [](const PlyElement& element, std::array<int, 3>& rgb)
+  {
     for (const char* prefix : { "", "diffuse_" })
     {
       const std::string p = prefix;
@@ -322,7 +330,9 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
     {
       if (++rowsRead % 65536 == 0)
       {
-        poll(size > 0 ? static_cast<double>(std::max<std::streamoff>(0, in.tellg())) / static_cast<double>(size) : 0.0);
+        poll(size > 0 ? static_cast<double>(std::max<std::streamoff>(0, in.tellg())) /
+              static_cast<double>(size)
+                      : 0.0);
       }
       const std::string what = element.name + " " + std::to_string(e);
       row.assign(element.properties.size(), 0.0);
@@ -349,10 +359,11 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
           const double value = values.read(property.type, what + " " + property.name);
           if (indices)
           {
-            if (value < 0 || value >= static_cast<double>(scene.points->GetNumberOfPoints()) || value != std::floor(value))
+            if (value < 0 || value >= static_cast<double>(scene.points->GetNumberOfPoints()) ||
+              value != std::floor(value))
             {
-              fail("names vertex " + std::to_string(static_cast<long long>(value)) + " in " + what + " but has " +
-                std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
+              fail("names vertex " + std::to_string(static_cast<long long>(value)) + " in " + what +
+                " but has " + std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
             }
             ids.push_back(static_cast<vtkIdType>(value));
           }
@@ -361,7 +372,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
       if (isVertex)
       {
         scene.points->InsertNextPoint(row[static_cast<std::size_t>(vertex->find("x"))],
-          row[static_cast<std::size_t>(vertex->find("y"))], row[static_cast<std::size_t>(vertex->find("z"))]);
+          row[static_cast<std::size_t>(vertex->find("y"))],
+          row[static_cast<std::size_t>(vertex->find("z"))]);
         if (vertexColours)
         {
           std::array<double, 3> rgb{};
@@ -381,7 +393,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
           continue;
         }
         scene.polygons->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-        std::array<double, 3> rgb{ { FallbackReflectance, FallbackReflectance, FallbackReflectance } };
+        std::array<double, 3> rgb{ { FallbackReflectance, FallbackReflectance,
+          FallbackReflectance } };
         if (faceColours)
         {
           for (std::size_t c = 0; c < 3; ++c)
@@ -397,7 +410,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
           {
             for (std::size_t c = 0; c < 3; ++c)
             {
-              rgb[c] += vertexColour[static_cast<std::size_t>(id)][c] / static_cast<double>(ids.size());
+              rgb[c] +=
+                vertexColour[static_cast<std::size_t>(id)][c] / static_cast<double>(ids.size());
             }
           }
         }
@@ -418,7 +432,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
   const std::string stem = std::filesystem::path(path).stem().string();
   if (!faceColours && !vertexColours)
   {
-    warn("the PLY file " + named(path) + " has no red/green/blue colours: every surface is grey 0.5");
+    warn(
+      "the PLY file " + named(path) + " has no red/green/blue colours: every surface is grey 0.5");
   }
   // Colours of 255 (1.0) are common: clamp them with one warning for the file.
   std::size_t clamped = 0;

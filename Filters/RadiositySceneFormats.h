@@ -72,9 +72,9 @@ std::array<double, 3> checkedReflectance(
 /// Wavefront OBJ and the MTL files its mtllib lines name (relative to the OBJ's folder).
 /// Kd becomes the reflectance, Ke the radiance; map_Kd and map_Ke multiply them by the mean
 /// linear colour of their PNG or JPEG texture (map_Kd without Kd: the mean alone), and a
-/// texture that cannot be read or decoded is a warning. A missing MTL file or material falls back to
-/// grey FallbackReflectance with a warning naming it. Points (p) and lines (l) are skipped
-/// with a warning. FileError when the file cannot be read, is malformed, or has no faces.
+/// texture that cannot be read or decoded is a warning. A missing MTL file or material falls back
+/// to grey FallbackReflectance with a warning naming it. Points (p) and lines (l) are skipped with
+/// a warning. FileError when the file cannot be read, is malformed, or has no faces.
 Scene readObj(const std::string& path, const Warn& warn, const Progress& progress);
 
 /// glTF 2.0, .gltf (JSON, buffers embedded as data: URIs or in files beside it) or .glb, with

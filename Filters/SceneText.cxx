@@ -93,7 +93,8 @@ std::ifstream openFile(const std::string& path, const std::string& kind)
   std::ifstream in(path, std::ios::binary);
   if (!in)
   {
-    throw FileError("the " + kind + " " + named(path) + " cannot be opened: " + std::strerror(errno));
+    throw FileError(
+      "the " + kind + " " + named(path) + " cannot be opened: " + std::strerror(errno));
   }
   return in;
 }

@@ -48,7 +48,8 @@ public:
   }
   void operator()(double fraction)
   {
-    if (this->Callback && !this->Callback(this->From + (this->To - this->From) * std::clamp(fraction, 0.0, 1.0)))
+    if (this->Callback &&
+      !this->Callback(this->From + (this->To - this->From) * std::clamp(fraction, 0.0, 1.0)))
     {
       throw Aborted{};
     }

@@ -107,7 +107,8 @@ vtkSmartPointer<vtkImageData> decodePng(const std::string& bytes, std::string& p
 /// image it declares; 0 when no frame header is found (the reader then reports the damage).
 std::uint64_t jpegPixels(const std::string& bytes)
 {
-  auto byte = [&](std::size_t i) { return static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[i])); };
+  auto byte = [&](std::size_t i)
+  { return static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[i])); };
   std::size_t at = 2;
   while (at + 4 <= bytes.size() && byte(at) == 0xff)
   {
@@ -126,10 +127,13 @@ std::uint64_t jpegPixels(const std::string& bytes)
     {
       return 0; // end of image or scan data before any frame header
     }
-    const bool frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    const bool frame =
+      marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
     if (frame)
     {
-      return at + 9 <= bytes.size() ? ((byte(at + 5) << 8) | byte(at + 6)) * ((byte(at + 7) << 8) | byte(at + 8)) : 0;
+      return at + 9 <= bytes.size()
+        ? ((byte(at + 5) << 8) | byte(at + 6)) * ((byte(at + 7) << 8) | byte(at + 8))
+        : 0;
     }
     at += 2 + static_cast<std::size_t>((byte(at + 2) << 8) | byte(at + 3));
   }
@@ -217,7 +221,8 @@ bool readTextureFile(const std::filesystem::path& file, std::string& bytes, std:
   }
   if (!std::filesystem::is_regular_file(status))
   {
-    problem = std::filesystem::is_directory(status) ? "its file is a folder" : "its file is not a regular file";
+    problem = std::filesystem::is_directory(status) ? "its file is a folder"
+                                                    : "its file is not a regular file";
     return false;
   }
   const std::uintmax_t size = std::filesystem::file_size(file, error);

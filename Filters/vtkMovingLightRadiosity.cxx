@@ -1,7 +1,7 @@
 #include "vtkMovingLightRadiosity.h"
 
-#include "MovingLightRadiosityInputs.h"
 #include "MovingLightRadiosityDisplay.h"
+#include "MovingLightRadiosityInputs.h"
 #include "MovingLightRadiosityOutputs.h"
 #include "MovingLightRadiosityParallel.h"
 
@@ -14,8 +14,8 @@
 
 #include "vtkAppendPolyData.h"
 #include "vtkCellData.h"
-#include "vtkDoubleArray.h"
 #include "vtkDataObject.h"
+#include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
@@ -40,7 +40,6 @@
 
 static_assert(mlr::MaximumPathsPerFrame == 100000000000ULL,
   "keep the clamp of vtkMovingLightRadiosity::NumberOfPaths equal to Core's maximum");
-
 
 /// The last solve: every frame of the animation, kept until an input or a property changes.
 struct vtkMovingLightRadiosity::vtkInternals
@@ -182,22 +181,22 @@ mlr::vtkinputs::Trajectory trajectoryOf(
   {
     if (lights > 1)
     {
-      throw mlr::Error("the Light holds " + std::to_string(lights) + " lights (LightId): "
+      throw mlr::Error("the Light holds " + std::to_string(lights) +
+        " lights (LightId): "
         "connect a Trajectory with one polyline per light");
     }
     const double* start = self->GetPathStart();
     const double* end = self->GetPathEnd();
-    if (self->GetLightType() == vtkMovingLightRadiosity::AREA_LIGHT &&
-      !*self->GetLightMaterial() &&
+    if (self->GetLightType() == vtkMovingLightRadiosity::AREA_LIGHT && !*self->GetLightMaterial() &&
       self->GetNumberOfInputConnections(vtkMovingLightRadiosity::LIGHT_PORT) == 0)
     {
       // No light: the scene's own emissive surfaces light it, and nothing moves: one frame,
       // not NumberOfPositions copies of it.
-      return mlr::vtkinputs::straightTrajectory({ start[0], start[1], start[2] },
-        { start[0], start[1], start[2] }, 1);
+      return mlr::vtkinputs::straightTrajectory(
+        { start[0], start[1], start[2] }, { start[0], start[1], start[2] }, 1);
     }
-    return mlr::vtkinputs::straightTrajectory({ start[0], start[1], start[2] },
-      { end[0], end[1], end[2] }, self->GetNumberOfPositions());
+    return mlr::vtkinputs::straightTrajectory(
+      { start[0], start[1], start[2] }, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
   }
   return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0), lights);
 }
@@ -237,8 +236,9 @@ int vtkMovingLightRadiosity::RequestInformation(
   std::vector<double> times;
   try
   {
-    times = trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]))
-              .times;
+    times =
+      trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]))
+        .times;
   }
   catch (const mlr::Error& e)
   {
@@ -261,8 +261,8 @@ int vtkMovingLightRadiosity::RequestInformation(
       // Every rank must execute, whatever piece it asks for: the ranks solve together.
       outInfo->Set(vtkAlgorithm::CAN_HANDLE_PIECE_REQUEST(), 1);
     }
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(),
-      static_cast<int>(times.size()));
+    outInfo->Set(
+      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
   return 1;
@@ -461,9 +461,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         {
           continue; // an optional input not connected, on every rank alike
         }
-        wholeInputs[port] = mlr::vtkparallel::gatherPieces(controller,
-          vtkDataObject::GetData(inputVector[port], 0), names[port],
-          port == SCENE_PORT ? &cellRanks : nullptr);
+        wholeInputs[port] =
+          mlr::vtkparallel::gatherPieces(controller, vtkDataObject::GetData(inputVector[port], 0),
+            names[port], port == SCENE_PORT ? &cellRanks : nullptr);
         vtkNew<vtkInformation> info;
         info->Set(vtkDataObject::DATA_OBJECT(), wholeInputs[port]);
         gathered[port]->Append(info);
@@ -482,7 +482,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     mlr::vtkinputs::MaterialLight materialLight;
     if (fromMaterial)
     {
-      materialLight = mlr::vtkinputs::materialLight(sceneData, this->LightMaterial, this->EmissionArrayName);
+      materialLight =
+        mlr::vtkinputs::materialLight(sceneData, this->LightMaterial, this->EmissionArrayName);
     }
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
@@ -535,8 +536,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           // Core would blame a zero Normal, which the user never gave: name AimPoint.
           if (const std::optional<std::size_t> k = mlr::aimAt(inputs, aim))
           {
-            throw mlr::Error("light " + std::to_string(i) + " (in LightId order) is at "
-              "AimPoint in frame " + std::to_string(*k) + " and cannot face it: move "
+            throw mlr::Error("light " + std::to_string(i) +
+              " (in LightId order) is at "
+              "AimPoint in frame " +
+              std::to_string(*k) +
+              " and cannot face it: move "
               "AimPoint off the light's Trajectory, or turn AimAtPoint off");
           }
         }
@@ -565,8 +569,10 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     options.remeshing.targetEdgeLength = this->PatchSize;
     // The outputs' estimate is linear in the counts; per item, rounded up.
     constexpr std::size_t many = std::size_t(1) << 20;
-    options.outputBytesPerElement = (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many;
-    options.outputBytesPerPoint = (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
+    options.outputBytesPerElement =
+      (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many;
+    options.outputBytesPerPoint =
+      (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
     mlr::validateOptions(solverOptions);
     if (controller)
     {
@@ -592,7 +598,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     const bool reportsProgress = !controller || controller->GetLocalProcessId() == 0;
 
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
-      [this, reportsProgress](double fraction) {
+      [this, reportsProgress](double fraction)
+      {
         // Core reports progress on this thread, so the abort flag can be polled right here.
         // Rank 0 reports for all: the ranks advance together.
         if (reportsProgress)
@@ -652,7 +659,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         array->InsertNextValue(value);
         cache.Statistics->AddArray(array);
       }
-      const mlr::vtkparallel::Verdict verdict = mlr::vtkparallel::agree(controller, false, false, {});
+      const mlr::vtkparallel::Verdict verdict =
+        mlr::vtkparallel::agree(controller, false, false, {});
       stage = Stage::Agreed;
       if (verdict.failed)
       {
@@ -733,9 +741,11 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ReflectanceArrayName: " << this->ReflectanceArrayName << "\n";
   os << indent << "EmissionArrayName: " << this->EmissionArrayName << "\n";
   os << indent << "LightMaterial: " << this->LightMaterial << "\n";
-  os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off") << "\n";
+  os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off")
+     << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
-  os << indent << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
+  os << indent
+     << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
      << "\n";
 }

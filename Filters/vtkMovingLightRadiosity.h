@@ -70,9 +70,9 @@
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with
- * empty outputs and an error; the next update clears the flag and solves again. Bad input (NaN points, a wrong
- * `Reflectance`, a light without polygons, ...) gives an error naming what to fix and empty
- * outputs. An empty scene gives empty outputs and no error.
+ * empty outputs and an error; the next update clears the flag and solves again. Bad input (NaN
+ * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to fix
+ * and empty outputs. An empty scene gives empty outputs and no error.
  *
  * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
  * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
@@ -128,10 +128,7 @@ public:
    */
   void SetSceneConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(0, output); }
   void SetLightConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
-  void SetTrajectoryConnection(vtkAlgorithmOutput* output)
-  {
-    this->SetInputConnection(2, output);
-  }
+  void SetTrajectoryConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(2, output); }
   void SetSceneData(vtkDataObject* data) { this->SetInputData(0, data); }
   void SetLightData(vtkDataObject* data) { this->SetInputData(1, data); }
   void SetTrajectoryData(vtkDataObject* data) { this->SetInputData(2, data); }

@@ -85,7 +85,8 @@ int vtkRadiositySceneReader::RequestData(
 
   namespace sf = mlr::scenefile;
   const sf::Warn warn = [this](const std::string& message) { vtkWarningMacro(<< message); };
-  const sf::Progress progress = [this](double fraction) {
+  const sf::Progress progress = [this](double fraction)
+  {
     this->UpdateProgress(0.9 * fraction);
     return !this->CheckAbort();
   };

@@ -36,7 +36,8 @@ vtkSunPathSource::vtkSunPathSource()
 }
 
 //------------------------------------------------------------------------------
-int vtkSunPathSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkSunPathSource::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   output->Initialize();

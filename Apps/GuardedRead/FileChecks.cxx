@@ -140,7 +140,8 @@ void checkObjFile(const std::string& path, const std::string& what)
       std::ostringstream problem;
       if (parts.size() > 3 || parts[0].empty())
       {
-        problem << "'" << printable(reference) << "' is not a vertex reference (v, v/vt, v/vt/vn or v//vn)";
+        problem << "'" << printable(reference)
+                << "' is not a vertex reference (v, v/vt, v/vt/vn or v//vn)";
       }
       for (std::size_t k = 0; k < parts.size() && k < 3 && problem.str().empty(); ++k)
       {
@@ -199,8 +200,9 @@ void checkStlFile(const std::string& path, const std::string& what)
   const std::uint64_t size = static_cast<std::uint64_t>(in.tellg());
   if (size < 84)
   {
-    throw InputError(what + " is not an STL file: too short for a binary STL header (84 bytes) "
-                            "and not ASCII STL text starting with 'solid'");
+    throw InputError(what +
+      " is not an STL file: too short for a binary STL header (84 bytes) "
+      "and not ASCII STL text starting with 'solid'");
   }
   const std::uint64_t count = static_cast<std::uint8_t>(head[80]) |
     (static_cast<std::uint64_t>(static_cast<std::uint8_t>(head[81])) << 8) |
@@ -219,10 +221,10 @@ namespace
 /// Bytes of one value of a PLY scalar type, 0 for a name PLY does not know.
 int plySize(const std::string& type)
 {
-  static const std::pair<const char*, int> types[] = { { "char", 1 }, { "uchar", 1 },
-    { "int8", 1 }, { "uint8", 1 }, { "short", 2 }, { "ushort", 2 }, { "int16", 2 },
-    { "uint16", 2 }, { "int", 4 }, { "uint", 4 }, { "int32", 4 }, { "uint32", 4 },
-    { "float", 4 }, { "float32", 4 }, { "double", 8 }, { "float64", 8 } };
+  static const std::pair<const char*, int> types[] = { { "char", 1 }, { "uchar", 1 }, { "int8", 1 },
+    { "uint8", 1 }, { "short", 2 }, { "ushort", 2 }, { "int16", 2 }, { "uint16", 2 }, { "int", 4 },
+    { "uint", 4 }, { "int32", 4 }, { "uint32", 4 }, { "float", 4 }, { "float32", 4 },
+    { "double", 8 }, { "float64", 8 } };
   for (const auto& [name, size] : types)
   {
     if (type == name)
@@ -237,9 +239,8 @@ int plySize(const std::string& type)
 void checkPlyFile(const std::string& path, const std::string& what)
 {
   std::ifstream in(path, std::ios::binary);
-  auto fail = [&](const std::string& problem) {
-    throw InputError(what + " is not a PLY file VTK can read: " + problem);
-  };
+  auto fail = [&](const std::string& problem)
+  { throw InputError(what + " is not a PLY file VTK can read: " + problem); };
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0)
   {
@@ -342,7 +343,8 @@ void checkPlyFile(const std::string& path, const std::string& what)
   }
   for (const char* axis : { "x", "y", "z" })
   {
-    if (!vertex || std::find(vertex->scalars.begin(), vertex->scalars.end(), axis) == vertex->scalars.end())
+    if (!vertex ||
+      std::find(vertex->scalars.begin(), vertex->scalars.end(), axis) == vertex->scalars.end())
     {
       fail("no element 'vertex' with properties x, y and z");
     }
@@ -356,7 +358,8 @@ void checkPlyFile(const std::string& path, const std::string& what)
   for (const Element& e : elements)
   {
     needed = saturatingSum(needed,
-      saturatingProduct(e.count, format == "ascii" ? saturatingProduct(2, e.values) : e.fixedBytes));
+      saturatingProduct(
+        e.count, format == "ascii" ? saturatingProduct(2, e.values) : e.fixedBytes));
   }
   if (needed > saturatingSum(rest, 1))
   {

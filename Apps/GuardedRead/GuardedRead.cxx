@@ -190,7 +190,8 @@ vtkSmartPointer<vtkAlgorithm> makeReader(
   }
   else
   {
-    throw InputError(what + " has an unknown extension: give a .vtp .vtu .vtk .obj .ply or .stl file");
+    throw InputError(
+      what + " has an unknown extension: give a .vtp .vtu .vtk .obj .ply or .stl file");
   }
   return reader;
 }
@@ -271,8 +272,8 @@ ChildOutcome runGuarded(const std::function<int()>& work, std::uint64_t memoryBy
   Descriptor messages{ memoryFile("mlr-messages") };
   if (messages.fd < 0)
   {
-    throw InputError(std::string("cannot start a reading process: no memory file (") +
-      std::strerror(errno) + ")");
+    throw InputError(
+      std::string("cannot start a reading process: no memory file (") + std::strerror(errno) + ")");
   }
   std::cout.flush();
   std::cerr.flush();
@@ -297,7 +298,8 @@ ChildOutcome runGuarded(const std::function<int()>& work, std::uint64_t memoryBy
     byDefault.sa_handler = SIG_DFL;
     sigaction(SIGCHLD, &byDefault, nullptr);
   }
-  auto restoreSignals = [&] {
+  auto restoreSignals = [&]
+  {
     if (childIgnored)
     {
       sigaction(SIGCHLD, &previousChild, nullptr);
@@ -368,8 +370,8 @@ ChildOutcome runGuarded(const std::function<int()>& work, std::uint64_t memoryBy
 
   ChildOutcome outcome;
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point deadline =
-    Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wallSeconds));
+  const Clock::time_point deadline = Clock::now() +
+    std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wallSeconds));
   int status = 0;
   rusage usage = {};
   int interrupt = 0;
@@ -527,8 +529,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
   }
 
   // Readers need some room whatever the limit.
-  const std::uint64_t room =
-    std::max<std::uint64_t>(MemoryBudget(limits.memoryBytes).limitBytes(), std::uint64_t(256) << 20);
+  const std::uint64_t room = std::max<std::uint64_t>(
+    MemoryBudget(limits.memoryBytes).limitBytes(), std::uint64_t(256) << 20);
   const double cpuSeconds = limits.time.cpuSeconds(size);
   const double wallSeconds = limits.time.wallSeconds(size);
 
@@ -540,7 +542,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
   }
   const std::string dataPath = "/proc/self/fd/" + std::to_string(data.fd);
   const ChildOutcome outcome = runGuarded(
-    [&]() -> int {
+    [&]() -> int
+    {
       if (!vtkObject::GetGlobalWarningDisplay())
       {
         // The error counter turns the display on; vtkLogger would then print what the caller
@@ -566,7 +569,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
     room, cpuSeconds, wallSeconds);
 
   using End = ChildOutcome::End;
-  const std::string reader = own ? std::string(own->GetClassName()) : "VTK's " + extension + " reader";
+  const std::string reader =
+    own ? std::string(own->GetClassName()) : "VTK's " + extension + " reader";
   switch (outcome.end)
   {
     case End::Interrupted:
@@ -602,8 +606,10 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
   }
   if (outcome.code == OutOfMemory)
   {
-    throw InputError(reader + " ran out of memory on " + what + ": the file is damaged, or "
-      "reading it needs more than the memory limit of " + gibibytes(room));
+    throw InputError(reader + " ran out of memory on " + what +
+      ": the file is damaged, or "
+      "reading it needs more than the memory limit of " +
+      gibibytes(room));
   }
   if (outcome.code != ReadOk)
   {
@@ -615,7 +621,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
   vtkSmartPointer<vtkPolyData> polygons = polygonsOf(back);
   if (!polygons)
   {
-    throw InputError("cannot read " + what + ": its data did not come back from the reading process");
+    throw InputError(
+      "cannot read " + what + ": its data did not come back from the reading process");
   }
   if (polygons->GetNumberOfPoints() == 0)
   {

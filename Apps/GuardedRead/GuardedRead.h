@@ -49,7 +49,10 @@ struct TimeLimit
 
   /// CPU seconds for a file of `bytes`, in whole seconds (RLIMIT_CPU's unit), at least 1.
   double cpuSeconds(std::uint64_t bytes) const;
-  double wallSeconds(std::uint64_t bytes) const { return this->wallFactor * this->cpuSeconds(bytes); }
+  double wallSeconds(std::uint64_t bytes) const
+  {
+    return this->wallFactor * this->cpuSeconds(bytes);
+  }
 };
 
 struct ReadLimits
@@ -77,8 +80,8 @@ struct ReadLimits
 /// A reader of the caller's own for some files (e.g. with materials), given the path and
 /// its lowercase extension (".obj"); null for the files VTK's readers take as usual. It runs
 /// in the guarded reading process, in place of VTK's reader and its checks.
-using ReaderFactory =
-  std::function<vtkSmartPointer<vtkAlgorithm>(const std::string& path, const std::string& extension)>;
+using ReaderFactory = std::function<vtkSmartPointer<vtkAlgorithm>(
+  const std::string& path, const std::string& extension)>;
 
 vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std::string& role,
   const ReadLimits& limits = {}, const ReaderFactory& ownReader = {});
@@ -107,8 +110,8 @@ struct ChildOutcome
   End end = End::Exited;
   int code = 0;
   int signal = 0;
-  double cpuSeconds = 0;  ///< user + system time of the child
-  std::string messages;   ///< what it wrote to stdout and stderr
+  double cpuSeconds = 0; ///< user + system time of the child
+  std::string messages;  ///< what it wrote to stdout and stderr
 };
 
 /**

@@ -24,7 +24,8 @@ PatchMesh floorMesh()
 
 MovingLight someLight(std::size_t frames = 2)
 {
-  return MovingLight(scenes::squareLightFacingDown({ 0.5, 0.5, 1 }, 0.2), Rgb(1), std::vector<Vec3>(frames));
+  return MovingLight(
+    scenes::squareLightFacingDown({ 0.5, 0.5, 1 }, 0.2), Rgb(1), std::vector<Vec3>(frames));
 }
 
 const double notANumber = std::numeric_limits<double>::quiet_NaN();
@@ -71,13 +72,37 @@ TEST(BadInput, DegenerateLight)
 {
   const std::vector<Vec3> frames(1);
   expectError([&] { MovingLight({}, Rgb(1), frames); }, "no polygon");
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 } } }, Rgb(1), frames); }, "needs at least 3");
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 }, { 2, 0, 0 } } }, Rgb(1), frames); }, "zero area");
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } } }, Rgb(1), frames); }, "zero area");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 } } }, Rgb(1), frames);
+    },
+    "needs at least 3");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 }, { 2, 0, 0 } } }, Rgb(1), frames);
+    },
+    "zero area");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } } }, Rgb(1), frames);
+    },
+    "zero area");
   // Edges that cross, enclosing a net area of 2.
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 3, 0, 0 }, { 0, 2, 0 }, { 1, 2, 0 } } }, Rgb(1), frames); }, "not a simple polygon");
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0.5 }, { 0, 1, 0 } } }, Rgb(1), frames); }, "not planar");
-  expectError([&] { MovingLight({ { { 0, 0, 0 }, { 1, 0, notANumber }, { 0, 1, 0 } } }, Rgb(1), frames); }, "NaN");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 3, 0, 0 }, { 0, 2, 0 }, { 1, 2, 0 } } }, Rgb(1), frames);
+    },
+    "not a simple polygon");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0.5 }, { 0, 1, 0 } } }, Rgb(1), frames);
+    },
+    "not planar");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 0 }, { 1, 0, notANumber }, { 0, 1, 0 } } }, Rgb(1), frames);
+    },
+    "NaN");
   const auto square = scenes::squareLightFacingDown({ 0, 0, 0 }, 1);
   expectError([&] { MovingLight(square, Rgb(1, -1, 1), frames); }, "light power");
   expectError([&] { MovingLight(square, Rgb(1, notANumber, 1), frames); }, "light power");
@@ -89,8 +114,10 @@ TEST(BadInput, SolverOptionsOutOfRange)
 {
   const Scene scene = Scene::fromPatchMesh(floorMesh());
   const MovingLight light = someLight();
-  auto with = [&](auto change) {
-    return [&scene, &light, change] {
+  auto with = [&](auto change)
+  {
+    return [&scene, &light, change]
+    {
       SolverOptions o;
       o.pathsPerFrame = 100;
       change(o);
@@ -142,7 +169,8 @@ TEST(Cancel, StopsPromptlyAndReportsIt)
     std::chrono::steady_clock::time_point cancelledAt;
     double lastFraction = -1;
     bool monotonic = true;
-    auto progress = [&](double fraction) {
+    auto progress = [&](double fraction)
+    {
       monotonic = monotonic && fraction >= lastFraction;
       lastFraction = fraction;
       if (fraction > 0.0005)
@@ -172,9 +200,11 @@ TEST(Cancel, ProgressReachesOne)
   SolverOptions o;
   o.pathsPerFrame = 20000;
   double last = 0;
-  solve(scene, someLight(), o, [&](double f) {
-    last = f;
-    return true;
-  });
+  solve(scene, someLight(), o,
+    [&](double f)
+    {
+      last = f;
+      return true;
+    });
   EXPECT_DOUBLE_EQ(last, 1.0);
 }

@@ -1,6 +1,6 @@
 // The same seed gives the same bits whatever the thread count; another seed does not.
-#include "FixedPointAccumulator.h"
 #include "CoreChecks.h"
+#include "FixedPointAccumulator.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -66,16 +66,17 @@ TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
   SolverOptions o;
   o.threads = 3;
   o.memoryLimitBytes = std::uint64_t(1) << 40;
-  const MemoryPlan roomy = planSolveMemory(
-    scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const MemoryPlan roomy =
+    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
   ASSERT_TRUE(roomy.accumulatorCopyPerWorker);
   o.memoryLimitBytes = 2 * roomy.peak - 1;
-  const MemoryPlan tight = planSolveMemory(
-    scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const MemoryPlan tight =
+    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
   ASSERT_FALSE(tight.accumulatorCopyPerWorker);
   // One copy instead of three, each buffer in whole pages: on a scene this small both fit
   // in the same pages, so the shared copy saves nothing here, but it never costs more.
-  const auto copies = [&](int n) {
+  const auto copies = [&](int n)
+  {
     return FixedPointAccumulator<1>::allocatedBytes(n, scene.elementCount(), Frames) +
       FixedPointAccumulator<3>::allocatedBytes(n, scene.patchCount(), Frames);
   };
@@ -105,7 +106,8 @@ TEST_P(Determinism, DifferentSeedsGiveDifferentResults)
 INSTANTIATE_TEST_SUITE_P(AllReuseModes, Determinism,
   ::testing::Values(std::make_pair(false, false), std::make_pair(true, false),
     std::make_pair(false, true), std::make_pair(true, true)),
-  [](const auto& info) {
+  [](const auto& info)
+  {
     return std::string(info.param.first ? "ShootingReuse" : "ShootingClassic") +
       (info.param.second ? "GatheringReuse" : "GatheringClassic");
   });

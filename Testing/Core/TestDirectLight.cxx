@@ -25,8 +25,10 @@ DirectLightCase floorUnderSquareLight()
 {
   PatchMesh mesh;
   scenes::addGriddedQuad(mesh, { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, 8, 8, Rgb(0.5, 0.3, 0.7));
-  DirectLightCase c{ Scene::fromPatchMesh(mesh), scenes::squareLightFacingDown({ 0.5, 0.5, 0.5 }, 0.2), Rgb(10, 10, 10), {} };
-  c.translations = scenes::translationsAlong({ 0.5, 0.5, 0.5 }, { 0.35, 0.35, 0.5 }, { 0.65, 0.6, 0.45 }, 5);
+  DirectLightCase c{ Scene::fromPatchMesh(mesh),
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.5 }, 0.2), Rgb(10, 10, 10), {} };
+  c.translations =
+    scenes::translationsAlong({ 0.5, 0.5, 0.5 }, { 0.35, 0.35, 0.5 }, { 0.65, 0.6, 0.45 }, 5);
   return c;
 }
 
@@ -54,7 +56,8 @@ ZScores compareWithLambert(const DirectLightCase& c, const Solution& solution, s
     {
       const Triangle& t = c.scene.elementTriangles()[e];
       const auto& p = c.scene.points();
-      const double F = elementFormFactor(p[t[0]], p[t[1]], p[t[2]], c.scene.elementNormal(e), polygon);
+      const double F =
+        elementFormFactor(p[t[0]], p[t[1]], p[t[2]], c.scene.elementNormal(e), polygon);
       const Rgb& rho = c.scene.elementReflectance(e);
       const double area = c.scene.elementArea(e);
       for (int ch = 0; ch < 3; ++ch)
@@ -69,7 +72,8 @@ ZScores compareWithLambert(const DirectLightCase& c, const Solution& solution, s
         z.meanSquare += score * score;
         z.maxAbs = std::max(z.maxAbs, std::abs(score));
         ++z.count;
-        EXPECT_EQ(solution.direct(f, e, Side::Back)[ch], 0.0) << "the floor's underside sees no light";
+        EXPECT_EQ(solution.direct(f, e, Side::Back)[ch], 0.0)
+          << "the floor's underside sees no light";
       }
     }
   }

@@ -13,7 +13,8 @@ namespace
 {
 std::vector<Vec3> boxTrajectory(std::size_t frames)
 {
-  return scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.25, 0.3, 0.9 }, { 0.75, 0.7, 0.8 }, frames);
+  return scenes::translationsAlong(
+    { 0.5, 0.5, 0.9 }, { 0.25, 0.3, 0.9 }, { 0.75, 0.7, 0.8 }, frames);
 }
 
 void expectAbsorbsAllPower(bool reuseShooting, bool reuseGathering)
@@ -23,7 +24,8 @@ void expectAbsorbsAllPower(bool reuseShooting, bool reuseGathering)
     Rgb(0.7, 0.4, 0.6), Rgb(0.4, 0.3, 0.7), Rgb(0.55, 0.65, 0.45) };
   const Scene scene = Scene::fromPatchMesh(scenes::closedBox(6, true, walls));
   const Rgb power(3, 5, 7);
-  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(4));
+  const MovingLight light(
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(4));
   SolverOptions options;
   options.pathsPerFrame = 400000;
   options.reuseShooting = reuseShooting;
@@ -68,14 +70,16 @@ TEST(EnergyBalance, UniformReflectanceGivesGeometricSeries)
   {
     const Scene scene = Scene::fromPatchMesh(scenes::closedBox(6, true, { Rgb(rho) }));
     const Rgb power(2, 2, 2);
-    const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(3));
+    const MovingLight light(
+      scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), power, boxTrajectory(3));
     SolverOptions options;
     options.pathsPerFrame = 300000;
     const Solution solution = solve(scene, light, options);
     for (std::size_t f = 0; f < light.frameCount(); ++f)
     {
       const Balance b = balanceOfFrame(scene, solution, f);
-      EXPECT_NEAR(b.radiantPower.r / (power.r * rho / (1 - rho)), 1.0, 0.01) << "rho " << rho << " frame " << f;
+      EXPECT_NEAR(b.radiantPower.r / (power.r * rho / (1 - rho)), 1.0, 0.01)
+        << "rho " << rho << " frame " << f;
     }
   }
 }
@@ -84,7 +88,8 @@ TEST(EnergyBalance, WithoutGatheringPatchSolutionStillBalances)
 {
   // k = 0: no final gathering, the elements take their patch's shooting solution.
   const Scene scene = Scene::fromPatchMesh(scenes::closedBox(5, true, { Rgb(0.5) }));
-  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1), boxTrajectory(2));
+  const MovingLight light(
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1), boxTrajectory(2));
   SolverOptions options;
   options.pathsPerFrame = 300000;
   options.gatheringRatio = 0;

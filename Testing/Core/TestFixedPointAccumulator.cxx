@@ -58,8 +58,8 @@ std::vector<std::int64_t> expectedQuanta(const std::vector<Score>& scores)
 
 /// Scores `scores` with `workers` workers, score i by worker i % workers, in the given
 /// order, and returns every total.
-std::vector<double> totals(const std::vector<Score>& scores, int workers, bool copyPerWorker,
-  FrameLayout layout)
+std::vector<double> totals(
+  const std::vector<Score>& scores, int workers, bool copyPerWorker, FrameLayout layout)
 {
   FixedPointAccumulator<1> sums(workers, copyPerWorker, Records, Frames, Quantum, layout);
   for (std::size_t i = 0; i < scores.size(); ++i)
@@ -104,7 +104,8 @@ TEST(FixedPointAccumulator, SumsDoNotDependOnOrderWorkersSharingOrLayout)
   // these must not.
   std::vector<Score> reversed(scores.rbegin(), scores.rend());
   std::vector<Score> sorted = scores;
-  std::sort(sorted.begin(), sorted.end(), [](const Score& a, const Score& b) { return a.value > b.value; });
+  std::sort(
+    sorted.begin(), sorted.end(), [](const Score& a, const Score& b) { return a.value > b.value; });
   for (const std::vector<Score>* order : { &scores, &reversed, &sorted })
   {
     for (int workers : { 1, 2, 3, 8 })
@@ -133,12 +134,14 @@ TEST(FixedPointAccumulator, ConcurrentAddsToOneSharedCopyLoseNothing)
   std::vector<std::thread> pool;
   for (int w = 0; w < threads; ++w)
   {
-    pool.emplace_back([&, w] {
-      for (const Score& s : scores)
+    pool.emplace_back(
+      [&, w]
       {
-        sums.add(sums.slots(w, s.record, s.side), s.frame, &s.value);
-      }
-    });
+        for (const Score& s : scores)
+        {
+          sums.add(sums.slots(w, s.record, s.side), s.frame, &s.value);
+        }
+      });
   }
   for (std::thread& t : pool)
   {
@@ -166,12 +169,9 @@ TEST(FixedPointAccumulator, EachValueRoundsToTheNearestQuantum)
     double value;
     double expected;
   } cases[] = {
-    { 0.0, 0.0 },
-    { 0.0049, 0.0 },    // below half a quantum: lost
-    { 0.0051, 0.01 },   // above half: one quantum
-    { 0.0149, 0.01 },
-    { 0.0151, 0.02 },
-    { 12.3456, 12.35 }, // 1234.56 quanta
+    { 0.0, 0.0 }, { 0.0049, 0.0 },                          // below half a quantum: lost
+    { 0.0051, 0.01 },                                       // above half: one quantum
+    { 0.0149, 0.01 }, { 0.0151, 0.02 }, { 12.3456, 12.35 }, // 1234.56 quanta
   };
   for (const auto& c : cases)
   {
@@ -236,9 +236,8 @@ TEST(FixedPointAccumulator, EverySlotIsDistinctInBothLayouts)
   {
     const std::size_t records = 4, frames = 3;
     FixedPointAccumulator<3> sums(1, true, records, frames, 1.0, layout);
-    auto code = [&](std::size_t r, int side, std::size_t f, int c) {
-      return static_cast<double>(((r * 2 + side) * frames + f) * 3 + c + 1);
-    };
+    auto code = [&](std::size_t r, int side, std::size_t f, int c)
+    { return static_cast<double>(((r * 2 + side) * frames + f) * 3 + c + 1); };
     for (std::size_t r = 0; r < records; ++r)
     {
       for (int side = 0; side < 2; ++side)

@@ -30,7 +30,8 @@ TEST(FormFactor, MatchesHowellCatalogueForParallelRectangle)
 {
   const double a = 0.6, b = 0.3, c = 0.5;
   const std::vector<Vec3> rect = { { 0, 0, c }, { a, 0, c }, { a, b, c }, { 0, b, c } };
-  EXPECT_NEAR(pointToPolygonFormFactor({ 0, 0, 0 }, { 0, 0, 1 }, rect), cornerFormFactor(a, b, c), 1e-12);
+  EXPECT_NEAR(
+    pointToPolygonFormFactor({ 0, 0, 0 }, { 0, 0, 1 }, rect), cornerFormFactor(a, b, c), 1e-12);
   // Below the centre: four corner rectangles.
   EXPECT_NEAR(pointToPolygonFormFactor({ a / 2, b / 2, 0 }, { 0, 0, 1 }, rect),
     4 * cornerFormFactor(a / 2, b / 2, c), 1e-12);
@@ -47,13 +48,15 @@ TEST(FormFactor, TiltedReceiverFollowsCosineForDistantSmallSource)
   const std::vector<Vec3> tiny = { { -s, -s, r }, { s, -s, r }, { s, s, r }, { -s, s, r } };
   const double theta = 0.7;
   const Vec3 n(std::sin(theta), 0, std::cos(theta));
-  EXPECT_NEAR(pointToPolygonFormFactor({ 0, 0, 0 }, n, tiny), std::cos(theta) * 4 * s * s / (pi * r * r), 1e-12);
+  EXPECT_NEAR(pointToPolygonFormFactor({ 0, 0, 0 }, n, tiny),
+    std::cos(theta) * 4 * s * s / (pi * r * r), 1e-12);
 }
 
 TEST(PolygonTriangulation, ConcavePolygonKeepsItsArea)
 {
   // An L shape (area 3) and a star (concave), both counter-clockwise in the xy plane.
-  const std::vector<Vec3> ell = { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 1, 1, 0 }, { 1, 2, 0 }, { 0, 2, 0 } };
+  const std::vector<Vec3> ell = { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 1, 1, 0 }, { 1, 2, 0 },
+    { 0, 2, 0 } };
   const auto triangles = triangulatePolygon(ell);
   ASSERT_EQ(triangles.size(), 4u);
   double area = 0;
@@ -92,8 +95,10 @@ TEST(Scene, SplitsEveryPatchIntoFourElementsOfAQuarterArea)
     const std::size_t p = Scene::patchOfElement(e);
     EXPECT_NEAR(scene.elementArea(e), scene.patchArea(p) / 4, 1e-14);
     const Triangle& t = scene.elementTriangles()[e];
-    const Vec3 n = normalize(triangleAreaVector(scene.points()[t[0]], scene.points()[t[1]], scene.points()[t[2]]));
-    EXPECT_GT(dot(n, scene.patchNormal(p)), 0.999999) << "element " << e << " keeps its patch's orientation";
+    const Vec3 n = normalize(
+      triangleAreaVector(scene.points()[t[0]], scene.points()[t[1]], scene.points()[t[2]]));
+    EXPECT_GT(dot(n, scene.patchNormal(p)), 0.999999)
+      << "element " << e << " keeps its patch's orientation";
   }
   // Inward normals: the floor's normal points up.
   EXPECT_GT(scene.patchNormal(static_cast<std::size_t>(4 * 18)).z, 0.99);
@@ -114,7 +119,8 @@ TEST(MovingLight, AreaCentroidNormalAndUniformSampling)
   const int samples = 20000;
   for (int i = 0; i < samples; ++i)
   {
-    light.samplePoint((i + 0.5) / samples, std::fmod(i * 0.618034, 1.0), std::fmod(i * 0.7548777, 1.0), p, n);
+    light.samplePoint(
+      (i + 0.5) / samples, std::fmod(i * 0.618034, 1.0), std::fmod(i * 0.7548777, 1.0), p, n);
     EXPECT_NEAR(n.z, -1.0, 1e-14);
     mean += p / samples;
   }

@@ -114,13 +114,15 @@ ZScores compareWithLambert(const Scene& scene, const std::vector<Vec3>& light, c
     std::vector<Vec3> polygon;
     for (const Vec3& v : light)
     {
-      polygon.push_back(turnAbout(turns[f].axis, turns[f].angle, v - centroid) + turns[f].pose.position);
+      polygon.push_back(
+        turnAbout(turns[f].axis, turns[f].angle, v - centroid) + turns[f].pose.position);
     }
     for (std::size_t e = 0; e < scene.elementCount(); ++e)
     {
       const Triangle& t = scene.elementTriangles()[e];
       const auto& p = scene.points();
-      const double F = elementFormFactor(p[t[0]], p[t[1]], p[t[2]], scene.elementNormal(e), polygon);
+      const double F =
+        elementFormFactor(p[t[0]], p[t[1]], p[t[2]], scene.elementNormal(e), polygon);
       const Rgb& rho = scene.elementReflectance(e);
       const double area = scene.elementArea(e);
       const double hitProbability = F * area / lightArea;
@@ -151,7 +153,8 @@ ZScores compareWithLambert(const Scene& scene, const std::vector<Vec3>& light, c
         z.meanSquare += s * s;
         z.maxAbs = std::max(z.maxAbs, std::abs(s));
         ++z.count;
-        EXPECT_EQ(solution.direct(f, e, Side::Back)[ch], 0.0) << "the floor's underside sees no light";
+        EXPECT_EQ(solution.direct(f, e, Side::Back)[ch], 0.0)
+          << "the floor's underside sees no light";
       }
     }
   }
@@ -162,20 +165,24 @@ ZScores compareWithLambert(const Scene& scene, const std::vector<Vec3>& light, c
 Scene unitFloor(int cells)
 {
   PatchMesh mesh;
-  scenes::addGriddedQuad(mesh, { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, cells, cells, Rgb(0.5, 0.3, 0.7));
+  scenes::addGriddedQuad(
+    mesh, { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, cells, cells, Rgb(0.5, 0.3, 0.7));
   return Scene::fromPatchMesh(mesh);
 }
 
 /// The closed unit box of coloured walls (inward), its elements grouped by wall.
 struct ColouredBox
 {
-  Scene scene = Scene::fromPatchMesh(scenes::closedBox(4, true,
-    { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
-  std::size_t wallOf(std::size_t element) const { return element / (this->scene.elementCount() / 6); }
+  Scene scene = Scene::fromPatchMesh(scenes::closedBox(
+    4, true, { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
+  std::size_t wallOf(std::size_t element) const
+  {
+    return element / (this->scene.elementCount() / 6);
+  }
   std::vector<double> wallPowers(const Solution& solution, int channel = 1) const
   {
-    return checks::groupPowers(this->scene, solution, 6,
-      [this](std::size_t e) { return this->wallOf(e); }, channel);
+    return checks::groupPowers(
+      this->scene, solution, 6, [this](std::size_t e) { return this->wallOf(e); }, channel);
   }
 };
 
@@ -192,7 +199,8 @@ MovingLight panningLight(const Rgb& power = Rgb(1))
 }
 
 /// Expects `scaled` to be `factor` times `reference`, channel by channel, to the last bits.
-void expectScaled(const Rgb& scaled, const Rgb& reference, const Rgb& factor, const std::string& what)
+void expectScaled(
+  const Rgb& scaled, const Rgb& reference, const Rgb& factor, const std::string& what)
 {
   for (int c = 0; c < 3; ++c)
   {
@@ -218,8 +226,8 @@ TEST(LightRigs, TurningLightMatchesLambertOnTheTurnedPolygon)
     options.gatheringRatio = 0; // a lone floor reflects nothing onto itself
     const Solution solution = solve(scene, moving, options);
     const ZScores z = compareWithLambert(scene, light, power, turns, solution, options);
-    std::cout << (reuse ? "full reuse" : "classic") << ": mean z^2 " << z.meanSquare
-              << ", max |z| " << z.maxAbs << " over " << z.count << "\n";
+    std::cout << (reuse ? "full reuse" : "classic") << ": mean z^2 " << z.meanSquare << ", max |z| "
+              << z.maxAbs << " over " << z.count << "\n";
     if (reuse)
     {
       // sigma is an upper bound: the mean square is at most 1, plus its own noise.
@@ -246,11 +254,13 @@ TEST(LightRigs, ReuseStaysUnbiasedUnderRotation)
   {
     for (int r = 0; r < runs; ++r)
     {
-      const Solution solution = solve(box.scene, light, modeOptions(mode == 1, 3000, 500 + r + 100 * mode));
+      const Solution solution =
+        solve(box.scene, light, modeOptions(mode == 1, 3000, 500 + r + 100 * mode));
       moments[mode].add(box.wallPowers(solution));
     }
   }
-  const double chiSquare = checks::expectSameMeans(moments[1], { &moments[0] }, "reuse against classic");
+  const double chiSquare =
+    checks::expectSameMeans(moments[1], { &moments[0] }, "reuse against classic");
   std::cout << "mean z^2 over 6 walls x 5 frames: " << chiSquare << "\n";
 }
 
@@ -261,7 +271,8 @@ TEST(LightRigs, PowerFactorScalesItsFrameExactly)
   std::vector<LightPose> poses = full.poses();
   poses[1].power = Rgb(0.5);
   poses[3].power = Rgb(1, 0.5, 0.25);
-  const MovingLight dimmed(scenes::squareLightFacingDown({ 0.5, 0.5, 0.8 }, 0.2), Rgb(2, 3, 4), poses);
+  const MovingLight dimmed(
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.8 }, 0.2), Rgb(2, 3, 4), poses);
   poses[2].power = Rgb(0);
   const MovingLight off(scenes::squareLightFacingDown({ 0.5, 0.5, 0.8 }, 0.2), Rgb(2, 3, 4), poses);
   for (bool reuse : { false, true })
@@ -279,7 +290,8 @@ TEST(LightRigs, PowerFactorScalesItsFrameExactly)
       {
         for (Side side : { Side::Front, Side::Back })
         {
-          const std::string what = mode + " frame " + std::to_string(f) + " element " + std::to_string(e);
+          const std::string what =
+            mode + " frame " + std::to_string(f) + " element " + std::to_string(e);
           expectScaled(b.direct(f, e, side), a.direct(f, e, side), factor, what + " direct");
           expectScaled(b.indirect(f, e, side), a.indirect(f, e, side), factor, what + " indirect");
           lit += a.total(f, e, side).sum();
@@ -294,7 +306,8 @@ TEST(LightRigs, PowerFactorScalesItsFrameExactly)
     }
     EXPECT_GT(lit, 0.0);
     // A position that is off casts no path.
-    EXPECT_EQ(c.statistics.pathsCast, reuse ? options.pathsPerFrame : 4 * options.pathsPerFrame) << mode;
+    EXPECT_EQ(c.statistics.pathsCast, reuse ? options.pathsPerFrame : 4 * options.pathsPerFrame)
+      << mode;
     if (!reuse)
     {
       // Classic frames are independent: the others are those of the light that stays on.
@@ -326,8 +339,10 @@ TEST(LightRigs, TwoLightsTogetherEqualTheSumOfEachAlone)
       EXPECT_EQ(s12.statistics.sources, 2u);
       EXPECT_EQ(s12.statistics.pathsCast, 2 * 3000u) << "each moving light reuses its own N paths";
       together.add(box.wallPowers(s12, channel));
-      first.add(box.wallPowers(solve(box.scene, panning, modeOptions(true, 3000, 2000 + r)), channel));
-      second.add(box.wallPowers(solve(box.scene, sliding, modeOptions(true, 3000, 3000 + r)), channel));
+      first.add(
+        box.wallPowers(solve(box.scene, panning, modeOptions(true, 3000, 2000 + r)), channel));
+      second.add(
+        box.wallPowers(solve(box.scene, sliding, modeOptions(true, 3000, 3000 + r)), channel));
     }
     const double chiSquare = checks::expectSameMeans(together, { &first, &second },
       "channel " + std::to_string(channel) + ": both lights against the sum of each");
@@ -346,7 +361,8 @@ TEST(LightRigs, LightsOfOneRigAreIndependentEstimates)
   LightRig copies;
   copies.areaLights = { half, half };
   // No final gathering: it runs once on the sum of the sources, with the same noise either way.
-  auto options = [](std::uint64_t seed) {
+  auto options = [](std::uint64_t seed)
+  {
     SolverOptions o = modeOptions(true, 2000, seed);
     o.gatheringRatio = 0;
     return o;
@@ -420,14 +436,17 @@ TEST(LightRigs, StaticLightIsCastOnceAndLightsEveryFrameAlike)
       }
       for (int c = 0; c < 3; ++c)
       {
-        EXPECT_NEAR(lampDirect[f][c], staticPower[c], 1e-6 * staticPower[c]) << mode << " frame " << f;
+        EXPECT_NEAR(lampDirect[f][c], staticPower[c], 1e-6 * staticPower[c])
+          << mode << " frame " << f;
         // Alike up to the single-precision rounding of the stored results (PackedRgb).
-        EXPECT_NEAR(lampDirect[f][c], lampDirect[0][c], 1e-7 * staticPower[c]) << mode << " frame " << f;
+        EXPECT_NEAR(lampDirect[f][c], lampDirect[0][c], 1e-7 * staticPower[c])
+          << mode << " frame " << f;
         EXPECT_GT(lampIndirect[f][c], 0.0);
         if (reuse)
         {
           // One set of gathering rays serves every frame: the lamp's indirect light is the same.
-          EXPECT_NEAR(lampIndirect[f][c], lampIndirect[0][c], 1e-7 * lampIndirect[0][c]) << mode << " frame " << f;
+          EXPECT_NEAR(lampIndirect[f][c], lampIndirect[0][c], 1e-7 * lampIndirect[0][c])
+            << mode << " frame " << f;
         }
       }
     }
@@ -482,7 +501,8 @@ TEST(LightRigs, EmissiveWallInClosedBoxBalancesEmittedAndLightPower)
       for (int c = 0; c < 3; ++c)
       {
         const double absorbed = b.absorbed[c] - emitterTerm[c];
-        EXPECT_NEAR(absorbed / (emitted[c] + lightPower[c]), 1.0, 0.01) << mode << " frame " << f << " channel " << c;
+        EXPECT_NEAR(absorbed / (emitted[c] + lightPower[c]), 1.0, 0.01)
+          << mode << " frame " << f << " channel " << c;
       }
     }
   }
@@ -490,14 +510,25 @@ TEST(LightRigs, EmissiveWallInClosedBoxBalancesEmittedAndLightPower)
 
 TEST(LightRigs, BadInputIsRefusedWithWhatToFix)
 {
-  const std::vector<std::vector<Vec3>> square = scenes::squareLightFacingDown({ 0.5, 0.5, 0.5 }, 0.2);
+  const std::vector<std::vector<Vec3>> square =
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.5 }, 0.2);
   const std::vector<LightPose> twoPoses(2);
-  expectError([&] { MovingLight({ { { 0, 0, 1 }, { 1, 1, 1 }, { 2, 2, 1 } } }, Rgb(1), twoPoses); }, "zero area");
-  expectError([&] { MovingLight({ { { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 } } }, Rgb(1), twoPoses); }, "zero area");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 1 }, { 1, 1, 1 }, { 2, 2, 1 } } }, Rgb(1), twoPoses);
+    },
+    "zero area");
+  expectError(
+    [&] {
+      MovingLight({ { { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 } } }, Rgb(1), twoPoses);
+    },
+    "zero area");
   expectError([&] { MovingLight(square, Rgb(1), std::vector<LightPose>{}); }, "zero frames");
 
-  auto withPose = [&](std::size_t frame, const std::function<void(LightPose&)>& change) {
-    return [&square, frame, change] {
+  auto withPose = [&](std::size_t frame, const std::function<void(LightPose&)>& change)
+  {
+    return [&square, frame, change]
+    {
       std::vector<LightPose> poses(3);
       for (LightPose& p : poses)
       {
@@ -507,14 +538,21 @@ TEST(LightRigs, BadInputIsRefusedWithWhatToFix)
       MovingLight(square, Rgb(1), poses);
     };
   };
-  expectError(withPose(1, [](LightPose& p) { p.power = Rgb(1, -0.1, 1); }), "power factor of light position 1");
-  expectError(withPose(2, [](LightPose& p) { p.power = Rgb(std::nan("")); }), "power factor of light position 2");
+  expectError(withPose(1, [](LightPose& p) { p.power = Rgb(1, -0.1, 1); }),
+    "power factor of light position 1");
+  expectError(withPose(2, [](LightPose& p) { p.power = Rgb(std::nan("")); }),
+    "power factor of light position 2");
   expectError(withPose(0, [](LightPose& p) { p.position.y = std::nan(""); }), "light position 0");
   // Scaled, sheared, mirrored, NaN: none is a rotation.
-  expectError(withPose(1, [](LightPose& p) { p.rotation.row0 = { 2, 0, 0 }; }), "orientation of light position 1 is not a rotation");
+  expectError(withPose(1,
+                [](LightPose& p) {
+                  p.rotation.row0 = { 2, 0, 0 };
+                }),
+    "orientation of light position 1 is not a rotation");
   expectError(withPose(1, [](LightPose& p) { p.rotation.row0 = { 1, 0.3, 0 }; }), "not a rotation");
   expectError(withPose(2, [](LightPose& p) { p.rotation.row2 = { 0, 0, -1 }; }), "not a rotation");
-  expectError(withPose(0, [](LightPose& p) { p.rotation.row1.x = std::nan(""); }), "not a rotation");
+  expectError(
+    withPose(0, [](LightPose& p) { p.rotation.row1.x = std::nan(""); }), "not a rotation");
   // A proper rotation, far from the identity, is accepted.
   withPose(1, [](LightPose& p) { p.rotation = Rotation::fromQuaternion(0.5, 0.5, -0.5, 0.5); })();
 
@@ -526,13 +564,15 @@ TEST(LightRigs, BadInputIsRefusedWithWhatToFix)
   rig.areaLights.emplace_back(square, Rgb(1), std::vector<Vec3>(3));
   expectError([&] { frameCount(rig, false); }, "light 2 has 3 positions but light 0 has 4");
   const Scene scene = unitFloor(2);
-  expectError([&] { solve(scene, rig, modeOptions(true, 1000, 1)); }, "every moving light needs one position per frame");
+  expectError([&] { solve(scene, rig, modeOptions(true, 1000, 1)); },
+    "every moving light needs one position per frame");
   expectError([&] { frameCount(LightRig(), false); }, "nothing emits");
   EXPECT_EQ(frameCount(LightRig(), true), 1u) << "the scene's own emitters are enough";
 
   // Reuse needs a path per light position that emits; the message names the minimum.
   const MovingLight six(square, Rgb(1), std::vector<Vec3>(6));
-  expectError([&] { solve(scene, six, modeOptions(true, 5, 1)); }, "give at least 6 paths per frame");
+  expectError(
+    [&] { solve(scene, six, modeOptions(true, 5, 1)); }, "give at least 6 paths per frame");
   EXPECT_NO_THROW(solve(scene, six, modeOptions(true, 6, 1)));
   EXPECT_NO_THROW(solve(scene, six, modeOptions(false, 5, 1))) << "classic has no such minimum";
 }

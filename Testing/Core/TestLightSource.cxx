@@ -1,8 +1,8 @@
 // The light interface on its own, without a solve: each kind's reuse kernel against the
 // exact form factor, the directional disc against the scene, emitted power and positions.
+#include "FormFactor.h"
 #include "GeneratedScenes.h"
 #include "LightSource.h"
-#include "FormFactor.h"
 #include "RayTracer.h"
 
 #include <gtest/gtest.h>
@@ -74,7 +74,8 @@ TEST(LightSource, AreaKernelIntegratesToTheFormFactorOfEveryPosition)
     {
       const double exact = pointToPolygonFormFactor(y, up, placed(light, k));
       const double estimate = kernelQuadrature(light, source, k, y, up, tracer, 200000);
-      EXPECT_NEAR(estimate, exact, 0.01 * exact) << "position " << k << " at (" << y.x << ", " << y.y << ")";
+      EXPECT_NEAR(estimate, exact, 0.01 * exact)
+        << "position " << k << " at (" << y.x << ", " << y.y << ")";
     }
   }
 }
@@ -96,7 +97,8 @@ TEST(LightSource, AreaKernelIsZeroBehindTheLightAndForPositionsThatAreOff)
   EmittedPath path;
   path.ownPoint = light.centroid();
   path.ownNormal = Vec3(0, 0, -1);
-  const std::size_t shadowRays = source.kernel(path, Vec3(0.1, 0, 0), Vec3(0, 0, 1), 0, tracer, scratch);
+  const std::size_t shadowRays =
+    source.kernel(path, Vec3(0.1, 0, 0), Vec3(0, 0, 1), 0, tracer, scratch);
   EXPECT_GT(scratch.kernel[0], 0);
   EXPECT_EQ(scratch.kernel[1], 0);
   EXPECT_EQ(scratch.kernel[2], 0);
@@ -108,7 +110,8 @@ TEST(LightSource, DirectionalKernelIsTheCosineTowardsTheLight)
 {
   const Scene scene = floorScene();
   const RayTracer tracer(scene);
-  const std::vector<Vec3> towards = { { 0, 0, 1 }, { 1, 0, 1 }, { 0, -3, 1 }, { 1, 0, -1 }, { 0, 1, 2 } };
+  const std::vector<Vec3> towards = { { 0, 0, 1 }, { 1, 0, 1 }, { 0, -3, 1 }, { 1, 0, -1 },
+    { 0, 1, 2 } };
   const std::vector<Rgb> factors = { Rgb(1), Rgb(1), Rgb(0.5), Rgb(1), Rgb(0) };
   const DirectionalLight light(towards, Rgb(100, 100, 100), factors);
   const LightSource source(DirectionalSource(light, Vec3(0, 0, 0), 1.5), 0);
@@ -118,7 +121,8 @@ TEST(LightSource, DirectionalKernelIsTheCosineTowardsTheLight)
   const std::size_t shadowRays = source.kernel({}, Vec3(0.3, 0.2, 0), ny, 0, tracer, scratch);
   for (std::size_t k = 0; k < towards.size(); ++k)
   {
-    const double expected = factors[k].maxComponent() > 0 ? std::max(0.0, dot(ny, light.direction(k))) : 0.0;
+    const double expected =
+      factors[k].maxComponent() > 0 ? std::max(0.0, dot(ny, light.direction(k))) : 0.0;
     EXPECT_DOUBLE_EQ(scratch.kernel[k], expected) << "position " << k;
   }
   // Positions 1 and 2 are above the horizon, lit and not the origin: the open sky is visible.

@@ -75,8 +75,8 @@ TEST(ManifoldCheck, SameVerdictsAsCgalOnTrickySoups)
   expectSameVerdict(flipped, false, "a box with one triangle the wrong way round");
   expectSameVerdict({ { 0, 1, 2 }, { 0, 1, 3 } }, false, "two triangles, same oriented edge");
 
-  expectSameVerdict({ { 0, 1, 2 }, { 1, 0, 3 }, { 0, 4, 1 } }, false,
-    "an edge shared by 3 triangles");
+  expectSameVerdict(
+    { { 0, 1, 2 }, { 1, 0, 3 }, { 0, 4, 1 } }, false, "an edge shared by 3 triangles");
   expectSameVerdict({ { 0, 1, 2 }, { 1, 0, 3 }, { 0, 1, 4 }, { 1, 0, 5 } }, false,
     "an edge shared by 4 triangles, two each way");
 
@@ -108,7 +108,8 @@ TEST(ManifoldCheck, SameVerdictsAsCgalOnTrickySoups)
 TEST(ManifoldCheck, SameVerdictsAsCgalOnSmallDrawnSoups)
 {
   std::uint64_t state = 0x9e3779b97f4a7c15ULL;
-  auto draw = [&state](std::size_t n) {
+  auto draw = [&state](std::size_t n)
+  {
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
     return static_cast<std::size_t>((state >> 33) % n);
   };

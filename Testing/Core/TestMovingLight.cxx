@@ -37,7 +37,8 @@ MovingLight aimedLight(const std::vector<Vec3>& positions, const Vec3& target)
   std::vector<PoseInput> inputs = inputsAt(positions);
   EXPECT_FALSE(aimAt(inputs, target).has_value());
   std::vector<std::string> warnings;
-  const MovingLight light(lampPolygons(), Rgb(1, 1, 1), posesFromInputs(lampPolygons(), inputs, warnings));
+  const MovingLight light(
+    lampPolygons(), Rgb(1, 1, 1), posesFromInputs(lampPolygons(), inputs, warnings));
   EXPECT_TRUE(warnings.empty());
   return light;
 }
@@ -50,7 +51,8 @@ double distance(const Vec3& a, const Vec3& b)
 
 TEST(MovingLightAim, FacesTheTargetFromEveryPosition)
 {
-  const std::vector<Vec3> positions = { { 0, 0, 2 }, { 1, -1, 2.5 }, { -2, 3, 0.5 }, { 0.3, 0.2, -1 } };
+  const std::vector<Vec3> positions = { { 0, 0, 2 }, { 1, -1, 2.5 }, { -2, 3, 0.5 },
+    { 0.3, 0.2, -1 } };
   // Below, beside, diagonal, far away and straight above: the light faces down as given, so
   // the last needs the half turn of opposite directions.
   const std::vector<Vec3> targets = { { 0, 0, -5 }, { 4, 0, 1 }, { -1, 2, 3 }, { 100, -50, 20 },
@@ -157,7 +159,8 @@ TEST(MovingLightAim, ALightAtTheTargetCannotFaceIt)
   ASSERT_TRUE(frame.has_value());
   EXPECT_EQ(*frame, 2u);
   std::vector<std::string> warnings;
-  expectError([&] { posesFromInputs(lampPolygons(), inputs, warnings); }, "Normal of light position 2");
+  expectError(
+    [&] { posesFromInputs(lampPolygons(), inputs, warnings); }, "Normal of light position 2");
 }
 
 TEST(MovingLightAim, AnOrientationWinsOverTheAim)

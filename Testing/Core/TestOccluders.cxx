@@ -31,8 +31,8 @@ MovingLight lightOf(const OccludedRoom& room)
 }
 
 /// sum_e A_e B_e over the elements of one face, on its side, in one frame (W).
-Rgb facePower(const Scene& scene, const Solution& solution, const FaceGroup& face,
-  std::size_t frame)
+Rgb facePower(
+  const Scene& scene, const Solution& solution, const FaceGroup& face, std::size_t frame)
 {
   Rgb power;
   for (std::size_t p = face.firstPatch; p < face.firstPatch + face.patchCount; ++p)
@@ -164,8 +164,8 @@ double visibleFormFactor(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 }
 
 /// Every channel: sum_i A_i (1 - rho_i)/rho_i B_i = Phi in every frame of a closed room.
-void expectBalance(const OccludedRoom& room, const Scene& scene, const Solution& solution,
-  double tolerance)
+void expectBalance(
+  const OccludedRoom& room, const Scene& scene, const Solution& solution, double tolerance)
 {
   for (std::size_t f = 0; f < solution.frameCount(); ++f)
   {
@@ -283,7 +283,8 @@ void expectDirectLightMatchesLambert(bool reuse)
     EXPECT_NEAR(meanSquare, 1.0, 0.1);
     EXPECT_LT(maxAbs, 5.0);
   }
-  EXPECT_LT(std::abs(shadedError / shadedSigma), 4.0) << "light leaks past or is lost at the occluders";
+  EXPECT_LT(std::abs(shadedError / shadedSigma), 4.0)
+    << "light leaks past or is lost at the occluders";
   EXPECT_EQ(hiddenButLit, 0u) << "floor elements in full shadow got direct light";
 
   // The floor under the block is closed in: no light at all.
@@ -293,7 +294,8 @@ void expectDirectLightMatchesLambert(bool reuse)
     {
       for (std::size_t f = 0; f < solution.frameCount(); ++f)
       {
-        EXPECT_EQ(solution.total(f, e, Side::Front), Rgb()) << "floor element " << e << " under the block";
+        EXPECT_EQ(solution.total(f, e, Side::Front), Rgb())
+          << "floor element " << e << " under the block";
       }
     }
   }
@@ -395,13 +397,14 @@ TEST(OccludedRoom, ReachableSidesComeFromGeometryAlone)
     std::uint64_t paths, seed;
     int threads;
   };
-  for (const Run& run : { Run{ false, 1000, 1, 1 }, Run{ true, 1000, 2, 2 }, Run{ true, 200000, 3, 2 },
-         Run{ false, 200000, 4, 1 } })
+  for (const Run& run : { Run{ false, 1000, 1, 1 }, Run{ true, 1000, 2, 2 },
+         Run{ true, 200000, 3, 2 }, Run{ false, 200000, 4, 1 } })
   {
     SolverOptions options = modeOptions(run.reuse, run.paths, run.seed);
     options.threads = run.threads;
     const Solution solution = solve(scene, lightOf(room), options);
-    EXPECT_EQ(solution.statistics.reachableSides, expected) << "N " << run.paths << " seed " << run.seed;
+    EXPECT_EQ(solution.statistics.reachableSides, expected)
+      << "N " << run.paths << " seed " << run.seed;
     // Each reachable side's four elements gather (no face is black).
     EXPECT_EQ(solution.statistics.gatheringSides, 4 * expected);
     for (std::size_t e = 0; e < scene.elementCount(); ++e)
@@ -430,7 +433,8 @@ TEST(PathCount, ReuseWithFewerPathsThanPositionsIsRefusedNamingTheMinimum)
   const OccludedRoom room = scenes::occludedRoom(6);
   const Scene scene = Scene::fromPatchMesh(room.mesh);
   // Positions without a path would leave holes in the mixture density and unbounded weights.
-  expectError([&] { solve(scene, lightOf(room), modeOptions(true, 5, 1)); }, "give at least 6 paths per frame");
+  expectError([&] { solve(scene, lightOf(room), modeOptions(true, 5, 1)); },
+    "give at least 6 paths per frame");
   SolverOptions shootingOnly = modeOptions(true, 5, 1);
   shootingOnly.reuseGathering = false;
   expectError([&] { solve(scene, lightOf(room), shootingOnly); }, "give at least 6");

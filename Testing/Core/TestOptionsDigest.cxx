@@ -14,20 +14,34 @@ namespace
 /// `options` with the field named `name` changed to another valid value.
 SolverOptions changed(SolverOptions options, const std::string& name)
 {
-  if (name == "pathsPerFrame") options.pathsPerFrame += 1;
-  else if (name == "gatheringRatio") options.gatheringRatio *= 2;
-  else if (name == "firstBounceSurvival") options.firstBounceSurvival = 0.5;
-  else if (name == "reuseShooting") options.reuseShooting = !options.reuseShooting;
-  else if (name == "reuseGathering") options.reuseGathering = !options.reuseGathering;
-  else if (name == "twoSided") options.twoSided = !options.twoSided;
-  else if (name == "seed") options.seed += 1;
-  else if (name == "threads") options.threads = 3;
-  else if (name == "memoryLimitBytes") options.memoryLimitBytes = 1 << 30;
-  else if (name == "rank") options.rank = 1;
-  else if (name == "ranks") options.ranks = 2;
-  else if (name == "sumAcrossRanks") options.sumAcrossRanks = [](std::int64_t*, std::size_t) {};
-  else if (name == "sumDoublesAcrossRanks") options.sumDoublesAcrossRanks = [](double*, std::size_t) {};
-  else ADD_FAILURE() << "no change for option " << name << ": add it to this test";
+  if (name == "pathsPerFrame")
+    options.pathsPerFrame += 1;
+  else if (name == "gatheringRatio")
+    options.gatheringRatio *= 2;
+  else if (name == "firstBounceSurvival")
+    options.firstBounceSurvival = 0.5;
+  else if (name == "reuseShooting")
+    options.reuseShooting = !options.reuseShooting;
+  else if (name == "reuseGathering")
+    options.reuseGathering = !options.reuseGathering;
+  else if (name == "twoSided")
+    options.twoSided = !options.twoSided;
+  else if (name == "seed")
+    options.seed += 1;
+  else if (name == "threads")
+    options.threads = 3;
+  else if (name == "memoryLimitBytes")
+    options.memoryLimitBytes = 1 << 30;
+  else if (name == "rank")
+    options.rank = 1;
+  else if (name == "ranks")
+    options.ranks = 2;
+  else if (name == "sumAcrossRanks")
+    options.sumAcrossRanks = [](std::int64_t*, std::size_t) {};
+  else if (name == "sumDoublesAcrossRanks")
+    options.sumDoublesAcrossRanks = [](double*, std::size_t) {};
+  else
+    ADD_FAILURE() << "no change for option " << name << ": add it to this test";
   return options;
 }
 
@@ -73,12 +87,14 @@ TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)
 
 TEST(OptionsDigest, RankOutcomeFindsDifferentDigestsAndFailures)
 {
-  auto agreed = [](std::vector<std::tuple<bool, bool, std::uint64_t>> ranks) {
+  auto agreed = [](std::vector<std::tuple<bool, bool, std::uint64_t>> ranks)
+  {
     long long maxima[RankOutcome::Size];
     for (std::size_t r = 0; r < ranks.size(); ++r)
     {
       long long mine[RankOutcome::Size];
-      RankOutcome::encode(std::get<0>(ranks[r]), std::get<1>(ranks[r]), std::get<2>(ranks[r]), mine);
+      RankOutcome::encode(
+        std::get<0>(ranks[r]), std::get<1>(ranks[r]), std::get<2>(ranks[r]), mine);
       for (std::size_t i = 0; i < RankOutcome::Size; ++i)
       {
         maxima[i] = r == 0 ? mine[i] : std::max(maxima[i], mine[i]);
@@ -93,7 +109,8 @@ TEST(OptionsDigest, RankOutcomeFindsDifferentDigestsAndFailures)
   // Differences in the low half only, the high half only, and in both are all found.
   EXPECT_TRUE(agreed({ { false, false, a }, { false, false, a ^ 1 } }).digestsDiffer);
   EXPECT_TRUE(agreed({ { false, false, a }, { false, false, a ^ (1ULL << 63) } }).digestsDiffer);
-  EXPECT_TRUE(agreed({ { false, false, a }, { false, false, a }, { false, false, b } }).digestsDiffer);
+  EXPECT_TRUE(
+    agreed({ { false, false, a }, { false, false, a }, { false, false, b } }).digestsDiffer);
   const RankOutcome failed = agreed({ { false, false, a }, { true, false, a } });
   EXPECT_TRUE(failed.failed);
   EXPECT_FALSE(failed.cancelled);

@@ -39,14 +39,16 @@ TEST(ParallelFor, VisitsEveryTaskExactlyOnce)
       std::vector<std::atomic<int>> visits(tasks);
       std::atomic<int> badWorker{ 0 };
       parallelFor(tasks, threads,
-        [&](std::size_t task, int worker) {
+        [&](std::size_t task, int worker)
+        {
           visits[task].fetch_add(1);
           badWorker += worker < 0 || worker >= threads ? 1 : 0;
         },
         {});
       for (std::size_t t = 0; t < tasks; ++t)
       {
-        ASSERT_EQ(visits[t].load(), 1) << "task " << t << " of " << tasks << ", " << threads << " threads";
+        ASSERT_EQ(visits[t].load(), 1)
+          << "task " << t << " of " << tasks << ", " << threads << " threads";
       }
       EXPECT_EQ(badWorker.load(), 0);
     }
@@ -59,15 +61,18 @@ TEST(ParallelFor, WorkerZeroIsTheCallerAndTicksStayOnIt)
   std::atomic<int> wrongThread{ 0 };
   std::vector<std::size_t> ticks;
   const std::size_t tasks = 2000;
-  parallelFor(tasks, 4,
-    [&](std::size_t, int worker) {
+  parallelFor(
+    tasks, 4,
+    [&](std::size_t, int worker)
+    {
       if ((worker == 0) != (std::this_thread::get_id() == caller))
       {
         ++wrongThread;
       }
       std::this_thread::sleep_for(std::chrono::microseconds(20));
     },
-    [&](std::size_t done) {
+    [&](std::size_t done)
+    {
       wrongThread += std::this_thread::get_id() == caller ? 0 : 1;
       ticks.push_back(done);
       return true;
@@ -91,8 +96,10 @@ TEST(ParallelFor, RethrowsTheExceptionATaskThrows)
     std::atomic<int> ran{ 0 };
     try
     {
-      parallelFor(1000, threads,
-        [&](std::size_t task, int) {
+      parallelFor(
+        1000, threads,
+        [&](std::size_t task, int)
+        {
           ++ran;
           if (task == 37)
           {
@@ -113,7 +120,8 @@ TEST(ParallelFor, RethrowsTheExceptionATaskThrows)
   // One worker: tasks run in order and none starts after the failure.
   std::atomic<int> ran{ 0 };
   EXPECT_THROW(parallelFor(1000, 1,
-                 [&](std::size_t task, int) {
+                 [&](std::size_t task, int)
+                 {
                    ++ran;
                    if (task == 37)
                    {
@@ -134,7 +142,13 @@ TEST(ParallelFor, RethrowsTheExceptionATaskThrows)
     EXPECT_EQ(e.Task, 0u);
   }
   // A failure wins over a cancel that the progress asks for at the same time.
-  EXPECT_THROW(parallelFor(10, 1, [](std::size_t task, int) { if (task == 3) throw TaskFailed(task); },
+  EXPECT_THROW(parallelFor(
+                 10, 1,
+                 [](std::size_t task, int)
+                 {
+                   if (task == 3)
+                     throw TaskFailed(task);
+                 },
                  [](std::size_t) { return false; }, 1e9),
     TaskFailed);
 }
@@ -144,8 +158,10 @@ TEST(ParallelFor, CancelStopsStartingTasks)
   // One worker, a tick after every task: the first tick that says stop is the last task.
   std::atomic<int> ran{ 0 };
   int tickCalls = 0;
-  EXPECT_THROW(parallelFor(1000, 1, [&](std::size_t, int) { ++ran; },
-                 [&](std::size_t done) {
+  EXPECT_THROW(parallelFor(
+                 1000, 1, [&](std::size_t, int) { ++ran; },
+                 [&](std::size_t done)
+                 {
                    ++tickCalls;
                    return done < 10;
                  },
@@ -159,8 +175,10 @@ TEST(ParallelFor, CancelStopsStartingTasks)
   for (int threads : { 2, 4 })
   {
     std::atomic<int> started{ 0 };
-    EXPECT_THROW(parallelFor(100000, threads,
-                   [&](std::size_t, int) {
+    EXPECT_THROW(parallelFor(
+                   100000, threads,
+                   [&](std::size_t, int)
+                   {
                      ++started;
                      std::this_thread::sleep_for(std::chrono::milliseconds(1));
                    },
@@ -176,8 +194,9 @@ TEST(ParallelFor, TheFinalTickCanCancelToo)
   // All tasks ran, but a "no" from the tick that reports the end still cancels: a caller's
   // last chance to say stop is not lost.
   std::atomic<int> ran{ 0 };
-  EXPECT_THROW(parallelFor(50, 3, [&](std::size_t, int) { ++ran; },
-                 [](std::size_t done) { return done < 50; }, 1e9),
+  EXPECT_THROW(
+    parallelFor(
+      50, 3, [&](std::size_t, int) { ++ran; }, [](std::size_t done) { return done < 50; }, 1e9),
     Cancelled);
   EXPECT_EQ(ran.load(), 50);
   // Without a tick nothing can cancel.
@@ -189,11 +208,15 @@ TEST(ParallelFor, ResultsKeyedByTaskDoNotDependOnTheWorkers)
   // What the solver does: each task draws from its own stream and adds to the fixed-point
   // sums of the worker that runs it. Every worker count gives the same bits.
   const std::size_t tasks = 5000, records = 13;
-  auto run = [&](int threads, bool copyPerWorker) {
-    FixedPointAccumulator<1> sums(threads, copyPerWorker, records, 1, 1e-9, FrameLayout::FramesInner);
+  auto run = [&](int threads, bool copyPerWorker)
+  {
+    FixedPointAccumulator<1> sums(
+      threads, copyPerWorker, records, 1, 1e-9, FrameLayout::FramesInner);
     std::vector<double> perTask(tasks);
-    parallelFor(tasks, threads,
-      [&](std::size_t task, int worker) {
+    parallelFor(
+      tasks, threads,
+      [&](std::size_t task, int worker)
+      {
         RandomStream random(77, StreamPurpose::Shooting, task);
         double drawn = 0;
         for (int k = 0; k < 10; ++k)

@@ -13,7 +13,8 @@ using mlr::predictedSpeedup;
 
 TEST(PredictedSpeedup, MatchesEquationFourWorkedByHand)
 {
-  // n = 30, k = 1, lambda = 0.25, l = 5: lambda (l - 1) = 1; (30 * 2 + 30) / (30 + 1 + 1) = 90 / 32.
+  // n = 30, k = 1, lambda = 0.25, l = 5: lambda (l - 1) = 1; (30 * 2 + 30) / (30 + 1 + 1) = 90
+  // / 32.
   EXPECT_DOUBLE_EQ(predictedSpeedup(30, 1.0, 0.25, 5.0), 2.8125);
   // n = 2, k = 1, lambda = 1, l = 3: lambda (l - 1) = 2; (2 * 3 + 2) / (2 + 2 + 1) = 8 / 5.
   EXPECT_DOUBLE_EQ(predictedSpeedup(2, 1.0, 1.0, 3.0), 1.6);

@@ -95,7 +95,8 @@ TEST(RandomStream, NeighbouringStreamsAreUncorrelated)
   double s = 0, ss = 0;
   for (int k = 0; k < n; ++k)
   {
-    const double u = RandomStream(9, StreamPurpose::Gathering, static_cast<std::uint64_t>(k)).uniform();
+    const double u =
+      RandomStream(9, StreamPurpose::Gathering, static_cast<std::uint64_t>(k)).uniform();
     s += u, ss += u * u;
   }
   EXPECT_NEAR(s / n, 0.5, 5 * std::sqrt(1.0 / 12 / n));

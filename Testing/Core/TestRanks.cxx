@@ -2,8 +2,8 @@
 // any number of ranks and threads, and a cancel or failure on one rank stops them all. The
 // ranks are threads of this process here, their sums a barrier: Core knows no MPI, only
 // SolverOptions' sum hooks (the filter's tests run the same under mpiexec).
-#include "Error.h"
 #include "CoreChecks.h"
+#include "Error.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -98,22 +98,25 @@ std::vector<RankResult> solveOnRanks(const Scene& scene, const LightRig& rig,
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)
   {
-    threads.emplace_back([&, r] {
-      RankResult& result = results[static_cast<std::size_t>(r)];
-      try
+    threads.emplace_back(
+      [&, r]
       {
-        result.solution = solve(scene, rig, group.optionsFor(r, options), progress ? progress(r) : ProgressCallback());
-      }
-      catch (const Cancelled& e)
-      {
-        result.cancelled = true;
-        result.error = e.what();
-      }
-      catch (const std::exception& e)
-      {
-        result.error = e.what();
-      }
-    });
+        RankResult& result = results[static_cast<std::size_t>(r)];
+        try
+        {
+          result.solution = solve(
+            scene, rig, group.optionsFor(r, options), progress ? progress(r) : ProgressCallback());
+        }
+        catch (const Cancelled& e)
+        {
+          result.cancelled = true;
+          result.error = e.what();
+        }
+        catch (const std::exception& e)
+        {
+          result.error = e.what();
+        }
+      });
   }
   for (std::thread& t : threads)
   {
@@ -192,9 +195,8 @@ TEST(RankFailures, ACancelOnOneRankStopsEveryRank)
   options.threads = 1;
   // Rank 1 cancels a quarter of the way; the others never would.
   const std::vector<RankResult> results = solveOnRanks(scene, twoLights(), options, 3,
-    [](int rank) -> ProgressCallback {
-      return [rank](double fraction) { return rank != 1 || fraction < 0.25; };
-    });
+    [](int rank) -> ProgressCallback
+    { return [rank](double fraction) { return rank != 1 || fraction < 0.25; }; });
   for (const RankResult& result : results)
   {
     EXPECT_TRUE(result.cancelled) << result.error;
@@ -212,30 +214,33 @@ TEST(RankFailures, AFailureOnOneRankIsReportedOnEveryRank)
   std::vector<std::thread> threads;
   for (int r = 0; r < 2; ++r)
   {
-    threads.emplace_back([&, r] {
-      SolverOptions mine = group.optionsFor(r, options);
-      // Rank 1 alone has a memory limit the solve does not fit in.
-      mine.memoryLimitBytes = r == 1 ? 1024 : 0;
-      try
+    threads.emplace_back(
+      [&, r]
       {
-        results[static_cast<std::size_t>(r)].solution = solve(scene, twoLights(), mine);
-      }
-      catch (const FailedOnAnotherRank& e)
-      {
-        results[static_cast<std::size_t>(r)].error = std::string("elsewhere: ") + e.what();
-      }
-      catch (const Error& e)
-      {
-        results[static_cast<std::size_t>(r)].error = e.what();
-      }
-    });
+        SolverOptions mine = group.optionsFor(r, options);
+        // Rank 1 alone has a memory limit the solve does not fit in.
+        mine.memoryLimitBytes = r == 1 ? 1024 : 0;
+        try
+        {
+          results[static_cast<std::size_t>(r)].solution = solve(scene, twoLights(), mine);
+        }
+        catch (const FailedOnAnotherRank& e)
+        {
+          results[static_cast<std::size_t>(r)].error = std::string("elsewhere: ") + e.what();
+        }
+        catch (const Error& e)
+        {
+          results[static_cast<std::size_t>(r)].error = e.what();
+        }
+      });
   }
   for (std::thread& t : threads)
   {
     t.join();
   }
   EXPECT_NE(results[1].error.find("memory limit"), std::string::npos) << results[1].error;
-  EXPECT_NE(results[0].error.find("elsewhere: the solve failed on 1 other rank of 2"), std::string::npos)
+  EXPECT_NE(
+    results[0].error.find("elsewhere: the solve failed on 1 other rank of 2"), std::string::npos)
     << results[0].error;
 }
 

@@ -26,7 +26,8 @@ constexpr double BlockerLow = 0.4, BlockerHigh = 0.6, BlockerHeight = 0.5;
 void addSquare(PatchMesh& mesh, double lo, double hi, double z, bool up)
 {
   const auto first = static_cast<std::uint32_t>(mesh.points.size());
-  mesh.points.insert(mesh.points.end(), { { lo, lo, z }, { hi, lo, z }, { hi, hi, z }, { lo, hi, z } });
+  mesh.points.insert(
+    mesh.points.end(), { { lo, lo, z }, { hi, lo, z }, { hi, hi, z }, { lo, hi, z } });
   if (up)
   {
     mesh.triangles.push_back({ first, first + 1, first + 2 });
@@ -63,9 +64,8 @@ int elementAt(const Scene& scene, const Vec3& p)
     {
       continue;
     }
-    auto edge = [&](const Vec3& u, const Vec3& v) {
-      return (v.x - u.x) * (p.y - u.y) - (v.y - u.y) * (p.x - u.x);
-    };
+    auto edge = [&](const Vec3& u, const Vec3& v)
+    { return (v.x - u.x) * (p.y - u.y) - (v.y - u.y) * (p.x - u.x); };
     const double e0 = edge(a, b), e1 = edge(b, c), e2 = edge(c, a);
     if ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0))
     {
@@ -83,11 +83,13 @@ struct Expected
   double distance;
   bool blocker;
 };
-std::optional<Expected> analyticHit(const Vec3& o, const Vec3& d, bool& ambiguous, double margin = 1e-4)
+std::optional<Expected> analyticHit(
+  const Vec3& o, const Vec3& d, bool& ambiguous, double margin = 1e-4)
 {
   std::optional<Expected> best;
   ambiguous = false;
-  auto consider = [&](double z, double lo, double hi, bool blocker) {
+  auto consider = [&](double z, double lo, double hi, bool blocker)
+  {
     if (d.z == 0)
     {
       return;
@@ -199,7 +201,8 @@ TEST(RayTracer, RandomRaysAgreeWithTheClosedFormAndNearestSide)
   int hits = 0, blockerHits = 0, misses = 0;
   for (int i = 0; i < 20000; ++i)
   {
-    const Vec3 origin(-0.5 + 2 * random.uniform(), -0.5 + 2 * random.uniform(), -1 + 3 * random.uniform());
+    const Vec3 origin(
+      -0.5 + 2 * random.uniform(), -0.5 + 2 * random.uniform(), -1 + 3 * random.uniform());
     // A third of the rays aim at the floor's plane, a third at the blocker's, around and
     // across their edges; the others go anywhere.
     Vec3 direction = randomDirection(random);
@@ -209,7 +212,8 @@ TEST(RayTracer, RandomRaysAgreeWithTheClosedFormAndNearestSide)
     }
     else if (i % 3 == 1)
     {
-      direction = Vec3(0.3 + 0.4 * random.uniform(), 0.3 + 0.4 * random.uniform(), BlockerHeight) - origin;
+      direction =
+        Vec3(0.3 + 0.4 * random.uniform(), 0.3 + 0.4 * random.uniform(), BlockerHeight) - origin;
     }
     direction = direction * (0.1 + 3 * random.uniform());
     bool ambiguous = false;
@@ -256,7 +260,8 @@ TEST(RayTracer, QueriesFromManyThreadsGiveTheSameAnswers)
 {
   const Scene scene = Scene::fromPatchMesh(floorAndBlocker());
   const RayTracer tracer(scene);
-  auto trace = [&](std::vector<std::int64_t>& out) {
+  auto trace = [&](std::vector<std::int64_t>& out)
+  {
     RandomStream random(3, StreamPurpose::Gathering, 9);
     for (int i = 0; i < 5000; ++i)
     {
@@ -319,8 +324,8 @@ TEST(RayTracer, VisibilityOfSegmentsAndDirections)
   int blocked = 0;
   for (std::size_t i = 0; i < visible.size(); ++i)
   {
-    EXPECT_EQ(visible[i], expected[i]) << "segment " << i << " to (" << dx[i] << ", " << dy[i]
-                                       << ", " << dz[i] << ")";
+    EXPECT_EQ(visible[i], expected[i])
+      << "segment " << i << " to (" << dx[i] << ", " << dy[i] << ", " << dz[i] << ")";
     blocked += expected[i] == 0 ? 1 : 0;
   }
   EXPECT_GT(blocked, 5);

@@ -4,8 +4,8 @@
 #include "GeneratedScenes.h"
 #include "LightSource.h"
 #include "OccluderScenes.h"
-#include "Reachability.h"
 #include "RayTracer.h"
+#include "Reachability.h"
 
 #include <gtest/gtest.h>
 
@@ -41,7 +41,8 @@ std::vector<std::uint8_t> reachable(const Scene& scene, const LightRig& rig,
 {
   const RayTracer tracer(scene);
   const std::vector<LightSource> sources = lightSources(scene, rig, sceneEmitters(scene));
-  return reachableSides(scene, tracer, sources, options, workers, [](double) { return true; }, rays);
+  return reachableSides(
+    scene, tracer, sources, options, workers, [](double) { return true; }, rays);
 }
 }
 
@@ -94,7 +95,8 @@ TEST(Reachability, ALightOffInEveryFrameReachesNothing)
   std::vector<LightPose> poses(2);
   for (std::size_t k = 0; k < 2; ++k)
   {
-    poses[k].position = room.translations[k] + MovingLight(room.light, room.power, room.translations).centroid();
+    poses[k].position =
+      room.translations[k] + MovingLight(room.light, room.power, room.translations).centroid();
     poses[k].power = Rgb(0, 0, 0);
   }
   LightRig rig;
@@ -132,11 +134,14 @@ TEST(GatheringSides, OnlyReachableSidesThatReflectGatherAndShareTheRays)
     }
   }
   EXPECT_EQ(sides, expected);
-  EXPECT_EQ(rays, static_cast<std::uint64_t>(std::llround(1000.0 / static_cast<double>(expected.size()))));
+  EXPECT_EQ(
+    rays, static_cast<std::uint64_t>(std::llround(1000.0 / static_cast<double>(expected.size()))));
   // Fewer rays than sides: every side still casts one.
   gatheringSides(scene, reachableSides, rays, 3);
   EXPECT_EQ(rays, 1u);
   // Nothing reachable: nothing gathers.
-  EXPECT_TRUE(gatheringSides(scene, std::vector<std::uint8_t>(2 * scene.patchCount(), 0), rays, 1000).empty());
+  EXPECT_TRUE(
+    gatheringSides(scene, std::vector<std::uint8_t>(2 * scene.patchCount(), 0), rays, 1000)
+      .empty());
   EXPECT_EQ(rays, 0u);
 }

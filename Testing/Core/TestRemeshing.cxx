@@ -150,7 +150,8 @@ const std::vector<Rgb> sixWalls = { Rgb(0.6, 0.2, 0.3), Rgb(0.3, 0.6, 0.2), Rgb(
 
 TEST(Remeshing, UnitCubeKeepsFacesEdgesAndShape)
 {
-  const RemeshResult result = remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }), withEdgeLength(0.1));
+  const RemeshResult result =
+    remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }), withEdgeLength(0.1));
   const PatchMesh& mesh = result.mesh;
   EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
   EXPECT_EQ(result.statistics.fallbackRegions, 0u);
@@ -182,16 +183,19 @@ TEST(Remeshing, UnitCubeKeepsFacesEdgesAndShape)
 
 TEST(Remeshing, EveryElementCarriesTheReflectanceOfItsWall)
 {
-  const RemeshResult result = remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls), withEdgeLength(0.12));
+  const RemeshResult result =
+    remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls), withEdgeLength(0.12));
   EXPECT_EQ(result.statistics.fallbackRegions, 0u);
   const Scene scene = Scene::fromPatchMesh(result.mesh);
   for (std::size_t e = 0; e < scene.elementCount(); ++e)
   {
     const Triangle& t = scene.elementTriangles()[e];
-    const Vec3 centroid = (scene.points()[t[0]] + scene.points()[t[1]] + scene.points()[t[2]]) / 3.0;
+    const Vec3 centroid =
+      (scene.points()[t[0]] + scene.points()[t[1]] + scene.points()[t[2]]) / 3.0;
     const int face = cubeFaceOf(centroid);
     ASSERT_GE(face, 0) << "element " << e << " is not inside one face of the box";
-    EXPECT_EQ(scene.elementReflectance(e), sixWalls[static_cast<std::size_t>(face)]) << "element " << e;
+    EXPECT_EQ(scene.elementReflectance(e), sixWalls[static_cast<std::size_t>(face)])
+      << "element " << e;
   }
 }
 
@@ -211,7 +215,8 @@ TEST(Remeshing, OutputKeepsTheOrientationOfEachInputPolygon)
       Vec3 inward;
       inward[faces[0] / 2] = faces[0] % 2 == 0 ? 1 : -1;
       const double expected = faces[0] == static_cast<int>(odd) ? -1 : 1;
-      EXPECT_NEAR(dot(normal(mesh, p), inward), expected, 1e-9) << "odd wall " << odd << ", patch " << p;
+      EXPECT_NEAR(dot(normal(mesh, p), inward), expected, 1e-9)
+        << "odd wall " << odd << ", patch " << p;
     }
   }
 }
@@ -237,7 +242,8 @@ TEST(Remeshing, FineIcosphereCoarsensToAboutTheTargetCount)
 TEST(Remeshing, PaperScaleRoomGivenAsBigQuads)
 {
   const Rgb white(0.75), red(0.63, 0.065, 0.05), green(0.14, 0.45, 0.091);
-  PolygonSoup room = boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
+  PolygonSoup room =
+    boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
   append(room, boxOfQuads({ 1.3, 0.65, 0 }, { 2.95, 2.3, 1.65 }, { white }, false, true));
   append(room, boxOfQuads({ 2.65, 2.95, 0 }, { 4.3, 4.6, 3.3 }, { white }, false, true));
   RemeshOptions options;
@@ -246,7 +252,8 @@ TEST(Remeshing, PaperScaleRoomGivenAsBigQuads)
   EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
   EXPECT_GE(result.statistics.patches, 2200u);
   EXPECT_LE(result.statistics.patches, 3300u);
-  EXPECT_NEAR(result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  EXPECT_NEAR(
+    result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
   double redArea = 0;
   for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
   {
@@ -273,7 +280,8 @@ TEST(RemeshingMessyInput, EdgeSharedByThreeFacesIsSplitAndRemeshed)
   soup.polygons = { { 0, 2, 3, 1 }, { 0, 1, 5, 4 }, { 0, 6, 7, 1 } };
   soup.materials.assign(3, Material{ Rgb(0.5) });
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "where the surface is not a manifold")) << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "where the surface is not a manifold"))
+    << joined(result.warnings);
   EXPECT_EQ(result.statistics.fallbackRegions, 0u);
   EXPECT_NEAR(result.statistics.outputArea, 3.0, 3.0 * 0.005);
   for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
@@ -286,13 +294,16 @@ TEST(RemeshingMessyInput, EdgeSharedByThreeFacesIsSplitAndRemeshed)
 TEST(RemeshingMessyInput, FacesMeetingAtOnePointAreSplitThere)
 {
   PolygonSoup soup;
-  soup.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { -1, 0, 1 }, { -1, -1, 1 }, { 0, -1, 1 } };
+  soup.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { -1, 0, 1 }, { -1, -1, 1 },
+    { 0, -1, 1 } };
   soup.polygons = { { 0, 1, 2, 3 }, { 0, 4, 5, 6 } };
   soup.materials.assign(2, Material{ Rgb(0.5) });
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "split 1 point where the surface is not a manifold")) << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "split 1 point where the surface is not a manifold"))
+    << joined(result.warnings);
   EXPECT_EQ(result.statistics.fallbackRegions, 0u);
-  EXPECT_NEAR(result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  EXPECT_NEAR(
+    result.statistics.outputArea, result.statistics.inputArea, 0.005 * result.statistics.inputArea);
 }
 
 TEST(RemeshingMessyInput, OpenSurfaceKeepsItsBorderAndCorners)
@@ -305,7 +316,8 @@ TEST(RemeshingMessyInput, OpenSurfaceKeepsItsBorderAndCorners)
   EXPECT_NEAR(totalArea(result.mesh), 2.0, 2.0 * 0.005);
   for (const Vec3& c : corners)
   {
-    EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), c) != result.mesh.points.end());
+    EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), c) !=
+      result.mesh.points.end());
   }
   for (const Vec3& p : result.mesh.points)
   {
@@ -335,7 +347,8 @@ TEST(RemeshingMessyInput, SelfIntersectingSurfacesAreRemeshedAsGiven)
 {
   PolygonSoup crossing;
   addPolygon(crossing, { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } }, Rgb(0.5));
-  addPolygon(crossing, { { 0.5, -0.2, -0.5 }, { 0.5, 1.2, -0.5 }, { 0.5, 1.2, 0.5 }, { 0.5, -0.2, 0.5 } }, Rgb(0.5));
+  addPolygon(crossing,
+    { { 0.5, -0.2, -0.5 }, { 0.5, 1.2, -0.5 }, { 0.5, 1.2, 0.5 }, { 0.5, -0.2, 0.5 } }, Rgb(0.5));
   // A strip that folds back through its own first face.
   PolygonSoup folded;
   folded.points = { { 0, 0, 0 }, { 0, 1, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 1, 0, 1 }, { 1, 1, 1 },
@@ -346,7 +359,8 @@ TEST(RemeshingMessyInput, SelfIntersectingSurfacesAreRemeshedAsGiven)
   {
     const RemeshResult result = remesh(soup, withEdgeLength(0.1));
     EXPECT_EQ(result.statistics.fallbackRegions, 0u) << joined(result.warnings);
-    EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+    EXPECT_NEAR(
+      totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
   }
 }
 
@@ -358,7 +372,8 @@ TEST(RemeshingMessyInput, ZeroAreaPolygonsAreIgnoredWithACount)
   soup.polygons.push_back({ 0, 0, 1 });
   soup.materials.push_back(Material{ Rgb(0.5) });
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "ignored 2 polygons with zero area")) << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "ignored 2 polygons with zero area"))
+    << joined(result.warnings);
   EXPECT_EQ(result.statistics.droppedPolygons, 2u);
   EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
 }
@@ -382,7 +397,8 @@ TEST(RemeshingMessyInput, DuplicatePolygonsAreIgnoredKeepingTheFirstMaterial)
   const std::vector<Vec3> quad = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } };
   addPolygon(soup, quad, Rgb(0.5));
   addPolygon(soup, quad, Rgb(0.3));
-  addPolygon(soup, { quad.rbegin(), quad.rend() }, Rgb(0.5)); // the back face, as exporters write it
+  addPolygon(
+    soup, { quad.rbegin(), quad.rend() }, Rgb(0.5)); // the back face, as exporters write it
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
   EXPECT_TRUE(contains(result.warnings, "ignored 2 duplicate polygons")) << joined(result.warnings);
   EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
@@ -399,21 +415,25 @@ TEST(RemeshingMessyInput, SelfCrossingPolygonIsIgnoredWithAWarning)
   addPolygon(soup, { { 0, 0, 0 }, { 1, 1, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, Rgb(0.5)); // a bow tie
   addPolygon(soup, { { 0, 0, 1 }, { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } }, Rgb(0.5));
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "ignored 1 self-crossing polygon")) << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "ignored 1 self-crossing polygon"))
+    << joined(result.warnings);
   EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
 }
 
 TEST(RemeshingMessyInput, ConcaveAndNonPlanarPolygonsAreKept)
 {
   PolygonSoup soup;
-  addPolygon(soup, { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 1, 1, 0 }, { 1, 2, 0 }, { 0, 2, 0 } }, Rgb(0.5));
+  addPolygon(soup, { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 1, 0 }, { 1, 1, 0 }, { 1, 2, 0 }, { 0, 2, 0 } },
+    Rgb(0.5));
   addPolygon(soup, { { 3, 0, 0 }, { 4, 0, 0.05 }, { 4, 1, 0 }, { 3, 1, 0.05 } }, Rgb(0.5));
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
   EXPECT_TRUE(result.warnings.empty()) << joined(result.warnings);
-  EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  EXPECT_NEAR(
+    totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
   // The reflex corner of the L stays, and nothing fills the notch.
   const Vec3 reflex(1, 1, 0);
-  EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), reflex) != result.mesh.points.end());
+  EXPECT_TRUE(std::find(result.mesh.points.begin(), result.mesh.points.end(), reflex) !=
+    result.mesh.points.end());
   for (const Vec3& p : result.mesh.points)
   {
     EXPECT_FALSE(p.x > 1 + 1e-12 && p.x < 2 && p.y > 1 + 1e-12) << p.x << " " << p.y;
@@ -446,9 +466,12 @@ TEST(RemeshingMessyInput, RegionTooCurvedForThePatchSizeIsOnlyRefined)
   append(soup, ball);
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
   EXPECT_EQ(result.statistics.fallbackRegions, 1u);
-  EXPECT_TRUE(contains(result.warnings, "(reflectance (0.2, 0.2, 0.2), 2000 input triangles) was only refined, not remeshed: remeshing changed its area by"))
+  EXPECT_TRUE(contains(result.warnings,
+    "(reflectance (0.2, 0.2, 0.2), 2000 input triangles) was only refined, not remeshed: remeshing "
+    "changed its area by"))
     << joined(result.warnings);
-  EXPECT_NEAR(totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
+  EXPECT_NEAR(
+    totalArea(result.mesh), result.statistics.inputArea, 0.005 * result.statistics.inputArea);
   std::size_t ballPatches = 0;
   for (const Rgb& rho : result.mesh.reflectance)
   {
@@ -502,10 +525,12 @@ TEST(Remeshing, ProgressRisesToOneAndCancellingStopsQuickly)
 {
   const PolygonSoup room = paperRoomSoup();
   std::vector<double> reported;
-  const RemeshResult result = remesh(room, RemeshOptions{}, [&](double f) {
-    reported.push_back(f);
-    return true;
-  });
+  const RemeshResult result = remesh(room, RemeshOptions{},
+    [&](double f)
+    {
+      reported.push_back(f);
+      return true;
+    });
   EXPECT_EQ(result.statistics.fallbackRegions, 0u) << joined(result.warnings);
   ASSERT_GE(reported.size(), 3u);
   EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
@@ -518,19 +543,22 @@ TEST(Remeshing, ProgressRisesToOneAndCancellingStopsQuickly)
     bool cancelled = false;
     try
     {
-      remesh(room, RemeshOptions{}, [&](double f) {
-        if (f < cancelAt)
+      remesh(room, RemeshOptions{},
+        [&](double f)
         {
-          return true;
-        }
-        asked = std::chrono::steady_clock::now();
-        return false;
-      });
+          if (f < cancelAt)
+          {
+            return true;
+          }
+          asked = std::chrono::steady_clock::now();
+          return false;
+        });
     }
     catch (const Cancelled&)
     {
       cancelled = true;
-      const double latency = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+      const double latency =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
       // 0.5 s on a quiet machine; ten times that under the gate's load (no timing verdicts).
       EXPECT_LT(latency, 5.0) << "cancelled at " << cancelAt;
     }
@@ -555,7 +583,8 @@ TEST(Remeshing, RemeshedClosedBoxAbsorbsAllPower)
   // TestEnergyBalance's closed box, given as 6 big inward quads and remeshed.
   RemeshOptions options;
   options.targetPatchCount = 500;
-  const RemeshResult remeshed = remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls, true), options);
+  const RemeshResult remeshed =
+    remesh(boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, sixWalls, true), options);
   ASSERT_EQ(remeshed.statistics.fallbackRegions, 0u) << joined(remeshed.warnings);
   const Scene scene = Scene::fromPatchMesh(remeshed.mesh);
   const Rgb power(3, 5, 7);
@@ -587,10 +616,12 @@ TEST(Remeshing, CancellingAtAnyProgressCallStopsWithCancelled)
   RemeshOptions options;
   options.targetPatchCount = 1500;
   std::size_t calls = 0;
-  const RemeshResult whole = remesh(soup, options, [&calls](double) {
-    ++calls;
-    return true;
-  });
+  const RemeshResult whole = remesh(soup, options,
+    [&calls](double)
+    {
+      ++calls;
+      return true;
+    });
   ASSERT_GE(calls, 8u);
   EXPECT_GT(whole.statistics.contactSplitTriangles, 0u);
   EXPECT_GT(whole.statistics.coveredTriangles, 0u);

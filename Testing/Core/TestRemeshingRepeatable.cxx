@@ -28,8 +28,8 @@ PolygonSoup boxOnFloor(double x0, double y0)
   const double top = side;
   PolygonSoup soup;
   soup.points = { { -6, -6, 0 }, { 6, -6, 0 }, { 6, 6, 0 }, { -6, 6, 0 }, // floor
-    { x0, y0, top }, { x1, y0, top }, { x1, y1, top }, { x0, y1, top },    // lid
-    { x0, y0, 0 }, { x1, y0, 0 }, { x1, y1, 0 }, { x0, y1, 0 } };          // foot
+    { x0, y0, top }, { x1, y0, top }, { x1, y1, top }, { x0, y1, top },   // lid
+    { x0, y0, 0 }, { x1, y0, 0 }, { x1, y1, 0 }, { x0, y1, 0 } };         // foot
   soup.polygons = { { 0, 1, 2, 3 }, { 4, 5, 6, 7 }, { 8, 9, 5, 4 }, { 9, 10, 6, 5 },
     { 10, 11, 7, 6 }, { 11, 8, 4, 7 } };
   soup.materials.assign(soup.polygons.size(), Material());
@@ -74,7 +74,8 @@ public:
   explicit HeapShuffle(std::uint32_t seed)
   {
     std::uint32_t state = seed * 2654435761u + 1;
-    auto next = [&state] {
+    auto next = [&state]
+    {
       state = state * 1664525u + 1013904223u;
       return state >> 8;
     };
@@ -108,21 +109,25 @@ private:
 template <typename T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b)
 {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+    (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 void expectRepeatable(const PolygonSoup& soup, const std::string& scene)
 {
   const RemeshResult first = remesh(soup, RemeshOptions());
-  ASSERT_GT(first.statistics.contactSplitTriangles, 0u) << scene << ": the floor was not split under the box";
+  ASSERT_GT(first.statistics.contactSplitTriangles, 0u)
+    << scene << ": the floor was not split under the box";
   // On the unfixed code 2 (boxes) to 14 (sphere) of these 24 heaps changed the patches. The
   // seeds are fixed: the heaps are the same in every run of the test.
   for (std::uint32_t seed = 1; seed <= 24; ++seed)
   {
     HeapShuffle shuffle(seed);
     const RemeshResult again = remesh(soup, RemeshOptions());
-    EXPECT_EQ(again.mesh.triangles.size(), first.mesh.triangles.size()) << scene << ", heap " << seed;
-    EXPECT_TRUE(sameBits(again.mesh.points, first.mesh.points) && sameBits(again.mesh.triangles, first.mesh.triangles) &&
+    EXPECT_EQ(again.mesh.triangles.size(), first.mesh.triangles.size())
+      << scene << ", heap " << seed;
+    EXPECT_TRUE(sameBits(again.mesh.points, first.mesh.points) &&
+      sameBits(again.mesh.triangles, first.mesh.triangles) &&
       sameBits(again.mesh.reflectance, first.mesh.reflectance))
       << scene << ", heap " << seed << ": the patches differ";
   }

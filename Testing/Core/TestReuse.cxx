@@ -13,8 +13,8 @@ namespace
 {
 struct BoxWithLight
 {
-  Scene scene = Scene::fromPatchMesh(scenes::closedBox(4, true,
-    { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
+  Scene scene = Scene::fromPatchMesh(scenes::closedBox(
+    4, true, { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
   std::vector<std::vector<Vec3>> light = scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2);
 };
 
@@ -35,7 +35,8 @@ std::vector<double> wallMeans(const BoxWithLight& s, const Solution& solution)
 }
 
 /// Area-weighted mean square error of total radiosity (all channels) against a reference.
-double meanSquareError(const Scene& scene, const Solution& a, const Solution& reference, std::size_t frame)
+double meanSquareError(
+  const Scene& scene, const Solution& a, const Solution& reference, std::size_t frame)
 {
   double sum = 0;
   for (std::size_t e = 0; e < scene.elementCount(); ++e)
@@ -60,7 +61,8 @@ SolverOptions modeOptions(bool reuse, std::uint64_t paths, std::uint64_t seed)
 TEST(Reuse, MeanOverSeedsEqualsClassicMeanForEveryFrame)
 {
   const BoxWithLight s;
-  const MovingLight light(s.light, Rgb(1), scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.2, 0.9 }, { 0.8, 0.8, 0.9 }, 5));
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.2, 0.9 }, { 0.8, 0.8, 0.9 }, 5));
   constexpr int runs = 40;
   const std::size_t values = 6 * light.frameCount();
   std::vector<double> sum[2], sumSquares[2];
@@ -70,7 +72,8 @@ TEST(Reuse, MeanOverSeedsEqualsClassicMeanForEveryFrame)
     sumSquares[mode].assign(values, 0.0);
     for (int r = 0; r < runs; ++r)
     {
-      const Solution solution = solve(s.scene, light, modeOptions(mode == 1, 3000, 1000 + r + 100 * mode));
+      const Solution solution =
+        solve(s.scene, light, modeOptions(mode == 1, 3000, 1000 + r + 100 * mode));
       const std::vector<double> m = wallMeans(s, solution);
       for (std::size_t i = 0; i < values; ++i)
       {
@@ -101,7 +104,8 @@ TEST(Reuse, MeanOverSeedsEqualsClassicMeanForEveryFrame)
 TEST(Reuse, ErrorFallsAsInverseSquareRootOfPaths)
 {
   const BoxWithLight s;
-  const MovingLight light(s.light, Rgb(1), scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 4));
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 4));
   const Solution reference = solve(s.scene, light, modeOptions(false, 1600000, 99));
   for (bool reuse : { false, true })
   {
@@ -150,14 +154,16 @@ TEST(Reuse, IdenticalPositionsGiveTheErrorOfClassic)
 TEST(Reuse, CastsFewerRaysThanClassic)
 {
   const BoxWithLight s;
-  const MovingLight light(s.light, Rgb(1), scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 10));
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, 10));
   const Solution classic = solve(s.scene, light, modeOptions(false, 20000, 1));
   const Solution reuse = solve(s.scene, light, modeOptions(true, 20000, 1));
   EXPECT_EQ(classic.statistics.pathsCast, 10u * 20000);
   EXPECT_EQ(reuse.statistics.pathsCast, 20000u);
   EXPECT_EQ(classic.statistics.shadowRays, 0u);
   EXPECT_GT(reuse.statistics.shadowRays, 0u);
-  EXPECT_NEAR(double(classic.statistics.gatheringRays) / double(reuse.statistics.gatheringRays), 10.0, 1e-9);
+  EXPECT_NEAR(
+    double(classic.statistics.gatheringRays) / double(reuse.statistics.gatheringRays), 10.0, 1e-9);
   EXPECT_LT(reuse.statistics.shootingRays * 5, classic.statistics.shootingRays);
   // Both estimate the same mean path length l.
   EXPECT_NEAR(reuse.statistics.meanPathLength / classic.statistics.meanPathLength, 1.0, 0.05);

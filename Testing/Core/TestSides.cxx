@@ -11,7 +11,8 @@ using namespace mlr;
 
 namespace
 {
-const std::vector<Rgb> walls = { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) };
+const std::vector<Rgb> walls = { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6),
+  Rgb(0.5), Rgb(0.7) };
 
 MovingLight boxLight()
 {

@@ -231,8 +231,8 @@ struct Measured
 {
   const char* mode = "";
   MemoryPlan plan;
-  std::uint64_t peak = 0;     ///< the heap's peak during the solve, above what was live before
-  std::uint64_t held = 0;     ///< what the solution holds after it
+  std::uint64_t peak = 0; ///< the heap's peak during the solve, above what was live before
+  std::uint64_t held = 0; ///< what the solution holds after it
 };
 
 /// The three ways a solve keeps its accumulators, on the scene of ManyFrames: one copy per
@@ -243,12 +243,13 @@ std::vector<Measured> measureTheModes()
   const std::size_t frames = f.light.frameCount();
   EXPECT_EQ(frames, 1000u);
   // Embree's device, TBB's threads and other once-per-process allocations come first.
-  solve(f.scene, MovingLight(f.light.polygons(), Rgb(1), std::vector<Vec3>{ Vec3(), Vec3(0.01, 0, 0) }),
+  solve(f.scene,
+    MovingLight(f.light.polygons(), Rgb(1), std::vector<Vec3>{ Vec3(), Vec3(0.01, 0, 0) }),
     optionsFor(2, 0));
 
   const int threads = 3;
-  const MemoryPlan perWorker = planSolveMemory(
-    f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(), frames, optionsFor(threads, 0));
+  const MemoryPlan perWorker = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
+    f.scene.points().size(), frames, optionsFor(threads, 0));
   EXPECT_TRUE(perWorker.accumulatorCopyPerWorker);
   // A limit of the per-worker peak leaves no room for the copies (they need it to be within
   // half the limit): the workers share one copy.
@@ -268,7 +269,8 @@ std::vector<Measured> measureTheModes()
     const Solution solution = solve(f.scene, f.light, mode.options);
     r.peak = m.peak();
     r.held = m.live();
-    EXPECT_EQ(solution.statistics.accumulatorCopyPerWorker, r.plan.accumulatorCopyPerWorker) << mode.name;
+    EXPECT_EQ(solution.statistics.accumulatorCopyPerWorker, r.plan.accumulatorCopyPerWorker)
+      << mode.name;
     EXPECT_EQ(solution.statistics.memoryEstimateBytes, r.plan.peak) << mode.name;
     std::printf("%s: estimate %.3f MB (results %.3f, accumulators %.3f, other %.3f); measured "
                 "peak %.3f MB, results held "
@@ -304,4 +306,3 @@ TEST(SolveMemory, TheEstimateBoundsThePeakAndTheResultsTightly)
     EXPECT_LE(r.held, r.plan.results + r.plan.other) << mode;
   }
 }
-

@@ -36,7 +36,8 @@ LightRig sunRig(const DirectionalLight& sun)
 /// A square ground [-size/2, size/2]^2 at z = 0, facing up, cells x cells.
 void addGround(PatchMesh& mesh, double size, int cells, const Rgb& rho)
 {
-  scenes::addGriddedQuad(mesh, { -size / 2, -size / 2, 0 }, { size, 0, 0 }, { 0, size, 0 }, cells, cells, rho);
+  scenes::addGriddedQuad(
+    mesh, { -size / 2, -size / 2, 0 }, { size, 0, 0 }, { 0, size, 0 }, cells, cells, rho);
 }
 
 /// 2D convex hull (Andrew's monotone chain) of the points' x and y, counter-clockwise.
@@ -44,9 +45,8 @@ std::vector<Vec3> convexHull(std::vector<Vec3> points)
 {
   std::sort(points.begin(), points.end(),
     [](const Vec3& a, const Vec3& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  auto turn = [](const Vec3& o, const Vec3& a, const Vec3& b) {
-    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-  };
+  auto turn = [](const Vec3& o, const Vec3& a, const Vec3& b)
+  { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
   std::vector<Vec3> hull(2 * points.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -191,12 +191,14 @@ TEST(Sun, UnoccludedGroundGetsRhoTimesIrradianceTimesSineOfElevation)
         {
           const double rhoE = scene.elementReflectance(e)[c] * irradiance[c];
           const double exact = rhoE * sine;
-          const double z = (solution.direct(f, e, Side::Front)[c] - exact) / (rhoE * score * std::sqrt(variance));
+          const double z =
+            (solution.direct(f, e, Side::Front)[c] - exact) / (rhoE * score * std::sqrt(variance));
           meanSquare += z * z;
           maxAbs = std::max(maxAbs, std::abs(z));
           ++count;
           EXPECT_EQ(solution.direct(f, e, Side::Back)[c], 0.0) << "the ground's underside is dark";
-          EXPECT_EQ(solution.indirect(f, e, Side::Front)[c], 0.0) << "a lone plane reflects nothing onto itself";
+          EXPECT_EQ(solution.indirect(f, e, Side::Front)[c], 0.0)
+            << "a lone plane reflects nothing onto itself";
         }
       }
     }
@@ -220,7 +222,8 @@ TEST(Sun, BoxBuildingCastsItsProjectedShadow)
   const std::size_t groundElements = mesh.triangles.size() * Scene::ElementsPerPatch;
   scenes::addBox(mesh, lo, hi, 0.25, false, { Rgb(0.6) }, true);
   const Scene scene = Scene::fromPatchMesh(mesh);
-  const std::vector<Vec3> directions = { sunDirection(35, 30), sunDirection(50, 160), sunDirection(70, 260) };
+  const std::vector<Vec3> directions = { sunDirection(35, 30), sunDirection(50, 160),
+    sunDirection(70, 260) };
   const Rgb irradiance(1000, 900, 700);
   const DirectionalLight sun(directions, irradiance);
   const double discArea = M_PI * std::pow(0.5 * scene.diagonal(), 2);
@@ -250,7 +253,8 @@ TEST(Sun, BoxBuildingCastsItsProjectedShadow)
         if (inShadow)
         {
           ++shadowed;
-          EXPECT_EQ(solution.direct(f, e, Side::Front), Rgb()) << mode << " frame " << f << " element " << e;
+          EXPECT_EQ(solution.direct(f, e, Side::Front), Rgb())
+            << mode << " frame " << f << " element " << e;
         }
       }
       EXPECT_GT(shadowed, 50u);
@@ -258,16 +262,18 @@ TEST(Sun, BoxBuildingCastsItsProjectedShadow)
       // With reuse a path scores at most 1/M_f of rho E A_disc in frame f (its weight), so
       // the variance is at most (rho E A_disc)^2 q / M_f: sigma is that bound.
       const double q = s.z * litArea / discArea;
-      const double relativeSigma = reuse ? std::sqrt(q / M) / q : std::sqrt(N * q * (1 - q)) / (N * q);
+      const double relativeSigma =
+        reuse ? std::sqrt(q / M) / q : std::sqrt(N * q * (1 - q)) / (N * q);
       for (int c = 0; c < 3; ++c)
       {
         const double exact = groundRho[c] * irradiance[c] * s.z * litArea;
         EXPECT_NEAR(power[c] / exact, 1.0, 4 * relativeSigma)
           << mode << " frame " << f << " channel " << c << ": shadow area " << polygonArea(shadow);
       }
-      std::cout << mode << " frame " << f << ": ground direct power / exact " << power.g / (groundRho.g * irradiance.g * s.z * litArea)
-                << ", sigma " << relativeSigma << ", shadow " << polygonArea(shadow) << " m^2, "
-                << shadowed << " elements fully in it\n";
+      std::cout << mode << " frame " << f << ": ground direct power / exact "
+                << power.g / (groundRho.g * irradiance.g * s.z * litArea) << ", sigma "
+                << relativeSigma << ", shadow " << polygonArea(shadow) << " m^2, " << shadowed
+                << " elements fully in it\n";
     }
   }
 }
@@ -278,14 +284,16 @@ TEST(Sun, ReuseMatchesClassicInEveryFrame)
   addGround(mesh, 4, 8, Rgb(0.5, 0.4, 0.3));
   const std::size_t groundElements = mesh.triangles.size() * Scene::ElementsPerPatch;
   scenes::addBox(mesh, { -0.5, -0.5, 0 }, { 0.5, 0.5, 1 }, 0.5, false,
-    { Rgb(0.7, 0.2, 0.2), Rgb(0.2, 0.7, 0.2), Rgb(0.6), Rgb(0.4), Rgb(0.5), Rgb(0.6, 0.6, 0.2) }, true);
+    { Rgb(0.7, 0.2, 0.2), Rgb(0.2, 0.7, 0.2), Rgb(0.6), Rgb(0.4), Rgb(0.5), Rgb(0.6, 0.6, 0.2) },
+    true);
   const Scene scene = Scene::fromPatchMesh(mesh);
   // Groups: the ground, then the box's walls -x, +x, -y, +y and its roof, 8 patches each.
   const std::size_t faceElements = 8 * Scene::ElementsPerPatch;
   ASSERT_EQ(scene.elementCount(), groundElements + 5 * faceElements);
-  auto groupOf = [&](std::size_t e) { return e < groundElements ? 0 : 1 + (e - groundElements) / faceElements; };
-  const DirectionalLight sun({ sunDirection(20, 0), sunDirection(45, 60), sunDirection(65, 150),
-                               sunDirection(30, 230) },
+  auto groupOf = [&](std::size_t e)
+  { return e < groundElements ? 0 : 1 + (e - groundElements) / faceElements; };
+  const DirectionalLight sun(
+    { sunDirection(20, 0), sunDirection(45, 60), sunDirection(65, 150), sunDirection(30, 230) },
     Rgb(1000), { Rgb(1), Rgb(0.8, 0.9, 1), Rgb(1), Rgb(0.5) });
   constexpr int runs = 20;
   SeedMoments moments[2];
@@ -293,11 +301,13 @@ TEST(Sun, ReuseMatchesClassicInEveryFrame)
   {
     for (int r = 0; r < runs; ++r)
     {
-      const Solution solution = solve(scene, sunRig(sun), modeOptions(mode == 1, 4000, 700 + r + 100 * mode));
+      const Solution solution =
+        solve(scene, sunRig(sun), modeOptions(mode == 1, 4000, 700 + r + 100 * mode));
       moments[mode].add(checks::groupPowers(scene, solution, 6, groupOf, 1));
     }
   }
-  const double chiSquare = checks::expectSameMeans(moments[1], { &moments[0] }, "reuse against classic");
+  const double chiSquare =
+    checks::expectSameMeans(moments[1], { &moments[0] }, "reuse against classic");
   std::cout << "mean z^2 over 6 groups x 4 frames: " << chiSquare << "\n";
 }
 
@@ -307,8 +317,10 @@ TEST(Sun, NightFrameIsDarkAndCastsNothing)
   addGround(mesh, 4, 6, Rgb(0.5));
   scenes::addBox(mesh, { -0.5, -0.5, 0 }, { 0.5, 0.5, 1 }, 0.5, false, { Rgb(0.6) }, true);
   const Scene scene = Scene::fromPatchMesh(mesh);
-  const Vec3 morning = sunDirection(25, 80), noon = sunDirection(60, 180), evening = sunDirection(20, 280);
-  const DirectionalLight withNight({ morning, noon, evening }, Rgb(900), { Rgb(1), Rgb(0), Rgb(0.5, 1, 1) });
+  const Vec3 morning = sunDirection(25, 80), noon = sunDirection(60, 180),
+             evening = sunDirection(20, 280);
+  const DirectionalLight withNight(
+    { morning, noon, evening }, Rgb(900), { Rgb(1), Rgb(0), Rgb(0.5, 1, 1) });
   const DirectionalLight dayOnly({ morning, evening }, Rgb(900), { Rgb(1), Rgb(0.5, 1, 1) });
   for (bool reuse : { false, true })
   {
@@ -316,7 +328,8 @@ TEST(Sun, NightFrameIsDarkAndCastsNothing)
     const SolverOptions options = modeOptions(reuse, 20000, 5);
     const Solution a = solve(scene, sunRig(withNight), options);
     const Solution b = solve(scene, sunRig(dayOnly), options);
-    EXPECT_EQ(a.statistics.pathsCast, reuse ? options.pathsPerFrame : 2 * options.pathsPerFrame) << mode;
+    EXPECT_EQ(a.statistics.pathsCast, reuse ? options.pathsPerFrame : 2 * options.pathsPerFrame)
+      << mode;
     EXPECT_TRUE(a.warnings.empty()) << mode;
     double day = 0;
     for (std::size_t e = 0; e < scene.elementCount(); ++e)
@@ -338,7 +351,8 @@ TEST(Sun, NightFrameIsDarkAndCastsNothing)
     EXPECT_GT(day, 0.0);
     if (reuse)
     {
-      EXPECT_EQ(a.statistics.shadowRays, b.statistics.shadowRays) << "no shadow ray towards the night";
+      EXPECT_EQ(a.statistics.shadowRays, b.statistics.shadowRays)
+        << "no shadow ray towards the night";
     }
   }
 }
@@ -359,7 +373,8 @@ TEST(Sun, NoSurfaceFacingTheSunGivesZeroWithAWarning)
     Solution solution;
     ASSERT_NO_THROW(solution = solve(scene, sunRig(sun), modeOptions(reuse, 10000, 2)));
     ASSERT_EQ(solution.warnings.size(), 1u);
-    EXPECT_NE(solution.warnings[0].find("no light reached the scene"), std::string::npos) << solution.warnings[0];
+    EXPECT_NE(solution.warnings[0].find("no light reached the scene"), std::string::npos)
+      << solution.warnings[0];
     for (std::size_t f = 0; f < 2; ++f)
     {
       for (std::size_t e = 0; e < scene.elementCount(); ++e)
@@ -375,18 +390,31 @@ TEST(Sun, BadInputIsRefusedWithWhatToFix)
 {
   const double nan = std::nan("");
   const std::vector<Vec3> two = { sunDirection(30, 0), sunDirection(40, 90) };
-  expectError([&] { DirectionalLight({ sunDirection(30, 0), Vec3(0, 0, 0) }, Rgb(1000)); },
+  expectError(
+    [&] {
+      DirectionalLight({ sunDirection(30, 0), Vec3(0, 0, 0) }, Rgb(1000));
+    },
     "direction 1 towards the light is (0, 0, 0): it must be finite and not zero");
-  expectError([&] { DirectionalLight({ Vec3(nan, 0, 1) }, Rgb(1000)); }, "direction 0 towards the light");
+  expectError(
+    [&] { DirectionalLight({ Vec3(nan, 0, 1) }, Rgb(1000)); }, "direction 0 towards the light");
   expectError([&] { DirectionalLight({}, Rgb(1000)); }, "no direction");
   for (const Rgb& bad : { Rgb(0), Rgb(-1000), Rgb(1000, -1, 1000), Rgb(nan), Rgb(1000, nan, 1000) })
   {
     expectError([&] { DirectionalLight(two, bad); }, "irradiance");
   }
   EXPECT_NO_THROW(DirectionalLight(two, Rgb(1000, 0, 0))) << "one dark channel is fine";
-  expectError([&] { DirectionalLight(two, Rgb(1000), { Rgb(1), Rgb(-0.5) }); }, "power factor of direction 1");
-  expectError([&] { DirectionalLight(two, Rgb(1000), { Rgb(nan), Rgb(1) }); }, "power factor of direction 0");
-  expectError([&] { DirectionalLight(two, Rgb(1000), { Rgb(1) }); }, "2 directions but 1 power factors");
+  expectError(
+    [&] {
+      DirectionalLight(two, Rgb(1000), { Rgb(1), Rgb(-0.5) });
+    },
+    "power factor of direction 1");
+  expectError(
+    [&] {
+      DirectionalLight(two, Rgb(1000), { Rgb(nan), Rgb(1) });
+    },
+    "power factor of direction 0");
+  expectError(
+    [&] { DirectionalLight(two, Rgb(1000), { Rgb(1) }); }, "2 directions but 1 power factors");
 
   // A sun and a moving lamp must agree on the frames; a static lamp always does.
   LightRig rig;
@@ -395,11 +423,13 @@ TEST(Sun, BadInputIsRefusedWithWhatToFix)
   rig.areaLights.emplace_back(lamp, Rgb(1), std::vector<Vec3>(1));
   EXPECT_EQ(frameCount(rig, false), 2u);
   rig.areaLights.emplace_back(lamp, Rgb(1), std::vector<Vec3>(3));
-  expectError([&] { frameCount(rig, false); }, "directional light 0 has 2 positions but light 1 has 3");
+  expectError(
+    [&] { frameCount(rig, false); }, "directional light 0 has 2 positions but light 1 has 3");
 
   PatchMesh mesh;
   addGround(mesh, 1, 2, Rgb(0.5));
   const Scene scene = Scene::fromPatchMesh(mesh);
-  expectError([&] { solve(scene, sunRig(DirectionalLight(two, Rgb(1000))), modeOptions(true, 1, 1)); },
+  expectError([&]
+    { solve(scene, sunRig(DirectionalLight(two, Rgb(1000))), modeOptions(true, 1, 1)); },
     "give at least 2 paths per frame");
 }

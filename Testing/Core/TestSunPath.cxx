@@ -28,8 +28,8 @@ TEST(SunPath, MatchesTheSolarPositionAlgorithmExample)
   // table A4.1: Golden, Colorado, 2003-10-17 12:30:30 local time (UTC-7): topocentric zenith
   // 50.11162 degrees (with refraction, about 0.02 degrees at this height), azimuth 194.34024.
   double azimuth = 0, elevation = 0;
-  sunAzimuthElevation(39.742476, -105.1786, julianDay(2003, 10, 17, 19.5 + 30.0 / 3600), azimuth,
-    elevation);
+  sunAzimuthElevation(
+    39.742476, -105.1786, julianDay(2003, 10, 17, 19.5 + 30.0 / 3600), azimuth, elevation);
   EXPECT_NEAR(elevation, 90 - 50.11162, 0.1);
   EXPECT_NEAR(azimuth, 194.34024, 0.1);
 }

@@ -25,8 +25,8 @@ namespace mlr::testing
 
 namespace
 {
-vtkSmartPointer<vtkPolyData> polygons(const std::vector<Vec3>& points,
-  const std::vector<std::vector<vtkIdType>>& cells)
+vtkSmartPointer<vtkPolyData> polygons(
+  const std::vector<Vec3>& points, const std::vector<std::vector<vtkIdType>>& cells)
 {
   vtkNew<vtkPoints> vtkPoints;
   vtkPoints->SetDataTypeToDouble();
@@ -139,7 +139,8 @@ std::vector<double> timeSteps(vtkAlgorithm* algorithm)
 
 double fieldValue(vtkDataObject* data, const char* name)
 {
-  vtkDataArray* array = data && data->GetFieldData() ? data->GetFieldData()->GetArray(name) : nullptr;
+  vtkDataArray* array =
+    data && data->GetFieldData() ? data->GetFieldData()->GetArray(name) : nullptr;
   return array && array->GetNumberOfTuples() > 0 ? array->GetComponent(0, 0)
                                                  : std::numeric_limits<double>::quiet_NaN();
 }

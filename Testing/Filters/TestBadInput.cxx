@@ -156,8 +156,8 @@ TEST(FilterBadInput, TrajectoryTimesMustIncreaseAndNoEarlierResultStays)
   ASSERT_TRUE(filter->UpdateTimeStep(0));
   ASSERT_GT(filter->GetOutput()->GetNumberOfCells(), 0);
 
-  filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT,
-    trajectoryPolyData(setup.positions, { 0, 2, 1 }));
+  filter->SetInputData(
+    vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectoryPolyData(setup.positions, { 0, 2, 1 }));
   auto messages = vtkSmartPointer<MessageRecorder>::New();
   messages->watch(filter);
   EXPECT_FALSE(filter->UpdateTimeStep(0));
@@ -258,15 +258,17 @@ TEST(FilterBadInput, AbortStopsQuicklyWithEmptyOutputsAndRecovers)
   } state{ filter };
   vtkNew<vtkCallbackCommand> abortMidway;
   abortMidway->SetClientData(&state);
-  abortMidway->SetCallback([](vtkObject*, unsigned long, void* data, void*) {
-    auto* s = static_cast<AbortState*>(data);
-    if (!s->aborted && s->filter->GetProgress() > 0.1)
+  abortMidway->SetCallback(
+    [](vtkObject*, unsigned long, void* data, void*)
     {
-      s->aborted = true;
-      s->abortedAt = Clock::now();
-      s->filter->SetAbortExecute(1);
-    }
-  });
+      auto* s = static_cast<AbortState*>(data);
+      if (!s->aborted && s->filter->GetProgress() > 0.1)
+      {
+        s->aborted = true;
+        s->abortedAt = Clock::now();
+        s->filter->SetAbortExecute(1);
+      }
+    });
   filter->AddObserver(vtkCommand::ProgressEvent, abortMidway);
   const FilterRun run = runFilter(filter);
   const double seconds = std::chrono::duration<double>(Clock::now() - state.abortedAt).count();

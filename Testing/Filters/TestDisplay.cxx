@@ -105,9 +105,8 @@ TEST(FilterDisplay, ColorIsTheNamedToneMapOfTheExposedRadiosity)
   EXPECT_DOUBLE_EQ(scale, std::exp2(fieldValue(elements, "AutoExposure")));
   EXPECT_EQ(fieldValue(elements, "Exposure"), 0.0);
 
-  for (vtkDataSetAttributes* data :
-    { static_cast<vtkDataSetAttributes*>(elements->GetCellData()),
-      static_cast<vtkDataSetAttributes*>(elements->GetPointData()) })
+  for (vtkDataSetAttributes* data : { static_cast<vtkDataSetAttributes*>(elements->GetCellData()),
+         static_cast<vtkDataSetAttributes*>(elements->GetPointData()) })
   {
     auto* color = vtkUnsignedCharArray::SafeDownCast(data->GetArray("Color"));
     vtkDataArray* radiosity = data->GetArray("Radiosity");
@@ -121,8 +120,8 @@ TEST(FilterDisplay, ColorIsTheNamedToneMapOfTheExposedRadiosity)
       for (int c = 0; c < 3; ++c)
       {
         const double expected = srgb(aces(scale * radiosity->GetComponent(i, c)));
-        worst = std::max(worst, static_cast<int>(std::ceil(
-                                  std::abs(expected - color->GetTypedComponent(i, c)) - 0.5)));
+        worst = std::max(worst,
+          static_cast<int>(std::ceil(std::abs(expected - color->GetTypedComponent(i, c)) - 0.5)));
       }
     }
     EXPECT_EQ(worst, 0) << "Color differs from round(sRGB(ACES(ExposureScale x Radiosity)))";

@@ -132,7 +132,8 @@ double wallPower(vtkPolyData* elements, int axis, bool high, const char* name)
 }
 
 /// Adds the point array `name` with `components` components to `data`.
-void addPointArray(vtkPolyData* data, const char* name, int components, const std::vector<double>& values)
+void addPointArray(
+  vtkPolyData* data, const char* name, int components, const std::vector<double>& values)
 {
   vtkNew<vtkDoubleArray> array;
   array->SetName(name);
@@ -420,7 +421,8 @@ TEST(FilterRigs, TwoLightsAddUp)
   // (a light is switched off by a LightPower of 0, keeping the LightId groups).
   const Rgb p0(2, 3, 4), p1(4, 2, 1), off(0, 0, 0);
   BoxSetup setup = closedBoxSetup(3);
-  auto solve = [&](const Rgb& a, const Rgb& b, const char* name) {
+  auto solve = [&](const Rgb& a, const Rgb& b, const char* name)
+  {
     setup.light = twoLights(a, b);
     setup.trajectory = twoLightTrajectory(false);
     auto filter = boxFilter(setup, 200000);
@@ -538,7 +540,8 @@ namespace
 {
 /// The closed box of closedBoxSetup with the top wall (z = 1, facing down into the box)
 /// emitting `emission` from the cell array `name`; reflectance 0.5 everywhere.
-vtkSmartPointer<vtkPolyData> emissiveBox(const std::vector<double>& emission, const char* name = "Emission")
+vtkSmartPointer<vtkPolyData> emissiveBox(
+  const std::vector<double>& emission, const char* name = "Emission")
 {
   auto scene = closedBoxSetup(1).scene;
   vtkNew<vtkDoubleArray> array;
@@ -601,7 +604,8 @@ TEST(FilterRigs, EmissiveWallInAClosedBox)
         emitted->GetComponent(c, k) + direct->GetComponent(c, k) + indirect->GetComponent(c, k),
         1e-5 * radiosity->GetComponent(c, k));
       // Absorbed = (1 - rho) x irradiance = (1 - rho) / rho x reflected, reflected = B - E.
-      absorbed[k] += 0.5 * length(area) * (radiosity->GetComponent(c, k) - emitted->GetComponent(c, k));
+      absorbed[k] +=
+        0.5 * length(area) * (radiosity->GetComponent(c, k) - emitted->GetComponent(c, k));
     }
   }
   EXPECT_GT(emitters, 0);
@@ -654,8 +658,8 @@ TEST(FilterRigs, EmissionAddsToALight)
     {
       for (int k = 0; k < 3; ++k)
       {
-        absorbed[k] += triangleArea(elements, c) *
-          (radiosity->GetComponent(c, k) - emitted->GetComponent(c, k));
+        absorbed[k] +=
+          triangleArea(elements, c) * (radiosity->GetComponent(c, k) - emitted->GetComponent(c, k));
       }
     }
     for (int k = 0; k < 3; ++k)
@@ -678,7 +682,8 @@ TEST(FilterRigs, EmissionAndReflectanceArrayNames)
   ASSERT_TRUE(r.succeeded) << r.messages->allErrors();
   EXPECT_EQ(r.messages->allWarnings().find("Reflectance"), std::string::npos)
     << r.messages->allWarnings();
-  EXPECT_FLOAT_EQ(static_cast<float>(maxValue(cellValues(filter->GetOutput(), "EmittedRadiosity"))), 3.0f);
+  EXPECT_FLOAT_EQ(
+    static_cast<float>(maxValue(cellValues(filter->GetOutput(), "EmittedRadiosity"))), 3.0f);
 }
 
 TEST(FilterRigs, NegativeEmissionIsAnError)
@@ -708,7 +713,8 @@ vtkSmartPointer<vtkPolyData> sunDirections(const std::vector<double>& elevations
   for (std::size_t i = 0; i < elevations.size(); ++i)
   {
     const double e = elevations[i] * Pi / 180, a = azimuths[i] * Pi / 180;
-    points.push_back(Vec3(std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e)) * lengths[i]);
+    points.push_back(
+      Vec3(std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e)) * lengths[i]);
   }
   auto data = trajectoryPolyData(points);
   addPointArray(data, "SunAzimuth", 1, azimuths);
@@ -716,7 +722,8 @@ vtkSmartPointer<vtkPolyData> sunDirections(const std::vector<double>& elevations
   return data;
 }
 
-vtkSmartPointer<vtkMovingLightRadiosity> sunFilter(vtkPolyData* scene, vtkPolyData* directions, vtkIdType paths)
+vtkSmartPointer<vtkMovingLightRadiosity> sunFilter(
+  vtkPolyData* scene, vtkPolyData* directions, vtkIdType paths)
 {
   auto filter = vtkSmartPointer<vtkMovingLightRadiosity>::New();
   filter->SetSceneData(scene);
@@ -777,7 +784,8 @@ TEST(FilterSun, GroundGetsRhoTimesIrradianceTimesSinElevation)
       EXPECT_NEAR(sun->GetComponent(0, 2), s, 1e-12);
       EXPECT_NEAR(fieldValue(elements, "SunElevation"), elevations[f], 1e-12);
       EXPECT_NEAR(fieldValue(elements, "SunAzimuth"), azimuths[f], 1e-12);
-      EXPECT_NEAR(fieldValue(filter->GetOutput(vtkMovingLightRadiosity::PATCHES_PORT), "SunElevation"),
+      EXPECT_NEAR(
+        fieldValue(filter->GetOutput(vtkMovingLightRadiosity::PATCHES_PORT), "SunElevation"),
         elevations[f], 1e-12);
     }
   }
@@ -787,7 +795,8 @@ TEST(FilterSun, TimeStepsArePointsAndPowerScalesIrradiance)
 {
   // The same four directions (elevation 40) at times 6, 9, 12 and 18.5, with three Power
   // arrays: none, half at 9, and night (0) at 12.
-  auto filterWith = [](const std::vector<double>& power) {
+  auto filterWith = [](const std::vector<double>& power)
+  {
     auto directions = sunDirections({ 40, 40, 40, 40 }, { 0, 90, 180, 270 }, { 1, 1, 1, 1 });
     addPointArray(directions, "Time", 1, { 6, 9, 12, 18.5 });
     if (!power.empty())

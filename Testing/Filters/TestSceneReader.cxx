@@ -10,11 +10,11 @@
 #include "vtkJPEGWriter.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
-#include "vtkUnsignedCharArray.h"
 #include "vtkPolyData.h"
 #include "vtkRadiositySceneReader.h"
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <gtest/gtest.h>
 
@@ -93,7 +93,8 @@ std::array<double, 3> tuple3(vtkPolyData* mesh, const char* name, vtkIdType cell
 std::vector<std::string> materialNames(vtkPolyData* mesh)
 {
   std::vector<std::string> names;
-  auto* array = vtkStringArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray("MaterialNames"));
+  auto* array =
+    vtkStringArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray("MaterialNames"));
   for (vtkIdType i = 0; array && i < array->GetNumberOfValues(); ++i)
   {
     names.push_back(array->GetValue(i));
@@ -127,7 +128,7 @@ void expectRgbNear(const std::array<double, 3>& actual, double r, double g, doub
 const double White[3] = { 0.725, 0.71, 0.68 };
 const double Red[3] = { 0.63, 0.065, 0.05 };
 const float Corners[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, // floor
-  { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 1 }, { 0, 0, 1 } };                          // wall
+  { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 1 }, { 0, 0, 1 } };                           // wall
 const std::uint16_t Triangles[4][3] = { { 0, 1, 2 }, { 0, 2, 3 }, { 4, 5, 6 }, { 4, 6, 7 } };
 
 void expectTwoMaterialScene(vtkPolyData* mesh, double tolerance)
@@ -178,14 +179,18 @@ std::string gltfJson(const std::string& bufferUri, const std::string& extra = ""
   "asset": {"version": "2.0"},
   "scene": 0,
   "scenes": [{"nodes": [0]}],
-  "nodes": [{"translation": )" + translation + R"(, "children": [1]}, {"mesh": 0}],
+  "nodes": [{"translation": )" +
+    translation + R"(, "children": [1]}, {"mesh": 0}],
   "meshes": [{"primitives": [
-    {"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": )" + std::to_string(mode) + R"(},
-    {"attributes": {"POSITION": 0}, "indices": 2, "material": 1, "mode": )" + std::to_string(mode) + R"(}]}],
+    {"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": )" +
+    std::to_string(mode) + R"(},
+    {"attributes": {"POSITION": 0}, "indices": 2, "material": 1, "mode": )" +
+    std::to_string(mode) + R"(}]}],
   "materials": [
     {"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}},
     {"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}}],
-  "buffers": [{)" + uri + R"("byteLength": 120}],
+  "buffers": [{)" +
+    uri + R"("byteLength": 120}],
   "bufferViews": [
     {"buffer": 0, "byteOffset": 0, "byteLength": 96},
     {"buffer": 0, "byteOffset": 96, "byteLength": 24}],
@@ -382,8 +387,8 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
 {
   const TestFolder scratch("formats");
   const fs::path& folder = scratch.path;
-  writeFile(folder / "scene.mtl",
-    "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
+  writeFile(
+    folder / "scene.mtl", "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
   writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
   writeFile(folder / "scene.gltf", gltfJson(dataUri(gltfBuffer())));
   writeFile(folder / "scene.glb", glbFile(gltfJson(""), gltfBuffer()));
@@ -391,12 +396,14 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   writeFile(folder / "external.gltf", gltfJson("scene%20data.bin"));
 
   // PLY, ASCII with float face colours (exact) and binary with 8-bit vertex colours.
-  std::string ascii = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
-                      "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
-                      "property float red\nproperty float green\nproperty float blue\nend_header\n";
+  std::string ascii =
+    "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+    "property float red\nproperty float green\nproperty float blue\nend_header\n";
   for (const auto& corner : Corners)
   {
-    ascii += std::to_string(corner[0]) + " " + std::to_string(corner[1]) + " " + std::to_string(corner[2]) + "\n";
+    ascii += std::to_string(corner[0]) + " " + std::to_string(corner[1]) + " " +
+      std::to_string(corner[2]) + "\n";
   }
   for (int f = 0; f < 4; ++f)
   {
@@ -433,7 +440,8 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   const ReadResult obj = readScene(folder / "scene.obj");
   ASSERT_TRUE(obj.succeeded) << obj.errors();
   expectTwoMaterialScene(obj.output, 1e-6);
-  for (const char* name : { "scene.gltf", "scene.glb", "external.gltf", "faces.ply", "vertices.ply" })
+  for (const char* name :
+    { "scene.gltf", "scene.glb", "external.gltf", "faces.ply", "vertices.ply" })
   {
     SCOPED_TRACE(name);
     const ReadResult other = readScene(folder / name);
@@ -455,7 +463,8 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   EXPECT_EQ(materialId(gltf.output, 3), 1);
   EXPECT_EQ(stringField(gltf.output, "SceneFormat"), "glTF");
   EXPECT_EQ(stringField(readScene(folder / "faces.ply").output, "SceneFormat"), "PLY");
-  EXPECT_EQ(materialNames(readScene(folder / "faces.ply").output), (std::vector<std::string>{ "faces" }));
+  EXPECT_EQ(
+    materialNames(readScene(folder / "faces.ply").output), (std::vector<std::string>{ "faces" }));
 }
 
 TEST(SceneReader, GltfNodeTransformsAndEmission)
@@ -464,7 +473,8 @@ TEST(SceneReader, GltfNodeTransformsAndEmission)
   const fs::path& folder = scratch.path;
   // The red material emits (1, 0.5, 0.25) x strength 4 as radiance, like Ke 4 2 1.
   std::string json = gltfJson(dataUri(gltfBuffer()), "", "[1, 2, 3]");
-  const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
+  const std::string red =
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
   replaceOnce(json, red,
     R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]},
         "emissiveFactor": [1, 0.5, 0.25],
@@ -498,7 +508,9 @@ std::string pngImage(const std::array<std::array<int, 3>, 4>& texels)
   {
     for (int c = 0; c < 3; ++c)
     {
-      scalars->SetTypedComponent(t, c, static_cast<unsigned char>(texels[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)]));
+      scalars->SetTypedComponent(t, c,
+        static_cast<unsigned char>(
+          texels[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)]));
     }
   }
   auto writer = vtkSmartPointer<vtkPNGWriter>::New();
@@ -506,7 +518,8 @@ std::string pngImage(const std::array<std::array<int, 3>, 4>& texels)
   writer->WriteToMemoryOn();
   writer->Write();
   vtkUnsignedCharArray* bytes = writer->GetResult();
-  return std::string(reinterpret_cast<const char*>(bytes->GetPointer(0)), static_cast<std::size_t>(bytes->GetNumberOfValues()));
+  return std::string(reinterpret_cast<const char*>(bytes->GetPointer(0)),
+    static_cast<std::size_t>(bytes->GetNumberOfValues()));
 }
 
 double srgbToLinear(double value)
@@ -520,25 +533,31 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
   const fs::path& folder = scratch.path;
   // Half the texels white, half black in red and blue; green 128 everywhere (sRGB, so 0.2159
   // in linear light). The factor multiplies the mean.
-  const std::string png = pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
+  const std::string png =
+    pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
   writeFile(folder / "wood.png", png);
   std::string json = gltfJson(dataUri(gltfBuffer()),
     R"(,
   "textures": [{"source": 0}, {"source": 1}],
-  "images": [{"uri": "data:image/png;base64,)" + base64(png) + R"("}, {"uri": "wood.png"}])");
-  const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
+  "images": [{"uri": "data:image/png;base64,)" +
+      base64(png) + R"("}, {"uri": "wood.png"}])");
+  const std::string white =
+    R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
   replaceOnce(json, white,
     R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 1, 0.6, 1], "baseColorTexture": {"index": 0}}})");
-  const std::string red = R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
-  replaceOnce(json, red,
-    R"({"name": "red", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})");
+  const std::string red =
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})";
+  replaceOnce(
+    json, red, R"({"name": "red", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})");
   writeFile(folder / "textured.gltf", json);
   const ReadResult result = readScene(folder / "textured.gltf");
   ASSERT_TRUE(result.succeeded) << result.errors();
   EXPECT_EQ(result.warnings(), "");
   const double green = srgbToLinear(128 / 255.0);
-  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, green, 0.6 * 0.5, 1e-9, "data: URI texture");
-  expectRgbNear(tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-9, "texture file beside the glTF");
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, green, 0.6 * 0.5, 1e-9,
+    "data: URI texture");
+  expectRgbNear(
+    tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-9, "texture file beside the glTF");
 
   // A damaged image (a byte of its pixel data changed: the chunk's CRC no longer matches) is
   // a warning naming the material, and its factor alone gives the reflectance.
@@ -568,7 +587,8 @@ TEST(SceneReader, ObjMapKdMultipliesKdByTheTextureMeanInLinearColour)
   const TestFolder scratch("obj-texture");
   const fs::path& folder = scratch.path;
   // The glTF test's texture: red and blue half white, half black; green 128 (sRGB) everywhere.
-  writeFile(folder / "tex.png", pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } }));
+  writeFile(folder / "tex.png",
+    pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } }));
   fs::create_directories(folder / "textures");
   writeFile(folder / "textures" / "wood grain.png",
     pngImage({ { { 200, 100, 50 }, { 200, 100, 50 }, { 200, 100, 50 }, { 200, 100, 50 } } }));
@@ -587,22 +607,28 @@ Kd 0.5
 Ke 2 4 6
 map_Ke tex.png
 )");
-  writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "plain", "optioned", "textureonly", "glow" }));
+  writeFile(folder / "scene.obj",
+    quadPerMaterialObj("scene.mtl", { "plain", "optioned", "textureonly", "glow" }));
   const ReadResult result = readScene(folder / "scene.obj");
   ASSERT_TRUE(result.succeeded) << result.errors();
   EXPECT_EQ(result.warnings(), "");
   const double green = srgbToLinear(128 / 255.0);
-  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, 0.8 * green, 0.8 * 0.5, 1e-6, "Kd 0.8 x texture");
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.8 * 0.5, 0.8 * green, 0.8 * 0.5, 1e-6,
+    "Kd 0.8 x texture");
   expectRgbNear(tuple3(result.output, "Reflectance", 1), srgbToLinear(200 / 255.0),
-    0.5 * srgbToLinear(100 / 255.0), srgbToLinear(50 / 255.0), 1e-6, "options before the file name");
-  expectRgbNear(tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-6, "map_Kd without Kd");
+    0.5 * srgbToLinear(100 / 255.0), srgbToLinear(50 / 255.0), 1e-6,
+    "options before the file name");
+  expectRgbNear(
+    tuple3(result.output, "Reflectance", 2), 0.5, green, 0.5, 1e-6, "map_Kd without Kd");
   expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 1e-6, "glow's Kd");
   // Emission is the exitance, pi x radiance.
-  expectRgbNear(tuple3(result.output, "Emission", 3), 2 * 0.5 * Pi, 4 * green * Pi, 6 * 0.5 * Pi, 1e-6, "Ke x map_Ke");
+  expectRgbNear(tuple3(result.output, "Emission", 3), 2 * 0.5 * Pi, 4 * green * Pi, 6 * 0.5 * Pi,
+    1e-6, "Ke x map_Ke");
   expectRgbNear(tuple3(result.output, "Emission", 0), 0, 0, 0, 0, "no Ke");
 
   // Kd 1 1 1 with a white texture is still clamped, with the clamping's warning.
-  writeFile(folder / "white.png", pngImage({ { { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 } } }));
+  writeFile(folder / "white.png",
+    pngImage({ { { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 }, { 255, 255, 255 } } }));
   writeFile(folder / "scene.mtl", "newmtl plain\nKd 1 1 1\nmap_Kd white.png\n");
   writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "plain" }));
   const ReadResult white = readScene(folder / "scene.obj");
@@ -616,14 +642,16 @@ TEST(SceneReader, ObjTextureThatCannotBeUsedIsAWarningAndKdAloneIsUsed)
   const TestFolder scratch("obj-bad-texture");
   const fs::path& folder = scratch.path;
   writeFile(folder / "notes.txt", "not an image, though named in map_Kd\n");
-  std::string damaged = pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
+  std::string damaged =
+    pngImage({ { { 255, 128, 0 }, { 0, 128, 255 }, { 255, 128, 0 }, { 0, 128, 255 } } });
   damaged[damaged.size() - 20] = static_cast<char>(damaged[damaged.size() - 20] ^ 0x5a);
   writeFile(folder / "damaged.png", damaged);
   fs::create_directories(folder / "folder.png");
   // Each refused quickly, without reading more than a signature: missing, not an image, a
   // folder, a device that never ends, a damaged PNG; and a map_Kd without a file name.
   const std::vector<std::pair<std::string, std::string>> cases = { { "missing", "absent.png" },
-    { "text", "notes.txt" }, { "folder", "folder.png" }, { "device", "/dev/zero" }, { "damaged", "damaged.png" } };
+    { "text", "notes.txt" }, { "folder", "folder.png" }, { "device", "/dev/zero" },
+    { "damaged", "damaged.png" } };
   std::string mtl, names;
   std::vector<std::string> materials;
   for (const auto& [name, file] : cases)
@@ -645,15 +673,19 @@ TEST(SceneReader, ObjTextureThatCannotBeUsedIsAWarningAndKdAloneIsUsed)
     const std::string expected = "material '" + name + "' of '" + (folder / "scene.obj").string() +
       "': its map_Kd texture '" + path.string() + "': ";
     EXPECT_NE(warnings.find(expected), std::string::npos) << expected << "\nin\n" << warnings;
-    expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(i)), 0.3, 0.4, 0.5, 1e-12, name);
+    expectRgbNear(
+      tuple3(result.output, "Reflectance", static_cast<vtkIdType>(i)), 0.3, 0.4, 0.5, 1e-12, name);
   }
   EXPECT_NE(warnings.find("does not exist, so Kd alone is used"), std::string::npos) << warnings;
-  EXPECT_NE(warnings.find("its image is neither PNG nor JPEG, so Kd alone is used"), std::string::npos) << warnings;
+  EXPECT_NE(
+    warnings.find("its image is neither PNG nor JPEG, so Kd alone is used"), std::string::npos)
+    << warnings;
   EXPECT_NE(warnings.find("its file is a folder"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("its file is not a regular file"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("its PNG image could not be decoded"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("'map_Kd' names no file"), std::string::npos) << warnings;
-  expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(cases.size())), 0.3, 0.4, 0.5, 1e-12, "nofile");
+  expectRgbNear(tuple3(result.output, "Reflectance", static_cast<vtkIdType>(cases.size())), 0.3,
+    0.4, 0.5, 1e-12, "nofile");
 }
 
 TEST(SceneReader, ObjJpegTextureIsAveragedAndAHugeOneRefused)
@@ -680,7 +712,8 @@ TEST(SceneReader, ObjJpegTextureIsAveragedAndAHugeOneRefused)
   writer->WriteToMemoryOn();
   writer->Write();
   vtkUnsignedCharArray* bytes = writer->GetResult();
-  std::string jpeg(reinterpret_cast<const char*>(bytes->GetPointer(0)), static_cast<std::size_t>(bytes->GetNumberOfValues()));
+  std::string jpeg(reinterpret_cast<const char*>(bytes->GetPointer(0)),
+    static_cast<std::size_t>(bytes->GetNumberOfValues()));
   writeFile(folder / "tex.jpg", jpeg);
   // The same file whose frame header (SOFn: FF C0, C1 or C2 (VTK writes progressive JPEG),
   // length, precision, height, width) claims 65535 x 65535 texels: refused before the decoder
@@ -696,14 +729,16 @@ TEST(SceneReader, ObjJpegTextureIsAveragedAndAHugeOneRefused)
     jpeg[i] = '\xff';
   }
   writeFile(folder / "huge.jpg", jpeg);
-  writeFile(folder / "scene.mtl", "newmtl jpeg\nKd 0.5\nmap_Kd tex.jpg\nnewmtl huge\nKd 0.5\nmap_Kd huge.jpg\n");
+  writeFile(folder / "scene.mtl",
+    "newmtl jpeg\nKd 0.5\nmap_Kd tex.jpg\nnewmtl huge\nKd 0.5\nmap_Kd huge.jpg\n");
   writeFile(folder / "scene.obj", quadPerMaterialObj("scene.mtl", { "jpeg", "huge" }));
   const ReadResult result = readScene(folder / "scene.obj");
   ASSERT_TRUE(result.succeeded) << result.errors();
   expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.5 * srgbToLinear(200 / 255.0),
     0.5 * srgbToLinear(100 / 255.0), 0.5 * srgbToLinear(50 / 255.0), 0.005, "JPEG");
   EXPECT_NE(result.warnings().find("'huge'"), std::string::npos) << result.warnings();
-  EXPECT_NE(result.warnings().find("its JPEG image is larger than 64 Mpixels, so Kd alone is used"), std::string::npos)
+  EXPECT_NE(result.warnings().find("its JPEG image is larger than 64 Mpixels, so Kd alone is used"),
+    std::string::npos)
     << result.warnings();
   expectRgbNear(tuple3(result.output, "Reflectance", 1), 0.5, 0.5, 0.5, 0, "huge JPEG");
 }
@@ -715,10 +750,13 @@ TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
   // VTK 9.2's vtkGLTFDocumentLoader aborts on a material without pbrMetallicRoughness; glTF's
   // default for it is white, which is clamped with a warning. Strips and fans make triangles.
   std::string json = gltfJson(dataUri(gltfBuffer()));
-  const std::string white = R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
+  const std::string white =
+    R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})";
   replaceOnce(json, white, R"({"name": "lamp", "emissiveFactor": [1, 1, 1]})");
-  replaceOnce(json, R"("indices": 1, "material": 0, "mode": 4)", R"("indices": 1, "material": 0, "mode": 5)");
-  replaceOnce(json, R"("indices": 2, "material": 1, "mode": 4)", R"("indices": 2, "material": 1, "mode": 6)");
+  replaceOnce(
+    json, R"("indices": 1, "material": 0, "mode": 4)", R"("indices": 1, "material": 0, "mode": 5)");
+  replaceOnce(
+    json, R"("indices": 2, "material": 1, "mode": 4)", R"("indices": 2, "material": 1, "mode": 6)");
   writeFile(folder / "modes.gltf", json);
   const ReadResult result = readScene(folder / "modes.gltf");
   ASSERT_TRUE(result.succeeded) << result.errors();
@@ -749,7 +787,8 @@ TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
   replaceOnce(json, R"("count": 6, "type": "SCALAR"}])",
     R"("count": 6, "type": "SCALAR"},
     {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"}])");
-  replaceOnce(json, R"("POSITION": 0}, "indices": 1)", R"("POSITION": 0, "COLOR_0": 3}, "indices": 1)");
+  replaceOnce(
+    json, R"("POSITION": 0}, "indices": 1)", R"("POSITION": 0, "COLOR_0": 3}, "indices": 1)");
   writeFile(folder / "colours.gltf", json);
   const ReadResult result = readScene(folder / "colours.gltf");
   ASSERT_TRUE(result.succeeded) << result.errors();
@@ -797,7 +836,8 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
   replaceOnce(cycle, R"({"mesh": 0})", R"({"mesh": 0, "children": [0]})");
   std::string glb = glbFile(gltfJson(""), buffer);
   std::string draco = gltfJson(dataUri(buffer));
-  replaceOnce(draco, R"("scene": 0,)", R"("scene": 0, "extensionsRequired": ["KHR_draco_mesh_compression"],)");
+  replaceOnce(draco, R"("scene": 0,)",
+    R"("scene": 0, "extensionsRequired": ["KHR_draco_mesh_compression"],)");
   std::string version1 = gltfJson(dataUri(buffer));
   replaceOnce(version1, R"("version": "2.0")", R"("version": "1.0")");
   std::string notBase64 = gltfJson("data:application/octet-stream;base64,#!");
@@ -822,13 +862,20 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     { "badkd.obj", "mtllib badkd.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
       "'Kd red' is not a colour" },
     { "notply.ply", "solid cube\n", "does not start with 'ply'" },
-    { "novertex.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n3 0 1 2\n",
+    { "novertex.ply",
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int "
+      "vertex_indices\nend_header\n3 0 1 2\n",
       "no element 'vertex'" },
-    { "short.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n",
+    { "short.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+      "z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n",
       "truncated" },
-    { "faceindex.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
+    { "faceindex.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+      "z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 "
+      "0 1 7\n",
       "names vertex 7" },
     { "scene.stl", "solid x\nendsolid x\n", "extension '.stl'" },
   };
@@ -843,7 +890,8 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     const ReadResult result = readScene(folder / file.name);
     EXPECT_FALSE(result.succeeded);
     ASSERT_FALSE(result.messages->errors.empty());
-    EXPECT_NE(result.errors().find((folder / file.name).string()), std::string::npos) << result.errors();
+    EXPECT_NE(result.errors().find((folder / file.name).string()), std::string::npos)
+      << result.errors();
     EXPECT_NE(result.errors().find(file.expected), std::string::npos) << result.errors();
     EXPECT_EQ(result.output->GetNumberOfCells(), 0);
     EXPECT_EQ(result.output->GetNumberOfPoints(), 0);
@@ -856,7 +904,8 @@ TEST(SceneReader, MissingFileAndNoFileNameAreErrors)
   const fs::path& folder = scratch.path;
   const ReadResult missing = readScene(folder / "nowhere.obj");
   EXPECT_FALSE(missing.succeeded);
-  EXPECT_NE(missing.errors().find("nowhere.obj' does not exist"), std::string::npos) << missing.errors();
+  EXPECT_NE(missing.errors().find("nowhere.obj' does not exist"), std::string::npos)
+    << missing.errors();
 
   auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
   auto messages = vtkSmartPointer<MessageRecorder>::New();

@@ -57,7 +57,8 @@ double floorMatch(vtkPolyData* elements, const Vec3& light)
     measured.push_back(direct->GetComponent(c, 1));
     predicted.push_back(h2 / std::pow(h2 + dx * dx + dy * dy, 2));
   }
-  const auto mean = [](const std::vector<double>& v) {
+  const auto mean = [](const std::vector<double>& v)
+  {
     double s = 0;
     for (double x : v)
     {
@@ -251,8 +252,8 @@ TEST(FilterTime, PredictedSpeedupIsEquationFourOfTheSolve)
   ASSERT_EQ(n, 2);
   EXPECT_GT(l, 1.5) << "walks in a closed box of reflectance 0.5 average about two hits";
   const double walk = 0.6 * (l - 1);
-  EXPECT_NEAR(fieldValue(elements, "PredictedSpeedup"),
-    (2 * (1 + walk) + 0.5 * 2) / (2 + walk + 0.5), 1e-12);
+  EXPECT_NEAR(
+    fieldValue(elements, "PredictedSpeedup"), (2 * (1 + walk) + 0.5 * 2) / (2 + walk + 0.5), 1e-12);
 }
 
 TEST(FilterTime, OutputsCarryTheDocumentedArrays)
@@ -264,8 +265,8 @@ TEST(FilterTime, OutputsCarryTheDocumentedArrays)
   vtkPolyData* patches = filter->GetOutput(1);
   ASSERT_GT(elements->GetNumberOfCells(), 0);
   EXPECT_EQ(elements->GetNumberOfCells(), 4 * patches->GetNumberOfCells());
-  for (const char* name : { "Radiosity", "DirectRadiosity", "IndirectRadiosity",
-         "RadiosityFront", "RadiosityBack", "Reflectance" })
+  for (const char* name : { "Radiosity", "DirectRadiosity", "IndirectRadiosity", "RadiosityFront",
+         "RadiosityBack", "Reflectance" })
   {
     vtkDataArray* array = elements->GetCellData()->GetArray(name);
     ASSERT_NE(array, nullptr) << name;
@@ -277,10 +278,10 @@ TEST(FilterTime, OutputsCarryTheDocumentedArrays)
   {
     ASSERT_NE(patches->GetCellData()->GetArray(name), nullptr) << name;
   }
-  for (const char* name : { "Frames", "Patches", "Elements", "PathsPerFrame", "PathsCast",
-         "ShootingRays", "ShadowRays", "GatheringRays", "SecondsRemeshing", "SecondsShooting",
-         "SecondsGathering", "SecondsTotal", "ReuseShooting", "ReuseGathering",
-         "PredictedSpeedup", "FrameIndex", "SolveCount" })
+  for (const char* name :
+    { "Frames", "Patches", "Elements", "PathsPerFrame", "PathsCast", "ShootingRays", "ShadowRays",
+      "GatheringRays", "SecondsRemeshing", "SecondsShooting", "SecondsGathering", "SecondsTotal",
+      "ReuseShooting", "ReuseGathering", "PredictedSpeedup", "FrameIndex", "SolveCount" })
   {
     EXPECT_FALSE(std::isnan(fieldValue(elements, name))) << name;
   }

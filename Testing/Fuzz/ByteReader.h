@@ -20,10 +20,7 @@ public:
   {
   }
 
-  std::uint8_t byte()
-  {
-    return this->Position < this->Size ? this->Data[this->Position++] : 0;
-  }
+  std::uint8_t byte() { return this->Position < this->Size ? this->Data[this->Position++] : 0; }
 
   std::uint32_t u16()
   {
@@ -56,14 +53,22 @@ public:
     }
     switch (kind % 8)
     {
-      case 0: return std::numeric_limits<double>::quiet_NaN();
-      case 1: return std::numeric_limits<double>::infinity();
-      case 2: return -std::numeric_limits<double>::infinity();
-      case 3: return 1e300;
-      case 4: return 1e-300;
-      case 5: return std::numeric_limits<double>::denorm_min();
-      case 6: return (this->u16() / 65535.0 - 0.5) * 4.0 + this->u16() * 1e-12;
-      default: return this->rawDouble();
+      case 0:
+        return std::numeric_limits<double>::quiet_NaN();
+      case 1:
+        return std::numeric_limits<double>::infinity();
+      case 2:
+        return -std::numeric_limits<double>::infinity();
+      case 3:
+        return 1e300;
+      case 4:
+        return 1e-300;
+      case 5:
+        return std::numeric_limits<double>::denorm_min();
+      case 6:
+        return (this->u16() / 65535.0 - 0.5) * 4.0 + this->u16() * 1e-12;
+      default:
+        return this->rawDouble();
     }
   }
 

@@ -13,16 +13,16 @@
 // reader that loops is refused, not reported as a hang: the replay in ctest must end.
 #include "GuardedRead.h"
 
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkLogger.h"
 #include "vtkMovingLightRadiosity.h"
 #include "vtkNew.h"
 #include "vtkObject.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkRadiositySceneReader.h"
-#include "vtkCellArray.h"
-#include "vtkLogger.h"
 
 #include <cmath>
 #include <cstdio>
@@ -104,7 +104,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     mlr::guarded::ReadLimits limits;
     limits.time.baseSeconds = 1;
     scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits,
-      [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm> {
+      [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
+      {
         auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
         reader->SetFileName(file.c_str());
         return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;

@@ -151,7 +151,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bool cancels = (flags & 0x40) != 0;
   const std::size_t cancelAfter = in.below(40);
   std::size_t reports = 0;
-  auto progress = [&](double fraction) {
+  auto progress = [&](double fraction)
+  {
     if (!(fraction >= 0.0 && fraction <= 1.0))
     {
       finding("progress fraction out of [0, 1]: " + std::to_string(fraction));

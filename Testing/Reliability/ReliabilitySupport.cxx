@@ -23,19 +23,21 @@ PolygonSoup sphereSoup(int frequency)
 
 DelayedCancel::DelayedCancel(double delaySeconds)
 {
-  const auto at = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(delaySeconds));
-  this->Timer = std::thread([this, at] {
-    while (!this->Stop.load() && Clock::now() < at)
+  const auto at = Clock::now() +
+    std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delaySeconds));
+  this->Timer = std::thread(
+    [this, at]
     {
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-    if (!this->Stop.load())
-    {
-      this->RequestedAt = Clock::now();
-      this->Requested.store(true);
-    }
-  });
+      while (!this->Stop.load() && Clock::now() < at)
+      {
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+      if (!this->Stop.load())
+      {
+        this->RequestedAt = Clock::now();
+        this->Requested.store(true);
+      }
+    });
 }
 
 DelayedCancel::~DelayedCancel()

@@ -24,11 +24,11 @@ constexpr bool UnderAddressSanitizer = false;
 constexpr bool UnderAddressSanitizer = false;
 #endif
 
-/// The bound the cancellation tests assert: ten times the 0.5 s promised (Documentation/Reliability.md) on a
-/// quiet machine, so that the gate's verdict does not depend on the machine's load (the test
-/// command runs two tests at a time on two cores). The tests print the latency they measured;
-/// a stretch without a cancellation check shows there as a regression long before it fails.
-/// Sanitizer builds run several times slower and get three times as long.
+/// The bound the cancellation tests assert: ten times the 0.5 s promised
+/// (Documentation/Reliability.md) on a quiet machine, so that the gate's verdict does not depend on
+/// the machine's load (the test command runs two tests at a time on two cores). The tests print the
+/// latency they measured; a stretch without a cancellation check shows there as a regression long
+/// before it fails. Sanitizer builds run several times slower and get three times as long.
 constexpr double CancelLatencyBound = UnderAddressSanitizer ? 15.0 : 5.0;
 
 /// Resident set size of this process, in bytes (/proc/self/statm).

@@ -21,8 +21,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <string>
@@ -38,9 +38,9 @@ using Clock = std::chrono::steady_clock;
 
 enum class Outcome
 {
-  Error,        ///< the update fails with `text` in the errors, both outputs empty
-  Result,       ///< the update succeeds with cells (and `text` in the warnings, if given)
-  EmptyResult,  ///< the update succeeds with empty outputs (and `text` in the warnings)
+  Error,       ///< the update fails with `text` in the errors, both outputs empty
+  Result,      ///< the update succeeds with cells (and `text` in the warnings, if given)
+  EmptyResult, ///< the update succeeds with empty outputs (and `text` in the warnings)
 };
 
 /// The inputs and the filter of one row; setUp changes them from the closed box default.
@@ -119,7 +119,8 @@ std::vector<Row> rows()
     { "EmptyScene", [](Case& c) { c.setup.scene = vtkSmartPointer<vtkPolyData>::New(); },
       Outcome::EmptyResult, "" },
     { "SceneOfOnlyLinesAndPoints",
-      [](Case& c) {
+      [](Case& c)
+      {
         vtkNew<vtkPolyData> scene;
         scene->SetPoints(c.setup.scene->GetPoints());
         vtkNew<vtkCellArray> verts, lines;
@@ -138,22 +139,24 @@ std::vector<Row> rows()
       Outcome::Result, "no cell array Reflectance", 10,
       [](Case& c) { EXPECT_GT(maximumRadiosity(c.filter->GetOutput(0)), 0); } },
     { "AllDegenerateTriangles",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.setup.scene = polyData({ { 0, 0, 0 }, { 1, 0, 0 }, { 2, 0, 0 }, { 0, 1, 0 } },
           { { 0, 1, 2 }, { 3, 3, 3 }, { 0, 0, 1 }, { 2, 1, 0 } });
       },
       Outcome::Error, "the scene has no polygon with an area" },
-    { "NaNCoordinates",
-      [](Case& c) { c.setup.scene->GetPoints()->SetPoint(5, 0.5, NaN, 0.5); }, Outcome::Error,
-      "1 point with NaN or infinite coordinates" },
+    { "NaNCoordinates", [](Case& c) { c.setup.scene->GetPoints()->SetPoint(5, 0.5, NaN, 0.5); },
+      Outcome::Error, "1 point with NaN or infinite coordinates" },
     { "InfiniteCoordinates",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.setup.scene->GetPoints()->SetPoint(5, Inf, 0, 0);
         c.setup.scene->GetPoints()->SetPoint(6, 0, -Inf, 0);
       },
       Outcome::Error, "2 points with NaN or infinite coordinates" },
     { "TenMillionDuplicatedPoints",
-      [](Case& c) {
+      [](Case& c)
+      {
         // 10^7 points, three distinct positions: 3.3 million copies of one triangle.
         vtkNew<vtkPoints> points;
         points->SetDataTypeToFloat();
@@ -180,16 +183,18 @@ std::vector<Row> rows()
       "Scene cell 4 has Reflectance (1, 1, 1): every value must be >= 0 and < 1" },
     { "NegativeReflectance", [](Case& c) { setReflectanceOfCell(c, 0, 0.5, -0.25, 0.5); },
       Outcome::Error, "Scene cell 0 has Reflectance (0.5, -0.25, 0.5)" },
-    { "NaNReflectance", [](Case& c) { setReflectanceOfCell(c, 2, NaN, 0.5, 0.5); },
-      Outcome::Error, "Scene cell 2 has Reflectance (nan, 0.5, 0.5)" },
+    { "NaNReflectance", [](Case& c) { setReflectanceOfCell(c, 2, NaN, 0.5, 0.5); }, Outcome::Error,
+      "Scene cell 2 has Reflectance (nan, 0.5, 0.5)" },
     { "LightWithZeroArea",
-      [](Case& c) {
-        c.setup.light = polyData({ { 0.4, 0.5, 0.9 }, { 0.5, 0.5, 0.9 }, { 0.6, 0.5, 0.9 } },
-          { { 0, 1, 2 } });
+      [](Case& c)
+      {
+        c.setup.light =
+          polyData({ { 0.4, 0.5, 0.9 }, { 0.5, 0.5, 0.9 }, { 0.6, 0.5, 0.9 } }, { { 0, 1, 2 } });
       },
       Outcome::Error, "is degenerate (zero area)" },
     { "LightFacingAwayFromTheScene",
-      [](Case& c) {
+      [](Case& c)
+      {
         // An open floor below a light that faces up: no light ever reaches it.
         PatchMesh floor;
         scenes::addGriddedQuad(floor, { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, 4, 4, Rgb(0.5));
@@ -203,11 +208,13 @@ std::vector<Row> rows()
     { "TrajectoryOfNoPoint", [](Case& c) { c.setup.trajectory = trajectoryPolyData({}); },
       Outcome::Error, "the Trajectory has no points" },
     { "TrajectoryOfOnePoint",
-      [](Case& c) { c.setup.trajectory = trajectoryPolyData({ { 0.5, 0.5, 0.9 } }); },
-      Outcome::Result, "", 10,
-      [](Case& c) { EXPECT_EQ(timeSteps(c.filter).size(), 1u); } },
-    { "TenThousandFramesOnALargeScene",
       [](Case& c) {
+        c.setup.trajectory = trajectoryPolyData({ { 0.5, 0.5, 0.9 } });
+      },
+      Outcome::Result, "", 10, [](Case& c) { EXPECT_EQ(timeSteps(c.filter).size(), 1u); } },
+    { "TenThousandFramesOnALargeScene",
+      [](Case& c)
+      {
         // 200,000 triangles at a patch size giving ~85,000 patches: ~180 GB for 10,000
         // frames, refused before remeshing starts.
         c.setup.scene = soupPolyData(sphereSoup(100));
@@ -224,30 +231,35 @@ std::vector<Row> rows()
       Outcome::Error, "(10000 frames x (about", 5,
       [](Case& c) { EXPECT_EQ(c.filter->GetPatchSize(), 0.02); } },
     { "LargeSceneOverTheMemoryLimitIsRefusedBeforeCopying",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.setup.scene = soupPolyData(sphereSoup(100)); // ~20 MB as a soup
         c.filter->SetMemoryLimit(8);
       },
-      Outcome::Error, "the Scene has 200000 cells on 100002 points: taking them for remeshing needs an estimated", 2 },
+      Outcome::Error,
+      "the Scene has 200000 cells on 100002 points: taking them for remeshing needs an estimated",
+      2 },
     // Clamped to one path, fewer than the light positions: reuse refuses it.
-    { "PathsZeroIsClampedToOne", [](Case& c) { c.filter->SetNumberOfPaths(0); },
-      Outcome::Error, "give at least", 10,
-      [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 1); } },
+    { "PathsZeroIsClampedToOne", [](Case& c) { c.filter->SetNumberOfPaths(0); }, Outcome::Error,
+      "give at least", 10, [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 1); } },
     { "PathsTwoToThe62IsClampedAndAbortable",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.filter->SetNumberOfPaths(vtkIdType(1) << 62);
         c.abortAfter = 0.3; // the clamped 10^11 paths would take days
       },
       Outcome::Error, "aborted", 10,
       [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 100000000000LL); } },
     { "AbortMidSolve",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.filter->SetNumberOfPaths(50000000);
         c.abortAfter = 0.4;
       },
       Outcome::Error, "aborted" },
     { "AbortMidRemeshing",
-      [](Case& c) {
+      [](Case& c)
+      {
         c.setup.scene = soupPolyData(sphereSoup(100));
         c.setup.light = lightPolyData(scenes::squareLightFacingDown({ 0, 0, 0 }, 0.2));
         c.filter->SetPatchSize(0);
@@ -289,17 +301,19 @@ TEST_P(FilterMatrix, Row)
   } abort{ c.filter, Clock::now(), {}, c.abortAfter };
   vtkNew<vtkCallbackCommand> onProgress;
   onProgress->SetClientData(&abort);
-  onProgress->SetCallback([](vtkObject*, unsigned long, void* data, void*) {
-    auto* s = static_cast<AbortState*>(data);
-    if (s->after >= 0 && !s->aborted &&
-      std::chrono::duration<double>(Clock::now() - s->start).count() >= s->after)
+  onProgress->SetCallback(
+    [](vtkObject*, unsigned long, void* data, void*)
     {
-      s->aborted = true;
-      s->at = s->start + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(s->after));
-      s->filter->SetAbortExecute(1);
-    }
-  });
+      auto* s = static_cast<AbortState*>(data);
+      if (s->after >= 0 && !s->aborted &&
+        std::chrono::duration<double>(Clock::now() - s->start).count() >= s->after)
+      {
+        s->aborted = true;
+        s->at = s->start +
+          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s->after));
+        s->filter->SetAbortExecute(1);
+      }
+    });
   c.filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
 
   abort.start = Clock::now();

@@ -182,18 +182,21 @@ TEST_F(GuardedRead, KeepsCellArraysOfXmlFiles)
 TEST_F(GuardedRead, RefusesMissingEmptyAndUnknownFiles)
 {
   EXPECT_TRUE(contains(refusal((this->Directory / "none.obj").string()),
-    "the scene file '" + (this->Directory / "none.obj").string() + "' does not exist or is not a file"));
+    "the scene file '" + (this->Directory / "none.obj").string() +
+      "' does not exist or is not a file"));
   EXPECT_TRUE(contains(refusal(this->Directory.string()), "does not exist or is not a file"));
   EXPECT_TRUE(contains(refusal(this->write("empty.vtp", "")), "empty.vtp' is empty"));
   EXPECT_TRUE(contains(refusal(this->write("scene.dae", "<COLLADA/>")),
     "has an unknown extension: give a .vtp .vtu .vtk .obj .ply or .stl file"));
-  EXPECT_TRUE(contains(refusal(this->write("obj.vtp", ObjSquare)), "is not a VTK XML PolyData file"));
+  EXPECT_TRUE(
+    contains(refusal(this->write("obj.vtp", ObjSquare)), "is not a VTK XML PolyData file"));
 }
 
 TEST_F(GuardedRead, ChecksRefuseWhatCrashesVtksReaders)
 {
-  EXPECT_TRUE(contains(refusal(this->write("texture.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/3\n")),
-    "texture.obj', line 4: '1/1' names texture coordinate 1 but the file defines 0 (vt lines)"));
+  EXPECT_TRUE(
+    contains(refusal(this->write("texture.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/3\n")),
+      "texture.obj', line 4: '1/1' names texture coordinate 1 but the file defines 0 (vt lines)"));
   EXPECT_TRUE(contains(refusal(this->write("head.ply", "ply\nformat ascii 1.0\nend_header\n")),
     "is not a PLY file VTK can read: no element 'vertex' with properties x, y and z"));
   std::string stl(84, '\0');
@@ -232,26 +235,31 @@ TEST_F(GuardedRead, LegacyReaderThatLoopsIsStoppedByTheCpuLimit)
   limits.time.baseSeconds = 1;
   limits.time.wallFactor = 30; // the CPU limit must be what stops it, however loaded the machine
   const std::string message = refusal(path, limits);
-  EXPECT_TRUE(contains(message, "VTK's .vtk reader did not finish reading the scene file '" + path +
-    "' within 1 s of CPU time")) << message;
+  EXPECT_TRUE(contains(message,
+    "VTK's .vtk reader did not finish reading the scene file '" + path +
+      "' within 1 s of CPU time"))
+    << message;
   EXPECT_TRUE(contains(message, "Convert it to another format")) << message;
 }
 
 TEST_F(GuardedRead, TimeLimitGrowsWithTheFile)
 {
   const mlr::guarded::TimeLimit limit;
-  EXPECT_EQ(limit.cpuSeconds(300), 5);            // 5 s + 1 s per MiB, in whole seconds
-  EXPECT_EQ(limit.cpuSeconds(100u << 20), 105);   // 100 MiB
+  EXPECT_EQ(limit.cpuSeconds(300), 5);          // 5 s + 1 s per MiB, in whole seconds
+  EXPECT_EQ(limit.cpuSeconds(100u << 20), 105); // 100 MiB
   EXPECT_EQ(limit.wallSeconds(100u << 20), 420);
 }
 
 // --- The guard itself -----------------------------------------------------------------------
 TEST_F(GuardedRead, ChildStatusAndMessagesComeBack)
 {
-  const ChildOutcome outcome = mlr::guarded::runGuarded([] {
-    std::fputs("a message\n", stderr);
-    return 7;
-  }, 0, 10, 60);
+  const ChildOutcome outcome = mlr::guarded::runGuarded(
+    []
+    {
+      std::fputs("a message\n", stderr);
+      return 7;
+    },
+    0, 10, 60);
   EXPECT_EQ(outcome.end, End::Exited);
   EXPECT_EQ(outcome.code, 7);
   EXPECT_EQ(outcome.messages, "a message\n");
@@ -259,12 +267,15 @@ TEST_F(GuardedRead, ChildStatusAndMessagesComeBack)
 
 TEST_F(GuardedRead, SpinningChildIsStoppedByItsCpuTime)
 {
-  const ChildOutcome outcome = mlr::guarded::runGuarded([] {
-    for (volatile unsigned long i = 0;; i = i + 1)
+  const ChildOutcome outcome = mlr::guarded::runGuarded(
+    []
     {
-    }
-    return 0;
-  }, 0, 1, 600);
+      for (volatile unsigned long i = 0;; i = i + 1)
+      {
+      }
+      return 0;
+    },
+    0, 1, 600);
   EXPECT_EQ(outcome.end, End::CpuTime);
   // It spun until stopped; the kernel's count against RLIMIT_CPU and the CPU time getrusage
   // reports differ by up to a few scheduler ticks.
@@ -273,19 +284,25 @@ TEST_F(GuardedRead, SpinningChildIsStoppedByItsCpuTime)
 
 TEST_F(GuardedRead, BlockedChildIsStoppedByTheWallClock)
 {
-  const ChildOutcome outcome = mlr::guarded::runGuarded([] {
-    pause(); // uses no CPU time: only the wall-clock limit ends it
-    return 0;
-  }, 0, 60, 0.5);
+  const ChildOutcome outcome = mlr::guarded::runGuarded(
+    []
+    {
+      pause(); // uses no CPU time: only the wall-clock limit ends it
+      return 0;
+    },
+    0, 60, 0.5);
   EXPECT_EQ(outcome.end, End::WallTime);
 }
 
 TEST_F(GuardedRead, CrashCostsOnlyTheChild)
 {
-  const ChildOutcome outcome = mlr::guarded::runGuarded([] {
-    std::raise(SIGSEGV);
-    return 0;
-  }, 0, 10, 60);
+  const ChildOutcome outcome = mlr::guarded::runGuarded(
+    []
+    {
+      std::raise(SIGSEGV);
+      return 0;
+    },
+    0, 10, 60);
   EXPECT_EQ(outcome.end, End::Crashed);
   EXPECT_EQ(outcome.signal, SIGSEGV);
 }
@@ -303,11 +320,14 @@ TEST_F(GuardedRead, InterruptStopsTheChildAndReachesTheCallersHandler)
   sigaction(SIGTERM, &counting, &previous);
   Terminations = 0;
   // The child sends the caller SIGTERM, then waits for ever.
-  const ChildOutcome outcome = mlr::guarded::runGuarded([] {
-    kill(getppid(), SIGTERM);
-    pause();
-    return 0;
-  }, 0, 60, 600);
+  const ChildOutcome outcome = mlr::guarded::runGuarded(
+    []
+    {
+      kill(getppid(), SIGTERM);
+      pause();
+      return 0;
+    },
+    0, 60, 600);
   sigaction(SIGTERM, &previous, nullptr);
   EXPECT_EQ(outcome.end, End::Interrupted);
   EXPECT_EQ(Terminations, 1);
@@ -325,15 +345,18 @@ TEST_F(GuardedRead, ChildDiesWithItsParent)
   if (parent == 0)
   {
     close(pipeEnds[0]);
-    mlr::guarded::runGuarded([&] {
-      const pid_t self = getpid();
-      if (::write(pipeEnds[1], &self, sizeof(self)) != sizeof(self))
+    mlr::guarded::runGuarded(
+      [&]
       {
-        return 1;
-      }
-      pause();
-      return 0;
-    }, 0, 600, 600);
+        const pid_t self = getpid();
+        if (::write(pipeEnds[1], &self, sizeof(self)) != sizeof(self))
+        {
+          return 1;
+        }
+        pause();
+        return 0;
+      },
+      0, 600, 600);
     _exit(0);
   }
   close(pipeEnds[1]);

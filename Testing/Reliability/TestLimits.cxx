@@ -31,7 +31,6 @@ double secondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-
 /// Remeshing, scene and solve of the 200,000-triangle sphere lit from inside, as the filter
 /// runs them; `keepGoing(lastPoll)` is polled through both progress callbacks, `lastPoll`
 /// true at the solve's final poll (fraction 1), the last chance to cancel. Returns the phase
@@ -57,8 +56,8 @@ struct Pipeline
       SolverOptions options;
       options.pathsPerFrame = 300000;
       phase = "solving";
-      solve(scene, moving, options,
-        [&](double fraction) { return keepGoing(fraction >= 1 - 1e-9); });
+      solve(
+        scene, moving, options, [&](double fraction) { return keepGoing(fraction >= 1 - 1e-9); });
       return "done";
     }
     catch (const Cancelled&)
@@ -89,28 +88,31 @@ TEST(CancelLatency, AnyPhaseOfRemeshingAndSolvingA200kTriangleSphere)
     const double delay = total * (k + 0.5) / runs;
     DelayedCancel cancel(delay);
     bool waited = false;
-    const std::string phase = pipeline.run([&](bool lastPoll) {
-      waited = waited || (lastPoll && !cancel.requested());
-      while (lastPoll && !cancel.requested())
+    const std::string phase = pipeline.run(
+      [&](bool lastPoll)
       {
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      }
-      return cancel.keepGoing();
-    });
+        waited = waited || (lastPoll && !cancel.requested());
+        while (lastPoll && !cancel.requested())
+        {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        return cancel.keepGoing();
+      });
     cancel.finished();
     ASSERT_TRUE(cancel.requested()) << "cancel " << k;
     ASSERT_TRUE(cancel.refused()) << "cancelled at " << delay << " s but no poll saw it";
     ASSERT_NE(phase, "done") << "cancelled at " << delay << " s but not stopped";
     const double latency = cancel.latency();
     ASSERT_GE(latency, 0.0);
-    std::printf("cancel at %.2f s of %.2f s: stopped %s after %.3f s\n", delay, total, phase.c_str(),
-      latency);
+    std::printf("cancel at %.2f s of %.2f s: stopped %s after %.3f s\n", delay, total,
+      phase.c_str(), latency);
     EXPECT_LT(latency, CancelLatencyBound) << "cancelled at " << delay << " s, while " << phase;
     worst = std::max(worst, latency);
     cancelledBeforeTheEnd += waited ? 0 : 1;
   }
   std::printf("worst cancellation latency: %.3f s (bound %.1f s); %d of %d runs stopped before "
-              "their final poll\n", worst, CancelLatencyBound, cancelledBeforeTheEnd, runs);
+              "their final poll\n",
+    worst, CancelLatencyBound, cancelledBeforeTheEnd, runs);
 }
 
 TEST(MemoryLimit, RemeshingIsRefusedBeforeAllocating)
@@ -153,7 +155,9 @@ TEST(MemoryLimit, SolveEstimateSaturates)
   const std::uint64_t huge = estimateSolveMemory(std::size_t(1) << 40, std::size_t(1) << 42,
     std::size_t(1) << 41, std::size_t(1) << 30, options);
   EXPECT_EQ(huge, UINT64_MAX);
-  const std::string message =
-    errorOf([&] { checkSolveMemory(huge, 1u << 30, std::size_t(1) << 40, std::size_t(1) << 42, options, true); });
+  const std::string message = errorOf(
+    [&] {
+      checkSolveMemory(huge, 1u << 30, std::size_t(1) << 40, std::size_t(1) << 42, options, true);
+    });
   EXPECT_NE(message.find("about 1099511627776 patches"), std::string::npos) << message;
 }

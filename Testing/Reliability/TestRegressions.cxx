@@ -38,7 +38,8 @@ TEST(FuzzRegression, CoordinatesBeyondWhatEmbreeTracesAreRefused)
   EXPECT_NE(errorOf([&] { MovingLight(square, Rgb(1), { Vec3(0, 0, -3e15) }); }).find(OutOfRange),
     std::string::npos);
   const auto far = scenes::squareLightFacingDown({ 2e15, 0, 0 }, 1);
-  EXPECT_NE(errorOf([&] { MovingLight(far, Rgb(1), { Vec3() }); }).find(OutOfRange), std::string::npos);
+  EXPECT_NE(
+    errorOf([&] { MovingLight(far, Rgb(1), { Vec3() }); }).find(OutOfRange), std::string::npos);
 }
 
 // The bound itself is safe: a scene, a light and positions at its scale solve.
@@ -46,7 +47,8 @@ TEST(FuzzRegression, ScenesAtTheCoordinateBoundSolve)
 {
   const double size = 1e14, at = 8e14;
   PatchMesh mesh;
-  scenes::addBox(mesh, { at, at, at }, { at + size, at + size, at + size }, size / 4, true, { Rgb(0.5) });
+  scenes::addBox(
+    mesh, { at, at, at }, { at + size, at + size, at + size }, size / 4, true, { Rgb(0.5) });
   const Scene scene = Scene::fromPatchMesh(mesh);
   const Vec3 centre(at + size / 2, at + size / 2, at + 0.9 * size);
   const MovingLight light(scenes::squareLightFacingDown(centre, 0.2 * size), Rgb(100),

@@ -28,10 +28,18 @@ TEST(Soak, TwoHundredSolvesThroughTheFilterDoNotGrowResidentMemory)
     // work (the cache must be dropped) of a size seen before.
     switch (i % 4)
     {
-      case 0: filter->SetSeed(i + 1); break;
-      case 1: filter->SetLightPower(101 + i % 7, 100, 100); break;
-      case 2: filter->SetGatheringRatio(i % 8 == 2 ? 0.5 : 0.75); break;
-      default: filter->SetPatchSize(i % 8 == 3 ? 0.2 : 0.25); break;
+      case 0:
+        filter->SetSeed(i + 1);
+        break;
+      case 1:
+        filter->SetLightPower(101 + i % 7, 100, 100);
+        break;
+      case 2:
+        filter->SetGatheringRatio(i % 8 == 2 ? 0.5 : 0.75);
+        break;
+      default:
+        filter->SetPatchSize(i % 8 == 3 ? 0.2 : 0.25);
+        break;
     }
     ASSERT_TRUE(filter->UpdateTimeStep(i % 3)) << "solve " << i;
     ASSERT_EQ(filter->GetSolveCount(), i + 1);

@@ -43,12 +43,12 @@ void addBox(PatchMesh& mesh, const Vec3& lo, const Vec3& hi, double cell, bool i
     Vec3 origin, u, v; // u x v points out of the box
   };
   const Face faces[6] = {
-    { lo, ez, ey },            // -x
-    { lo + ex, ey, ez },       // +x
-    { lo, ex, ez },            // -y
-    { lo + ey, ez, ex },       // +y
-    { lo, ey, ex },            // -z
-    { lo + ez, ex, ey },       // +z
+    { lo, ez, ey },      // -x
+    { lo + ex, ey, ez }, // +x
+    { lo, ex, ez },      // -y
+    { lo + ey, ez, ex }, // +y
+    { lo, ey, ex },      // -z
+    { lo + ez, ex, ey }, // +z
   };
   for (int f = 0; f < 6; ++f)
   {
@@ -60,11 +60,13 @@ void addBox(PatchMesh& mesh, const Vec3& lo, const Vec3& hi, double cell, bool i
     const Rgb& rho = faceReflectance[static_cast<std::size_t>(f) % faceReflectance.size()];
     if (inward)
     {
-      addGriddedQuad(mesh, face.origin, face.v, face.u, cells(length(face.v)), cells(length(face.u)), rho);
+      addGriddedQuad(
+        mesh, face.origin, face.v, face.u, cells(length(face.v)), cells(length(face.u)), rho);
     }
     else
     {
-      addGriddedQuad(mesh, face.origin, face.u, face.v, cells(length(face.u)), cells(length(face.v)), rho);
+      addGriddedQuad(
+        mesh, face.origin, face.u, face.v, cells(length(face.u)), cells(length(face.v)), rho);
     }
   }
 }
@@ -106,8 +108,7 @@ PaperRoom paperScaleRoom(std::size_t frames, double cell)
   addBox(room.mesh, Vec3(2.65, 2.95, 0), Vec3(4.3, 4.6, 3.3), cell, false, { white }, true);
   const Vec3 centre(2.75, 2.75, 5.49);
   room.light = squareLightFacingDown(centre, 1.15);
-  room.translations =
-    translationsAlong(centre, Vec3(1.9, 1.9, 5.49), Vec3(3.6, 3.6, 5.49), frames);
+  room.translations = translationsAlong(centre, Vec3(1.9, 1.9, 5.49), Vec3(3.6, 3.6, 5.49), frames);
   return room;
 }
 
@@ -127,13 +128,15 @@ void addPolygon(PolygonSoup& soup, const std::vector<Vec3>& corners, const Rgb& 
 std::vector<Vec3> boxFace(const Vec3& lo, const Vec3& hi, int axis, bool high)
 {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  auto corner = [&](bool su, bool sv) {
+  auto corner = [&](bool su, bool sv)
+  {
     Vec3 p = high ? hi : lo;
     p[u] = su ? hi[u] : lo[u];
     p[v] = sv ? hi[v] : lo[v];
     return p;
   };
-  std::vector<Vec3> face = { corner(false, false), corner(true, false), corner(true, true), corner(false, true) };
+  std::vector<Vec3> face = { corner(false, false), corner(true, false), corner(true, true),
+    corner(false, true) };
   if (!high)
   {
     std::reverse(face.begin(), face.end());
@@ -141,8 +144,8 @@ std::vector<Vec3> boxFace(const Vec3& lo, const Vec3& hi, int axis, bool high)
   return face;
 }
 
-PolygonSoup boxOfQuads(const Vec3& lo, const Vec3& hi, const std::vector<Rgb>& walls,
-  bool inward, bool skipBottom)
+PolygonSoup boxOfQuads(
+  const Vec3& lo, const Vec3& hi, const std::vector<Rgb>& walls, bool inward, bool skipBottom)
 {
   PolygonSoup soup;
   for (int f = 0; f < 6; ++f)
@@ -190,8 +193,10 @@ PolygonSoup icosphere(int frequency, double radius)
   // A point is a weighted sum of icosahedron corners; keyed by its sorted (corner, weight)
   // pairs so that faces sharing an edge share its points exactly.
   std::map<std::vector<std::pair<int, int>>, std::uint32_t> pointOf;
-  auto point = [&](std::vector<std::pair<int, int>> weights) {
-    weights.erase(std::remove_if(weights.begin(), weights.end(), [](auto w) { return w.second == 0; }),
+  auto point = [&](std::vector<std::pair<int, int>> weights)
+  {
+    weights.erase(
+      std::remove_if(weights.begin(), weights.end(), [](auto w) { return w.second == 0; }),
       weights.end());
     std::sort(weights.begin(), weights.end());
     const auto found = pointOf.find(weights);
@@ -235,7 +240,8 @@ PolygonSoup icosphere(int frequency, double radius)
 PolygonSoup paperRoomOfQuads()
 {
   const Rgb white(0.75, 0.75, 0.75), red(0.63, 0.065, 0.05), green(0.14, 0.45, 0.091);
-  PolygonSoup room = boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
+  PolygonSoup room =
+    boxOfQuads({ 0, 0, 0 }, { 5.5, 5.5, 5.5 }, { red, green, white, white, white, white }, true);
   append(room, boxOfQuads({ 1.3, 0.65, 0 }, { 2.95, 2.3, 1.65 }, { white }, false, true));
   append(room, boxOfQuads({ 2.65, 2.95, 0 }, { 4.3, 4.6, 3.3 }, { white }, false, true));
   return room;
@@ -245,7 +251,8 @@ PolygonSoup blockOnFloor(double floorSize, const Vec3& blockLo, const Vec3& bloc
   const Rgb& floor, const Rgb& block, bool openBottom)
 {
   PolygonSoup soup;
-  addPolygon(soup, { { 0, 0, 0 }, { floorSize, 0, 0 }, { floorSize, floorSize, 0 }, { 0, floorSize, 0 } }, floor);
+  addPolygon(soup,
+    { { 0, 0, 0 }, { floorSize, 0, 0 }, { floorSize, floorSize, 0 }, { 0, floorSize, 0 } }, floor);
   append(soup, boxOfQuads(blockLo, blockHi, { block }, false, openBottom));
   return soup;
 }
@@ -256,11 +263,14 @@ PolygonSoup panelThroughWall(double thickness)
   addPolygon(soup, { { 0, 0, 0 }, { 0, 1, 0 }, { 0, 1, 1 }, { 0, 0, 1 } }, Rgb(0.5));
   if (thickness > 0)
   {
-    append(soup, boxOfQuads({ -0.3, 0.5 - thickness / 2, 0.2 }, { 0.3, 0.5 + thickness / 2, 0.8 }, { Rgb(0.3) }));
+    append(soup,
+      boxOfQuads(
+        { -0.3, 0.5 - thickness / 2, 0.2 }, { 0.3, 0.5 + thickness / 2, 0.8 }, { Rgb(0.3) }));
   }
   else
   {
-    addPolygon(soup, { { -0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.8 }, { -0.3, 0.5, 0.8 } }, Rgb(0.3));
+    addPolygon(soup,
+      { { -0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.2 }, { 0.3, 0.5, 0.8 }, { -0.3, 0.5, 0.8 } }, Rgb(0.3));
   }
   return soup;
 }

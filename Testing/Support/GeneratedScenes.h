@@ -28,8 +28,8 @@ std::vector<std::vector<Vec3>> squareLightFacingDown(const Vec3& centre, double 
 
 /// `count` positions on the segment from `from` to `to`, as translations of a light
 /// whose centroid is `centroid`.
-std::vector<Vec3> translationsAlong(const Vec3& centroid, const Vec3& from, const Vec3& to,
-  std::size_t count);
+std::vector<Vec3> translationsAlong(
+  const Vec3& centroid, const Vec3& from, const Vec3& to, std::size_t count);
 
 /**
  * The paper's configuration, generated: a Cornell-like closed room (5.5 m, white with a red

@@ -14,8 +14,8 @@ const char* const FaceNames[6] = { "-x", "+x", "-y", "+y", "-z", "+z" };
 
 /// Groups the patches addBox appended from `first` on by the face of `box` they lie on (it
 /// appends one face after the other), named `prefix` + the face.
-void groupBoxFaces(OccludedRoom& room, const std::string& prefix, const AxisBox& box,
-  std::size_t first)
+void groupBoxFaces(
+  OccludedRoom& room, const std::string& prefix, const AxisBox& box, std::size_t first)
 {
   const auto& points = room.mesh.points;
   for (std::size_t p = first; p < room.mesh.triangles.size(); ++p)

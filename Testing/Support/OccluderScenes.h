@@ -28,11 +28,11 @@ struct FaceGroup
 
 /**
  * A closed 4 x 4 x 2.5 m room (inward normals, square cells of `cell` metres cut into two
- * patches, a different reflectance on every face) with a 1 m block standing on the floor (open at its bottom, aligned with the
- * floor's patches so that no floor patch straddles its footprint) and a 1.5 x 1 m panel
- * hanging at y = 2.75, seen from both sides. A 0.5 m square light facing down moves along a
- * diagonal under the ceiling, over the block and across the panel's plane. Everything, light
- * included, is moved by `shift`.
+ * patches, a different reflectance on every face) with a 1 m block standing on the floor (open at
+ * its bottom, aligned with the floor's patches so that no floor patch straddles its footprint) and
+ * a 1.5 x 1 m panel hanging at y = 2.75, seen from both sides. A 0.5 m square light facing down
+ * moves along a diagonal under the ceiling, over the block and across the panel's plane.
+ * Everything, light included, is moved by `shift`.
  */
 struct OccludedRoom
 {

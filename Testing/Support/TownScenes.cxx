@@ -34,7 +34,8 @@ TownBlock townBlock(double wallCell, double groundCell)
   // corners, so the ground is one connected surface.
   const int n = static_cast<int>(std::lround((town.ground.hi.x - town.ground.lo.x) / groundCell));
   std::vector<std::int64_t> pointIndex(static_cast<std::size_t>((n + 1) * (n + 1)), -1);
-  auto point = [&](int i, int j) {
+  auto point = [&](int i, int j)
+  {
     std::int64_t& index = pointIndex[static_cast<std::size_t>(j * (n + 1) + i)];
     if (index < 0)
     {
@@ -51,15 +52,17 @@ TownBlock townBlock(double wallCell, double groundCell)
       bool covered = false;
       for (const Building& b : town.buildings)
       {
-        covered = covered || (centre.x > b.box.lo.x && centre.x < b.box.hi.x &&
-                               centre.y > b.box.lo.y && centre.y < b.box.hi.y);
+        covered = covered ||
+          (centre.x > b.box.lo.x && centre.x < b.box.hi.x && centre.y > b.box.lo.y &&
+            centre.y < b.box.hi.y);
       }
       if (covered)
       {
         continue;
       }
       // Counter-clockwise seen from above: facing up.
-      const std::uint32_t a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1), d = point(i, j + 1);
+      const std::uint32_t a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
+                          d = point(i, j + 1);
       town.mesh.triangles.push_back({ a, b, c });
       town.mesh.triangles.push_back({ a, c, d });
       town.mesh.reflectance.push_back(paving);
@@ -73,8 +76,8 @@ TownBlock townBlock(double wallCell, double groundCell)
     const bool brickRow = b.name == "east row";
     const Rgb walls = b.name == "pavilion" ? pavilionGlass : brickRow ? brick : limestone;
     // Faces -x, +x, -y, +y, -z (left out), +z: roofs of zinc.
-    addBox(town.mesh, b.box.lo, b.box.hi, wallCell, false, { walls, walls, walls, walls, walls, zinc },
-      true);
+    addBox(town.mesh, b.box.lo, b.box.hi, wallCell, false,
+      { walls, walls, walls, walls, walls, zinc }, true);
   }
   return town;
 }
