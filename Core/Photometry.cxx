@@ -1,10 +1,20 @@
 #include "Photometry.h"
 
 #include "Error.h"
+#include "PhotometricParsing.h"
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstring>
 #include <sstream>
+#include <utility>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace mlr
 {
@@ -472,6 +482,226 @@ IntensityDistribution IntensityDistribution::tabulated(
   d.What = Kind::Tabulated;
   d.Data = std::move(table);
   return d;
+}
+
+namespace photometry
+{
+
+std::vector<std::string_view> splitLines(std::string_view text)
+{
+  if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF")
+  {
+    text.remove_prefix(3);
+  }
+  std::vector<std::string_view> lines;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < text.size(); ++i)
+  {
+    if (text[i] == '\n' || text[i] == '\r')
+    {
+      lines.push_back(text.substr(start, i - start));
+      if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n')
+      {
+        ++i;
+      }
+      start = i + 1;
+    }
+  }
+  if (start < text.size())
+  {
+    lines.push_back(text.substr(start));
+  }
+  return lines;
+}
+
+std::string_view trim(std::string_view text)
+{
+  auto blank = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  while (!text.empty() && blank(text.front()))
+  {
+    text.remove_prefix(1);
+  }
+  while (!text.empty() && blank(text.back()))
+  {
+    text.remove_suffix(1);
+  }
+  return text;
+}
+
+bool parseNumber(std::string_view token, double& value)
+{
+  if (!token.empty() && token.front() == '+')
+  {
+    token.remove_prefix(1);
+  }
+  if (token.empty() || token.front() == '+')
+  {
+    return false;
+  }
+  // from_chars, unlike strtod, ignores the locale: a file reads the same everywhere.
+  const auto result = std::from_chars(token.data(), token.data() + token.size(), value);
+  return result.ec == std::errc() && result.ptr == token.data() + token.size() &&
+    std::isfinite(value);
+}
+
+IntensityDistribution fullTurn(const std::vector<double>& gammasDegrees,
+  const std::vector<double>& planesDegrees, const std::vector<double>& candela,
+  PlaneSymmetry symmetry)
+{
+  constexpr double toRadians = Pi / 180;
+  std::vector<double> gammas(gammasDegrees.size());
+  for (std::size_t g = 0; g < gammas.size(); ++g)
+  {
+    gammas[g] = gammasDegrees[g] * toRadians;
+  }
+  if (symmetry == PlaneSymmetry::Rotational)
+  {
+    return IntensityDistribution::tabulated(std::move(gammas), { 0.0 }, candela);
+  }
+  // Each mirror is C -> sign C + offset; the image planes take their source's values.
+  std::vector<std::pair<double, double>> mirrors{ { 1, 0 } };
+  switch (symmetry)
+  {
+    case PlaneSymmetry::AboutC0C180:
+      mirrors.push_back({ -1, 360 });
+      break;
+    case PlaneSymmetry::AboutC90C270:
+      mirrors.push_back({ -1, 180 });
+      break;
+    case PlaneSymmetry::Quadrants:
+      mirrors.insert(mirrors.end(), { { -1, 180 }, { 1, 180 }, { -1, 360 } });
+      break;
+    default:
+      break;
+  }
+  struct Image
+  {
+    double angle;
+    std::size_t mirror, source;
+  };
+  std::vector<Image> images;
+  for (std::size_t m = 0; m < mirrors.size(); ++m)
+  {
+    for (std::size_t p = 0; p < planesDegrees.size(); ++p)
+    {
+      double c = std::fmod(mirrors[m].first * planesDegrees[p] + mirrors[m].second, 360.0);
+      if (c < 0)
+      {
+        c += 360;
+      }
+      images.push_back({ c, m, p });
+    }
+  }
+  // Where images coincide (the mirror planes themselves, 0 and 360), the file's own plane wins.
+  std::sort(images.begin(), images.end(),
+    [](const Image& a, const Image& b)
+    {
+      return a.angle < b.angle ||
+        (a.angle == b.angle &&
+          (a.mirror < b.mirror || (a.mirror == b.mirror && a.source < b.source)));
+    });
+  const std::size_t nG = gammas.size();
+  std::vector<double> planes, values;
+  double last = -1;
+  for (std::size_t i = 0; i < images.size(); ++i)
+  {
+    if (images[i].angle - last < 1e-9)
+    {
+      continue;
+    }
+    last = images[i].angle;
+    planes.push_back(images[i].angle * toRadians);
+    values.insert(values.end(), candela.begin() + images[i].source * nG,
+      candela.begin() + (images[i].source + 1) * nG);
+  }
+  return IntensityDistribution::tabulated(std::move(gammas), std::move(planes), std::move(values));
+}
+
+} // namespace photometry
+
+namespace
+{
+constexpr off_t MaximumFileSize = 16 << 20;
+
+std::string readRegularFile(const std::string& path)
+{
+  struct stat info;
+  if (::stat(path.c_str(), &info) != 0)
+  {
+    throw Error("cannot read the photometric file " + path + ": " + std::strerror(errno));
+  }
+  // A FIFO or device would block or never end: only regular files are read.
+  if (!S_ISREG(info.st_mode))
+  {
+    throw Error(
+      "the photometric file " + path + " is not a regular file: give an .ies or .ldt file");
+  }
+  if (info.st_size > MaximumFileSize)
+  {
+    throw Error("the photometric file " + path + " has " + std::to_string(info.st_size) +
+      " bytes, more than the 16 MiB any real IES or EULUMDAT file needs");
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+  {
+    throw Error("cannot open the photometric file " + path + ": " + std::strerror(errno));
+  }
+  std::string text;
+  struct stat opened;
+  if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode))
+  {
+    ::close(fd);
+    throw Error(
+      "the photometric file " + path + " is not a regular file: give an .ies or .ldt file");
+  }
+  char buffer[65536];
+  for (;;)
+  {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n < 0)
+    {
+      const int error = errno;
+      ::close(fd);
+      throw Error("cannot read the photometric file " + path + ": " + std::strerror(error));
+    }
+    if (n == 0)
+    {
+      break;
+    }
+    text.append(buffer, static_cast<std::size_t>(n));
+    if (text.size() > static_cast<std::size_t>(MaximumFileSize))
+    {
+      ::close(fd);
+      throw Error("the photometric file " + path +
+        " has more than the 16 MiB any real IES or EULUMDAT file needs");
+    }
+  }
+  ::close(fd);
+  return text;
+}
+} // namespace
+
+Luminaire readPhotometricFile(const std::string& path)
+{
+  const std::size_t dot = path.find_last_of('.');
+  std::string extension = dot == std::string::npos ? "" : path.substr(dot + 1);
+  for (char& c : extension)
+  {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  if (extension == "ies")
+  {
+    return parseIes(readRegularFile(path), path);
+  }
+  if (extension == "ldt")
+  {
+    return parseEulumdat(readRegularFile(path), path);
+  }
+  throw Error("the photometric file " + path + " must end in .ies (IES LM-63) or .ldt (EULUMDAT)");
 }
 
 } // namespace mlr
