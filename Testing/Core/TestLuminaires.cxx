@@ -46,7 +46,7 @@ IntensityDistribution asymmetricTable()
   std::vector<double> gammas, planes, candela;
   for (int g = 0; g <= 6; ++g)
   {
-    gammas.push_back(g * 15 * Degree); // 0 to 90 degrees: nothing above the horizon
+    gammas.push_back(g * 15 * Degree); // 0 to 90 degrees, falling to 0: no edge to resolve
   }
   for (int p = 0; p <= 4; ++p)
   {
@@ -56,7 +56,7 @@ IntensityDistribution asymmetricTable()
   {
     for (double g : gammas)
     {
-      candela.push_back(100 * (1 + 0.8 * std::cos(c)) * std::cos(g) + 20);
+      candela.push_back((120 + 80 * std::cos(c)) * std::cos(g));
     }
   }
   return IntensityDistribution::tabulated(gammas, planes, candela);
