@@ -107,6 +107,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->MemoryLimit = 0;
   this->SolveCount = 0;
   this->Exposure = 0.0;
+  this->LuminousEfficacy = 179.0;
   this->LightType = AREA_LIGHT;
   this->SunIrradiance = 1000.0;
   this->AimAtPoint = 0;
@@ -745,6 +746,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
+  os << indent << "LuminousEfficacy: " << this->LuminousEfficacy << " lm/W\n";
   os << indent
      << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
      << "\n";

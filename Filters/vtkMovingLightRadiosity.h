@@ -351,6 +351,18 @@ public:
   void SetExposure(double exposure);
   vtkGetMacro(Exposure, double);
   ///@}
+
+  ///@{
+  /**
+   * Luminous efficacy K of the light, lm/W: the `Illuminance` arrays (lx) are K times the
+   * luminance (0.2126 R + 0.7152 G + 0.0722 B) of `Irradiance` (W/m^2). It must be > 0 and
+   * at most 683 (the efficacy of monochromatic 555 nm light); other values, NaN included, are
+   * kept as given and make the update fail with an error naming LuminousEfficacy.
+   * Default 179 (Radiance's value for white light).
+   */
+  vtkSetMacro(LuminousEfficacy, double);
+  vtkGetMacro(LuminousEfficacy, double);
+  ///@}
   // --------------------------------------------------------------- end of Display block
 
   /**
@@ -394,6 +406,7 @@ protected:
   vtkTypeBool LightPowerFromMaterial;
   vtkIdType SolveCount;
   double Exposure;
+  double LuminousEfficacy;
 
 private:
   vtkMovingLightRadiosity(const vtkMovingLightRadiosity&) = delete;
