@@ -37,6 +37,7 @@
 #include <cstdint>
 #include <new>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -212,10 +213,12 @@ mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
 {
   const std::string file = self->GetLightDistributionFile();
   const double half = self->GetSpotHalfAngle(), soft = self->GetSpotSoftEdge();
+  std::ostringstream message;
   if (!file.empty() && half > 0)
   {
-    throw mlr::Error("both a LightDistributionFile and a spot (SpotHalfAngle " +
-      std::to_string(half) + ") are set: give one of them");
+    message << "both a LightDistributionFile and a spot (SpotHalfAngle " << half
+            << " degrees) are set: give one of them";
+    throw mlr::Error(message.str());
   }
   if (!file.empty())
   {
@@ -227,8 +230,9 @@ mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
   }
   if (soft > 0)
   {
-    throw mlr::Error("SpotSoftEdge is " + std::to_string(soft) +
-      " degrees but SpotHalfAngle is 0 (no spot): give the spot's half angle too");
+    message << "SpotSoftEdge is " << soft
+            << " degrees but SpotHalfAngle is 0 (no spot): give the spot's half angle too";
+    throw mlr::Error(message.str());
   }
   return mlr::IntensityDistribution::lambertian();
 }
@@ -245,10 +249,10 @@ mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour)
   const double luminance = 0.2126 * colour.r + 0.7152 * colour.g + 0.0722 * colour.b;
   if (!(luminance > 0))
   {
-    throw mlr::Error("LightFluxLumens needs a light colour (LightPower) with some luminance: "
-                     "it is (" +
-      std::to_string(colour.r) + ", " + std::to_string(colour.g) + ", " + std::to_string(colour.b) +
-      ")");
+    std::ostringstream message;
+    message << "LightFluxLumens needs a light colour (LightPower) with some luminance: it is ("
+            << colour.r << ", " << colour.g << ", " << colour.b << ")";
+    throw mlr::Error(message.str());
   }
   return colour * (lumens / self->GetLuminousEfficacy() / luminance);
 }
