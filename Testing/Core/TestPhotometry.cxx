@@ -392,6 +392,74 @@ TEST(Photometry, SamplesFollowTheDensity)
   expectSamplesFollowDensity(lobe, 0, 7);
 }
 
+TEST(Photometry, SamplesNearCellCornersFollowTheDensity)
+{
+  // A table in 15 by 90 degree cells: one-degree bins on both sides of its cell corners
+  // (gamma 60, C 180 and gamma 15, C 90), where an error in the cell CDF or the remainder of
+  // the cell choice would show first.
+  std::vector<double> gammas, planes;
+  for (int g = 0; g <= 6; ++g)
+  {
+    gammas.push_back(g * 15 * Pi / 180);
+  }
+  for (int p = 0; p <= 4; ++p)
+  {
+    planes.push_back(p * 90 * Pi / 180);
+  }
+  const IntensityDistribution t = table(
+    gammas, planes, [](double g, double c) { return (120 + 80 * std::cos(c)) * std::cos(g); });
+  expectSamplesFollowDensity(t, 0, 8);
+  const double degree = Pi / 180;
+  const double corners[2][2] = { { 60, 180 }, { 15, 90 } };
+  const int n = 2000000;
+  std::vector<double> observed(32, 0), expected(32, 0);
+  for (int k = 0; k < 2; ++k)
+  {
+    for (int a = 0; a < 4; ++a)
+    {
+      for (int b = 0; b < 4; ++b)
+      {
+        double sum = 0;
+        for (int i = 0; i < 16; ++i)
+        {
+          for (int j = 0; j < 16; ++j)
+          {
+            const double g = (corners[k][0] - 2 + a + (i + 0.5) / 16) * degree;
+            const double c = (corners[k][1] - 2 + b + (j + 0.5) / 16) * degree;
+            sum += t.density(direction(g, c)) * std::sin(g);
+          }
+        }
+        expected[k * 16 + a * 4 + b] = sum * degree * degree / 256 * n;
+      }
+    }
+  }
+  RandomStream random(75, StreamPurpose::Shooting, 75);
+  for (int s = 0; s < n; ++s)
+  {
+    const double u1 = random.uniform(), u2 = random.uniform();
+    const Vec3 v = t.sample(u1, u2);
+    const double g = std::acos(v.z) / degree;
+    double c = std::atan2(v.y, v.x) / degree;
+    c += c < 0 ? 360 : 0;
+    for (int k = 0; k < 2; ++k)
+    {
+      const int a = static_cast<int>(std::floor(g - corners[k][0] + 2));
+      const int b = static_cast<int>(std::floor(c - corners[k][1] + 2));
+      if (a >= 0 && a < 4 && b >= 0 && b < 4)
+      {
+        observed[k * 16 + a * 4 + b] += 1;
+      }
+    }
+  }
+  double chi = 0;
+  for (int i = 0; i < 32; ++i)
+  {
+    ASSERT_GT(expected[i], 20);
+    chi += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+  }
+  EXPECT_LT(chi, 32 + 5 * std::sqrt(64.0)) << chi;
+}
+
 TEST(Photometry, TableIsRefusedWhenMalformed)
 {
   checks::expectError([] { IntensityDistribution::tabulated({ 0 }, { 0 }, { 1 }); }, "two");
