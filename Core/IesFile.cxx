@@ -329,9 +329,12 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   const std::size_t units = tokens.count("the units type (1 feet, 2 metres)", 1, 2);
   const double toMetres = units == 1 ? 0.3048 : 1;
-  // Negative sizes stand for round openings (their diameters) in LM-63-2002 and later.
-  luminaire.width = std::abs(tokens.number("the width of the luminous opening")) * toMetres;
-  luminaire.length = std::abs(tokens.number("the length of the luminous opening")) * toMetres;
+  // Negative sizes stand for round openings, by their diameters: in both width and length
+  // since LM-63-2002, in the width alone (length 0) before.
+  const double width = tokens.number("the width of the luminous opening");
+  const double length = tokens.number("the length of the luminous opening");
+  luminaire.width = std::abs(width) * toMetres;
+  luminaire.length = (width < 0 && length == 0 ? std::abs(width) : std::abs(length)) * toMetres;
   luminaire.height = std::abs(tokens.number("the height of the luminous opening")) * toMetres;
   const double ballast = tokens.number("the ballast factor");
   if (!(ballast > 0))

@@ -188,8 +188,12 @@ struct IntensityDistribution::Table
 
     // C: the marginal density is linear in t, from m0 to m1; its CDF is a quadratic, solved
     // in the form that does not cancel.
-    const double m0 = this->value(p0, g) * w0 + this->value(p0, g + 1) * w1;
-    const double m1 = this->value(p1, g) * w0 + this->value(p1, g + 1) * w1;
+    // Scaled to the larger, so that the squares below cannot overflow.
+    double m0 = this->value(p0, g) * w0 + this->value(p0, g + 1) * w1;
+    double m1 = this->value(p1, g) * w0 + this->value(p1, g + 1) * w1;
+    const double largest = std::max(m0, m1);
+    m0 /= largest;
+    m1 /= largest;
     const double t = std::clamp(
       r * (m0 + m1) / (m0 + std::sqrt(std::max(0.0, m0 * m0 + r * (m1 * m1 - m0 * m0)))), 0.0, 1.0);
     double c = c0 + t * w;
@@ -471,9 +475,13 @@ IntensityDistribution IntensityDistribution::tabulated(
       table->Cumulative[k * nG + g] = sum;
     }
   }
-  if (!(sum > 0) || !std::isfinite(sum))
+  if (!(sum > 0))
   {
     throw Error("the intensity table emits no flux: give some positive candela values");
+  }
+  if (!std::isfinite(sum))
+  {
+    throw Error("the intensity table's flux overflows: its candela values are far too large");
   }
   table->Flux = sum;
   table->MaximumDensity = largest / sum;
