@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace mlr::vtkoutputs
 {
@@ -319,7 +320,7 @@ void addIrradianceArrays(const Solution& solution, const SmoothShading& shading,
   }
   const std::vector<Rgb> pointIrradiance = pointMeans(shading, irradiance);
   for (const auto& [values, data] :
-    { std::make_pair(&irradiance, static_cast<vtkDataSetAttributes*>(cellData)),
+    { std::make_pair(&std::as_const(irradiance), static_cast<vtkDataSetAttributes*>(cellData)),
       std::make_pair(&pointIrradiance, static_cast<vtkDataSetAttributes*>(pointData)) })
   {
     auto rgb = rgbArray("Irradiance", values->size());
@@ -328,11 +329,12 @@ void addIrradianceArrays(const Solution& solution, const SmoothShading& shading,
     lux->SetNumberOfValues(static_cast<vtkIdType>(values->size()));
     for (std::size_t i = 0; i < values->size(); ++i)
     {
-      // From the stored (single precision) irradiance, so that the two arrays agree exactly.
-      const Rgb stored = PackedRgb((*values)[i]);
-      setRgb(rgb, i, stored);
-      lux->SetValue(
-        static_cast<vtkIdType>(i), static_cast<float>(luminousEfficacy * luminance(stored)));
+      // From the array's single-precision values, so that the two arrays agree exactly.
+      setRgb(rgb, i, (*values)[i]);
+      float stored[3];
+      rgb->GetTypedTuple(static_cast<vtkIdType>(i), stored);
+      lux->SetValue(static_cast<vtkIdType>(i),
+        static_cast<float>(luminousEfficacy * luminance(Rgb(stored[0], stored[1], stored[2]))));
     }
     data->AddArray(rgb);
     data->AddArray(lux);
