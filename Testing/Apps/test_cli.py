@@ -174,7 +174,7 @@ def test_every_option_of_the_help_is_known(tmp_path):
     """Every option the help lists is registered: alone, it asks for its value."""
     options = sorted(set(re.findall(r"--[a-z][a-z-]+", run(["--help"], tmp_path).stdout)) -
                      {"--help"})
-    assert len(options) == 26, options
+    assert len(options) == 27, options
     for option in options:
         result = run([option], tmp_path)
         assert result.returncode == 2
