@@ -26,7 +26,10 @@ struct PhotometricFrame
   /// Throws mlr::Error when they are parallel or either is zero.
   static PhotometricFrame fromNadir(const Vec3& nadir, const Vec3& zeroPlane);
 
-  Vec3 toWorld(const Vec3& local) const { return this->x * local.x + this->y * local.y + this->z * local.z; }
+  Vec3 toWorld(const Vec3& local) const
+  {
+    return this->x * local.x + this->y * local.y + this->z * local.z;
+  }
   Vec3 toLocal(const Vec3& world) const
   {
     return Vec3(dot(world, this->x), dot(world, this->y), dot(world, this->z));
@@ -109,7 +112,11 @@ struct Luminaire
   /// the candela multiplier and ballast factor.
   double lumens = 0;
   /// The luminous opening in metres (0 when not given): an area luminaire emits from it.
+  /// length runs along C0-C180 (x of the frame), width along C90-C270 (y); a round opening
+  /// has its diameter in both.
   double width = 0, length = 0, height = 0;
+  /// What was read but not applied (a TILT=INCLUDE table that varies, values after the table,
+  /// an unknown edition, several lamp sets), one sentence each naming the file.
   std::vector<std::string> warnings;
 };
 

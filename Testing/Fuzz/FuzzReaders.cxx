@@ -1,17 +1,22 @@
 // libFuzzer target: arbitrary bytes -> a scene file read as the command line reads it, through
 // the guarded reading (Apps/GuardedRead: .vtp .obj .ply .stl .vtu .vtk, chosen by the first
-// byte modulo 6, in that order; .obj and .ply by our vtkRadiositySceneReader with their
+// byte modulo 8, in that order; .obj and .ply by our vtkRadiositySceneReader with their
 // materials, as the command line reads them) -> the vtkMovingLightRadiosity filter with a fixed
-// light and a 2-frame trajectory, few paths and a small memory limit.
+// light and a 2-frame trajectory, few paths and a small memory limit. The first byte's last two
+// values (6, 7) make a photometric file instead (.ies, .ldt) read by mlr::readPhotometricFile,
+// whose distribution must then be finite and sample where its density is positive.
 //
 // A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
-// out of time in its child process) or a filter error is a normal outcome. Findings are crashes,
-// sanitizer reports in our code, exceptions escaping, hangs and memory over -rss_limit_mb.
+// out of time in its child process; mlr::Error for a photometric file) or a filter error is a
+// normal outcome. Findings are crashes, sanitizer reports in our code, exceptions escaping,
+// hangs and memory over -rss_limit_mb.
 // VTK's readers are not instrumented: a fault inside them shows as a crash of the reading
 // process, and GuardedRead must turn it into a refusal. The reader's time limit here (1 s of
 // CPU time, 4 s in all, plus 1 s per MiB) stays well under the fuzzer's -timeout, so that a
 // reader that loops is refused, not reported as a hang: the replay in ctest must end.
+#include "Error.h"
 #include "GuardedRead.h"
+#include "Photometry.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -82,20 +87,65 @@ struct Setup
 
   ~Setup() { fs::remove_all(this->directory); }
 };
+
+/// A photometric file that reads must describe a finite, positive distribution whose samples
+/// fall where its density is positive.
+void checkPhotometricFile(const fs::path& path)
+{
+  mlr::Luminaire luminaire;
+  try
+  {
+    luminaire = mlr::readPhotometricFile(path.string());
+  }
+  catch (const mlr::Error&)
+  {
+    return;
+  }
+  const mlr::IntensityDistribution& d = luminaire.distribution;
+  if (!std::isfinite(luminaire.lumens) || !(luminaire.lumens > 0) ||
+    !std::isfinite(d.maximumDensity()) || !(d.maximumDensity() > 0))
+  {
+    finding("a photometric file read with no finite, positive flux");
+  }
+  if (!std::isfinite(luminaire.width) || !std::isfinite(luminaire.length) ||
+    !std::isfinite(luminaire.height) || luminaire.width < 0 || luminaire.length < 0 ||
+    luminaire.height < 0)
+  {
+    finding("a photometric file read with a luminous opening that is negative or not finite");
+  }
+  for (int k = 0; k < 64; ++k)
+  {
+    const mlr::Vec3 v = d.sample((k + 0.5) / 64, std::fmod((k + 0.5) * 0.618033988749895, 1.0));
+    const double f = d.density(v);
+    if (!mlr::isFinite(v) || std::abs(mlr::length(v) - 1) > 1e-9 || !std::isfinite(f) || !(f > 0) ||
+      f > d.maximumDensity() * (1 + 1e-9))
+    {
+      finding("a photometric distribution sampled a direction of zero, excessive or non-finite "
+              "density");
+    }
+  }
+}
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
   static Setup setup;
-  static const char* const extensions[] = { ".vtp", ".obj", ".ply", ".stl", ".vtu", ".vtk" };
+  static const char* const extensions[] = { ".vtp", ".obj", ".ply", ".stl", ".vtu", ".vtk", ".ies",
+    ".ldt" };
   if (size == 0)
   {
     return 0;
   }
-  const fs::path path = setup.directory / (std::string("scene") + extensions[data[0] % 6]);
+  const unsigned kind = data[0] % 8;
+  const fs::path path = setup.directory / (std::string("scene") + extensions[kind]);
   {
     std::ofstream file(path, std::ios::binary | std::ios::trunc);
     file.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
+  }
+  if (kind >= 6)
+  {
+    checkPhotometricFile(path);
+    return 0;
   }
 
   vtkSmartPointer<vtkPolyData> scene;

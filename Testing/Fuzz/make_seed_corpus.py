@@ -5,8 +5,9 @@ solve:   byte strings that FuzzSolve.cxx decodes into small valid scenes (boxes,
          an L-shaped pair of walls) with a light, a trajectory and options; the fuzzer mutates
          them into everything else.
 readers: a first byte choosing the extension (0 .vtp, 1 .obj, 2 .ply, 3 .stl, 4 .vtu, 5 .vtk,
-         as in FuzzReaders.cxx), then a small file of that format: a box with a cell array
-         Reflectance, in every encoding the writers offer (ASCII, binary, appended, zlib).
+         6 .ies, 7 .ldt, as in FuzzReaders.cxx), then a small file of that format: a box with a
+         cell array Reflectance, in every encoding the writers offer (ASCII, binary, appended,
+         zlib); photometric files of every symmetry each format has, and a few malformed ones.
 
 Run with Debian's Python (VTK from python3-paraview): /usr/bin/python3 make_seed_corpus.py
 """
@@ -169,9 +170,78 @@ def reader_seeds():
                                                legacy)
 
 
+# --- readers: photometric files (IES LM-63 type C, EULUMDAT) -------------------------------
+def ies_text(vertical, horizontal, candela, header="IESNA:LM-63-2002", tilt="TILT=NONE",
+             units=2, lamp_line=None):
+    lines = [header, "[TEST] seed", "[MANUFAC] MovingLightRadiosity", tilt]
+    lines.append(lamp_line or f"1 -1 1 {len(vertical)} {len(horizontal)} 1 {units} 0.5 0.5 0")
+    lines.append("1 1 30")
+    lines.append(" ".join(f"{a:g}" for a in vertical))
+    lines.append(" ".join(f"{a:g}" for a in horizontal))
+    for row in candela:
+        lines.append(" ".join(f"{v:g}" for v in row))
+    return ("\n".join(lines) + "\n").encode()
+
+
+def ldt_text(isym, mc, gammas, stored_rows, flux=1000):
+    dc = 360 / mc
+    lines = ["Seed", "1", str(isym), str(mc), f"{dc:g}", str(len(gammas)),
+             f"{gammas[1] - gammas[0]:g}", "report", "luminaire", "number", "seed.ldt",
+             "2026-12-01", "600", "0", "80", "500", "300", "0", "0", "0", "0", "100", "80", "1",
+             "0", "1", "1", "LED", f"{flux:g}", "3000", "1B", "40"]
+    lines += ["0.5"] * 10
+    lines += [f"{i * dc:g}" for i in range(mc)]
+    lines += [f"{g:g}" for g in gammas]
+    for row in stored_rows:
+        lines += [f"{v:g}" for v in row]
+    return ("\r\n".join(lines) + "\r\n").encode()
+
+
+def photometric_seeds():
+    import math
+    vertical = [0, 22.5, 45, 67.5, 90]
+
+    def row(c):
+        return [round(100 * math.cos(math.radians(g)) * (1.2 + math.cos(math.radians(c))), 3)
+                for g in vertical]
+
+    for name, planes in (("rotational", [0]), ("quadrant", [0, 45, 90]),
+                         ("bilateral", [0, 90, 180]), ("full", [0, 90, 180, 270, 360]),
+                         ("ninety_to_270", [90, 180, 270])):
+        yield "ies_" + name, 6, ies_text(vertical, planes, [row(c) for c in planes])
+    yield "ies_1995_uplight_feet", 6, ies_text([90, 135, 180], [0], [[10, 50, 80]],
+                                                header="IESNA:LM-63-1995", units=1)
+    yield "ies_1986_no_header", 6, ies_text(vertical, [0], [row(0)], header="an old file")
+    yield "ies_2019_tilt_include", 6, ies_text(
+        vertical, [0], [row(0)], header="IES:LM-63-2019",
+        tilt="TILT=INCLUDE\n1\n3\n0 45 90\n1 0.95 0.9")
+    good = ies_text(vertical, [0, 90, 180], [row(c) for c in (0, 90, 180)])
+    yield "ies_truncated", 6, good[:len(good) - 12]
+    yield "ies_text_in_number", 6, good.replace(b"1 1 30", b"1 one 30")
+    yield "ies_huge_counts", 6, ies_text(vertical, [0], [row(0)],
+                                         lamp_line="1 -1 1 9999 9999 1 2 0 0 0")
+    yield "ies_tilt_file", 6, ies_text(vertical, [0], [row(0)], tilt="TILT=lamp.tlt")
+
+    gammas = [0, 30, 60, 90, 120, 150, 180]
+
+    def ldt_row(c):
+        return [round(max(0.0, 200 * math.cos(math.radians(g))) *
+                      (1.2 + math.sin(math.radians(c))), 3) for g in gammas]
+
+    for isym, planes in ((0, [0, 90, 180, 270]), (1, [0]), (2, [0, 90, 180]),
+                         (3, [270, 0, 90]), (4, [0, 90])):
+        yield f"ldt_isym{isym}", 7, ldt_text(isym, 4, gammas, [ldt_row(c) for c in planes])
+    good = ldt_text(0, 4, gammas, [ldt_row(c) for c in (0, 90, 180, 270)])
+    yield "ldt_truncated", 7, good[:len(good) // 2]
+    yield "ldt_negative_intensity", 7, good.replace(b"\r\n240\r\n", b"\r\n-240\r\n", 1)
+    yield "ldt_bad_symmetry", 7, good.replace(b"Seed\r\n1\r\n0\r\n", b"Seed\r\n1\r\n7\r\n", 1)
+
+
 def main():
     for target, seeds in (("solve", ((n, b) for n, b in solve_seeds())),
-                          ("readers", ((n, bytes([k]) + b) for n, k, b in reader_seeds()))):
+                          ("readers", ((n, bytes([k]) + b) for seeds in
+                                       (reader_seeds(), photometric_seeds())
+                                       for n, k, b in seeds))):
         directory = os.path.join(HERE, "corpus", target)
         os.makedirs(directory, exist_ok=True)
         for name, data in seeds:

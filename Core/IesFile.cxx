@@ -1,0 +1,428 @@
+// The IES LM-63 reader (1986, 1991, 1995, 2002 and 2019 editions), photometric type C. Its
+// keyword handling, multipliers and symmetries follow Radiance's ies2rad.
+#include "Error.h"
+#include "PhotometricParsing.h"
+#include "Photometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mlr
+{
+
+namespace
+{
+using photometry::MaximumAngles;
+using photometry::MaximumValues;
+
+std::string formatNumber(double value)
+{
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+/// The numbers after the TILT line: whitespace or commas between them, across lines.
+class Tokens
+{
+public:
+  Tokens(const std::vector<std::string_view>& lines, std::size_t first, const std::string& name)
+    : Lines(lines)
+    , Line(first)
+    , Name(name)
+  {
+  }
+
+  /// The next number, called `field()` in messages (built only for them: tables are long).
+  template <class Field>
+  double numberFor(const Field& field)
+  {
+    const std::string_view token = this->next(field);
+    double value;
+    if (!photometry::parseNumber(token, value))
+    {
+      this->fail(field() + " is '" + std::string(token) + "', not a finite number");
+    }
+    return value;
+  }
+
+  double number(const std::string& field)
+  {
+    return this->numberFor([&] { return field; });
+  }
+
+  /// The number of tokens the rest of the text can hold at most.
+  std::size_t capacity() const
+  {
+    std::size_t characters = 0;
+    for (std::size_t l = this->Line; l < this->Lines.size(); ++l)
+    {
+      characters += this->Lines[l].size() + 1;
+    }
+    return characters / 2 + 1;
+  }
+
+  /// The next number, a whole one within [lowest, highest].
+  std::size_t count(const std::string& field, std::size_t lowest, std::size_t highest)
+  {
+    const double value = this->number(field);
+    if (!(value >= static_cast<double>(lowest) && value <= static_cast<double>(highest)) ||
+      value != std::floor(value))
+    {
+      this->fail(field + " is " + formatNumber(value) + ": it must be a whole number from " +
+        std::to_string(lowest) + " to " + std::to_string(highest));
+    }
+    return static_cast<std::size_t>(value);
+  }
+
+  /// Throws naming the file and the line of the last token read.
+  [[noreturn]] void fail(const std::string& what) const
+  {
+    throw Error(this->Name + ", line " + std::to_string(this->TokenLine + 1) + ": " + what);
+  }
+
+  /// The values left after the table, and the line they start on.
+  std::size_t remaining(std::size_t& line)
+  {
+    std::size_t n = 0;
+    line = 0;
+    while (this->advance())
+    {
+      if (n++ == 0)
+      {
+        line = this->Line + 1;
+      }
+      this->skipToken();
+    }
+    return n;
+  }
+
+private:
+  static bool separator(char c)
+  {
+    return c == ' ' || c == '\t' || c == ',' || c == '\f' || c == '\v';
+  }
+
+  /// Moves to the start of the next token; false at the end of the text.
+  bool advance()
+  {
+    while (this->Line < this->Lines.size())
+    {
+      const std::string_view line = this->Lines[this->Line];
+      while (this->Column < line.size() && separator(line[this->Column]))
+      {
+        ++this->Column;
+      }
+      if (this->Column < line.size())
+      {
+        return true;
+      }
+      ++this->Line;
+      this->Column = 0;
+    }
+    return false;
+  }
+
+  std::string_view skipToken()
+  {
+    const std::string_view line = this->Lines[this->Line];
+    const std::size_t start = this->Column;
+    while (this->Column < line.size() && !separator(line[this->Column]))
+    {
+      ++this->Column;
+    }
+    return line.substr(start, this->Column - start);
+  }
+
+  template <class Field>
+  std::string_view next(const Field& field)
+  {
+    if (!this->advance())
+    {
+      throw Error(this->Name + ": the file ends (after line " + std::to_string(this->Lines.size()) +
+        ") before " + field() + ": it is truncated, or a count before it is too large");
+    }
+    this->TokenLine = this->Line;
+    return this->skipToken();
+  }
+
+  const std::vector<std::string_view>& Lines;
+  std::size_t Line, Column = 0, TokenLine = 0;
+  const std::string& Name;
+};
+
+/// Reads `n` strictly ascending angles within [lowest, highest] degrees.
+std::vector<double> readAngles(
+  Tokens& tokens, std::size_t n, const std::string& what, double lowest, double highest)
+{
+  std::vector<double> angles(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    auto field = [&] { return what + " " + std::to_string(i + 1) + " of " + std::to_string(n); };
+    angles[i] = tokens.numberFor(field);
+    if (angles[i] < lowest || angles[i] > highest)
+    {
+      tokens.fail(field() + " is " + formatNumber(angles[i]) + " degrees: it must be within [" +
+        formatNumber(lowest) + ", " + formatNumber(highest) + "]");
+    }
+    if (i > 0 && !(angles[i] > angles[i - 1]))
+    {
+      tokens.fail(field() + " is " + formatNumber(angles[i]) + " degrees, not above the previous " +
+        formatNumber(angles[i - 1]) + ": the angles must ascend strictly");
+    }
+  }
+  return angles;
+}
+
+bool near(double a, double b)
+{
+  return std::abs(a - b) < 1e-6;
+}
+} // namespace
+
+Luminaire parseIes(const std::string& text, const std::string& name)
+{
+  const std::vector<std::string_view> lines = photometry::splitLines(text);
+  if (lines.empty())
+  {
+    throw Error(name +
+      " is empty: an IES file starts with IESNA:LM-63-2002 (or another edition) "
+      "and its TILT line");
+  }
+  Luminaire luminaire;
+
+  // The edition: 1986 files have no such line, and there pfactor below still counts.
+  int year = 1986;
+  const std::string_view first = photometry::trim(lines[0]);
+  if (first.rfind("IESNA", 0) == 0 || first.rfind("IES:", 0) == 0)
+  {
+    if (first == "IESNA91")
+    {
+      year = 1991;
+    }
+    else if (first == "IESNA:LM-63-1995")
+    {
+      year = 1995;
+    }
+    else if (first == "IESNA:LM-63-2002")
+    {
+      year = 2002;
+    }
+    else if (first == "IES:LM-63-2019")
+    {
+      year = 2019;
+    }
+    else
+    {
+      year = 2002;
+      luminaire.warnings.push_back(
+        name + ", line 1: unknown edition '" + std::string(first) + "', read as LM-63-2002");
+    }
+  }
+
+  // Keyword lines ([TEST], [MANUFAC], ...) up to the TILT line: they carry nothing the solve
+  // needs.
+  std::size_t tiltLine = 0;
+  while (tiltLine < lines.size() && photometry::trim(lines[tiltLine]).rfind("TILT", 0) != 0)
+  {
+    ++tiltLine;
+  }
+  if (tiltLine == lines.size())
+  {
+    throw Error(name +
+      ": no TILT= line: an IES file gives TILT=NONE (or TILT=INCLUDE and its "
+      "tilt table) after its keyword lines");
+  }
+  std::string_view tilt = photometry::trim(lines[tiltLine]);
+  tilt.remove_prefix(4);
+  tilt = photometry::trim(tilt);
+  if (tilt.empty() || tilt.front() != '=')
+  {
+    throw Error(name + ", line " + std::to_string(tiltLine + 1) + ": the TILT line is '" +
+      std::string(photometry::trim(lines[tiltLine])) + "': write TILT=NONE or TILT=INCLUDE");
+  }
+  tilt = photometry::trim(tilt.substr(1));
+  Tokens tokens(lines, tiltLine + 1, name);
+  double tiltFactor = 1;
+  if (tilt == "INCLUDE")
+  {
+    // The tilt table scales the candela with the luminaire's tilt from its photometered
+    // position. The scene does not say which way is up for a light, so the luminaire is taken
+    // as photometered: the factor at 0 degrees.
+    tokens.count("the lamp-to-luminaire geometry (TILT=INCLUDE)", 1, 3);
+    const std::size_t n = tokens.count("the number of tilt angles", 1, MaximumAngles);
+    const std::vector<double> angles = readAngles(tokens, n, "tilt angle", -360, 360);
+    std::vector<double> factors(n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const std::string field =
+        "tilt multiplying factor " + std::to_string(i + 1) + " of " + std::to_string(n);
+      factors[i] = tokens.number(field);
+      if (factors[i] < 0)
+      {
+        tokens.fail(field + " is " + formatNumber(factors[i]) + ": factors must be >= 0");
+      }
+    }
+    const std::size_t above = std::upper_bound(angles.begin(), angles.end(), 0.0) - angles.begin();
+    if (above == 0)
+    {
+      tiltFactor = factors.front();
+    }
+    else if (above == n)
+    {
+      tiltFactor = factors.back();
+    }
+    else
+    {
+      const double t = (0 - angles[above - 1]) / (angles[above] - angles[above - 1]);
+      tiltFactor = (1 - t) * factors[above - 1] + t * factors[above];
+    }
+    if (std::any_of(factors.begin(), factors.end(), [&](double f) { return f != factors[0]; }))
+    {
+      luminaire.warnings.push_back(name +
+        ": the TILT=INCLUDE factors vary with the tilt; the "
+        "luminaire is taken as photometered (factor " +
+        formatNumber(tiltFactor) + " at 0 degrees)");
+    }
+  }
+  else if (tilt != "NONE")
+  {
+    throw Error(name + ", line " + std::to_string(tiltLine + 1) + ": TILT=" + std::string(tilt) +
+      " refers to a separate tilt file, which is not read: copy its data into the file with "
+      "TILT=INCLUDE, or write TILT=NONE");
+  }
+
+  tokens.number("the number of lamps");
+  const double lumensPerLamp = tokens.number("the lumens per lamp");
+  if (!(lumensPerLamp > 0) && lumensPerLamp != -1)
+  {
+    tokens.fail("the lumens per lamp are " + formatNumber(lumensPerLamp) +
+      ": give the rated lumens, or -1 for absolute photometry");
+  }
+  const double multiplier = tokens.number("the candela multiplier");
+  if (!(multiplier > 0))
+  {
+    tokens.fail("the candela multiplier is " + formatNumber(multiplier) + ": it must be above 0");
+  }
+  const std::size_t nV = tokens.count("the number of vertical angles", 2, MaximumAngles);
+  const std::size_t nH = tokens.count("the number of horizontal angles", 1, MaximumAngles);
+  if (nV * nH > MaximumValues)
+  {
+    tokens.fail(std::to_string(nV) + " vertical by " + std::to_string(nH) +
+      " horizontal angles make more than " + std::to_string(MaximumValues) + " candela values");
+  }
+  // Checked before allocating: the rest of the text must be able to hold the table.
+  if (nV + nH + nV * nH > tokens.capacity())
+  {
+    tokens.fail(std::to_string(nV) + " vertical by " + std::to_string(nH) +
+      " horizontal angles need " + std::to_string(nV * nH) +
+      " candela values, more than the rest of the file holds: a count is wrong or the file is "
+      "truncated");
+  }
+  const std::size_t type = tokens.count("the photometric type", 1, 3);
+  if (type != 1)
+  {
+    tokens.fail(std::string("the photometric type is ") +
+      (type == 2 ? "2 (type B)" : "3 (type A)") +
+      ", which is not read: only type C (1), the usual one for building luminaires, is");
+  }
+  const std::size_t units = tokens.count("the units type (1 feet, 2 metres)", 1, 2);
+  const double toMetres = units == 1 ? 0.3048 : 1;
+  // Negative sizes stand for round openings, by their diameters: in both width and length
+  // since LM-63-2002, in the width alone (length 0) before.
+  const double width = tokens.number("the width of the luminous opening");
+  const double length = tokens.number("the length of the luminous opening");
+  luminaire.width = std::abs(width) * toMetres;
+  luminaire.length = (width < 0 && length == 0 ? std::abs(width) : std::abs(length)) * toMetres;
+  luminaire.height = std::abs(tokens.number("the height of the luminous opening")) * toMetres;
+  const double ballast = tokens.number("the ballast factor");
+  if (!(ballast > 0))
+  {
+    tokens.fail("the ballast factor is " + formatNumber(ballast) + ": it must be above 0");
+  }
+  // The ballast-lamp photometric factor of the 1986 and 1991 editions, 1 since; the 2019
+  // edition puts its file generation type there.
+  double photometricFactor = tokens.number("the ballast-lamp photometric factor (future use)");
+  if (year == 2019)
+  {
+    photometricFactor = 1;
+  }
+  else if (!(photometricFactor > 0))
+  {
+    tokens.fail("the ballast-lamp photometric factor is " + formatNumber(photometricFactor) +
+      ": it must be above 0 (1 since LM-63-1995)");
+  }
+  tokens.number("the input watts");
+
+  const std::vector<double> vertical = readAngles(tokens, nV, "vertical angle", 0, 180);
+  const std::vector<double> horizontal = readAngles(tokens, nH, "horizontal angle", 0, 360);
+  photometry::PlaneSymmetry symmetry = photometry::PlaneSymmetry::None;
+  const double h0 = horizontal.front(), h1 = horizontal.back();
+  if (nH == 1)
+  {
+    symmetry = photometry::PlaneSymmetry::Rotational;
+  }
+  else if (near(h0, 0) && near(h1, 90))
+  {
+    symmetry = photometry::PlaneSymmetry::Quadrants;
+  }
+  else if (near(h0, 0) && near(h1, 180))
+  {
+    symmetry = photometry::PlaneSymmetry::AboutC0C180;
+  }
+  else if (near(h0, 90) && near(h1, 270))
+  {
+    symmetry = photometry::PlaneSymmetry::AboutC90C270;
+  }
+  else if (!(near(h0, 0) && h1 > 180))
+  {
+    tokens.fail("the horizontal angles run from " + formatNumber(h0) + " to " + formatNumber(h1) +
+      " degrees: type C tables run 0 to 0, 90, 180 or 360, or 90 to 270");
+  }
+
+  const double scale = multiplier * ballast * photometricFactor * tiltFactor;
+  std::vector<double> candela(nV * nH);
+  bool anyLight = false;
+  for (std::size_t h = 0; h < nH; ++h)
+  {
+    for (std::size_t v = 0; v < nV; ++v)
+    {
+      auto field = [&]
+      {
+        return "the candela value at horizontal angle " + formatNumber(horizontal[h]) +
+          ", vertical angle " + formatNumber(vertical[v]) + " (value " +
+          std::to_string(h * nV + v + 1) + " of " + std::to_string(nV * nH) + ")";
+      };
+      const double value = tokens.numberFor(field);
+      if (value < 0)
+      {
+        tokens.fail(field() + " is " + formatNumber(value) + ": candela must be >= 0");
+      }
+      candela[h * nV + v] = value * scale;
+      anyLight = anyLight || value > 0;
+    }
+  }
+  std::size_t extraLine;
+  if (const std::size_t extra = tokens.remaining(extraLine))
+  {
+    luminaire.warnings.push_back(name + ", line " + std::to_string(extraLine) + ": ignored " +
+      std::to_string(extra) + " values after the candela table");
+  }
+  if (!anyLight)
+  {
+    throw Error(name + ": every candela value is 0: the file describes no light");
+  }
+  try
+  {
+    luminaire.distribution = photometry::fullTurn(vertical, horizontal, candela, symmetry);
+  }
+  catch (const Error& e)
+  {
+    throw Error(name + ": " + e.what());
+  }
+  luminaire.lumens = luminaire.distribution.flux();
+  return luminaire;
+}
+
+} // namespace mlr
