@@ -265,6 +265,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--seed", "S", o.seed, parseInteger);
   option("--threads", "T", o.threads, parseInteger);
   option("--memory-limit", "MIB", o.memoryLimit, parseInteger);
+  option("--luminous-efficacy", "LM_PER_W", o.luminousEfficacy, parseNumber);
   option("--output", "PATH.pvd", o.output, parseOutput);
   option("--stats", "FILE.json", o.stats, asGiven);
   option("--png", "DIR", o.png, asGiven);
@@ -520,6 +521,19 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkRange<long long>("--memory-limit", *o.memoryLimit, 1, filter->GetMemoryLimitMaxValue());
     filter->SetMemoryLimit(static_cast<int>(*o.memoryLimit));
   }
+  if (o.luminousEfficacy)
+  {
+    // Above 0 and at most 683: range messages say "from ... to", which would let 0 through.
+    if (!(*o.luminousEfficacy > 0 && *o.luminousEfficacy <= 683))
+    {
+      std::ostringstream s;
+      s << "--luminous-efficacy is " << *o.luminousEfficacy
+        << ": give the light's luminous efficacy in lm/W, above 0 and at most 683 (179 for "
+           "white light)";
+      throw UsageError(s.str());
+    }
+    filter->SetLuminousEfficacy(*o.luminousEfficacy);
+  }
   if (o.from)
   {
     checkRange<long long>("--frames", *o.frames, filter->GetNumberOfPositionsMinValue(),
@@ -537,9 +551,10 @@ std::string helpText()
 Computes the radiosity of a scene lit by a light that moves along a path, all light
 positions at once with reuse of paths, and writes the animation as a .pvd + .vtu series
 (one unstructured grid per frame with the cell arrays Radiosity, DirectRadiosity,
-IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Reflectance, PatchId and
-Color, the display colour, and the point arrays Radiosity, Color and ScenePointId on points
-split along creases for smooth shading).
+IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Irradiance (the light
+arriving, W/m^2), Illuminance (lx), Reflectance, PatchId and Color, the display colour, and
+the point arrays Radiosity, Irradiance, Illuminance, Color and ScenePointId on points split
+along creases for smooth shading).
 
 Without any option it runs the built-in example: the Cornell box with its ceiling light
 moving through 30 positions along a diagonal just below the ceiling, and writes
@@ -616,6 +631,10 @@ Solver:
   --memory-limit MIB    refuse, before allocating, a solve (or reading a file) estimated to
                         need more memory than this (default: half the physical memory)
 Output:
+  --luminous-efficacy LM_PER_W
+                        lumens per watt of the light, which turn the Irradiance arrays
+                        (W/m^2) into Illuminance (lx for a scene in metres); above 0 and at
+                        most 683 (default 179, white light)
   --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)
   --stats FILE.json     also write the options, times and solver statistics as JSON

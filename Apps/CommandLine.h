@@ -70,6 +70,8 @@ struct Options
   std::optional<long long> threads;
   std::optional<long long> memoryLimit; ///< MiB
 
+  std::optional<double> luminousEfficacy; ///< lm/W, for the Illuminance arrays
+
   std::string output; ///< PATH.pvd
   std::string stats;  ///< FILE.json, or empty
   std::string png;    ///< DIR, or empty for no pictures

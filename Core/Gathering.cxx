@@ -16,8 +16,9 @@ constexpr std::size_t GatheringSidesPerTask = 32;
 
 /**
  * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
- * on it; each ray that reaches a patch side adds that side's shooting radiosity. With reuse
- * one set of rays serves every frame; otherwise each frame casts its own.
+ * on it; each ray that reaches a patch side adds that side's shooting radiosity. Their mean
+ * is the side's indirect irradiance (the Solution applies rho_e). With reuse one set of rays
+ * serves every frame; otherwise each frame casts its own.
  */
 void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
   std::uint32_t elementSide, std::uint64_t rays, Solution& solution, std::vector<Rgb>& sum,
@@ -82,10 +83,10 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
     }
     addPending();
   }
-  const Rgb scale = scene.elementReflectance(element) / static_cast<double>(rays);
+  const double scale = 1.0 / static_cast<double>(rays);
   for (std::size_t f = 0; f < frames; ++f)
   {
-    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(scale * sum[f]);
+    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(sum[f] * scale);
   }
 }
 
@@ -121,6 +122,30 @@ std::vector<std::uint32_t> gatheringSides(const Scene& scene,
   return sides;
 }
 
+std::vector<std::uint32_t> blackSides(
+  const Scene& scene, const std::vector<std::uint8_t>& reachable)
+{
+  std::vector<std::uint32_t> sides;
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    if (scene.patchReflectance(p).maxComponent() > 0)
+    {
+      continue;
+    }
+    for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch; ++e)
+    {
+      for (std::size_t s = 0; s < 2; ++s)
+      {
+        if (reachable[2 * p + s])
+        {
+          sides.push_back(static_cast<std::uint32_t>(e * 2 + s));
+        }
+      }
+    }
+  }
+  return sides;
+}
+
 GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
@@ -128,7 +153,16 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   std::uint64_t raysPerSide = 0;
   const auto total = static_cast<std::uint64_t>(
     std::llround(options.gatheringRatio * static_cast<double>(options.pathsPerFrame)));
-  const std::vector<std::uint32_t> sides = gatheringSides(scene, reachable, raysPerSide, total);
+  std::vector<std::uint32_t> sides = gatheringSides(scene, reachable, raysPerSide, total);
+  // Black sides gather after the others, at their rate (they do not change it, so the others'
+  // results do not depend on them), for their irradiance alone.
+  const std::vector<std::uint32_t> black = blackSides(scene, reachable);
+  if (sides.empty() && !black.empty())
+  {
+    raysPerSide = static_cast<std::uint64_t>(std::max<long long>(
+      1, std::llround(static_cast<double>(total) / static_cast<double>(black.size()))));
+  }
+  sides.insert(sides.end(), black.begin(), black.end());
   std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
   std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
   const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
@@ -174,8 +208,12 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
         }
         const Rgb patchDirect = directPower / scene.patchArea(p);
         const Rgb b = solution.patchRadiosity(f, p, static_cast<Side>(s));
-        const Rgb rest(std::max(0.0, b.r - patchDirect.r), std::max(0.0, b.g - patchDirect.g),
-          std::max(0.0, b.b - patchDirect.b));
+        // As irradiance: a channel the patch does not reflect shows none of its indirect light.
+        const Rgb& rho = scene.patchReflectance(p);
+        const auto irradiance = [](double radiosity, double directPart, double reflectance)
+        { return reflectance > 0 ? std::max(0.0, radiosity - directPart) / reflectance : 0.0; };
+        const Rgb rest(irradiance(b.r, patchDirect.r, rho.r), irradiance(b.g, patchDirect.g, rho.g),
+          irradiance(b.b, patchDirect.b, rho.b));
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {
           solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] =

@@ -24,6 +24,14 @@ class RayTracer;
 std::vector<std::uint32_t> gatheringSides(const Scene& scene,
   const std::vector<std::uint8_t>& reachable, std::uint64_t& rays, std::uint64_t total);
 
+/**
+ * The reachable element sides of black patches, as element * 2 + side in element order: they
+ * gather for their irradiance alone (their radiosity is zero), at the rate gatheringSides()
+ * sets for the others.
+ */
+std::vector<std::uint32_t> blackSides(
+  const Scene& scene, const std::vector<std::uint8_t>& reachable);
+
 /// What gathering traced on this rank.
 struct GatheringResult
 {
@@ -33,16 +41,19 @@ struct GatheringResult
 
 /**
  * Gathers k N rays (options.gatheringRatio) over the gathering sides of the `reachable` patch
- * sides, shared by the ranks and summed over them, into solution's indirect light (which
- * must be allocated). `fraction` gets the share done; false cancels.
+ * sides (and as many per side over their blackSides()), shared by the ranks and summed over them,
+ * into solution's indirect light (which must be allocated). `fraction` gets the share done; false
+ * cancels.
  */
 GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing,
   Solution& solution);
 
-/// Without gathering (k = 0) an element's indirect light is its patch's shooting solution
-/// minus the patch's direct part (the area-weighted direct of its four elements).
+/// Without gathering (k = 0) an element's indirect radiosity is its patch's shooting solution
+/// minus the patch's direct part (the area-weighted direct of its four elements), and its
+/// indirect irradiance that divided by the patch's reflectance: zero in a channel the patch
+/// does not reflect, so that a black patch shows only its direct irradiance.
 void indirectFromPatches(const Scene& scene, Solution& solution);
 
 } // namespace mlr

@@ -33,10 +33,11 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t scratch = saturatingProduct({ workers, frames,
     sizeof(double) + 3 * sizeof(float) + sizeof(std::uint32_t) + sizeof(std::uint8_t) +
       sizeof(Rgb) });
-  // Embree's BVH and buffers (generously), the emission and lit side of every element.
+  // Embree's BVH and buffers (generously), the emission, reflectance and lit side of every
+  // element.
   const std::uint64_t tracing =
     saturatingSum(saturatingProduct({ elements, 256 }), saturatingProduct({ points, 16 }));
-  const std::uint64_t perElement = saturatingProduct({ elements, sizeof(Rgb) + sizeof(Side) });
+  const std::uint64_t perElement = saturatingProduct({ elements, 2 * sizeof(Rgb) + sizeof(Side) });
   // Reachability: the probes' hits and their reverse edges (gone before gathering rays).
   const std::uint64_t reachability =
     saturatingProduct({ patches, 2, 2 * ReachabilityProbesPerSide + 2, sizeof(std::uint32_t) });

@@ -14,8 +14,8 @@ namespace mlr
 
 /**
  * How a solve uses memory: the one policy behind the estimate, the limit check and the
- * allocations. Results are single precision (PackedRgb): direct light per element side,
- * patch radiosity per patch side, and indirect light per element side, allocated when
+ * allocations. Results are single precision (PackedRgb): direct irradiance per element side,
+ * patch radiosity per patch side, and indirect irradiance per element side, allocated when
  * gathering starts, after the shooting accumulators are freed. The peak is the larger of the
  * two phases. Shooting accumulators (64-bit fixed point) take one copy per worker (plain
  * adds, the fastest) when that peak fits in half the memory limit, and otherwise one copy
@@ -26,7 +26,7 @@ namespace mlr
 struct MemoryPlan
 {
   bool accumulatorCopyPerWorker = true;
-  std::uint64_t results = 0;      ///< direct, indirect and patch radiosity of every frame
+  std::uint64_t results = 0;      ///< direct and indirect irradiance, patch radiosity, per frame
   std::uint64_t accumulators = 0; ///< the shooting accumulators of one source, all copies
   std::uint64_t other = 0;        ///< per-thread scratch, the ray-tracing scene, reachability
   std::uint64_t peak = 0;         ///< the estimate: the larger phase, shooting or gathering

@@ -90,6 +90,59 @@ double spotPartialFlux(double gamma, double halfAngle, double softEdge)
   }
   return f;
 }
+
+/**
+ * The gamma in [g0, g1] where the integral of ((1 - s) a + s b) sin(gamma), s the fraction
+ * (gamma - g0) / (g1 - g0), reaches the fraction u of its total: the inverse CDF of an
+ * intensity linear in gamma (a table's cell at a given C, a spot's soft edge). Newton steps,
+ * kept inside a shrinking bracket.
+ */
+double invertLinearSinCdf(double g0, double g1, double a, double b, double u)
+{
+  const double h = g1 - g0, s0 = std::sin(g0), c0 = std::cos(g0);
+  // The closed forms cancel for short intervals: those take the series.
+  const bool closed = h >= 1e-3;
+  auto cdf = [&](double g, double sg, double cg)
+  {
+    const double ramp = (closed ? sg - s0 - (g - g0) * cg : rampSinIntegral(g0, g)) / h;
+    return a * ((closed ? c0 - cg : sinIntegral(g0, g)) - ramp) + b * ramp;
+  };
+  const double target = u * cdf(g1, std::sin(g1), std::cos(g1));
+  if (!(target > 0))
+  {
+    return g0 + u * h;
+  }
+  // The start: the answer for sin(gamma) constant over the interval, where the CDF is a
+  // quadratic in s (solved as the C marginal's, scaled so that no square overflows).
+  const double largest = std::max(a, b), m0 = a / largest, m1 = b / largest;
+  const double s =
+    u * (m0 + m1) / (m0 + std::sqrt(std::max(0.0, m0 * m0 + u * (m1 * m1 - m0 * m0))));
+  double lo = g0, hi = g1, g = std::clamp(g0 + s * h, g0, g1);
+  for (int i = 0; i < 60 && hi - lo > 1e-13; ++i)
+  {
+    const double sg = std::sin(g), cg = std::cos(g);
+    const double f = cdf(g, sg, cg) - target;
+    if (f == 0)
+    {
+      break;
+    }
+    (f > 0 ? hi : lo) = g;
+    const double slope = (a + (b - a) * (g - g0) / h) * sg;
+    double next = slope > 0 ? g - f / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi))
+    {
+      next = 0.5 * (lo + hi);
+    }
+    // 1e-13 rad: the CDF's rounding moves the root by about that much, and no sample sees it.
+    const bool converged = std::abs(next - g) < 1e-13;
+    g = next;
+    if (converged)
+    {
+      break;
+    }
+  }
+  return g;
+}
 } // namespace
 
 /**
@@ -187,8 +240,7 @@ struct IntensityDistribution::Table
     this->gammaWeights(g, w0, w1);
 
     // C: the marginal density is linear in t, from m0 to m1; its CDF is a quadratic, solved
-    // in the form that does not cancel.
-    // Scaled to the larger, so that the squares below cannot overflow.
+    // in the form that does not cancel, with m0 and m1 scaled so that no square overflows.
     double m0 = this->value(p0, g) * w0 + this->value(p0, g + 1) * w1;
     double m1 = this->value(p1, g) * w0 + this->value(p1, g + 1) * w1;
     const double largest = std::max(m0, m1);
@@ -205,43 +257,7 @@ struct IntensityDistribution::Table
     // gamma: the intensity along the cell at this C is a (1 - s) + b s.
     const double a = (1 - t) * this->value(p0, g) + t * this->value(p1, g);
     const double b = (1 - t) * this->value(p0, g + 1) + t * this->value(p1, g + 1);
-    const double g0 = this->Gammas[g], g1 = this->Gammas[g + 1], h = g1 - g0;
-    auto cdf = [&](double gamma)
-    {
-      const double ramp = rampSinIntegral(g0, gamma) / h;
-      return a * (sinIntegral(g0, gamma) - ramp) + b * ramp;
-    };
-    const double target = u2 * cdf(g1);
-    double lo = g0, hi = g1, gamma = g0 + u2 * h;
-    if (!(target > 0))
-    {
-      return directionOf(std::cos(gamma), c);
-    }
-    for (int i = 0; i < 100 && hi - lo > 1e-15; ++i)
-    {
-      const double f = cdf(gamma) - target;
-      if (f > 0)
-      {
-        hi = gamma;
-      }
-      else
-      {
-        lo = gamma;
-      }
-      const double s = (gamma - g0) / h;
-      const double slope = (a * (1 - s) + b * s) * std::sin(gamma);
-      double next = slope > 0 ? gamma - f / slope : 0.5 * (lo + hi);
-      if (!(next > lo && next < hi))
-      {
-        next = 0.5 * (lo + hi);
-      }
-      const bool converged = std::abs(next - gamma) < 1e-15;
-      gamma = next;
-      if (converged)
-      {
-        break;
-      }
-    }
+    const double gamma = invertLinearSinCdf(this->Gammas[g], this->Gammas[g + 1], a, b, u2);
     return directionOf(std::cos(gamma), c);
   }
 };
@@ -325,39 +341,19 @@ Vec3 IntensityDistribution::sample(double u1, double u2) const
       return this->Data->sample(u1, u2);
   }
   // The CDF in gamma is 2 pi normalisation times spotPartialFlux: closed form inside the
-  // cone, safeguarded Newton steps on the soft edge (its density is the integrand).
+  // cone, then the soft edge's.
   const double target = u1 / (TwoPi * this->SpotNormalisation);
   const double cone = sinIntegral(0, this->HalfAngle);
-  if (target <= cone || this->SoftEdge <= 0)
+  const double edge = spotPartialFlux(Pi, this->HalfAngle, this->SoftEdge) - cone;
+  if (target <= cone || !(edge > 0))
   {
     return directionOf(std::max(-1.0, 1 - std::min(target, cone)), TwoPi * u2);
   }
-  double lo = this->HalfAngle, hi = std::min(Pi, this->HalfAngle + this->SoftEdge);
-  double g = 0.5 * (lo + hi);
-  for (int i = 0; i < 100; ++i)
-  {
-    const double f = spotPartialFlux(g, this->HalfAngle, this->SoftEdge) - target;
-    if (f > 0)
-    {
-      hi = g;
-    }
-    else
-    {
-      lo = g;
-    }
-    const double slope = spotProfile(g, this->HalfAngle, this->SoftEdge) * std::sin(g);
-    double next = slope > 0 ? g - f / slope : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi))
-    {
-      next = 0.5 * (lo + hi);
-    }
-    if (std::abs(next - g) < 1e-15 || hi - lo < 1e-15)
-    {
-      g = next;
-      break;
-    }
-    g = next;
-  }
+  // The soft edge, cut at the zenith, is linear in gamma from 1 down to `end`.
+  const double top = std::min(Pi, this->HalfAngle + this->SoftEdge);
+  const double end = 1 - (top - this->HalfAngle) / this->SoftEdge;
+  const double g =
+    invertLinearSinCdf(this->HalfAngle, top, 1, end, std::clamp((target - cone) / edge, 0.0, 1.0));
   return directionOf(std::cos(g), TwoPi * u2);
 }
 

@@ -77,8 +77,9 @@ public:
 
   void shootReused(std::uint64_t path, int worker);
   void shootClassic(std::size_t position, std::uint64_t path, int worker);
-  /// Adds this source's radiosity to `solution`: frame f gets position f, or the one
-  /// position of a static source, times that position's power factor.
+  /// Adds this source's light to `solution` (the elements' irradiance, the patches'
+  /// radiosity): frame f gets position f, or the one position of a static source, times
+  /// that position's power factor.
   void addTo(Solution& solution) const;
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
@@ -324,8 +325,8 @@ void ShootingRun::addTo(Solution& solution) const
   auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
   for (std::size_t e = 0; e < elements; ++e)
   {
-    const Rgb exitance = this->SceneRef.elementReflectance(e) * this->SourceRef.power() /
-      this->SceneRef.elementArea(e);
+    // Irradiance, not radiosity: the Solution applies rho_e, so black elements have it too.
+    const Rgb irradiance = this->SourceRef.power() / this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
       for (std::size_t f = 0; f < frames; ++f)
@@ -335,7 +336,7 @@ void ShootingRun::addTo(Solution& solution) const
         if (share != 0)
         {
           direct[solution.elementIndex(f, e, static_cast<Side>(s))] +=
-            exitance * this->SourceRef.factor(positionOf(f)) * share;
+            irradiance * this->SourceRef.factor(positionOf(f)) * share;
         }
       }
     }

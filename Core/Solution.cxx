@@ -9,6 +9,7 @@ Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches
   , Patches(patches)
   , Direct(frames * elements * 2)
   , Patch(frames * patches * 2)
+  , Reflectance(elements, Rgb(1))
   , LitSide(elements, Side::Front)
   , PatchLitSide(patches, Side::Front)
 {
@@ -23,6 +24,15 @@ void Solution::chooseLitSides()
     {
       front += this->total(f, e, Side::Front).sum();
       back += this->total(f, e, Side::Back).sum();
+    }
+    if (front == 0 && back == 0)
+    {
+      // A black element: the side light arrives on is the one its irradiance is shown for.
+      for (std::size_t f = 0; f < this->Frames; ++f)
+      {
+        front += this->irradiance(f, e, Side::Front).sum();
+        back += this->irradiance(f, e, Side::Back).sum();
+      }
     }
     this->LitSide[e] = back > front ? Side::Back : Side::Front;
   }

@@ -54,12 +54,17 @@ struct SolverStatistics
 };
 
 /**
- * Radiosity (W/m^2) of every element and patch side, for every frame.
+ * Radiosity (W/m^2) of every element and patch side, for every frame, and the irradiance
+ * of every element side it comes from.
  *
  * B_total = E + B_direct + B_indirect for elements, E the self-emission of the front side.
  * B_direct comes from the shooting walks' first hits (from every light and emitter);
- * B_indirect from final gathering of the patches' shooting solution. Both sides are kept;
- * litSide() and patchLitSide() pick the one to show, chosen once when the solve ends.
+ * B_indirect from final gathering of the patches' shooting solution. Elements store the
+ * irradiance (the power arriving per area, the emission of the surface itself excluded) and
+ * B_direct = rho_e E_direct, B_indirect = rho_e E_indirect, so that a black element has its
+ * irradiance too, at no memory per frame beyond the radiosity's (Documentation/Method.md,
+ * section 15). Both sides are kept; litSide() and patchLitSide() pick the one to show,
+ * chosen once when the solve ends.
  */
 class Solution
 {
@@ -73,13 +78,30 @@ public:
 
   Rgb direct(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Direct[this->elementIndex(frame, element, side)];
+    return this->Reflectance[element] * this->directIrradiance(frame, element, side);
   }
   /// Zero until gathering has run.
   Rgb indirect(std::size_t frame, std::size_t element, Side side) const
   {
+    return this->Reflectance[element] * this->indirectIrradiance(frame, element, side);
+  }
+  /// The irradiance (W/m^2) of an element side from the lights' and emitters' first hits.
+  Rgb directIrradiance(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Direct[this->elementIndex(frame, element, side)];
+  }
+  /// The irradiance from the rest of the scene: gathering's mean of the patch radiosity its
+  /// rays reach (k = 0: see indirectFromPatches). Zero until gathering has run.
+  Rgb indirectIrradiance(std::size_t frame, std::size_t element, Side side) const
+  {
     return this->Indirect.empty() ? Rgb()
                                   : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
+  }
+  /// All the light arriving on an element side: total() = emitted() + rho_e irradiance().
+  Rgb irradiance(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->directIrradiance(frame, element, side) +
+      this->indirectIrradiance(frame, element, side);
   }
   /// Self-emission (W/m^2): the scene's emission on the front side, zero on the back.
   Rgb emitted(std::size_t element, Side side) const
@@ -118,9 +140,10 @@ public:
     return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
   }
   // Results are stored in single precision (PackedRgb); see MemoryPlan.
+  /// The direct irradiance of every element side and frame.
   std::vector<PackedRgb>& directData() { return this->Direct; }
-  /// Empty until allocateIndirect(): the solver allocates it once the shooting accumulators
-  /// are freed, so that the two never take memory at once.
+  /// The indirect irradiance. Empty until allocateIndirect(): the solver allocates it once the
+  /// shooting accumulators are freed, so that the two never take memory at once.
   std::vector<PackedRgb>& indirectData() { return this->Indirect; }
   void allocateIndirect() { this->Indirect.assign(this->Direct.size(), PackedRgb()); }
   std::vector<PackedRgb>& patchData() { return this->Patch; }
@@ -128,11 +151,14 @@ public:
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
   /// One per element, or empty when nothing emits.
   std::vector<Rgb>& emissionData() { return this->Emission; }
+  /// rho_e of every element, which turns irradiance into radiosity; 1 until the solver sets
+  /// the scene's.
+  std::vector<Rgb>& reflectanceData() { return this->Reflectance; }
 
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
   std::vector<PackedRgb> Direct, Indirect, Patch;
-  std::vector<Rgb> Emission;
+  std::vector<Rgb> Emission, Reflectance;
   std::vector<Side> LitSide, PatchLitSide;
 };
 

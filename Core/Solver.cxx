@@ -193,6 +193,10 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       }
       tracerStorage.emplace(scene);
       solution = Solution(frames, scene.elementCount(), scene.patchCount());
+      for (std::size_t e = 0; e < scene.elementCount(); ++e)
+      {
+        solution.reflectanceData()[e] = scene.elementReflectance(e);
+      }
       if (scene.hasEmission())
       {
         solution.emissionData().resize(scene.elementCount());

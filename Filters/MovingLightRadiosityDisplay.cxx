@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace mlr::vtkoutputs
 {
@@ -263,36 +264,81 @@ void setColor(vtkUnsignedCharArray* array, std::size_t i, const Rgb& radiosity, 
 }
 }
 
+std::vector<Rgb> pointMeans(const SmoothShading& shading, const std::vector<Rgb>& elementValues)
+{
+  std::vector<Rgb> pointSum(shading.scenePoints.size());
+  for (std::size_t e = 0; e < elementValues.size(); ++e)
+  {
+    const Rgb weighted = elementValues[e] * shading.elementAreas[e];
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      pointSum[static_cast<std::size_t>(shading.cornerPoints[3 * e + k])] += weighted;
+    }
+  }
+  for (std::size_t p = 0; p < pointSum.size(); ++p)
+  {
+    pointSum[p] = pointSum[p] * shading.inverseArea[p];
+  }
+  return pointSum;
+}
+
 void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
   double exposureScale, vtkPointData* pointData, vtkCellData* cellData)
 {
   const std::size_t n = solution.elementCount();
   const std::size_t pointCount = shading.scenePoints.size();
   auto cellColor = rgbArray<vtkUnsignedCharArray>("Color", n);
-  std::vector<Rgb> pointSum(pointCount);
+  std::vector<Rgb> radiosity(n);
   for (std::size_t e = 0; e < n; ++e)
   {
-    const Rgb radiosity = solution.total(frame, e, solution.litSide(e));
-    setColor(cellColor, e, radiosity, exposureScale);
-    const Rgb weighted = radiosity * shading.elementAreas[e];
-    for (std::size_t k = 0; k < 3; ++k)
-    {
-      pointSum[static_cast<std::size_t>(shading.cornerPoints[3 * e + k])] += weighted;
-    }
+    radiosity[e] = solution.total(frame, e, solution.litSide(e));
+    setColor(cellColor, e, radiosity[e], exposureScale);
   }
-  auto pointRadiosity = rgbArray("Radiosity", pointCount);
+  const std::vector<Rgb> pointRadiosity = pointMeans(shading, radiosity);
+  auto pointRadiosityArray = rgbArray("Radiosity", pointCount);
   auto pointColor = rgbArray<vtkUnsignedCharArray>("Color", pointCount);
   for (std::size_t p = 0; p < pointCount; ++p)
   {
-    const Rgb radiosity = pointSum[p] * shading.inverseArea[p];
-    setRgb(pointRadiosity, p, radiosity);
-    setColor(pointColor, p, radiosity, exposureScale);
+    setRgb(pointRadiosityArray, p, pointRadiosity[p]);
+    setColor(pointColor, p, pointRadiosity[p], exposureScale);
   }
   cellData->AddArray(cellColor);
   cellData->SetActiveScalars("Color");
-  pointData->AddArray(pointRadiosity);
+  pointData->AddArray(pointRadiosityArray);
   pointData->AddArray(pointColor);
   pointData->SetActiveScalars("Color");
+}
+
+void addIrradianceArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData)
+{
+  const std::size_t n = solution.elementCount();
+  std::vector<Rgb> irradiance(n);
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    irradiance[e] = solution.irradiance(frame, e, solution.litSide(e));
+  }
+  const std::vector<Rgb> pointIrradiance = pointMeans(shading, irradiance);
+  for (const auto& [values, data] :
+    { std::make_pair(&std::as_const(irradiance), static_cast<vtkDataSetAttributes*>(cellData)),
+      std::make_pair(&pointIrradiance, static_cast<vtkDataSetAttributes*>(pointData)) })
+  {
+    auto rgb = rgbArray("Irradiance", values->size());
+    vtkNew<vtkFloatArray> lux;
+    lux->SetName("Illuminance");
+    lux->SetNumberOfValues(static_cast<vtkIdType>(values->size()));
+    for (std::size_t i = 0; i < values->size(); ++i)
+    {
+      // From the array's single-precision values, so that the two arrays agree exactly.
+      setRgb(rgb, i, (*values)[i]);
+      float stored[3];
+      rgb->GetTypedTuple(static_cast<vtkIdType>(i), stored);
+      lux->SetValue(static_cast<vtkIdType>(i),
+        static_cast<float>(luminousEfficacy * luminance(Rgb(stored[0], stored[1], stored[2]))));
+    }
+    data->AddArray(rgb);
+    data->AddArray(lux);
+  }
 }
 
 void addExposureFieldData(vtkFieldData* fieldData, double autoExposure, double exposure)

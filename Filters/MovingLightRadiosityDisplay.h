@@ -74,6 +74,19 @@ vtkSmartPointer<vtkPolyData> smoothElementMesh(const Scene& scene, const SmoothS
 void addDisplayArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
   double exposureScale, vtkPointData* pointData, vtkCellData* cellData);
 
+/// The area-weighted mean, at each point of `shading`, of one value per element.
+std::vector<Rgb> pointMeans(const SmoothShading& shading, const std::vector<Rgb>& elementValues);
+
+/**
+ * Adds, to cells and points, `Irradiance` (RGB, W/(scene unit)^2: the light arriving on each
+ * element's lit side in `frame`, direct and indirect, the element's own emission excluded;
+ * at points the area-weighted mean, as point `Radiosity`) and `Illuminance` (one component,
+ * lm/(scene unit)^2, lx for a scene in metres): `luminousEfficacy` (lm/W) times the
+ * luminance of `Irradiance` (Documentation/Method.md, section 15).
+ */
+void addIrradianceArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData);
+
 /// Adds `AutoExposure` and `Exposure` (EV) and `ExposureScale`, 2^(AutoExposure + Exposure),
 /// the factor applied to radiosity before the tone map.
 void addExposureFieldData(vtkFieldData* fieldData, double autoExposure, double exposure);

@@ -67,13 +67,14 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
   // floats) and PatchId; the patch mesh is a quarter of it. Smooth shading splits points at
   // creases: taken as a quarter more points than elements, each with 24 bytes of
   // coordinates, a ScenePointId and an inverse area, and 3 corner ids per element. Per
-  // frame: Radiosity, Direct, Indirect, Front and Back (3 floats each) and Color (3 bytes)
-  // per element, point Radiosity and Color, and the patches' Radiosity.
+  // frame: Radiosity, Direct, Indirect, Front, Back and Irradiance (3 floats each),
+  // Illuminance (a float) and Color (3 bytes) per element, point Radiosity, Irradiance,
+  // Illuminance and Color, and the patches' Radiosity.
   const std::uint64_t e = elements, p = points;
   const std::uint64_t split = p + e / 4;
   const std::uint64_t meshes =
     p * 24 + split * (24 + 4 + 8) + e * (32 + 12 + 8 + 24) + e / 4 * (32 + 12);
-  const std::uint64_t frame = e * (5 * 12 + 3) + split * (12 + 3) + e / 4 * 12;
+  const std::uint64_t frame = e * (6 * 12 + 4 + 3) + split * (12 + 12 + 4 + 3) + e / 4 * 12;
   return meshes + frame;
 }
 
@@ -196,6 +197,10 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   // one in millimetres.
   addValue<vtkStringArray>(fieldData, "PowerUnits", std::string("W"));
   addValue<vtkStringArray>(fieldData, "RadiosityUnits", std::string("W/(scene unit)^2"));
+  // Irradiance is per area as radiosity is; illuminance in lumens per square unit: lx for a
+  // scene in metres.
+  addValue<vtkStringArray>(fieldData, "IrradianceUnits", std::string("W/(scene unit)^2"));
+  addValue<vtkStringArray>(fieldData, "IlluminanceUnits", std::string("lm/(scene unit)^2"));
   return fieldData;
 }
 

@@ -75,7 +75,8 @@ void addPatchRadiosity(const Solution& solution, const std::vector<Side>& litSid
 
 /// One single-value array per statistic (counts, seconds, reuse modes), plus the predicted
 /// speed-up of full reuse over classic for these frames, k and lambda (paper eq. 4), and
-/// the strings PowerUnits ("W") and RadiosityUnits ("W/(scene unit)^2").
+/// the strings PowerUnits ("W"), RadiosityUnits and IrradianceUnits ("W/(scene unit)^2") and
+/// IlluminanceUnits ("lm/(scene unit)^2").
 vtkSmartPointer<vtkFieldData> statisticsFieldData(
   const SolverStatistics& statistics, const SolverOptions& options);
 

@@ -358,6 +358,13 @@ int vtkMovingLightRadiosity::RequestData(
   {
     vtkPolyData::GetData(outputVector, port)->Initialize();
   }
+  if (!(this->LuminousEfficacy > 0 && this->LuminousEfficacy <= 683))
+  {
+    vtkErrorMacro(<< "LuminousEfficacy is " << this->LuminousEfficacy
+                  << " lm/W: give the light's luminous efficacy, above 0 and at most 683 lm/W "
+                     "(179 for white light)");
+    return 0;
+  }
   vtkInternals& cache = *this->Internals;
   if (cache.Aborted)
   {
@@ -405,6 +412,8 @@ int vtkMovingLightRadiosity::RequestData(
         mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
           std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
           output->GetCellData());
+        mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
+          this->LuminousEfficacy, output->GetPointData(), output->GetCellData());
         if (cache.Distributed)
         {
           // Cut from the whole frame, so that the point arrays at the cut average over the
@@ -481,6 +490,8 @@ int vtkMovingLightRadiosity::RequestData(
         }
       }
       mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
+      mlr::vtkoutputs::addValue<vtkDoubleArray>(
+        fieldData, "LuminousEfficacy", this->LuminousEfficacy);
       output->SetFieldData(fieldData);
     }
     output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);

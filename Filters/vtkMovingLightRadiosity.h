@@ -49,13 +49,19 @@
  *   along creases (lit-side normals more than 30 degrees apart), between materials and
  *   between the lit sides of thin walls, and carry `Radiosity` (area-weighted mean of the
  *   cells around the point), `Color` (its display colour) and `ScenePointId` (the remeshed
- *   scene's point it was split from, the numbering of the Patches output). `Color` is the
- *   active scalars of points and cells. Its field data holds the solver statistics (paths,
- *   rays by kind, seconds by phase, patches, elements, frames, reuse modes, predicted
- *   speed-up), the frame shown (`FrameIndex`), where the light is in it (`LightPosition`, its
- *   centroid, and `LightTranslation`, from the Light input), `SolveCount`, and the exposure
- *   (`AutoExposure`, `Exposure`, `ExposureScale`). Every output's field data states the units:
- *   `PowerUnits` "W" and `RadiosityUnits` "W/(scene unit)^2" (W/m^2 for a scene in metres).
+ *   scene's point it was split from, the numbering of the Patches output). Cells and
+ *   points also carry `Irradiance` (3 components, W/m^2: the light arriving on the lit
+ *   side, direct and indirect, the surface's own emission excluded, so that black surfaces
+ *   have it too; at points averaged as `Radiosity`) and `Illuminance` (1 component, lx:
+ *   LuminousEfficacy times the luminance of `Irradiance`). `Color` is the active scalars of
+ *   points and cells. Its field data holds the solver statistics (paths, rays by kind,
+ *   seconds by phase, patches, elements, frames, reuse modes, predicted speed-up), the frame
+ *   shown (`FrameIndex`), where the light is in it (`LightPosition`, its centroid, and
+ *   `LightTranslation`, from the Light input), `SolveCount`, the exposure (`AutoExposure`,
+ *   `Exposure`, `ExposureScale`) and `LuminousEfficacy`. Every output's field data states
+ *   the units: `PowerUnits` "W", `RadiosityUnits` and `IrradianceUnits` "W/(scene unit)^2"
+ *   (W/m^2 for a scene in metres) and `IlluminanceUnits` "lm/(scene unit)^2" (lx for a
+ *   scene in metres).
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
  * - port 2, Light: the light's polygons where they are in the frame shown, with the cell

@@ -524,6 +524,13 @@ TEST(Photometry, IesCosinePowerGivesTheAnalyticFlux)
   }
   EXPECT_NEAR(parseIes(crlf, "crlf.ies").lumens, exact / 2, 2e-4 * exact);
 
+  // An uplight (90-180): 10 cd over the upper hemisphere, nothing below.
+  const Luminaire up =
+    parseIes(iesFile(degrees(90, 180, 10), { 0 }, [](double, double) { return 10.0; }), "up.ies");
+  EXPECT_NEAR(up.lumens, 10 * 2 * Pi, 1e-12);
+  EXPECT_EQ(up.distribution.density({ 0, 0, 1 }), 0);
+  EXPECT_NEAR(up.distribution.density({ 0.3, 0, -1 }), 1 / (2 * Pi), 1e-12);
+
   // TILT=INCLUDE: the factor at 0 degrees scales the candela.
   const std::string tilt = "TILT=INCLUDE\n1\n3\n0 45 90\n0.5 0.7 0.9";
   const Luminaire tilted = parseIes(iesFile(vertical, { 0 }, f, 1, 1, tilt), "tilt.ies");
