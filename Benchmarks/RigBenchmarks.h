@@ -1,5 +1,5 @@
-// mlr-benchmark's light-rig cases: a turning light and the sun over a town block
-//, each full reuse against classic with errors against a high-N classic reference.
+// mlr-benchmark's light-rig cases: a turning light, a panning spot and the sun over a town
+// block, each full reuse against classic with errors against a high-N classic reference.
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,7 @@ namespace mlr::bench
 struct RigCaseOptions
 {
   std::uint64_t paths = 600000; ///< N, effective paths per frame
-  std::size_t frames = 30;      ///< the turning light's frames
+  std::size_t frames = 30;      ///< the turning light's and the panning spot's frames
   int threads = 0;
   /// The reference is classic with this many times N paths per frame.
   int referenceFactor = 16;
@@ -34,5 +34,15 @@ std::string runTurningLight(const RigCaseOptions& options);
  * at the first frame, the highest sun and the last frame. Returns the results as JSON.
  */
 std::string runSunOverTown(const RigCaseOptions& options);
+
+/**
+ * The same room lit by a point light 0.3 m below the ceiling's centre with an IES LM-63-2002
+ * spot (type C, rotationally symmetric: half intensity at 30 degrees, none from 50), parsed
+ * with mlr::parseIes, panning 90 degrees about y over the frames: its beam crosses the room
+ * from the red wall over the floor to the green one. Prints classic and full reuse: seconds,
+ * ms per frame, speed-up, MSE at the first, middle and last frames and over all, and the
+ * solver's shadow-ray rate beside bare Embree's. Returns the results as JSON.
+ */
+std::string runPanningSpot(const RigCaseOptions& options);
 
 } // namespace mlr::bench

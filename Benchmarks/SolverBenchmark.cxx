@@ -28,10 +28,11 @@ struct Arguments
 {
   std::uint64_t paths = 600000;
   std::size_t frames = 30;
+  bool framesGiven = false; ///< --frames was given (else spotlight takes 60)
   int threads = 0;
   std::string json;
   std::string only;          ///< run just this mode (for profiling)
-  std::string which = "all"; ///< --case: all, paper, rotating, sun or remesh
+  std::string which = "all"; ///< --case: all, paper, rotating, spotlight, sun, ...
   int referenceFactor = 16;
   std::string cache = "output/benchmark-cache";
   std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
@@ -40,20 +41,24 @@ struct Arguments
 void usage()
 {
   std::printf(
-    "usage: mlr-benchmark [--case all|paper|rotating|sun|long|large|remesh] [--paths N] [--frames "
-    "n]\n"
-    "                     [--threads T] [--json FILE] [--reference-factor F] [--cache DIR]\n"
-    "                     [--only classic|gathering|shooting|full] [--memory-limit-mib M]\n"
+    "usage: mlr-benchmark [--case all|paper|rotating|spotlight|sun|long|large|remesh] [--paths N]\n"
+    "                     [--frames n] [--threads T] [--json FILE] [--reference-factor F]\n"
+    "                     [--cache DIR] [--only classic|gathering|shooting|full]\n"
+    "                     [--memory-limit-mib M]\n"
     "  paper:    the generated paper-scale room (about 2,800 patches, a small ceiling light on a\n"
     "            diagonal) in the four reuse modes, compared with bare Embree, and remeshing\n"
     "  rotating: a light turning 90 degrees in the same room\n"
+    "  spotlight: a point light with an IES spot panning 90 degrees in the same room, and its\n"
+    "            shadow-ray rate beside bare Embree's (about MINUTES minutes, not in all)\n"
     "  sun:      a town block of about 3,000 patches under 48 sun positions\n"
     "  remesh:   a 1,004,806-polygon input remeshed to 10,000 and 100,000 patches, and\n"
     "            cancelled at 20 times in each (about 5 minutes, not in all)\n"
     "  all:      paper, rotating and sun in turn (the default)\n"
-    "rotating and sun compare full reuse with classic, errors against a classic reference of\n"
+    "rotating, spotlight and sun compare full reuse with classic, errors against a classic "
+    "reference of\n"
     "F x N paths (default 16), cached in DIR (default output/benchmark-cache; '' keeps none).\n"
-    "--frames sets the frames of paper and rotating (30); --only profiles one paper mode.\n"
+    "--frames sets the frames of paper and rotating (30) and spotlight (60); --only profiles one\n"
+    "paper mode.\n"
     "  long:     the paper room over 300 frames, classic against full reuse, and where the\n"
     "            shadow rays go (about 2 minutes, not in all)\n"
     "  large:    the room in about 100,000 patches, 120 frames, N = 4,000,000, full reuse: time\n"
@@ -76,6 +81,7 @@ bool parse(int argc, char** argv, Arguments& a)
     else if (flag == "--frames" && hasValue)
     {
       a.frames = std::strtoull(argv[++i], nullptr, 10);
+      a.framesGiven = true;
     }
     else if (flag == "--threads" && hasValue)
     {
@@ -92,11 +98,13 @@ bool parse(int argc, char** argv, Arguments& a)
     else if (flag == "--case" && hasValue)
     {
       a.which = argv[++i];
-      if (a.which != "all" && a.which != "paper" && a.which != "rotating" && a.which != "sun" &&
-        a.which != "remesh" && a.which != "long" && a.which != "large")
+      if (a.which != "all" && a.which != "paper" && a.which != "rotating" &&
+        a.which != "spotlight" && a.which != "sun" && a.which != "remesh" && a.which != "long" &&
+        a.which != "large")
       {
         std::fprintf(stderr,
-          "mlr-benchmark: --case must be all, paper, rotating, sun, remesh, long or large\n");
+          "mlr-benchmark: --case must be all, paper, rotating, spotlight, sun, "
+          "remesh, long or large\n");
         return false;
       }
     }
@@ -324,6 +332,12 @@ int main(int argc, char** argv)
     if (args.which == "all" || args.which == "rotating")
     {
       json.push_back("  \"turning_light\": " + bench::runTurningLight(rigOptions));
+    }
+    if (args.which == "spotlight")
+    {
+      bench::RigCaseOptions spotOptions = rigOptions;
+      spotOptions.frames = args.framesGiven ? args.frames : 60;
+      json.push_back("  \"panning_spot\": " + bench::runPanningSpot(spotOptions));
     }
     if (args.which == "all" || args.which == "sun")
     {
