@@ -141,6 +141,29 @@ Triple parsePower(const std::string& option, const std::string& text)
   return { power, power, power };
 }
 
+/// HALF_ANGLE or HALF_ANGLE,SOFT_EDGE, degrees.
+std::array<double, 2> parseSpot(const std::string& option, const std::string& text)
+{
+  const std::vector<std::string> fields = split(text);
+  if (fields.size() > 2)
+  {
+    throw UsageError(option + " needs HALF_ANGLE_DEG[,SOFT_EDGE_DEG], not '" + text + "'");
+  }
+  return { parseNumber(option, fields[0]),
+    fields.size() == 2 ? parseNumber(option, fields[1]) : 0.0 };
+}
+
+/// A photometric file, by its extension (the filter reads it).
+std::string parseDistribution(const std::string& option, const std::string& text)
+{
+  if (!endsWith(text, ".ies") && !endsWith(text, ".ldt"))
+  {
+    throw UsageError(
+      option + " is '" + text + "': give an IES LM-63 file (.ies) or a EULUMDAT file (.ldt)");
+  }
+  return text;
+}
+
 std::string parseReuse(const std::string& option, const std::string& text)
 {
   if (text != "none" && text != "gathering" && text != "shooting" && text != "both")
@@ -187,6 +210,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   // --help prints helpText(), which says more about each option than CLI11's listing would.
   app.set_help_flag();
   const CLI::Option* help = app.add_flag("-h,--help", o.help);
+  const CLI::Option* point = app.add_flag("--point-light", o.pointLight);
   // Unknown options, arguments and repeated options are reported below, in the project's words.
   app.allow_extras();
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -230,6 +254,9 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--north", "X,Y,Z", o.north, parseTriple);
   option("--up", "X,Y,Z", o.up, parseTriple);
   option("--light-power", "R,G,B", o.lightPower, parsePower);
+  option("--light-distribution", "FILE.ies|FILE.ldt", o.lightDistribution, parseDistribution);
+  option("--spot", "HALF_ANGLE_DEG[,SOFT_EDGE_DEG]", o.spot, parseSpot);
+  option("--light-lumens", "LM", o.lightLumens, parseNumber);
   option("--paths", "N", o.paths, parseInteger);
   option("--gather-ratio", "K", o.gatherRatio, parseNumber);
   option("--survival", "L", o.survival, parseNumber);
@@ -249,7 +276,7 @@ Options parseCommandLine(int argc, const char* const* argv)
     const std::string arg = argv[i];
     const std::string name = arg.substr(0, arg.find('='));
     const CLI::Option* given = app.get_option_no_throw(name);
-    if (given == help && name.size() < arg.size())
+    if ((given == help || given == point) && name.size() < arg.size())
     {
       throw UsageError(name + " takes no value");
     }
@@ -282,7 +309,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   for (const CLI::Option* given : app.get_options())
   {
-    if (given->count() > 1 && given != help)
+    if (given->count() > 1 && given != help && given != point)
     {
       throw UsageError(given->get_name() + " is given twice");
     }
@@ -304,6 +331,32 @@ Options parseCommandLine(int argc, const char* const* argv)
       throw UsageError("--light-material needs --scene FILE (an .obj with its .mtl, a .gltf, "
                        ".glb or .ply with materials)");
     }
+  }
+  if (o.pointLight && (!o.light.empty() || o.lightMaterial || o.usesSun()))
+  {
+    throw UsageError("--point-light is a light of its own: give it without --light, "
+                     "--light-material, --sun-directions and --sun-path");
+  }
+  if (o.usesSun() && (!o.lightDistribution.empty() || o.spot || o.lightLumens))
+  {
+    throw UsageError("--light-distribution, --spot and --light-lumens are for a light, not "
+                     "the sun");
+  }
+  if (!o.lightDistribution.empty() && o.spot)
+  {
+    throw UsageError("give either --light-distribution FILE or --spot HALF_ANGLE_DEG, not both");
+  }
+  if (o.spot &&
+    !((*o.spot)[0] > 0 && (*o.spot)[0] <= 180 && (*o.spot)[1] >= 0 && (*o.spot)[1] <= 180))
+  {
+    throw UsageError("--spot is " + std::to_string((*o.spot)[0]) + "," +
+      std::to_string((*o.spot)[1]) +
+      ": give a half angle above 0 and at most 180 degrees and a soft edge from 0 to 180");
+  }
+  if (o.lightLumens && !(*o.lightLumens > 0))
+  {
+    throw UsageError("--light-lumens is " + std::to_string(*o.lightLumens) +
+      ": give the luminaire's luminous flux in lumens, above 0");
   }
   if (!o.sunDirections.empty() && o.sunPath)
   {
@@ -395,6 +448,23 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     filter->SetLightMaterial(o.lightMaterial->c_str());
     // An explicit --light-power wins over the material's emission.
     filter->SetLightPowerFromMaterial(!o.lightPower.has_value());
+  }
+  if (o.pointLight)
+  {
+    filter->SetLightTypeToPoint();
+  }
+  if (!o.lightDistribution.empty())
+  {
+    filter->SetLightDistributionFile(o.lightDistribution.c_str());
+  }
+  if (o.spot)
+  {
+    filter->SetSpotHalfAngle((*o.spot)[0]);
+    filter->SetSpotSoftEdge((*o.spot)[1]);
+  }
+  if (o.lightLumens)
+  {
+    filter->SetLightFluxLumens(*o.lightLumens);
   }
   if (o.aim)
   {
@@ -511,6 +581,20 @@ Scene and light:
                         (default 100,100,100)
                         A cell array LightId groups the polygons into several lights, and
                         a cell array LightPower (RGB, W) gives each its power.
+  --point-light         a point light instead of --light's polygons: it sits at the
+                        trajectory's points (or moves from --from to --to), of power
+                        --light-power, its nadir -z unless a Normal or Orientation turns it
+  --light-distribution FILE.ies|FILE.ldt
+                        every light emits with this luminous intensity distribution (IES
+                        LM-63 or EULUMDAT), its nadir along an area light's normal (C = 0
+                        along its first edge) or a point light's -z (C = 0 along +x);
+                        only its shape is used (default: diffuse, Lambertian)
+  --spot HALF_ANGLE_DEG[,SOFT_EDGE_DEG]
+                        a spot instead: uniform within the half angle of the nadir, falling
+                        to zero over the soft edge beyond it (default soft edge 0)
+  --light-lumens LM     the luminous flux of every light in lumens, instead of the watts of
+                        --light-power, whose colour it keeps: watts of luminance = LM over
+                        the luminous efficacy (179 lm/W by default)
                         Scene cells with a cell array Emission (RGB or grey, W/m^2) emit
                         from their front side in every frame, and reflect too.
 Light path (the positions of the light's area centroid, one per frame):

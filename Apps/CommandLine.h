@@ -54,6 +54,13 @@ struct Options
   std::optional<Triple> north, up;     ///< the scene's north and zenith for --sun-path
 
   std::optional<Triple> lightPower;
+
+  /// Luminaires: a point light instead of polygons, and the intensity distribution and flux
+  /// of every light.
+  bool pointLight = false;
+  std::string lightDistribution;             ///< FILE.ies or FILE.ldt
+  std::optional<std::array<double, 2>> spot; ///< half angle and soft edge, degrees
+  std::optional<double> lightLumens;         ///< lm
   std::optional<long long> paths;
   std::optional<double> gatherRatio;
   std::optional<double> survival;
@@ -75,7 +82,7 @@ struct Options
   bool sceneLightsItself() const
   {
     return !this->usesEmbeddedScene() && !this->usesSun() && this->light.empty() &&
-      !this->lightMaterial;
+      !this->lightMaterial && !this->pointLight;
   }
 };
 

@@ -236,7 +236,8 @@ int run(int argc, char** argv)
       " emits nothing, and the built-in light belongs to the Cornell box");
   }
   vtkSmartPointer<vtkPolyData> light;
-  if (!options.usesSun() && !options.lightMaterial && !options.sceneLightsItself())
+  if (!options.usesSun() && !options.lightMaterial && !options.sceneLightsItself() &&
+    !options.pointLight)
   {
     light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
                                   : readSurfaceFile(options.light, "light", memoryLimit);

@@ -37,11 +37,16 @@ std::size_t frameCount(const LightRig& rig, bool sceneEmits)
   {
     take(rig.areaLights[i].frameCount(), "light " + std::to_string(i));
   }
+  for (std::size_t i = 0; i < rig.pointLights.size(); ++i)
+  {
+    take(rig.pointLights[i].frameCount(), "point light " + std::to_string(i));
+  }
   for (std::size_t i = 0; i < rig.directionalLights.size(); ++i)
   {
     take(rig.directionalLights[i].frameCount(), "directional light " + std::to_string(i));
   }
-  if (rig.areaLights.empty() && rig.directionalLights.empty() && !sceneEmits)
+  if (rig.areaLights.empty() && rig.pointLights.empty() && rig.directionalLights.empty() &&
+    !sceneEmits)
   {
     throw Error("nothing emits light: give a light, a directional light or scene surfaces with "
                 "emission");
@@ -76,7 +81,33 @@ AreaSource::AreaSource(const MovingLight& light)
     {
       this->Pose[i][j] = values[i];
     }
+    this->Frames.push_back(light.photometricFrame(j));
   }
+}
+
+namespace
+{
+/// f_j(d / |d|) (-n_y.d) / |d|^3 for every position j, d = y - x_j, into `kernel` (0 for
+/// the positions that are off or behind y), with x_j = point(j).
+template <typename Point>
+void distributionKernel(const IntensityDistribution& f, const PhotometricFrame* frames,
+  std::size_t positions, const Point& point, const Vec3& y, const Vec3& ny, const double* on,
+  double* kernel)
+{
+  for (std::size_t j = 0; j < positions; ++j)
+  {
+    const Vec3 d = y - point(j);
+    const double cosY = -dot(ny, d);
+    const double r2 = dot(d, d);
+    double g = 0;
+    if (cosY > 0 && on[j] > 0 && r2 > 0)
+    {
+      const double r = std::sqrt(r2);
+      g = f.density(frames[j].toLocal(d / r)) * cosY / (r2 * r);
+    }
+    kernel[j] = g;
+  }
+}
 }
 
 void AreaSource::emit(
@@ -85,8 +116,18 @@ void AreaSource::emit(
   const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
   this->Light->samplePoint(u0, u1, u2, path.ownPoint, path.ownNormal);
   const Vec3 normal = this->Light->turn(position, path.ownNormal);
-  path.direction = sampleCosineDirection(normal, random);
-  path.start = this->Light->place(position, path.ownPoint) + normal * offset;
+  const IntensityDistribution& f = this->Light->distribution();
+  if (f.isLambertian())
+  {
+    path.direction = sampleCosineDirection(normal, random);
+    path.start = this->Light->place(position, path.ownPoint) + normal * offset;
+    return;
+  }
+  const double v1 = random.uniform(), v2 = random.uniform();
+  path.direction = this->Frames[position].toWorld(f.sample(v1, v2));
+  // Off the side the path leaves from: a distribution may emit behind the light too.
+  const double side = dot(path.direction, normal) < 0 ? -offset : offset;
+  path.start = this->Light->place(position, path.ownPoint) + normal * side;
 }
 
 std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny,
@@ -103,7 +144,30 @@ std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec
   }
   const double offset = tracer.surfaceOffset();
   std::size_t count = 0;
-  if (!this->Light->rotates())
+  const IntensityDistribution& f = this->Light->distribution();
+  if (!f.isLambertian())
+  {
+    const MovingLight& light = *this->Light;
+    distributionKernel(
+      f, this->Frames.data(), positions, [&](std::size_t j) { return light.place(j, x); }, y, ny,
+      on, kernel);
+    const Vec3 from = tracer.liftOff(y, ny);
+    for (std::size_t j = 0; j < positions; ++j)
+    {
+      if (kernel[j] > 0 && j != origin)
+      {
+        const Vec3 xj = light.place(j, x);
+        const Vec3 normal = light.turn(j, n);
+        const Vec3 d = xj + normal * (dot(y - xj, normal) < 0 ? -offset : offset) - from;
+        scratch.dx[count] = static_cast<float>(d.x);
+        scratch.dy[count] = static_cast<float>(d.y);
+        scratch.dz[count] = static_cast<float>(d.z);
+        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+        ++count;
+      }
+    }
+  }
+  else if (!this->Light->rotates())
   {
     // Translations only (the common case): x_j = x + o_j and n_j = n, a third of the work.
     const Vec3 toHit = y - x;
@@ -168,6 +232,58 @@ std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec
   {
     tracer.visibleFrom(tracer.liftOff(y, ny), scratch.dx.data(), scratch.dy.data(),
       scratch.dz.data(), count, scratch.visible.data());
+  }
+  return count;
+}
+
+// --- Point lights ---------------------------------------------------------------------------
+
+PointSource::PointSource(const PointLight& light)
+  : Light(&light)
+{
+  for (std::size_t j = 0; j < light.frameCount(); ++j)
+  {
+    this->Frames.push_back(light.photometricFrame(j));
+  }
+}
+
+void PointSource::emit(std::size_t position, RandomStream& random, double, EmittedPath& path) const
+{
+  const double u1 = random.uniform(), u2 = random.uniform();
+  path.direction = this->Frames[position].toWorld(this->Light->distribution().sample(u1, u2));
+  // A point is on no surface and occludes nothing: nothing to lift it off.
+  path.start = this->Light->position(position);
+  path.ownPoint = path.start;
+  path.ownNormal = path.direction;
+}
+
+std::size_t PointSource::kernel(const EmittedPath&, const Vec3& y, const Vec3& ny,
+  std::size_t origin, const double* on, const RayTracer& tracer, KernelScratch& scratch) const
+{
+  const PointLight& light = *this->Light;
+  const std::size_t positions = this->positions();
+  double* kernel = scratch.kernel.data();
+  distributionKernel(
+    light.distribution(), this->Frames.data(), positions,
+    [&](std::size_t j) { return light.position(j); }, y, ny, on, kernel);
+  const Vec3 from = tracer.liftOff(y, ny);
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < positions; ++j)
+  {
+    if (kernel[j] > 0 && j != origin)
+    {
+      const Vec3 d = light.position(j) - from;
+      scratch.dx[count] = static_cast<float>(d.x);
+      scratch.dy[count] = static_cast<float>(d.y);
+      scratch.dz[count] = static_cast<float>(d.z);
+      scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
+      ++count;
+    }
+  }
+  if (count > 0)
+  {
+    tracer.visibleFrom(
+      from, scratch.dx.data(), scratch.dy.data(), scratch.dz.data(), count, scratch.visible.data());
   }
   return count;
 }
@@ -341,6 +457,10 @@ std::vector<LightSource> lightSources(
   for (const MovingLight& light : emitters)
   {
     sources.emplace_back(AreaSource(light), nextStream());
+  }
+  for (const PointLight& light : rig.pointLights)
+  {
+    sources.emplace_back(PointSource(light), nextStream());
   }
   const Vec3 centre = (scene.boundsMin() + scene.boundsMax()) * 0.5;
   const double radius = std::max(0.5 * scene.diagonal(), 1e-9 * std::max(1.0, length(centre)));

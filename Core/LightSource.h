@@ -1,11 +1,13 @@
 // The lights a solve shoots from, behind one interface: area lights (moving or static
-// lamps, and the scene's own emissive surfaces) and directional lights (the sun). A light
+// lamps, and the scene's own emissive surfaces), point lights and directional lights (the
+// sun). A light
 // kind is one class here, with its path sampling and its reuse kernel; LightSource is the
 // one place that dispatches on the kind.
 #pragma once
 
 #include "DirectionalLight.h"
 #include "MovingLight.h"
+#include "PointLight.h"
 #include "Random.h"
 #include "Rgb.h"
 #include "Scene.h"
@@ -31,6 +33,7 @@ class RayTracer;
 struct LightRig
 {
   std::vector<MovingLight> areaLights;
+  std::vector<PointLight> pointLights;
   std::vector<DirectionalLight> directionalLights;
 };
 
@@ -67,9 +70,10 @@ struct BoundingDisc
 };
 
 /**
- * An area light: a MovingLight, posed in each position, emitting diffusely (cosine
- * distributed) from its front side. G_j(y) = (n_j.d)(-n_y.d) / |d|^4 with d = y - x_j; the
- * pi of the geometric term cancels in the reuse weights.
+ * An area light: a MovingLight, posed in each position, emitting from a uniform point with
+ * its intensity distribution f_j posed in position j. G_j(y) = f_j(d / |d|) (-n_y.d) / |d|^3
+ * with d = y - x_j; for the Lambertian distribution that is (n_j.d)(-n_y.d) / |d|^4, the pi
+ * of f cancelling in the reuse weights.
  */
 class AreaSource
 {
@@ -89,6 +93,30 @@ private:
   /// The poses as a structure of arrays, for the vectorised kernel: x_j = R_j x + o_j and
   /// n_j = R_j n (rows of R_j in 0..8, o_j in 9..11).
   std::vector<std::vector<double>> Pose;
+  /// The photometric frame of every position, for the distributions other than Lambertian.
+  std::vector<PhotometricFrame> Frames;
+};
+
+/**
+ * A point light at x_j in position j, emitting with its distribution f_j posed there.
+ * G_j(y) = f_j(d / |d|) (-n_y.d) / |d|^3 with d = y - x_j: the first-hit density per unit
+ * area of y (a solid angle d omega subtends the area r^2 d omega / cos theta_y).
+ */
+class PointSource
+{
+public:
+  explicit PointSource(const PointLight& light);
+
+  std::size_t positions() const { return this->Light->frameCount(); }
+  const Rgb& power() const { return this->Light->power(); }
+  const Rgb& factor(std::size_t position) const { return this->Light->pose(position).power; }
+  void emit(std::size_t position, RandomStream& random, double offset, EmittedPath& path) const;
+  std::size_t kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny, std::size_t origin,
+    const double* on, const RayTracer& tracer, KernelScratch& scratch) const;
+
+private:
+  const PointLight* Light;
+  std::vector<PhotometricFrame> Frames;
 };
 
 /**
@@ -128,7 +156,7 @@ private:
 class LightSource
 {
 public:
-  using Kind = std::variant<AreaSource, DirectionalSource>;
+  using Kind = std::variant<AreaSource, PointSource, DirectionalSource>;
 
   /// `stream` keys this source's random streams apart from the other sources' (0 for the
   /// first): lights of one rig are independent estimates, not the same numbers replayed.
@@ -136,8 +164,8 @@ public:
 
   std::size_t positions() const { return this->Positions; }
   bool isStatic() const { return this->Positions == 1; }
-  /// The power a whole path set carries before weights: Phi for an area light, E times the
-  /// disc's area for a directional one.
+  /// The power a whole path set carries before weights: Phi for an area or point light, E
+  /// times the disc's area for a directional one.
   const Rgb& power() const { return this->Power; }
   /// Per position, a factor on the power (0: that position is off and casts no path).
   const Rgb& factor(std::size_t position) const { return this->Factors[position]; }
@@ -176,8 +204,8 @@ private:
 /// light has one colour). They are part of the geometry too, so they occlude.
 std::vector<MovingLight> sceneEmitters(const Scene& scene);
 
-/// The sources of a solve: the rig's area lights, then `emitters`, then the rig's
-/// directional lights, streams numbered in that order. They view the lights given.
+/// The sources of a solve: the rig's area lights, then `emitters`, then the rig's point
+/// lights, then its directional lights, streams numbered in that order. They view the lights given.
 std::vector<LightSource> lightSources(
   const Scene& scene, const LightRig& rig, const std::vector<MovingLight>& emitters);
 

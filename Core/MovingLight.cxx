@@ -32,13 +32,23 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
   this->setPoses(poses);
 }
 
-void MovingLight::setPoses(const std::vector<LightPose>& poses)
+void checkLightPower(const Rgb& power)
+{
+  if (!power.isFinite() || power.minComponent() < 0)
+  {
+    std::ostringstream s;
+    s << "the light power (" << power.r << ", " << power.g << ", " << power.b
+      << ") must be finite and not negative";
+    throw Error(s.str());
+  }
+}
+
+void checkPoses(const std::vector<LightPose>& poses)
 {
   if (poses.empty())
   {
     throw Error("the light has zero frames: give at least one light position");
   }
-  this->Rotates = false;
   for (std::size_t k = 0; k < poses.size(); ++k)
   {
     const LightPose& pose = poses[k];
@@ -72,7 +82,16 @@ void MovingLight::setPoses(const std::vector<LightPose>& poses)
       throw Error("the orientation of light position " + std::to_string(k) +
         " is not a rotation (NaN, scaled, sheared or mirrored)");
     }
-    this->Rotates = this->Rotates || !r.isIdentity();
+  }
+}
+
+void MovingLight::setPoses(const std::vector<LightPose>& poses)
+{
+  checkPoses(poses);
+  this->Rotates = false;
+  for (const LightPose& pose : poses)
+  {
+    this->Rotates = this->Rotates || !pose.rotation.isIdentity();
   }
   this->Poses = poses;
 }
@@ -86,13 +105,7 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
   {
     throw Error("the light has no polygon: give at least one polygon with 3 or more points");
   }
-  if (!power.isFinite() || power.minComponent() < 0)
-  {
-    std::ostringstream s;
-    s << "the light power (" << power.r << ", " << power.g << ", " << power.b
-      << ") must be finite and not negative";
-    throw Error(s.str());
-  }
+  checkLightPower(power);
   for (std::size_t i = 0; i < polygons.size(); ++i)
   {
     const std::vector<Vec3>& polygon = polygons[i];
@@ -162,6 +175,14 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
     throw Error("the light has zero area: give a polygon that encloses some area");
   }
   this->Centroid = this->Centroid / this->Area;
+  // C = 0 along the first edge of non-zero length: an edge lies in the polygon's plane.
+  const std::vector<Vec3>& first = polygons[0];
+  std::size_t i = 1;
+  while (i + 1 < first.size() && !(length(first[i] - first[i - 1]) > 0))
+  {
+    ++i;
+  }
+  this->OwnFrame = PhotometricFrame::fromNadir(newellNormal(first), first[i] - first[i - 1]);
   this->setPoses(poses);
 }
 

@@ -1,6 +1,7 @@
-// The moving light: diffuse emitting polygons posed (moved, turned, dimmed) in every frame.
+// The moving light: emitting polygons posed (moved, turned, dimmed) in every frame.
 #pragma once
 
+#include "Photometry.h"
 #include "Rgb.h"
 #include "Rotation.h"
 #include "Vec3.h"
@@ -35,10 +36,12 @@ struct LightPose
 
 /**
  * A planar polygonal light (one or more simple polygons, convex or concave) with total power
- * Phi (RGB, W), emitting diffusely from the front side of each polygon, posed in every frame:
- * frame k maps a point x of the light as given to R_k (x - c) + p_k and its normal n to
- * R_k n, and emits s_k Phi. Power is spread uniformly over the area (exitance Phi/A_L). The
- * light does not occlude. A light with one pose does not move: it lights every frame alike.
+ * Phi (RGB, W), posed in every frame: frame k maps a point x of the light as given to
+ * R_k (x - c) + p_k and its normal n to R_k n, and emits s_k Phi. Power is spread uniformly
+ * over the area (exitance Phi/A_L); every point emits with the light's intensity
+ * distribution in its photometric frame, diffusely from the front side of each polygon
+ * unless another distribution is set. The light does not occlude. A light with one pose
+ * does not move: it lights every frame alike.
  * The constructors throw mlr::Error naming what is wrong.
  */
 class MovingLight
@@ -83,6 +86,22 @@ public:
   /// A uniformly distributed point on the light (own frame) and the normal there.
   void samplePoint(double u0, double u1, double u2, Vec3& point, Vec3& normal) const;
 
+  /// How every point of the light spreads its power over directions (Lambertian unless set).
+  const IntensityDistribution& distribution() const { return this->Distribution; }
+  void setDistribution(const IntensityDistribution& distribution)
+  {
+    this->Distribution = distribution;
+  }
+  /// The photometric frame of the light as given: nadir the first polygon's normal, C = 0
+  /// along its first edge.
+  const PhotometricFrame& ownPhotometricFrame() const { return this->OwnFrame; }
+  /// The photometric frame turned as in frame `frame`.
+  PhotometricFrame photometricFrame(std::size_t frame) const
+  {
+    const PhotometricFrame& own = this->OwnFrame;
+    return { this->turn(frame, own.x), this->turn(frame, own.y), this->turn(frame, own.z) };
+  }
+
 private:
   Rgb Power;
   double Area = 0;
@@ -92,9 +111,18 @@ private:
   std::vector<double> CumulativeArea;
   std::vector<LightPose> Poses;
   bool Rotates = false;
+  IntensityDistribution Distribution = IntensityDistribution::lambertian();
+  PhotometricFrame OwnFrame;
 
   void setPoses(const std::vector<LightPose>& poses);
 };
+
+/// Throws mlr::Error when a light's power is negative or not finite.
+void checkLightPower(const Rgb& power);
+
+/// Throws mlr::Error naming the first pose that is not finite, out of the coordinate range,
+/// not a rotation or of a negative power factor, or when there is no pose.
+void checkPoses(const std::vector<LightPose>& poses);
 
 /// What users give for a light in one frame (a Trajectory point and its arrays).
 struct PoseInput

@@ -8,6 +8,8 @@
 #include "Animation.h"
 #include "Error.h"
 #include "MovingLight.h"
+#include "Photometry.h"
+#include "PointLight.h"
 #include "Remeshing.h"
 #include "Scene.h"
 #include "Solver.h"
@@ -35,6 +37,7 @@
 #include <cstdint>
 #include <new>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -112,6 +115,9 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->SunIrradiance = 1000.0;
   this->AimAtPoint = 0;
   this->AimPoint[0] = this->AimPoint[1] = this->AimPoint[2] = 0.0;
+  this->SpotHalfAngle = 0.0;
+  this->SpotSoftEdge = 0.0;
+  this->LightFluxLumens = 0.0;
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
@@ -164,11 +170,10 @@ int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* 
 namespace
 {
 /// The number of lights whose poses the Trajectory holds: the Light's LightId groups for
-/// area lights, one for a directional light.
+/// area lights, one for a directional or point light.
 std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightInput)
 {
-  if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT ||
-    *self->GetLightMaterial())
+  if (self->GetLightType() != vtkMovingLightRadiosity::AREA_LIGHT || *self->GetLightMaterial())
   {
     return 1;
   }
@@ -201,6 +206,61 @@ mlr::vtkinputs::Trajectory trajectoryOf(
   }
   return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0), lights);
 }
+
+/// The distribution every area and point light emits with: LightDistributionFile's, a spot,
+/// or Lambertian.
+mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
+{
+  const std::string file = self->GetLightDistributionFile();
+  const double half = self->GetSpotHalfAngle(), soft = self->GetSpotSoftEdge();
+  std::ostringstream message;
+  if (!file.empty() && half > 0)
+  {
+    message << "both a LightDistributionFile and a spot (SpotHalfAngle " << half
+            << " degrees) are set: give one of them";
+    throw mlr::Error(message.str());
+  }
+  if (!file.empty())
+  {
+    return mlr::readPhotometricFile(file).distribution;
+  }
+  if (half > 0)
+  {
+    return mlr::IntensityDistribution::spot(half * M_PI / 180, soft * M_PI / 180);
+  }
+  if (soft > 0)
+  {
+    message << "SpotSoftEdge is " << soft
+            << " degrees but SpotHalfAngle is 0 (no spot): give the spot's half angle too";
+    throw mlr::Error(message.str());
+  }
+  return mlr::IntensityDistribution::lambertian();
+}
+
+/// A light's power: `colour` itself (W), or with LightFluxLumens that colour scaled to
+/// LightFluxLumens / LuminousEfficacy watts of luminance.
+mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour)
+{
+  const double lumens = self->GetLightFluxLumens();
+  if (!(lumens > 0))
+  {
+    return colour;
+  }
+  const double luminance = 0.2126 * colour.r + 0.7152 * colour.g + 0.0722 * colour.b;
+  if (!(luminance > 0))
+  {
+    std::ostringstream message;
+    message << "LightFluxLumens needs a light colour (LightPower) with some luminance: it is ("
+            << colour.r << ", " << colour.g << ", " << colour.b << ")";
+    throw mlr::Error(message.str());
+  }
+  return colour * (lumens / self->GetLuminousEfficacy() / luminance);
+}
+
+/// A triangle facing -z: its mean normal is a point light's nadir before posing, so that
+/// Core's pose inputs turn a point light as they turn an area light.
+const std::vector<std::vector<mlr::Vec3>> PointLightNadir = { { { 0, 0, 0 }, { 0, 1, 0 },
+  { 1, 0, 0 } } };
 }
 
 //------------------------------------------------------------------------------
@@ -401,6 +461,12 @@ int vtkMovingLightRadiosity::RequestData(
         position = light.pose(k).position;
         translation = light.translation(k);
       }
+      else if (!cache.Rig.pointLights.empty())
+      {
+        const mlr::PointLight& light = cache.Rig.pointLights.front();
+        position = light.position(light.frameCount() > 1 ? frame : 0);
+        translation = position - light.position(0);
+      }
       mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
       if (!cache.Rig.directionalLights.empty())
       {
@@ -490,7 +556,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     const mlr::vtkinputs::Trajectory trajectory =
       trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]));
     vtkPolyData* sceneData = vtkPolyData::GetData(inputs[SCENE_PORT], 0);
-    const bool fromMaterial = !directional && !this->LightMaterial.empty();
+    const bool fromMaterial = this->LightType == AREA_LIGHT && !this->LightMaterial.empty();
     mlr::vtkinputs::MaterialLight materialLight;
     if (fromMaterial)
     {
@@ -526,6 +592,24 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       }
       rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
     }
+    else if (this->LightType == POINT_LIGHT)
+    {
+      std::vector<mlr::PoseInput> inputs = trajectory.lights.front();
+      const mlr::Vec3 aim(this->AimPoint[0], this->AimPoint[1], this->AimPoint[2]);
+      if (this->AimAtPoint)
+      {
+        if (const std::optional<std::size_t> k = mlr::aimAt(inputs, aim))
+        {
+          throw mlr::Error("the point light is at AimPoint in frame " + std::to_string(*k) +
+            " and cannot face it: move AimPoint off the light's Trajectory, or turn AimAtPoint "
+            "off");
+        }
+      }
+      rig.pointLights.emplace_back(
+        luminairePower(
+          this, mlr::Rgb(this->LightPower[0], this->LightPower[1], this->LightPower[2])),
+        mlr::posesFromInputs(PointLightNadir, inputs, warnings), lightDistribution(this));
+    }
     else if (fromMaterial || (lightData && lightData->GetNumberOfCells() > 0))
     {
       std::vector<mlr::vtkinputs::LightInput> lights;
@@ -558,8 +642,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         }
         const std::vector<mlr::LightPose> poses =
           mlr::posesFromInputs(lights[i].polygons, inputs, warnings);
-        rig.areaLights.emplace_back(
-          lights[i].polygons, lights[i].hasPower ? lights[i].power : defaultPower, poses);
+        rig.areaLights.emplace_back(lights[i].polygons,
+          luminairePower(this, lights[i].hasPower ? lights[i].power : defaultPower), poses);
+      }
+      const mlr::IntensityDistribution distribution = lightDistribution(this);
+      for (mlr::MovingLight& light : rig.areaLights)
+      {
+        light.setDistribution(distribution);
       }
     }
     for (const std::string& warning : warnings)
@@ -596,7 +685,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       digest.add(options.remeshing.targetEdgeLength);
       digest.add(static_cast<std::uint64_t>(soup.points.size()));
       digest.add(static_cast<std::uint64_t>(soup.polygons.size()));
-      digest.add(static_cast<std::uint64_t>(rig.areaLights.size() + rig.directionalLights.size()));
+      digest.add(static_cast<std::uint64_t>(
+        rig.areaLights.size() + rig.pointLights.size() + rig.directionalLights.size()));
       digest.add(static_cast<std::uint64_t>(trajectory.times.size()));
       const mlr::vtkparallel::Verdict verdict =
         mlr::vtkparallel::agree(controller, false, false, {}, digest.value);
@@ -744,7 +834,10 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << this->PathEnd[2] << ")\n";
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
-  os << indent << "LightType: " << (this->LightType == DIRECTIONAL_LIGHT ? "Directional" : "Area")
+  os << indent << "LightType: "
+     << (this->LightType == DIRECTIONAL_LIGHT ? "Directional"
+            : this->LightType == POINT_LIGHT  ? "Point"
+                                              : "Area")
      << "\n";
   os << indent << "SunIrradiance: " << this->SunIrradiance << " W/m^2\n";
   os << indent << "AimAtPoint: " << (this->AimAtPoint ? "On" : "Off") << "\n";
@@ -753,6 +846,10 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ReflectanceArrayName: " << this->ReflectanceArrayName << "\n";
   os << indent << "EmissionArrayName: " << this->EmissionArrayName << "\n";
   os << indent << "LightMaterial: " << this->LightMaterial << "\n";
+  os << indent << "LightDistributionFile: " << this->LightDistributionFile << "\n";
+  os << indent << "SpotHalfAngle: " << this->SpotHalfAngle << " degrees\n";
+  os << indent << "SpotSoftEdge: " << this->SpotSoftEdge << " degrees\n";
+  os << indent << "LightFluxLumens: " << this->LightFluxLumens << " lm\n";
   os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off")
      << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";

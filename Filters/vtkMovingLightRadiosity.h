@@ -256,19 +256,24 @@ public:
   enum LightTypes
   {
     AREA_LIGHT = 0,
-    DIRECTIONAL_LIGHT = 1
+    DIRECTIONAL_LIGHT = 1,
+    POINT_LIGHT = 2
   };
 
   ///@{
   /**
    * Area: the Light input's polygons, moved along the Trajectory. Directional: a light at
    * infinity (the sun) whose direction in each frame is a Trajectory point; the Light input is
-   * not needed and SunIrradiance replaces LightPower. Default Area.
+   * not needed and SunIrradiance replaces LightPower. Point: one point light at the
+   * Trajectory's points (or from PathStart to PathEnd) of power LightPower, emitting with the
+   * light distribution (see LightDistributionFile) about its nadir, -z unless a Normal or
+   * Orientation turns it; the Light input is not needed. Default Area.
    */
-  vtkSetClampMacro(LightType, int, AREA_LIGHT, DIRECTIONAL_LIGHT);
+  vtkSetClampMacro(LightType, int, AREA_LIGHT, POINT_LIGHT);
   vtkGetMacro(LightType, int);
   void SetLightTypeToArea() { this->SetLightType(AREA_LIGHT); }
   void SetLightTypeToDirectional() { this->SetLightType(DIRECTIONAL_LIGHT); }
+  void SetLightTypeToPoint() { this->SetLightType(POINT_LIGHT); }
   ///@}
 
   ///@{
@@ -297,6 +302,44 @@ public:
   vtkSetVector3Macro(AimPoint, double);
   vtkGetVector3Macro(AimPoint, double);
   ///@}
+
+  // ---------------------------------------------------------------- Luminaires
+  ///@{
+  /**
+   * A photometric file (IES LM-63 .ies or EULUMDAT .ldt) whose luminous intensity
+   * distribution every area and point light emits with, in the light's photometric frame:
+   * the nadir (gamma 0) is an area light's emission normal (its first polygon's) or a point
+   * light's -z, C = 0 is along an area light's first edge or a point light's +x; the frame
+   * turns with the light. Only the shape of the distribution is used: the power is
+   * LightPower or LightFluxLumens. Default "" (diffuse, Lambertian, emitters).
+   */
+  vtkSetStdStringFromCharMacro(LightDistributionFile);
+  vtkGetCharFromStdStringMacro(LightDistributionFile);
+  ///@}
+
+  ///@{
+  /**
+   * A spot: uniform intensity within SpotHalfAngle (degrees, up to 180) of the nadir,
+   * falling linearly to zero over SpotSoftEdge degrees beyond it. A half angle of 0 is no
+   * spot; a spot and a LightDistributionFile exclude each other. Defaults 0 and 0.
+   */
+  vtkSetClampMacro(SpotHalfAngle, double, 0.0, 180.0);
+  vtkGetMacro(SpotHalfAngle, double);
+  vtkSetClampMacro(SpotSoftEdge, double, 0.0, 180.0);
+  vtkGetMacro(SpotSoftEdge, double);
+  ///@}
+
+  ///@{
+  /**
+   * A luminaire's luminous flux (lm), for every area and point light, instead of LightPower:
+   * the power is LightFluxLumens / LuminousEfficacy watts of luminance, with the light's
+   * colour (LightPower, or the Light's LightPower cell array) as the RGB ratio, scaled so
+   * that 0.2126 R + 0.7152 G + 0.0722 B of it equals that. 0 keeps LightPower. Default 0.
+   */
+  vtkSetClampMacro(LightFluxLumens, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(LightFluxLumens, double);
+  ///@}
+  // --------------------------------------------------------- end of Luminaires block
 
   ///@{
   /**
@@ -406,6 +449,10 @@ protected:
   double SunIrradiance;
   vtkTypeBool AimAtPoint;
   double AimPoint[3];
+  std::string LightDistributionFile;
+  double SpotHalfAngle;
+  double SpotSoftEdge;
+  double LightFluxLumens;
   std::string ReflectanceArrayName;
   std::string EmissionArrayName;
   std::string LightMaterial;

@@ -1,0 +1,152 @@
+"""The command line's luminaires: --point-light, --spot, --light-distribution (IES LM-63)
+and --light-lumens, each checked against the closed form of its direct light on a floor, and
+their bad values refused with a message naming the option.
+
+A point light of power Phi with the normalised intensity distribution f lights a floor
+element at distance r, seen at theta from the floor's normal, with the irradiance
+E = Phi f cos(theta) / r^2; the direct radiosity is rho E. Averages over a region of elements
+are compared within 4.5 standard deviations of the number of paths that land there.
+
+ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
+    MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
+"""
+import math
+import os
+import sys
+
+import numpy
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+sys.path.insert(0, os.path.dirname(__file__))
+from cli_support import all_files, run  # noqa: E402
+from test_cli_rigs_and_sun import (  # noqa: E402
+    DISCRETISATION, LAMP, RHO, SIGMAS, disc, solve, write_floor)
+
+PATHS = 100000
+HEIGHT = 1.0
+
+
+def point_direct(frame, selection, position, density, power=LAMP):
+    """rho Phi f(gamma) cos(theta) / r^2 over floor elements, area-weighted, for a light
+    whose nadir is -z; `density` maps cos(gamma) to f (1/sr)."""
+    d = frame.centre[selection] - numpy.asarray(position, dtype=float)
+    r = numpy.linalg.norm(d, axis=1)
+    cos = -d[:, 2] / r  # the angle from the nadir is the angle at the floor
+    values = RHO * power * density(cos) * cos / r ** 2
+    weights = frame.area[selection]
+    return (values * weights).sum() / weights.sum()
+
+
+def assert_point_light(frame, selection, position, density, paths=PATHS):
+    expected = point_direct(frame, selection, position, density)
+    reach = expected * frame.area[selection].sum() / (RHO * LAMP)
+    tolerance = SIGMAS / math.sqrt(paths * reach) + DISCRETISATION
+    measured = frame.mean("DirectRadiosity", selection)
+    assert measured == pytest.approx([expected] * 3, rel=tolerance), (measured, expected)
+    return measured[0]
+
+
+def point_run(tmp_path, extra, collection, paths=PATHS):
+    base = ["--scene", write_floor(tmp_path), "--point-light",
+            "--from", f"0,0,{HEIGHT}", "--to", f"0,0,{HEIGHT}", "--frames", "1"]
+    return solve(tmp_path, base + extra, collection, paths)
+
+
+def ring(frame, inner, outer):
+    on_floor = numpy.abs(frame.centre[:, 2]) < 1e-9
+    r = numpy.hypot(frame.centre[:, 0], frame.centre[:, 1])
+    return on_floor & (r > inner) & (r < outer)
+
+
+def test_point_light_follows_the_inverse_square_law(tmp_path):
+    # Lambertian about the nadir: f = cos(gamma) / pi.
+    (_, frame), = point_run(tmp_path, [], "lambert/s.pvd")
+    assert frame.field("LightPosition") == pytest.approx((0, 0, HEIGHT))
+    below = assert_point_light(frame, disc(frame, 0, 0), (0, 0, HEIGHT), lambda c: c / math.pi)
+    aside = assert_point_light(frame, ring(frame, 0.9, 1.1), (0, 0, HEIGHT),
+                               lambda c: c / math.pi)
+    # E = cos^2 / (pi r^2) = cos^4 / (pi h^2): at 1 beside a light 1 up, cos^4(45 degrees).
+    assert aside / below == pytest.approx(0.25, rel=0.1)
+
+
+def test_spot_lights_its_cone_only(tmp_path):
+    half = 20.0
+    (_, frame), = point_run(tmp_path, ["--spot", str(half)], "spot/s.pvd")
+    inside = 1 / (2 * math.pi * (1 - math.cos(math.radians(half))))
+    assert_point_light(frame, disc(frame, 0, 0, 0.25), (0, 0, HEIGHT),
+                       lambda c: numpy.full_like(c, inside))
+    # The cone meets the floor at tan(20 degrees) = 0.36: nothing lands beyond it.
+    beyond = ring(frame, 0.45, 2.0)
+    assert beyond.any()
+    assert numpy.all(frame.cells("DirectRadiosity")[beyond] == 0)
+
+
+def write_uniform_hemisphere(path):
+    """An IES LM-63-2002 file of 1000 cd over the lower hemisphere, none above."""
+    path.write_text("IESNA:LM-63-2002\n[TEST] uniform downlight\nTILT=NONE\n"
+                    "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0 45 90\n0\n1000 1000 1000\n")
+    return os.path.basename(str(path))
+
+
+def test_light_distribution_file_shapes_the_light(tmp_path):
+    ies = write_uniform_hemisphere(tmp_path / "down.ies")
+    (_, frame), = point_run(tmp_path, ["--light-distribution", ies], "ies/s.pvd")
+    # Uniform intensity over the lower hemisphere: f = 1 / (2 pi), so that E falls as
+    # cos / r^2, not cos^2 / r^2 as for a Lambertian light.
+    uniform = lambda c: numpy.full_like(c, 1 / (2 * math.pi))  # noqa: E731
+    below = assert_point_light(frame, disc(frame, 0, 0), (0, 0, HEIGHT), uniform)
+    aside = assert_point_light(frame, ring(frame, 0.9, 1.1), (0, 0, HEIGHT), uniform)
+    assert aside / below == pytest.approx(math.cos(math.pi / 4) ** 3, rel=0.1)
+
+
+def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):
+    watts = point_run(tmp_path, [], "watts/s.pvd")[0][1]
+    # 8950 lm at 179 lm/W is 50 W of luminance: half the default 100 W white light, the same
+    # paths (same seed), so half the radiosity to rounding.
+    lumens = point_run(tmp_path, ["--light-lumens", "8950"], "lumens/s.pvd")[0][1]
+    direct = watts.cells("DirectRadiosity")
+    lit = direct > 0
+    assert lit.any()
+    assert lumens.cells("DirectRadiosity")[lit] / direct[lit] == pytest.approx(0.5, rel=1e-6)
+    # A coloured light keeps its colour: (2, 1, 0) scaled so that its luminance is 50 W.
+    coloured = point_run(tmp_path, ["--light-lumens", "8950", "--light-power", "2,1,0"],
+                         "coloured/s.pvd")[0][1].cells("DirectRadiosity")
+    scale = 50 / (0.2126 * 2 + 0.7152 * 1)
+    assert coloured[lit[:, 0], 0] / direct[lit[:, 0], 0] == pytest.approx(
+        2 * scale / 100, rel=1e-6)
+    assert coloured[lit[:, 1], 1] / direct[lit[:, 1], 1] == pytest.approx(scale / 100, rel=1e-6)
+    assert numpy.all(coloured[:, 2] == 0)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--spot", "0"], "--spot"),
+    (["--spot", "200"], "--spot"),
+    (["--spot", "30,-1"], "--spot"),
+    (["--spot", "30,5,1"], "--spot"),
+    (["--light-lumens", "-5"], "--light-lumens"),
+    (["--light-lumens", "0"], "--light-lumens"),
+    (["--light-distribution", "lamp.txt"], "--light-distribution"),
+    (["--light-distribution", "a.ies", "--spot", "30"], "--light-distribution"),
+    (["--point-light=yes"], "--point-light"),
+    (["--point-light", "--light", "lamp.vtp"], "--point-light"),
+])
+def test_bad_luminaire_options_are_refused_naming_them(tmp_path, args, words):
+    floor = write_floor(tmp_path)
+    result = run(["--scene", floor, "--from", "0,0,1", "--to", "0,0,1", "--frames", "1",
+                  "--output", "out/s.pvd"] + args, tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert words in result.stderr, result.stderr
+    assert all_files(tmp_path) == [floor]
+
+
+def test_missing_or_bad_photometric_file_names_it(tmp_path):
+    floor = write_floor(tmp_path)
+    (tmp_path / "broken.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1\n")
+    for name in ("missing.ies", "broken.ies"):
+        result = run(["--scene", floor, "--point-light", "--from", "0,0,1", "--to", "0,0,1",
+                      "--frames", "1", "--light-distribution", name, "--output", "out/s.pvd"],
+                     tmp_path)
+        assert result.returncode == 1, result.stderr
+        assert name in result.stderr, result.stderr
+        assert not (tmp_path / "out").exists()
