@@ -5,7 +5,7 @@
   scale and the preset Illuminance (lux, log) of Plugin/Display/IlluminancePresets.json
   (registered by the plugin, its colours in order, its points a constant ratio apart as a log
   rescale leaves them), spans the data's range in lux (a minimum of 0 raised to 1e-4 of the
-  maximum) and the scalar bar is titled in lux;
+  maximum, at most 1 lx, as ParaView does) and the scalar bar is titled in lux;
 - coloured by Color again, Map Scalars turns off;
 - a lookup table for another array (Radiosity) keeps ParaView's defaults.
 
@@ -61,7 +61,7 @@ if check(points.shape == (len(preset_rgb), 4),
           f"the lookup table's points {points[:, 0].tolist()} are not evenly spaced in log")
     data = servermanager.Fetch(radiosity)
     lux = vtk_to_numpy(data.GetPointData().GetArray("Illuminance"))
-    low = lux.min() if lux.min() > 0 else 1e-4 * lux.max()
+    low = lux.min() if lux.min() > 0 else min(1e-4 * lux.max(), 1.0)  # ParaView's log range
     check(lux.max() > 0, "no element is lit")
     check(numpy.isclose(points[-1, 0], lux.max(), rtol=1e-6) and
           numpy.isclose(points[0, 0], low, rtol=1e-6),
