@@ -14,6 +14,15 @@
  *   </InitializationHelper>
  * </Hints>
  * \endcode
+ * A <ColorMap array="Illuminance" preset="Illuminance (lux, log)" log_scale="1"
+ * title="Illuminance (lx)" /> gives the lookup table ParaView makes for that array, whichever
+ * representation colours by it first, the named preset (one of IlluminancePresets.json, which
+ * the plugin registers), log scale and the scalar bar's title. The range stays ParaView's: the
+ * data's range at the time, a minimum of 0 raised to 1e-4 of the maximum but at most 1.
+ * It only changes what colouring by the array looks like: ColorBy still chooses the array.
+ * map_scalars="0|1" on a <ColorBy> or a <ColorMap> sets Map Scalars whenever the
+ * representation is coloured by that array again, so that switching between an array of
+ * display colours and one of values shows both right.
  * Each <Property> sets the named property (numbers separated by spaces, as in
  * default_values); <ColorBy> sets ColorArrayName. A property set by the caller since the
  * representation was created (Show(..., MapScalars=1) in Python) is left alone, and an
@@ -42,6 +51,8 @@ protected:
   ~vtkMovingLightRadiosityRepresentationDefaults() override = default;
 
 private:
+  void AddColorMap(vtkPVXMLElement* element);
+
   vtkMovingLightRadiosityRepresentationDefaults(
     const vtkMovingLightRadiosityRepresentationDefaults&) = delete;
   void operator=(const vtkMovingLightRadiosityRepresentationDefaults&) = delete;

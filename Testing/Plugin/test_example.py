@@ -111,7 +111,9 @@ def test_sun_example_writes_a_day(tmp_path):
 def test_spotlight_example_pans(tmp_path):
     """Examples/panning_spotlight.py: a Trajectory with a Normal array turns the lamp 90
     degrees; the green wall (x = 0) is lit more at the start and the red wall (x = 0.556) more
-    at the end, and the Light output's polygon faces each step's Normal."""
+    at the end, and the Light output's polygon faces each step's Normal. The lamp is a spot
+    (20 degrees and a 10 degree soft edge): the wall it turns away from, more than 70 degrees
+    off its axis at the first and last steps, gets no direct light at all."""
     output = tmp_path / "spotlight"
     run_example("panning_spotlight.py", output, ["--paths", "100000", "--steps", "5", "--size", "96"])
     entries = [e.get("file") for e in ElementTree.parse(output / "spotlight.pvd").getroot().iter("DataSet")]
@@ -136,6 +138,8 @@ def test_spotlight_example_pans(tmp_path):
     green0, red0 = wall_direct(entries[0])
     green4, red4 = wall_direct(entries[-1])
     assert green0 > 3 * red0 and red4 > 3 * green4, (green0, red0, green4, red4)
+    assert red0 == 0 and green4 == 0 and green0 > 0 and red4 > 0, (green0, red0, green4, red4)
+    assert (output / "png" / "illuminance.png").stat().st_size > 0
 
 
 def test_material_scenes_example(tmp_path):
