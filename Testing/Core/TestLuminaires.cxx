@@ -189,6 +189,12 @@ void expectInverseSquare(const PointLight& light, bool reuse, std::uint64_t seed
         }
         lit += mean;
         spread += variance;
+        if (mean * mean < 10 * variance)
+        {
+          // Fewer than about 10 hits expected: a single hit is far in the normal
+          // approximation's tail. Such elements count in the flux only.
+          continue;
+        }
         const double z = (value - scale * mean) / (scale * std::sqrt(variance));
         meanSquare += z * z;
         maxAbs = std::max(maxAbs, std::abs(z));
@@ -197,7 +203,8 @@ void expectInverseSquare(const PointLight& light, bool reuse, std::uint64_t seed
     }
   }
   ASSERT_GT(count, 0u);
-  // A few thousand z-scores: their mean square is 1 within about 0.03.
+  // A few thousand z-scores of elements with 10 or more effective hits: their mean square
+  // is 1 within about 0.03.
   EXPECT_LT(meanSquare / double(count), 1.2) << (reuse ? "reuse" : "classic");
   EXPECT_LT(maxAbs, 6.0) << (reuse ? "reuse" : "classic");
   // The floor catches the flux the distribution sends to it: the sums agree within 5
