@@ -12,15 +12,9 @@ namespace mlr
 
 namespace
 {
+using photometry::formatNumber;
 using photometry::MaximumAngles;
 using photometry::MaximumValues;
-
-std::string formatNumber(double value)
-{
-  std::ostringstream s;
-  s << value;
-  return s.str();
-}
 
 /// The file's lines, read in order, each one field.
 class Fields

@@ -13,15 +13,9 @@ namespace mlr
 
 namespace
 {
+using photometry::formatNumber;
 using photometry::MaximumAngles;
 using photometry::MaximumValues;
-
-std::string formatNumber(double value)
-{
-  std::ostringstream s;
-  s << value;
-  return s.str();
-}
 
 /// The numbers after the TILT line: whitespace or commas between them, across lines.
 class Tokens
