@@ -456,6 +456,9 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   if (!o.lightDistribution.empty())
   {
     filter->SetLightDistributionFile(o.lightDistribution.c_str());
+    // Precedence: --light-lumens, then --light-power's (or the material's) watts, then the
+    // file's own flux.
+    filter->SetLightFluxFromFile(!o.lightLumens && !o.lightPower && !o.lightMaterial);
   }
   if (o.spot)
   {
@@ -588,7 +591,8 @@ Scene and light:
                         every light emits with this luminous intensity distribution (IES
                         LM-63 or EULUMDAT), its nadir along an area light's normal (C = 0
                         along its first edge) or a point light's -z (C = 0 along +x);
-                        only its shape is used (default: diffuse, Lambertian)
+                        without --light-lumens or --light-power the light emits the file's
+                        own flux, else only its shape is used (default: diffuse, Lambertian)
   --spot HALF_ANGLE_DEG[,SOFT_EDGE_DEG]
                         a spot instead: uniform within the half angle of the nadir, falling
                         to zero over the soft edge beyond it (default soft edge 0)

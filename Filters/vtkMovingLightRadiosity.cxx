@@ -118,6 +118,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->SpotHalfAngle = 0.0;
   this->SpotSoftEdge = 0.0;
   this->LightFluxLumens = 0.0;
+  this->LightFluxFromFile = false;
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
@@ -237,11 +238,16 @@ mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
   return mlr::IntensityDistribution::lambertian();
 }
 
-/// A light's power: `colour` itself (W), or with LightFluxLumens that colour scaled to
-/// LightFluxLumens / LuminousEfficacy watts of luminance.
+/// A light's power: `colour` itself (W), or with LightFluxLumens (or LightFluxFromFile, the
+/// file's own flux) that colour scaled to those lumens / LuminousEfficacy watts of luminance.
 mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour)
 {
-  const double lumens = self->GetLightFluxLumens();
+  double lumens = self->GetLightFluxLumens();
+  const std::string file = self->GetLightDistributionFile();
+  if (!(lumens > 0) && self->GetLightFluxFromFile() && !file.empty())
+  {
+    lumens = mlr::readPhotometricFile(file).lumens;
+  }
   if (!(lumens > 0))
   {
     return colour;
@@ -850,6 +856,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SpotHalfAngle: " << this->SpotHalfAngle << " degrees\n";
   os << indent << "SpotSoftEdge: " << this->SpotSoftEdge << " degrees\n";
   os << indent << "LightFluxLumens: " << this->LightFluxLumens << " lm\n";
+  os << indent << "LightFluxFromFile: " << (this->LightFluxFromFile ? "On" : "Off") << "\n";
   os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off")
      << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";

@@ -339,6 +339,18 @@ public:
   vtkSetClampMacro(LightFluxLumens, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(LightFluxLumens, double);
   ///@}
+
+  ///@{
+  /**
+   * When LightFluxLumens is 0 and a LightDistributionFile is given, every area and point
+   * light emits the file's own luminous flux (the integral of its candela table, times the
+   * candela multiplier and ballast factor) instead of LightPower's watts, LightPower keeping
+   * only its colour, as with LightFluxLumens. Off keeps LightPower's watts. Default off.
+   */
+  vtkSetMacro(LightFluxFromFile, bool);
+  vtkGetMacro(LightFluxFromFile, bool);
+  vtkBooleanMacro(LightFluxFromFile, bool);
+  ///@}
   // --------------------------------------------------------- end of Luminaires block
 
   ///@{
@@ -453,6 +465,7 @@ protected:
   double SpotHalfAngle;
   double SpotSoftEdge;
   double LightFluxLumens;
+  bool LightFluxFromFile;
   std::string ReflectanceArrayName;
   std::string EmissionArrayName;
   std::string LightMaterial;

@@ -91,13 +91,33 @@ def write_uniform_hemisphere(path):
 
 def test_light_distribution_file_shapes_the_light(tmp_path):
     ies = write_uniform_hemisphere(tmp_path / "down.ies")
-    (_, frame), = point_run(tmp_path, ["--light-distribution", ies], "ies/s.pvd")
+    (_, frame), = point_run(tmp_path, ["--light-distribution", ies, "--light-power", "100"],
+                            "ies/s.pvd")
     # Uniform intensity over the lower hemisphere: f = 1 / (2 pi), so that E falls as
     # cos / r^2, not cos^2 / r^2 as for a Lambertian light.
     uniform = lambda c: numpy.full_like(c, 1 / (2 * math.pi))  # noqa: E731
     below = assert_point_light(frame, disc(frame, 0, 0), (0, 0, HEIGHT), uniform)
     aside = assert_point_light(frame, ring(frame, 0.9, 1.1), (0, 0, HEIGHT), uniform)
     assert aside / below == pytest.approx(math.cos(math.pi / 4) ** 3, rel=0.1)
+
+
+def test_light_distribution_file_gives_its_own_flux(tmp_path):
+    # Without --light-lumens or --light-power the light emits the file's flux: 1000 cd over
+    # the lower hemisphere (absolute photometry) is 2000 pi lm, at 179 lm/W of white light.
+    ies = write_uniform_hemisphere(tmp_path / "own.ies")
+    own = point_run(tmp_path, ["--light-distribution", ies], "own/s.pvd")[0][1]
+    watts = point_run(tmp_path, ["--light-distribution", ies, "--light-power", "100"],
+                      "own_watts/s.pvd")[0][1]
+    lumens = point_run(tmp_path, ["--light-distribution", ies, "--light-lumens", "8950"],
+                       "own_lumens/s.pvd")[0][1]
+    direct = watts.cells("DirectRadiosity")
+    lit = direct > 0
+    assert lit.any()
+    # The same paths (same seed): the radiosities scale with the power alone.
+    assert own.cells("DirectRadiosity")[lit] / direct[lit] == pytest.approx(
+        2000 * math.pi / 179 / 100, rel=1e-6)
+    # --light-lumens wins over the file's flux: 8950 lm is 50 W.
+    assert lumens.cells("DirectRadiosity")[lit] / direct[lit] == pytest.approx(0.5, rel=1e-6)
 
 
 def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):
