@@ -200,7 +200,8 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
   if (sets > 1)
   {
     luminaire.warnings.push_back(name + ": " + std::to_string(sets) +
-      " sets of lamps: the intensities are scaled to the first one's flux");
+      " sets of lamps, read as alternative equipments: the intensities are scaled to the "
+      "first set's flux, not to their sum");
   }
   for (std::size_t i = 0; i < sets; ++i)
   {

@@ -310,8 +310,8 @@ public:
    * distribution every area and point light emits with, in the light's photometric frame:
    * the nadir (gamma 0) is an area light's emission normal (its first polygon's) or a point
    * light's -z, C = 0 is along an area light's first edge or a point light's +x; the frame
-   * turns with the light. Only the shape of the distribution is used: the power is
-   * LightPower or LightFluxLumens. Default "" (diffuse, Lambertian, emitters).
+   * turns with the light. The power is LightFluxLumens, LightPower or, with
+   * LightFluxFromFile, the file's own flux. Default "" (diffuse, Lambertian, emitters).
    */
   vtkSetStdStringFromCharMacro(LightDistributionFile);
   vtkGetCharFromStdStringMacro(LightDistributionFile);

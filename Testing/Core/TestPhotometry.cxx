@@ -805,6 +805,30 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(error("").find("is empty"), std::string::npos);
 }
 
+TEST(Photometry, EulumdatLampSetsAreAlternativesScaledToTheFirst)
+{
+  // Two standard sets of lamps (1 x 1000 lm and 2 x 1500 lm) are alternative equipments: the
+  // cd/klm intensities scale to the first set's flux, not to the 4000 lm of both.
+  const std::vector<double> gammas = degrees(0, 90, 15);
+  auto f = [](double g, double) { return 300 * std::cos(g * Pi / 180); };
+  const std::string one = ldtFile(1, 90, gammas, f, 1000);
+  const std::string block = "\n1\n1\nLED\n1000\n3000\n1B\n40\n";
+  const std::size_t at = one.find(block);
+  ASSERT_NE(at, std::string::npos);
+  std::string two = one;
+  two.replace(at, block.size(), "\n2\n1\n2\nLED\nLED\n1000\n3000\n3000\n3000\n1B\n1B\n40\n80\n");
+  const Luminaire single = parseEulumdat(one, "one.ldt");
+  const Luminaire sets = parseEulumdat(two, "two.ldt");
+  EXPECT_NEAR(sets.lumens, single.lumens, 1e-12 * single.lumens);
+  // 300 cos(gamma) cd/klm at 1000 lm over the lower hemisphere: 300 pi lm.
+  EXPECT_NEAR(single.lumens, 300 * Pi, 0.01 * 300 * Pi);
+  ASSERT_EQ(sets.warnings.size(), 1u);
+  EXPECT_NE(
+    sets.warnings[0].find("2 sets of lamps, read as alternative equipments"), std::string::npos)
+    << sets.warnings[0];
+  EXPECT_TRUE(single.warnings.empty());
+}
+
 TEST(Photometry, BadEulumdatFilesNameTheLineAndField)
 {
   const std::vector<double> gammas = degrees(0, 90, 30);

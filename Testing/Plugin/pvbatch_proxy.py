@@ -91,7 +91,9 @@ EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurviva
 # Every property's documentation ends with its unit and its effect on the cost of a solve.
 UNIT_TAG, COST_TAG = "Unit:", "Cost:"
 # The luminaire's properties.
-EXPECTED |= {"LightDistributionFile", "SpotHalfAngle", "SpotSoftEdge", "LightFluxLumens"}
+EXPECTED |= {"LightDistributionFile", "SpotHalfAngle", "SpotSoftEdge", "LightFluxLumens",
+             "LightFluxFromFile"}
+BOOLEANS |= {"LightFluxFromFile"}
 STRINGS |= {"LightDistributionFile"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
