@@ -1,4 +1,4 @@
-// The IES LM-63 reader (1986, 1991, 1995, 2002 and 2019 editions), photometric type C. Its
+// The IES LM-63 reader (1986, 1991, 1995, 2002 and 2019 editions), photometric types C and B. Its
 // keyword handling, multipliers and symmetries follow Radiance's ies2rad.
 #include "Error.h"
 #include "PhotometricParsing.h"
@@ -173,6 +173,80 @@ bool near(double a, double b)
 {
   return std::abs(a - b) < 1e-6;
 }
+
+constexpr double Degree = 3.14159265358979323846 / 180;
+
+/**
+ * A type B table (angles in degrees, candela[h * vertical + v]) in the light's frame. Type B's
+ * polar axis is the luminaire's lateral axis, C = 90 (+y): the horizontal angle H turns a
+ * half-plane about it from the nadir (H = 0) towards C = 0 (+x), and the vertical angle V
+ * rises within that half-plane towards +y. So the direction of (H, V) is
+ * cos V (sin H, 0, cos H) + sin V (0, 1, 0), and the table is a C-gamma table in its own axes:
+ * gamma' = 90 - V from +y, C' = H - H0 from the half-plane H0. Interpolation stays bilinear in
+ * the file's own angles.
+ */
+IntensityDistribution typeB(
+  std::vector<double> vertical, std::vector<double> horizontal, std::vector<double> candela)
+{
+  const std::size_t nV = vertical.size();
+  if (horizontal.size() == 1)
+  {
+    // One half-plane stands for a distribution symmetric about the beam: I(gamma) = I(V = gamma).
+    const std::size_t zero =
+      std::find_if(vertical.begin(), vertical.end(), [](double v) { return near(v, 0); }) -
+      vertical.begin();
+    if (zero == nV || nV - zero < 2)
+    {
+      throw Error(
+        "a type B file with one horizontal angle is symmetric about its beam and needs the "
+        "vertical angles 0 and above (0 to 90)");
+    }
+    std::vector<double> gammas, values;
+    for (std::size_t v = zero; v < nV; ++v)
+    {
+      gammas.push_back(std::max(0.0, vertical[v]) * Degree);
+      values.push_back(candela[v]);
+    }
+    return IntensityDistribution::tabulated(std::move(gammas), { 0.0 }, std::move(values));
+  }
+  if (near(horizontal.front(), 0))
+  {
+    // Laterally symmetric: H -> -H mirrors the half-planes about the vertical plane of the beam.
+    std::vector<double> angles, values;
+    for (std::size_t h = horizontal.size(); h-- > 1;)
+    {
+      angles.push_back(-horizontal[h]);
+      values.insert(values.end(), candela.begin() + h * nV, candela.begin() + (h + 1) * nV);
+    }
+    angles.insert(angles.end(), horizontal.begin(), horizontal.end());
+    values.insert(values.end(), candela.begin(), candela.end());
+    horizontal = std::move(angles);
+    candela = std::move(values);
+  }
+  const double h0 = horizontal.front(), span = horizontal.back() - h0;
+  if (span > 360 + 1e-6)
+  {
+    throw Error("the type B horizontal angles span " + formatNumber(span) +
+      " degrees, more than the whole turn");
+  }
+  std::vector<double> gammas(nV), planes(horizontal.size()), values(candela.size());
+  for (std::size_t v = 0; v < nV; ++v)
+  {
+    gammas[v] = (90 - vertical[nV - 1 - v]) * Degree;
+  }
+  for (std::size_t h = 0; h < horizontal.size(); ++h)
+  {
+    planes[h] = (horizontal[h] - h0) * Degree;
+    for (std::size_t v = 0; v < nV; ++v)
+    {
+      values[h * nV + v] = candela[h * nV + nV - 1 - v];
+    }
+  }
+  const double s = std::sin(h0 * Degree), c = std::cos(h0 * Degree);
+  const PhotometricFrame axes{ { s, 0, c }, { c, 0, -s }, { 0, 1, 0 } };
+  return IntensityDistribution::tabulatedInAxes(
+    std::move(gammas), std::move(planes), std::move(values), axes, near(span, 360));
+}
 } // namespace
 
 Luminaire parseIes(const std::string& text, const std::string& name)
@@ -315,12 +389,12 @@ Luminaire parseIes(const std::string& text, const std::string& name)
       "truncated");
   }
   const std::size_t type = tokens.count("the photometric type", 1, 3);
-  if (type != 1)
+  if (type == 3)
   {
-    tokens.fail(std::string("the photometric type is ") +
-      (type == 2 ? "2 (type B)" : "3 (type A)") +
-      ", which is not read: only type C (1), the usual one for building luminaires, is");
+    tokens.fail("the photometric type is 3 (type A, for automotive lamps), which is not read: "
+                "only types C (1) and B (2) are");
   }
+  const bool typeBFile = type == 2;
   const std::size_t units = tokens.count("the units type (1 feet, 2 metres)", 1, 2);
   const double toMetres = units == 1 ? 0.3048 : 1;
   // Negative sizes stand for round openings, by their diameters: in both width and length
@@ -349,11 +423,18 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   tokens.number("the input watts");
 
-  const std::vector<double> vertical = readAngles(tokens, nV, "vertical angle", 0, 180);
-  const std::vector<double> horizontal = readAngles(tokens, nH, "horizontal angle", 0, 360);
+  const std::vector<double> vertical = typeBFile ? readAngles(tokens, nV, "vertical angle", -90, 90)
+                                                 : readAngles(tokens, nV, "vertical angle", 0, 180);
+  const std::vector<double> horizontal = typeBFile
+    ? readAngles(tokens, nH, "horizontal angle", -180, 360)
+    : readAngles(tokens, nH, "horizontal angle", 0, 360);
   photometry::PlaneSymmetry symmetry = photometry::PlaneSymmetry::None;
   const double h0 = horizontal.front(), h1 = horizontal.back();
-  if (nH == 1)
+  if (typeBFile)
+  {
+    // typeB() reads its own symmetries: 0 (about the beam), 0 to 90 (lateral), or as given.
+  }
+  else if (nH == 1)
   {
     symmetry = photometry::PlaneSymmetry::Rotational;
   }
@@ -409,7 +490,9 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   try
   {
-    luminaire.distribution = photometry::fullTurn(vertical, horizontal, candela, symmetry);
+    luminaire.distribution = typeBFile
+      ? typeB(vertical, horizontal, candela)
+      : photometry::fullTurn(vertical, horizontal, candela, symmetry);
   }
   catch (const Error& e)
   {

@@ -162,6 +162,10 @@ struct IntensityDistribution::Table
   std::vector<double> Cumulative;
   double Flux = 0, MaximumDensity = 0;
   std::size_t LastCell = 0; ///< the last cell with flux (where u1 rounding to 1 lands)
+  /// The table's own axes in the light's frame (identity unless Rotated), and whether its
+  /// planes wrap around the turn (Closed) or cover only [first, last], 0 beyond.
+  PhotometricFrame Axes{ { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  bool Rotated = false, Closed = true;
 
   /// C cell k (one per plane, the last one wrapping, of zero width when the planes end at
   /// 2 pi): its first plane, its last plane and its start and width (radians).
@@ -171,7 +175,8 @@ struct IntensityDistribution::Table
     p0 = k;
     p1 = k + 1 < n ? k + 1 : 0;
     c0 = this->Planes[k];
-    w = k + 1 < n ? this->Planes[k + 1] - c0 : std::max(0.0, this->Planes[0] + TwoPi - c0);
+    w = k + 1 < n ? this->Planes[k + 1] - c0
+                  : (this->Closed ? std::max(0.0, this->Planes[0] + TwoPi - c0) : 0.0);
   }
 
   double value(std::size_t plane, std::size_t g) const
@@ -189,8 +194,9 @@ struct IntensityDistribution::Table
   }
 
   /// The candela in a unit direction of the light's frame.
-  double intensity(const Vec3& local) const
+  double intensity(const Vec3& light) const
   {
+    const Vec3 local = this->Rotated ? this->Axes.toLocal(light) : light;
     const double gamma = gammaOf(local);
     if (gamma < this->Gammas.front() || gamma > this->Gammas.back())
     {
@@ -206,6 +212,10 @@ struct IntensityDistribution::Table
     }
     const std::size_t n = this->Planes.size();
     std::size_t k = n - 1;
+    if (!this->Closed && (c < this->Planes[0] || c > this->Planes[n - 1]))
+    {
+      return 0;
+    }
     if (c < this->Planes[0])
     {
       c += TwoPi;
@@ -258,7 +268,8 @@ struct IntensityDistribution::Table
     const double a = (1 - t) * this->value(p0, g) + t * this->value(p1, g);
     const double b = (1 - t) * this->value(p0, g + 1) + t * this->value(p1, g + 1);
     const double gamma = invertLinearSinCdf(this->Gammas[g], this->Gammas[g + 1], a, b, u2);
-    return directionOf(std::cos(gamma), c);
+    const Vec3 local = directionOf(std::cos(gamma), c);
+    return this->Rotated ? this->Axes.toWorld(local) : local;
   }
 };
 
@@ -393,6 +404,14 @@ bool IntensityDistribution::isLambertian() const
 IntensityDistribution IntensityDistribution::tabulated(
   std::vector<double> gammas, std::vector<double> planes, std::vector<double> candela)
 {
+  return tabulatedInAxes(std::move(gammas), std::move(planes), std::move(candela),
+    PhotometricFrame{ { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } }, true);
+}
+
+IntensityDistribution IntensityDistribution::tabulatedInAxes(std::vector<double> gammas,
+  std::vector<double> planes, std::vector<double> candela, const PhotometricFrame& axes,
+  bool closed)
+{
   if (gammas.size() < 2 || planes.empty())
   {
     throw Error("an intensity table needs at least two vertical angles and one plane (it has " +
@@ -445,6 +464,9 @@ IntensityDistribution IntensityDistribution::tabulated(
   }
 
   auto table = std::make_shared<Table>();
+  table->Axes = axes;
+  table->Rotated = !(axes.x.x == 1 && axes.y.y == 1 && axes.z.z == 1);
+  table->Closed = closed;
   table->Gammas = std::move(gammas);
   table->Planes = std::move(planes);
   table->Candela = std::move(candela);

@@ -71,6 +71,17 @@ public:
   static IntensityDistribution tabulated(
     std::vector<double> gammas, std::vector<double> planes, std::vector<double> candela);
 
+  /**
+   * A table as tabulated() takes it, but in its own axes: `axes` gives the table's x (C = 0),
+   * y (C = 90) and z (gamma = 0) as directions of the light's frame, so that a table whose
+   * polar axis is not the nadir (IES type B) keeps its bilinear interpolation in its own
+   * angles. With `closed` false the planes cover only [first, last] and the intensity is 0
+   * beyond them; with it true the last cell wraps to the first plane as in tabulated().
+   */
+  static IntensityDistribution tabulatedInAxes(std::vector<double> gammas,
+    std::vector<double> planes, std::vector<double> candela, const PhotometricFrame& axes,
+    bool closed);
+
   /// f(omega) in 1/sr for a unit direction in the light's frame.
   double density(const Vec3& local) const;
 

@@ -788,8 +788,8 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(e.find("line 3: TILT=lamp.tlt refers to a separate tilt file"), std::string::npos) << e;
   e = error(with("TILT=NONE", "[MORE] no tilt"));
   EXPECT_NE(e.find("no TILT= line"), std::string::npos) << e;
-  e = error(with(" 1 2 0.6", " 2 2 0.6"));
-  EXPECT_NE(e.find("line 4: the photometric type is 2 (type B)"), std::string::npos) << e;
+  e = error(with(" 1 2 0.6", " 3 2 0.6"));
+  EXPECT_NE(e.find("line 4: the photometric type is 3 (type A"), std::string::npos) << e;
   e = error(with(" 1 2 0.6", " 1 3 0.6"));
   EXPECT_NE(e.find("the units type"), std::string::npos) << e;
   e = error(with("\n1 1 40", "\n0 1 40"));
@@ -827,6 +827,98 @@ TEST(Photometry, EulumdatLampSetsAreAlternativesScaledToTheFirst)
     sets.warnings[0].find("2 sets of lamps, read as alternative equipments"), std::string::npos)
     << sets.warnings[0];
   EXPECT_TRUE(single.warnings.empty());
+}
+
+/// An IES LM-63-2002 type B file of the candela f(H, V) at the given angles (degrees).
+std::string typeBFile(const std::vector<double>& vertical, const std::vector<double>& horizontal,
+  const std::function<double(double, double)>& f, double multiplier = 1)
+{
+  std::ostringstream s;
+  s.precision(17);
+  s << "IESNA:LM-63-2002\n[TEST] type B\nTILT=NONE\n1 -1 " << multiplier << " " << vertical.size()
+    << " " << horizontal.size() << " 2 2 0 0 0\n1 1 100\n";
+  s << join(vertical, " ") << "\n" << join(horizontal, " ") << "\n";
+  for (double h : horizontal)
+  {
+    for (double v : vertical)
+    {
+      s << f(h, v) << " ";
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+/// The light-frame direction of type B angles (degrees): the half-plane H about the lateral
+/// axis +y, from the nadir towards +x, and V within it towards +y.
+Vec3 typeBDirection(double h, double v)
+{
+  const double hr = h * Pi / 180, vr = v * Pi / 180;
+  return Vec3(std::cos(vr) * std::sin(hr), std::sin(vr), std::cos(vr) * std::cos(hr));
+}
+
+TEST(Photometry, IesTypeBFollowsItsLateralAxis)
+{
+  // An asymmetric floodlight: every table point must come back, times the multiplier, in the
+  // direction the analytic conversion gives it, and its density integrates to 1.
+  const std::vector<double> vertical = degrees(-90, 90, 15), horizontal = degrees(-90, 90, 30);
+  auto f = [](double h, double v)
+  {
+    const double hr = h * Pi / 180, vr = v * Pi / 180;
+    return (100 + 50 * std::sin(hr) + 20 * std::sin(vr)) * std::cos(hr) * std::cos(vr) + 1;
+  };
+  const Luminaire b = parseIes(typeBFile(vertical, horizontal, f, 2), "b.ies");
+  for (double h : horizontal)
+  {
+    for (double v : vertical)
+    {
+      if (std::abs(v) == 90)
+      {
+        continue; // the poles of the lateral axis are one direction for every H
+      }
+      EXPECT_NEAR(b.distribution.intensity(typeBDirection(h, v)), 2 * f(h, v), 1e-9 * f(h, v))
+        << "H " << h << ", V " << v;
+    }
+  }
+  EXPECT_NEAR(sphereIntegral(b.distribution), 1, 2e-3);
+  EXPECT_NEAR(b.lumens, b.distribution.flux(), 1e-12 * b.lumens);
+  // Positive H leans towards C = 0 (+x), positive V towards C = 90 (+y).
+  EXPECT_GT(b.distribution.intensity(typeBDirection(30, 0)),
+    b.distribution.intensity(typeBDirection(-30, 0)));
+  EXPECT_GT(b.distribution.intensity(typeBDirection(0, 30)),
+    b.distribution.intensity(typeBDirection(0, -30)));
+  EXPECT_NEAR(b.distribution.intensity(Vec3(0.3, 0, 0.95) / length(Vec3(0.3, 0, 0.95))),
+    b.distribution.intensity(typeBDirection(std::atan2(0.3, 0.95) * 180 / Pi, 0)), 1e-9);
+  // Behind the luminaire (|H| > 90) the file says nothing: no light there.
+  EXPECT_EQ(b.distribution.intensity(typeBDirection(120, 10)), 0);
+  EXPECT_EQ(b.distribution.intensity(Vec3(0, 0, -1)), 0);
+  expectSamplesFollowDensity(b.distribution, -1, 31);
+
+  // Lateral symmetry (H from 0 to 90) equals its mirrored full table.
+  auto g = [](double h, double v)
+  { return (100 + 40 * std::cos(2 * h * Pi / 180)) * (95 - v) / 95; };
+  const Luminaire half = parseIes(typeBFile(vertical, degrees(0, 90, 30), g), "half.ies");
+  const Luminaire full = parseIes(typeBFile(vertical, horizontal, g), "full.ies");
+  EXPECT_LT(densityDifference(half.distribution, full.distribution), 1e-12);
+  EXPECT_NEAR(half.lumens, full.lumens, 1e-12 * full.lumens);
+
+  // One horizontal angle: symmetric about the beam, I(gamma) = I(V = gamma).
+  const Luminaire axial = parseIes(typeBFile(degrees(0, 90, 15), { 0 },
+                                     [](double, double v) { return 200 * std::cos(v * Pi / 180); }),
+    "axial.ies");
+  EXPECT_NEAR(axial.distribution.intensity(direction(0.5, 2.0)), 200 * std::cos(0.5), 2);
+  EXPECT_NEAR(axial.lumens, 200 * Pi, 0.01 * 200 * Pi);
+
+  // The back half (H 90 to 270) as given: light only behind.
+  const Luminaire back = parseIes(typeBFile(vertical, degrees(90, 270, 30), g), "back.ies");
+  EXPECT_EQ(back.distribution.intensity(typeBDirection(0, 0)), 0);
+  EXPECT_NEAR(back.distribution.intensity(typeBDirection(180, 0)), g(180, 0), 1e-9 * g(180, 0));
+  EXPECT_NEAR(sphereIntegral(back.distribution), 1, 2e-3);
+
+  // Type A stays refused by name.
+  std::string a = typeBFile(vertical, horizontal, f);
+  a.replace(a.find(" 2 2 0 0 0"), 10, " 3 2 0 0 0");
+  EXPECT_NE(checks::errorOf([&] { parseIes(a, "a.ies"); }).find("type A"), std::string::npos);
 }
 
 TEST(Photometry, BadEulumdatFilesNameTheLineAndField)

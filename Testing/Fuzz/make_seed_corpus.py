@@ -221,6 +221,14 @@ def photometric_seeds():
     yield "ies_huge_counts", 6, ies_text(vertical, [0], [row(0)],
                                          lamp_line="1 -1 1 9999 9999 1 2 0 0 0")
     yield "ies_tilt_file", 6, ies_text(vertical, [0], [row(0)], tilt="TILT=lamp.tlt")
+    # Type B (photometric type 2): vertical angles -90 to 90, laterally symmetric (H 0 to 90)
+    # and full (H -90 to 90).
+    b_vertical = [-90, -45, 0, 45, 90]
+    for name, planes in (("type_b_lateral", [0, 45, 90]), ("type_b_full", [-90, 0, 90])):
+        yield "ies_" + name, 6, ies_text(
+            b_vertical, planes, [[round(50 + 40 * math.cos(math.radians(v)), 3)
+                                  for v in b_vertical] for _ in planes],
+            lamp_line=f"1 -1 1 {len(b_vertical)} {len(planes)} 2 2 0.5 0.5 0")
 
     gammas = [0, 30, 60, 90, 120, 150, 180]
 
