@@ -93,6 +93,8 @@ UNIT_TAG, COST_TAG = "Unit:", "Cost:"
 # The luminaire's properties.
 EXPECTED |= {"LightDistributionFile", "SpotHalfAngle", "SpotSoftEdge", "LightFluxLumens"}
 STRINGS |= {"LightDistributionFile"}
+# The sky's properties.
+EXPECTED |= {"SkyModel", "SkyDiffuseHorizontal", "Up"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
