@@ -674,7 +674,7 @@ The sun (a directional light, instead of --light; needs --scene):
                         are the clock times in hours
   --time-zone HOURS     the clock times' offset from UTC (default 0: UTC; e.g. 2 for CEST)
   --north X,Y,Z         the scene's north (default 0,1,0)
-  --up X,Y,Z            the scene's zenith (default 0,0,1)
+  --up X,Y,Z            the scene's zenith, also the sky's (default 0,0,1)
   --sun-irradiance W/m2 on a surface facing the sun (default 1000; 0: no direct sun, the
                         frames and the sky's sun kept)
 The sky (beside the sun or alone; needs --scene; nothing lights from below the horizon):
@@ -683,7 +683,6 @@ The sky (beside the sun or alone; needs --scene; nothing lights from below the h
                         its direct normal irradiance (--sun-irradiance times Power)
   --sky-diffuse-horizontal W_PER_M2
                         what the sky gives an unobstructed horizontal surface (default 100)
-  --up X,Y,Z            the zenith, also of the sky (default 0,0,1)
 Solver:
   --paths N             effective shooting paths per frame (default 600000)
   --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)

@@ -674,7 +674,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         directions.push_back(in.position);
         factors.push_back(in.power);
       }
-      if (this->SunIrradiance > 0)
+      // 0 is no direct sun; anything else (NaN too) is the DirectionalLight's to check.
+      if (!(this->SunIrradiance == 0))
       {
         rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
       }
