@@ -15,6 +15,20 @@ namespace mlr::cli
 
 namespace
 {
+/// The filter's SkyModel of a --sky name.
+int skyModelIndex(const std::string& name)
+{
+  const char* names[] = { "uniform", "cie-overcast", "cie-clear", "perez" };
+  for (int i = 0; i < 4; ++i)
+  {
+    if (name == names[i])
+    {
+      return vtkMovingLightRadiosity::UNIFORM_SKY + i;
+    }
+  }
+  throw UsageError("--sky is '" + name + "': give uniform, cie-overcast, cie-clear or perez");
+}
+
 std::string lowercase(std::string text)
 {
   for (char& c : text)
@@ -253,6 +267,8 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--time-zone", "HOURS", o.timeZone, parseNumber);
   option("--north", "X,Y,Z", o.north, parseTriple);
   option("--up", "X,Y,Z", o.up, parseTriple);
+  option("--sky", "uniform|cie-overcast|cie-clear|perez", o.sky, asGiven);
+  option("--sky-diffuse-horizontal", "W_PER_M2", o.skyDiffuseHorizontal, parseNumber);
   option("--light-power", "R,G,B", o.lightPower, parsePower);
   option("--light-distribution", "FILE.ies|FILE.ldt", o.lightDistribution, parseDistribution);
   option("--spot", "HALF_ANGLE_DEG[,SOFT_EDGE_DEG]", o.spot, parseSpot);
@@ -378,14 +394,45 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--sun-irradiance needs --sun-directions FILE or --sun-path ...");
   }
-  if (!o.sunPath && (o.timeZone || o.north || o.up))
+  if (!o.sunPath && (o.timeZone || o.north))
   {
-    throw UsageError("--time-zone, --north and --up need --sun-path ...");
+    throw UsageError("--time-zone and --north need --sun-path ...");
   }
-  if (o.sunIrradiance && !(*o.sunIrradiance > 0))
+  if (!o.sunPath && !o.sky && o.up)
+  {
+    throw UsageError("--up needs --sun-path ... or --sky MODEL");
+  }
+  if (o.sunIrradiance && !(*o.sunIrradiance >= 0 && std::isfinite(*o.sunIrradiance)))
   {
     throw UsageError("--sun-irradiance is " + std::to_string(*o.sunIrradiance) +
-      ": give the irradiance on a surface facing the sun in W/m^2, above 0 (1000 by default)");
+      ": give the irradiance on a surface facing the sun in W/m^2, 0 or above (1000 by "
+      "default; 0 keeps the sun's frames for the sky with no direct sun)");
+  }
+  if (o.sky)
+  {
+    const int model = skyModelIndex(*o.sky);
+    if ((model == vtkMovingLightRadiosity::CIE_CLEAR_SKY ||
+          model == vtkMovingLightRadiosity::PEREZ_SKY) &&
+      !o.usesSun())
+    {
+      throw UsageError("--sky " + *o.sky +
+        " follows the sun: give --sun-directions FILE or --sun-path ..., or choose --sky "
+        "uniform or cie-overcast");
+    }
+    if (o.usesEmbeddedScene())
+    {
+      throw UsageError("the sky needs --scene FILE: the built-in Cornell box is closed");
+    }
+  }
+  else if (o.skyDiffuseHorizontal)
+  {
+    throw UsageError("--sky-diffuse-horizontal needs --sky MODEL");
+  }
+  if (o.skyDiffuseHorizontal &&
+    !(*o.skyDiffuseHorizontal >= 0 && std::isfinite(*o.skyDiffuseHorizontal)))
+  {
+    throw UsageError("--sky-diffuse-horizontal is " + std::to_string(*o.skyDiffuseHorizontal) +
+      ": give the sky's diffuse horizontal irradiance in W/m^2, 0 or above (100 by default)");
   }
   if (!o.trajectory.empty() && (o.from || o.to))
   {
@@ -478,6 +525,15 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     filter->SetLightTypeToDirectional();
     filter->SetSunIrradiance(o.sunIrradiance.value_or(1000.0));
+  }
+  if (o.sky)
+  {
+    filter->SetSkyModel(skyModelIndex(*o.sky));
+    filter->SetSkyDiffuseHorizontal(o.skyDiffuseHorizontal.value_or(100.0));
+    if (o.up)
+    {
+      filter->SetUp(o.up->data());
+    }
   }
   if (o.paths)
   {
@@ -622,8 +678,15 @@ The sun (a directional light, instead of --light; needs --scene):
                         are the clock times in hours
   --time-zone HOURS     the clock times' offset from UTC (default 0: UTC; e.g. 2 for CEST)
   --north X,Y,Z         the scene's north (default 0,1,0)
-  --up X,Y,Z            the scene's zenith (default 0,0,1)
-  --sun-irradiance W/m2 on a surface facing the sun (default 1000)
+  --up X,Y,Z            the scene's zenith, also the sky's (default 0,0,1)
+  --sun-irradiance W/m2 on a surface facing the sun (default 1000; 0: no direct sun, the
+                        frames and the sky's sun kept)
+The sky (beside the sun or alone; needs --scene; nothing lights from below the horizon):
+  --sky MODEL           uniform, cie-overcast, cie-clear or perez; cie-clear (CIE type 12)
+                        and perez (Perez all-weather) follow each frame's sun, perez from
+                        its direct normal irradiance (--sun-irradiance times Power)
+  --sky-diffuse-horizontal W_PER_M2
+                        what the sky gives an unobstructed horizontal surface (default 100)
 Solver:
   --paths N             effective shooting paths per frame (default 600000)
   --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)

@@ -49,9 +49,11 @@ struct Options
   /// The sun (a directional light) instead of --light: directions from a file, or computed.
   std::string sunDirections;
   std::optional<SunPathSpec> sunPath;
-  std::optional<double> sunIrradiance; ///< W/m^2
-  std::optional<double> timeZone;      ///< hours from UTC of the clock times of --sun-path
-  std::optional<Triple> north, up;     ///< the scene's north and zenith for --sun-path
+  std::optional<double> sunIrradiance;        ///< W/m^2
+  std::optional<double> timeZone;             ///< hours from UTC of the clock times of --sun-path
+  std::optional<Triple> north, up;            ///< the scene's north and zenith (--sun-path, --sky)
+  std::optional<std::string> sky;             ///< uniform, cie-overcast, cie-clear or perez
+  std::optional<double> skyDiffuseHorizontal; ///< W/m^2
 
   std::optional<Triple> lightPower;
 
@@ -78,7 +80,7 @@ struct Options
 
   bool usesEmbeddedScene() const { return this->scene.empty(); }
   bool usesSun() const { return !this->sunDirections.empty() || this->sunPath.has_value(); }
-  /// A scene given without any light: its own emissive surfaces light it, in one frame.
+  /// A scene given without any light: its own emissive surfaces (and the sky) light it.
   bool sceneLightsItself() const
   {
     return !this->usesEmbeddedScene() && !this->usesSun() && this->light.empty() &&

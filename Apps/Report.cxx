@@ -103,6 +103,10 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
           : options.sunPath                ? "sun path"
           : !options.sunDirections.empty() ? options.sunDirections
                                            : (options.scene.empty() ? builtIn : ""));
+  if (options.sky)
+  {
+    json["sky"] = *options.sky;
+  }
   json["output"] = options.output;
   json["settings"] = {
     { "lightPower", jsonTriple(filter->GetLightPower()) },

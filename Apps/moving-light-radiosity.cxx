@@ -227,7 +227,7 @@ int run(int argc, char** argv)
     options.memoryLimit ? static_cast<std::uint64_t>(*options.memoryLimit) << 20 : 0;
   const auto scene = options.usesEmbeddedScene() ? readEmbeddedFile("cornell_box.vtp")
                                                  : readSceneFile(options.scene, memoryLimit);
-  if (options.sceneLightsItself() && !emits(scene, filter->GetEmissionArrayName()))
+  if (options.sceneLightsItself() && !options.sky && !emits(scene, filter->GetEmissionArrayName()))
   {
     throw UsageError("--scene needs --light FILE or --light-material NAME, or surfaces that emit "
                      "(a cell array '" +

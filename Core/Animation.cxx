@@ -27,8 +27,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     soupEmits = soupEmits || m.emission.maxComponent() > 0;
   }
   const std::size_t frames = frameCount(lights, soupEmits);
-  const std::size_t lightCount =
-    lights.areaLights.size() + lights.pointLights.size() + lights.directionalLights.size();
+  const std::size_t lightCount = lights.areaLights.size() + lights.pointLights.size() +
+    lights.directionalLights.size() + lights.skies.size();
 
   RemeshOptions remeshing = options.remeshing;
   remeshing.memoryLimitBytes = options.solver.memoryLimitBytes;

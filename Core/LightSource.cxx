@@ -45,8 +45,12 @@ std::size_t frameCount(const LightRig& rig, bool sceneEmits)
   {
     take(rig.directionalLights[i].frameCount(), "directional light " + std::to_string(i));
   }
+  for (std::size_t i = 0; i < rig.skies.size(); ++i)
+  {
+    take(rig.skies[i].frameCount(), "sky " + std::to_string(i));
+  }
   if (rig.areaLights.empty() && rig.pointLights.empty() && rig.directionalLights.empty() &&
-    !sceneEmits)
+    rig.skies.empty() && !sceneEmits)
   {
     throw Error("nothing emits light: give a light, a directional light or scene surfaces with "
                 "emission");
@@ -366,6 +370,67 @@ std::size_t DirectionalSource::kernel(const EmittedPath&, const Vec3& y, const V
   return count;
 }
 
+// --- Skies ----------------------------------------------------------------------------------
+
+SkySource::SkySource(const Sky& sky, const Vec3& centre, double radius)
+  : SkyRef(&sky)
+  , Centre(centre)
+  , Radius(radius)
+{
+  double largest = 0;
+  for (std::size_t j = 0; j < sky.positions(); ++j)
+  {
+    largest = std::max(largest, sky.integral(j));
+  }
+  this->Power = Rgb(M_PI * radius * radius * largest);
+  for (std::size_t j = 0; j < sky.positions(); ++j)
+  {
+    this->Factors.push_back(Rgb(largest > 0 ? sky.integral(j) / largest : 0.0));
+  }
+}
+
+void SkySource::emit(
+  std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
+{
+  const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+  const Vec3 w = this->SkyRef->sample(position, u0, u1, u2);
+  Vec3 t, b;
+  orthonormalBasis(w, t, b);
+  double u, v;
+  do
+  {
+    u = 2.0 * random.uniform() - 1.0;
+    v = 2.0 * random.uniform() - 1.0;
+  } while (u * u + v * v >= 1.0);
+  const double radius = this->Radius;
+  path.start = this->Centre + w * (radius + 2 * offset) + (t * u + b * v) * radius;
+  path.direction = -w;
+  path.ownPoint = path.start;
+  path.ownNormal = path.direction;
+}
+
+std::size_t SkySource::kernel(const EmittedPath& path, const Vec3&, const Vec3&, std::size_t,
+  const double* on, const RayTracer&, KernelScratch& scratch) const
+{
+  // The first hit's cos(theta_y) and the disc's 1 / (pi r^2) are the same in every position
+  // and cancel in the weights: the kernel is the direction density alone.
+  const Sky& sky = *this->SkyRef;
+  const std::size_t positions = sky.positions();
+  const std::size_t cell = sky.cell(-path.direction);
+  double* kernel = scratch.kernel.data();
+  if (cell == Sky::Cells)
+  {
+    std::fill(kernel, kernel + positions, 0.0);
+    return 0;
+  }
+  const double* density = sky.densities(cell);
+  for (std::size_t j = 0; j < positions; ++j)
+  {
+    kernel[j] = on[j] > 0 ? density[j] : 0.0;
+  }
+  return 0;
+}
+
 // --- The one interface -----------------------------------------------------------------------
 
 LightSource::LightSource(Kind kind, std::uint64_t stream)
@@ -467,6 +532,10 @@ std::vector<LightSource> lightSources(
   for (const DirectionalLight& light : rig.directionalLights)
   {
     sources.emplace_back(DirectionalSource(light, centre, radius), nextStream());
+  }
+  for (const Sky& sky : rig.skies)
+  {
+    sources.emplace_back(SkySource(sky, centre, radius), nextStream());
   }
   return sources;
 }

@@ -11,6 +11,7 @@
 #include "Random.h"
 #include "Rgb.h"
 #include "Scene.h"
+#include "Sky.h"
 #include "Vec3.h"
 
 #include <cstddef>
@@ -35,6 +36,7 @@ struct LightRig
   std::vector<MovingLight> areaLights;
   std::vector<PointLight> pointLights;
   std::vector<DirectionalLight> directionalLights;
+  std::vector<Sky> skies;
 };
 
 /// The number of frames of a rig: the pose count of its moving lights, or 1 when nothing
@@ -150,13 +152,42 @@ private:
 };
 
 /**
+ * A sky: in position j the radiance L_j(w) from the directions w above the horizon. Paths
+ * start uniformly on a disc perpendicular to w that covers the scene's bounding sphere, with
+ * w drawn from p_j = L_j / Lambda_j (Lambda_j: L_j over the solid angle). The disc depends
+ * on w only, so a path is the same ray in every frame: G_j(y) = p_j(w), and a reused path
+ * needs no shadow ray (Documentation/Method.md, "The sky").
+ */
+class SkySource
+{
+public:
+  /// `centre` and `radius`: the scene's bounding sphere.
+  SkySource(const Sky& sky, const Vec3& centre, double radius);
+
+  std::size_t positions() const { return this->SkyRef->positions(); }
+  /// pi r^2 times the largest Lambda_j.
+  const Rgb& power() const { return this->Power; }
+  const Rgb& factor(std::size_t position) const { return this->Factors[position]; }
+  void emit(std::size_t position, RandomStream& random, double offset, EmittedPath& path) const;
+  std::size_t kernel(const EmittedPath& path, const Vec3& y, const Vec3& ny, std::size_t origin,
+    const double* on, const RayTracer& tracer, KernelScratch& scratch) const;
+
+private:
+  const Sky* SkyRef;
+  Vec3 Centre;
+  double Radius = 0;
+  Rgb Power;
+  std::vector<Rgb> Factors;
+};
+
+/**
  * One light the solver shoots from. It has positions() poses; one pose is a static light,
  * added to every frame. The light it views must outlive it.
  */
 class LightSource
 {
 public:
-  using Kind = std::variant<AreaSource, PointSource, DirectionalSource>;
+  using Kind = std::variant<AreaSource, PointSource, DirectionalSource, SkySource>;
 
   /// `stream` keys this source's random streams apart from the other sources' (0 for the
   /// first): lights of one rig are independent estimates, not the same numbers replayed.
@@ -205,7 +236,8 @@ private:
 std::vector<MovingLight> sceneEmitters(const Scene& scene);
 
 /// The sources of a solve: the rig's area lights, then `emitters`, then the rig's point
-/// lights, then its directional lights, streams numbered in that order. They view the lights given.
+/// lights, then its directional lights, then its skies, streams numbered in that order.
+/// They view the lights given.
 std::vector<LightSource> lightSources(
   const Scene& scene, const LightRig& rig, const std::vector<MovingLight>& emitters);
 

@@ -599,6 +599,17 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
           }
         }
       }
+      for (const char* name : { "SkyDiffuseHorizontal", "DirectNormalIrradiance" })
+      {
+        if (vtkDataArray* values = pointArray(trajectory, name, 1))
+        {
+          auto& into = name[0] == 'S' ? result.skyDiffuseHorizontal : result.directNormal;
+          for (vtkIdType id : perLight[l])
+          {
+            into.push_back(values->GetComponent(id, 0));
+          }
+        }
+      }
     }
     else if (count > 1 && count != frames)
     {

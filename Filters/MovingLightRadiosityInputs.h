@@ -69,6 +69,9 @@ struct Trajectory
   std::vector<std::vector<PoseInput>> lights;
   /// Per frame, from the point arrays SunAzimuth and SunElevation (degrees) when present.
   std::vector<double> sunAzimuth, sunElevation;
+  /// Per frame, from the point arrays SkyDiffuseHorizontal and DirectNormalIrradiance (W/m^2)
+  /// when present.
+  std::vector<double> skyDiffuseHorizontal, directNormal;
 };
 
 /**

@@ -12,6 +12,7 @@
 #include "PointLight.h"
 #include "Remeshing.h"
 #include "Scene.h"
+#include "Sky.h"
 #include "Solver.h"
 
 #include "vtkAppendPolyData.h"
@@ -29,6 +30,7 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
 #include "vtkTimeStamp.h"
 
 #include <algorithm>
@@ -55,6 +57,8 @@ struct vtkMovingLightRadiosity::vtkInternals
   mlr::LightRig Rig;
   /// Per frame, passed on from the Trajectory when it has them (degrees).
   std::vector<double> SunAzimuth, SunElevation;
+  /// Per frame with a sky: the Perez efficacy of its daylight on a horizontal surface (lm/W).
+  std::vector<double> DaylightEfficacy;
   // Display: what the colours of every frame need.
   mlr::vtkoutputs::SmoothShading Shading;
   double AutoExposure = 0;
@@ -113,6 +117,11 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->LuminousEfficacy = 179.0;
   this->LightType = AREA_LIGHT;
   this->SunIrradiance = 1000.0;
+  this->SkyModel = NO_SKY;
+  this->SkyDiffuseHorizontal = 100.0;
+  this->Up[0] = 0.0;
+  this->Up[1] = 0.0;
+  this->Up[2] = 1.0;
   this->AimAtPoint = 0;
   this->AimPoint[0] = this->AimPoint[1] = this->AimPoint[2] = 0.0;
   this->SpotHalfAngle = 0.0;
@@ -179,6 +188,66 @@ std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightI
     return 1;
   }
   return mlr::vtkinputs::lightCount(vtkPolyData::GetData(lightInput, 0));
+}
+
+/// The sky of SkyModel in `rig`: one frame per sun direction of a directional light (or one
+/// frame), E_dh and E_dn from the Trajectory's arrays or the properties, and per frame the
+/// Perez luminous efficacy of the daylight a horizontal surface receives into `efficacy`.
+void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& trajectory,
+  bool directional, mlr::LightRig& rig, std::vector<double>& efficacy)
+{
+  static const mlr::SkyModel models[] = { mlr::SkyModel::Uniform, mlr::SkyModel::CieOvercast,
+    mlr::SkyModel::CieClear, mlr::SkyModel::Perez };
+  const mlr::SkyModel model = models[self->GetSkyModel() - 1];
+  const double* u = self->GetUp();
+  const mlr::Vec3 up(u[0], u[1], u[2]);
+  if (!directional && (model == mlr::SkyModel::CieClear || model == mlr::SkyModel::Perez))
+  {
+    throw mlr::Error("the " + mlr::skyModelName(model) +
+      " sky follows the sun: set LightType to Directional with the sun's directions as the "
+      "Trajectory, or choose the uniform or cie-overcast sky");
+  }
+  std::vector<mlr::SkyFrame> frames;
+  if (directional)
+  {
+    const std::vector<mlr::PoseInput>& sun = trajectory.lights.front();
+    for (std::size_t f = 0; f < sun.size(); ++f)
+    {
+      mlr::SkyFrame frame;
+      frame.sun = mlr::normalize(sun[f].position);
+      frame.directNormal = self->GetSunIrradiance() * sun[f].power.r;
+      frames.push_back(frame);
+    }
+  }
+  else
+  {
+    frames.resize(std::max<std::size_t>(1, trajectory.times.size()));
+    for (mlr::SkyFrame& frame : frames)
+    {
+      frame.sun = up;
+    }
+  }
+  for (std::size_t f = 0; f < frames.size(); ++f)
+  {
+    frames[f].diffuseHorizontal = f < trajectory.skyDiffuseHorizontal.size()
+      ? trajectory.skyDiffuseHorizontal[f]
+      : self->GetSkyDiffuseHorizontal();
+    if (f < trajectory.directNormal.size())
+    {
+      frames[f].directNormal = trajectory.directNormal[f];
+    }
+  }
+  rig.skies.emplace_back(model, up, frames);
+  for (const mlr::SkyFrame& frame : frames)
+  {
+    const mlr::DaylightEfficacy k = mlr::perezEfficacy(frame, up);
+    const double sine = std::max(0.0, mlr::dot(frame.sun, mlr::normalize(up)));
+    const double direct =
+      directional && self->GetSunIrradiance() > 0 ? frame.directNormal * sine : 0;
+    const double total = direct + frame.diffuseHorizontal;
+    efficacy.push_back(
+      total > 0 ? (k.direct * direct + k.diffuse * frame.diffuseHorizontal) / total : k.diffuse);
+  }
 }
 
 mlr::vtkinputs::Trajectory trajectoryOf(
@@ -372,6 +441,13 @@ int vtkMovingLightRadiosity::RequestData(
     return 0;
   }
   vtkInternals& cache = *this->Internals;
+  // A sky's frames have the Perez efficacy of their daylight; other light LuminousEfficacy.
+  auto efficacyOf = [this](const vtkInternals& c, std::size_t f)
+  {
+    return c.DaylightEfficacy.empty()
+      ? this->LuminousEfficacy
+      : c.DaylightEfficacy[std::min(f, c.DaylightEfficacy.size() - 1)];
+  };
   if (cache.Aborted)
   {
     // This VTK no longer clears AbortExecute when an execution starts: the flag that stopped
@@ -419,7 +495,7 @@ int vtkMovingLightRadiosity::RequestData(
           std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
           output->GetCellData());
         mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
-          this->LuminousEfficacy, output->GetPointData(), output->GetCellData());
+          efficacyOf(cache, frame), output->GetPointData(), output->GetCellData());
         if (cache.Distributed)
         {
           // Cut from the whole frame, so that the point arrays at the cut average over the
@@ -497,7 +573,15 @@ int vtkMovingLightRadiosity::RequestData(
       }
       mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
       mlr::vtkoutputs::addValue<vtkDoubleArray>(
-        fieldData, "LuminousEfficacy", this->LuminousEfficacy);
+        fieldData, "LuminousEfficacy", efficacyOf(cache, frame));
+      if (!cache.DaylightEfficacy.empty())
+      {
+        vtkNew<vtkStringArray> model;
+        model->SetName("LuminousEfficacyModel");
+        model->InsertNextValue("Perez (1990) direct and diffuse efficacies, weighted by the "
+                               "frame's direct and diffuse horizontal irradiance");
+        fieldData->AddArray(model);
+      }
       output->SetFieldData(fieldData);
     }
     output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
@@ -596,7 +680,22 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         directions.push_back(in.position);
         factors.push_back(in.power);
       }
-      rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
+      // 0 is no direct sun; anything else (NaN too) is the DirectionalLight's to check.
+      if (!(this->SunIrradiance == 0))
+      {
+        rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
+      }
+      else
+      {
+        // No direct sun, but its frames: every position off.
+        rig.directionalLights.emplace_back(
+          directions, mlr::Rgb(1.0), std::vector<mlr::Rgb>(directions.size(), mlr::Rgb()));
+      }
+    }
+    cache.DaylightEfficacy.clear();
+    if (this->SkyModel != NO_SKY)
+    {
+      addSky(this, trajectory, directional, rig, cache.DaylightEfficacy);
     }
     else if (this->LightType == POINT_LIGHT)
     {
@@ -846,6 +945,9 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
                                               : "Area")
      << "\n";
   os << indent << "SunIrradiance: " << this->SunIrradiance << " W/m^2\n";
+  os << indent << "SkyModel: " << this->SkyModel << "\n";
+  os << indent << "SkyDiffuseHorizontal: " << this->SkyDiffuseHorizontal << " W/m^2\n";
+  os << indent << "Up: " << this->Up[0] << ", " << this->Up[1] << ", " << this->Up[2] << "\n";
   os << indent << "AimAtPoint: " << (this->AimAtPoint ? "On" : "Off") << "\n";
   os << indent << "AimPoint: (" << this->AimPoint[0] << ", " << this->AimPoint[1] << ", "
      << this->AimPoint[2] << ")\n";

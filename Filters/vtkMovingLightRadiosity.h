@@ -285,6 +285,45 @@ public:
   vtkGetMacro(SunIrradiance, double);
   ///@}
 
+  /// The sky models (SkyModel).
+  enum SkyModels
+  {
+    NO_SKY = 0,
+    UNIFORM_SKY = 1,
+    CIE_OVERCAST_SKY = 2,
+    CIE_CLEAR_SKY = 3,
+    PEREZ_SKY = 4
+  };
+
+  ///@{
+  /**
+   * A sky beside the other lights: none, uniform, CIE overcast, CIE clear (type 12) or Perez
+   * all-weather. The clear and Perez skies need LightType Directional: they follow its sun in
+   * every frame (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is
+   * scaled so that an unobstructed horizontal surface receives SkyDiffuseHorizontal, or the
+   * Trajectory's point array SkyDiffuseHorizontal per frame; the Perez sky also reads the
+   * direct normal irradiance, the array DirectNormalIrradiance or else the sun's irradiance
+   * (SunIrradiance times Power). Nothing lights from below the horizon. With a sky the
+   * Illuminance arrays use the Perez luminous efficacy of each frame's daylight (field data
+   * LuminousEfficacy and LuminousEfficacyModel). Default none.
+   */
+  vtkSetClampMacro(SkyModel, int, NO_SKY, PEREZ_SKY);
+  vtkGetMacro(SkyModel, int);
+  ///@}
+
+  ///@{
+  /// The sky's diffuse horizontal irradiance E_dh, W/m^2, when the Trajectory has no
+  /// SkyDiffuseHorizontal array. Default 100.
+  vtkSetClampMacro(SkyDiffuseHorizontal, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(SkyDiffuseHorizontal, double);
+  ///@}
+
+  ///@{
+  /// The zenith of the sky, any length but 0. Default 0, 0, 1.
+  vtkSetVector3Macro(Up, double);
+  vtkGetVector3Macro(Up, double);
+  ///@}
+
   ///@{
   /**
    * Aim every area light at AimPoint in every frame: its emission direction is turned to
@@ -459,6 +498,9 @@ protected:
   int MemoryLimit;
   int LightType;
   double SunIrradiance;
+  int SkyModel;
+  double SkyDiffuseHorizontal;
+  double Up[3];
   vtkTypeBool AimAtPoint;
   double AimPoint[3];
   std::string LightDistributionFile;

@@ -95,6 +95,8 @@ EXPECTED |= {"LightDistributionFile", "SpotHalfAngle", "SpotSoftEdge", "LightFlu
              "LightFluxFromFile"}
 BOOLEANS |= {"LightFluxFromFile"}
 STRINGS |= {"LightDistributionFile"}
+# The sky's properties.
+EXPECTED |= {"SkyModel", "SkyDiffuseHorizontal", "Up"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
