@@ -21,6 +21,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -36,6 +37,43 @@ using Json = nlohmann::json;
 /// A glTF's external buffer or image file larger than this is refused before it is read:
 /// every byte is held in memory.
 constexpr std::uintmax_t MaxResourceFileBytes = std::uintmax_t(4) << 30;
+// Real glTF files nest about 10 levels; extensions add a few more.
+constexpr std::size_t MaxJsonDepth = 256;
+
+/// The deepest nesting of arrays and objects in JSON text, skipping strings.
+std::size_t jsonDepth(const std::string& text)
+{
+  std::size_t depth = 0, deepest = 0;
+  bool inString = false;
+  for (std::size_t i = 0; i < text.size(); ++i)
+  {
+    const char c = text[i];
+    if (inString)
+    {
+      if (c == '\\')
+      {
+        ++i;
+      }
+      else if (c == '"')
+      {
+        inString = false;
+      }
+    }
+    else if (c == '"')
+    {
+      inString = true;
+    }
+    else if (c == '[' || c == '{')
+    {
+      deepest = std::max(deepest, ++depth);
+    }
+    else if ((c == ']' || c == '}') && depth > 0)
+    {
+      --depth;
+    }
+  }
+  return deepest;
+}
 
 std::int64_t componentBytes(std::int64_t componentType)
 {
@@ -202,12 +240,13 @@ public:
       const std::int64_t offset = this->integer(view, "byteOffset", where, 0);
       const std::int64_t length = this->integer(view, "byteLength", where);
       const std::int64_t stride = this->integer(view, "byteStride", where, 0);
-      if (offset < 0 || length < 0 ||
-        offset + length > this->BufferBytes[static_cast<std::size_t>(buffer)])
+      const std::int64_t bufferBytes = this->BufferBytes[static_cast<std::size_t>(buffer)];
+      // Compared by subtraction: offset + length can overflow 64 bits in a hostile file.
+      if (offset < 0 || length < 0 || length > bufferBytes || offset > bufferBytes - length)
       {
-        this->fail(where + " (bytes " + std::to_string(offset) + " to " +
-          std::to_string(offset + length) + ") does not fit in buffer " + std::to_string(buffer) +
-          " (" + std::to_string(this->BufferBytes[static_cast<std::size_t>(buffer)]) + " bytes)");
+        this->fail(where + " (" + std::to_string(length) + " bytes from byte " +
+          std::to_string(offset) + ") does not fit in buffer " + std::to_string(buffer) + " (" +
+          std::to_string(bufferBytes) + " bytes)");
       }
       if (view.contains("byteStride") && (stride < 4 || stride > 252))
       {
@@ -242,9 +281,11 @@ public:
       }
       const std::int64_t element = bytes * components;
       const std::int64_t stride = std::max(this->integer(view, "byteStride", where, 0), element);
-      const std::int64_t end = offset + (count - 1) * stride + element;
       const std::int64_t available = view["byteLength"].get<std::int64_t>();
-      if (count > INT32_MAX / stride || end > available)
+      // count is bounded before it multiplies, and offset is compared by subtraction, so
+      // nothing here overflows.
+      if (count > INT32_MAX / stride || offset > available ||
+        (count - 1) * stride + element > available - offset)
       {
         this->fail(where + " (" + std::to_string(count) + " elements of " +
           std::to_string(element) + " bytes from byte " + std::to_string(offset) +
@@ -575,6 +616,13 @@ Json readGltfJson(const std::string& path, bool glb, std::string& bin, std::int6
     }
     text = text.substr(20, jsonBytes);
   }
+  // nlohmann's parser recurses once per nesting level, so a deep file overflows the stack
+  // before any error could be raised: the depth is measured first, without recursion.
+  if (const std::size_t depth = jsonDepth(text); depth > MaxJsonDepth)
+  {
+    fail("nests its JSON " + std::to_string(depth) + " levels deep, more than the " +
+      std::to_string(MaxJsonDepth) + " this reader takes: the file is damaged or hostile");
+  }
   try
   {
     Json root = Json::parse(text);
@@ -685,22 +733,32 @@ public:
     , Folder(std::filesystem::path(path).parent_path())
   {
     const Json& buffers = root.contains("buffers") ? root["buffers"] : Json::array();
+    // Buffers that name the same URI share one copy: a file that names itself thousands of
+    // times would otherwise be read, and held, thousands of times.
+    std::map<std::string, std::shared_ptr<const std::string>> byUri;
     for (std::size_t i = 0; i < buffers.size(); ++i)
     {
       const std::size_t length = buffers[i]["byteLength"].get<std::size_t>();
-      std::string bytes;
+      std::shared_ptr<const std::string> bytes;
       if (!buffers[i].contains("uri"))
       {
-        bytes = bin; // GltfChecks: only buffer 0 of a .glb, and the BIN chunk holds byteLength
+        // GltfChecks: only buffer 0 of a .glb, and the BIN chunk holds byteLength
+        bytes = std::make_shared<const std::string>(std::move(bin));
       }
       else
       {
-        bytes = this->resource(
-          buffers[i]["uri"].get<std::string>(), "buffers[" + std::to_string(i) + "]");
+        const std::string uri = buffers[i]["uri"].get<std::string>();
+        auto& shared = byUri[uri];
+        if (!shared)
+        {
+          shared = std::make_shared<const std::string>(
+            this->resource(uri, "buffers[" + std::to_string(i) + "]"));
+        }
+        bytes = shared;
       }
-      if (bytes.size() < length)
+      if (bytes->size() < length)
       {
-        this->fail("buffers[" + std::to_string(i) + "] holds " + std::to_string(bytes.size()) +
+        this->fail("buffers[" + std::to_string(i) + "] holds " + std::to_string(bytes->size()) +
           " bytes, less than its byteLength " + std::to_string(length));
       }
       this->Buffers.push_back(std::move(bytes));
@@ -751,7 +809,7 @@ public:
   std::string view(std::size_t index) const
   {
     const Json& view = this->Root["bufferViews"][index];
-    return this->Buffers[view["buffer"].get<std::size_t>()].substr(
+    return this->Buffers[view["buffer"].get<std::size_t>()]->substr(
       view.value("byteOffset", std::size_t(0)), view["byteLength"].get<std::size_t>());
   }
 
@@ -766,7 +824,7 @@ public:
     const std::size_t count = accessor["count"].get<std::size_t>();
     const std::size_t stride =
       std::max<std::size_t>(view.value("byteStride", std::size_t(0)), bytes * components);
-    const std::string& buffer = this->Buffers[view["buffer"].get<std::size_t>()];
+    const std::string& buffer = *this->Buffers[view["buffer"].get<std::size_t>()];
     const std::size_t start =
       view.value("byteOffset", std::size_t(0)) + accessor.value("byteOffset", std::size_t(0));
     const bool normalized = accessor.value("normalized", false);
@@ -905,7 +963,7 @@ private:
   const Json& Root;
   std::string Path;
   std::filesystem::path Folder;
-  std::vector<std::string> Buffers;
+  std::vector<std::shared_ptr<const std::string>> Buffers;
 };
 
 std::array<double, 16> multiply(const std::array<double, 16>& a, const std::array<double, 16>& b)

@@ -313,7 +313,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
           throw FileError(where() + ": '" + printable(reference) +
             "' is not a vertex reference (v, v/vt, v/vt/vn or v//vn, v a non-zero whole number)");
         }
-        if (index < 0 && -index > defined)
+        // Compared without negating: -LLONG_MIN does not exist.
+        if (index < 0 && index < -defined)
         {
           throw FileError(where() + ": '" + printable(reference) + "' names vertex " +
             std::to_string(index) + " but only " + std::to_string(defined) +

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -252,6 +253,25 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
     fail(ended ? "has no format line" : "has a header without end_header");
   }
 
+  // Every row holds at least one byte, so a count larger than the file is a lie; a row
+  // without properties reads nothing, and a loop over 10^18 of them would never end.
+  const std::uintmax_t fileBytes = fileSize(path);
+  for (const auto& element : elements)
+  {
+    if (element.count > 0 && element.properties.empty())
+    {
+      fail("declares " + std::to_string(element.count) + " rows of the element '" +
+        printable(element.name) + "' but no properties: give the element its properties or "
+        "a count of 0");
+    }
+    if (element.count > fileBytes)
+    {
+      fail("declares " + std::to_string(element.count) + " rows of the element '" +
+        printable(element.name) + "', more than the file's " + std::to_string(fileBytes) +
+        " bytes can hold: the count is wrong or the file is truncated");
+    }
+  }
+
   const PlyElement* vertex = nullptr;
   const PlyElement* face = nullptr;
   for (const auto& element : elements)
@@ -306,7 +326,7 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
   }
 
   // The body: elements in header order; others are read and dropped.
-  const std::uintmax_t size = fileSize(path);
+  const std::uintmax_t size = fileBytes;
   PlyValues values(in, format, path);
   Scene scene;
   scene.format = "PLY";
@@ -362,7 +382,9 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
             if (value < 0 || value >= static_cast<double>(scene.points->GetNumberOfPoints()) ||
               value != std::floor(value))
             {
-              fail("names vertex " + std::to_string(static_cast<long long>(value)) + " in " + what +
+              std::ostringstream text;
+              text << value;
+              fail("names vertex " + text.str() + " in " + what +
                 " but has " + std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
             }
             ids.push_back(static_cast<vtkIdType>(value));

@@ -90,6 +90,13 @@ std::ifstream openFile(const std::string& path, const std::string& kind)
   {
     throw FileError("the " + kind + " " + named(path) + " is a folder, not a file");
   }
+  // Opening a FIFO blocks until a writer appears, and a device never ends: only regular
+  // files (or links to them) are read.
+  if (!std::filesystem::is_regular_file(path, error))
+  {
+    throw FileError("the " + kind + " " + named(path) +
+      " is not a regular file (a pipe, socket or device): save the scene to a file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in)
   {

@@ -105,17 +105,25 @@ vtkSmartPointer<vtkImageData> decodePng(const std::string& bytes, std::string& p
 
 /// The width x height of a JPEG's frame header (SOFn), read before vtkJPEGReader allocates the
 /// image it declares; 0 when no frame header is found (the reader then reports the damage).
-std::uint64_t jpegPixels(const std::string& bytes)
+// libjpeg skips stray bytes between segments to find the next marker, so this scan must
+// too: stopping at the first stray byte would let a frame header it hides through unchecked.
+// No frame header means no size to check, and such an image is refused.
+std::optional<std::uint64_t> jpegPixels(const std::string& bytes)
 {
   auto byte = [&](std::size_t i)
   { return static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[i])); };
   std::size_t at = 2;
-  while (at + 4 <= bytes.size() && byte(at) == 0xff)
+  while (at + 4 <= bytes.size())
   {
-    const std::uint64_t marker = byte(at + 1);
-    if (marker == 0xff)
+    if (byte(at) != 0xff)
     {
-      ++at; // fill byte
+      ++at; // extraneous byte
+      continue;
+    }
+    const std::uint64_t marker = byte(at + 1);
+    if (marker == 0xff || marker == 0x00)
+    {
+      ++at; // fill byte, or a stuffed zero outside any scan
       continue;
     }
     if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd8))
@@ -125,19 +133,21 @@ std::uint64_t jpegPixels(const std::string& bytes)
     }
     if (marker == 0xd9 || marker == 0xda)
     {
-      return 0; // end of image or scan data before any frame header
+      return std::nullopt; // end of image or scan data before any frame header
     }
     const bool frame =
       marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
     if (frame)
     {
-      return at + 9 <= bytes.size()
-        ? ((byte(at + 5) << 8) | byte(at + 6)) * ((byte(at + 7) << 8) | byte(at + 8))
-        : 0;
+      if (at + 9 > bytes.size())
+      {
+        return std::nullopt;
+      }
+      return ((byte(at + 5) << 8) | byte(at + 6)) * ((byte(at + 7) << 8) | byte(at + 8));
     }
     at += 2 + static_cast<std::size_t>((byte(at + 2) << 8) | byte(at + 3));
   }
-  return 0;
+  return std::nullopt;
 }
 } // namespace
 
@@ -150,7 +160,13 @@ std::optional<std::array<double, 3>> imageMean(const std::string& bytes, std::st
   }
   else if (isJpeg(bytes))
   {
-    if (jpegPixels(bytes) > MaxTexturePixels)
+    const std::optional<std::uint64_t> pixels = jpegPixels(bytes);
+    if (!pixels)
+    {
+      problem = "its JPEG image has no readable frame header, so its size is unknown";
+      return std::nullopt;
+    }
+    if (*pixels > MaxTexturePixels)
     {
       problem = "its JPEG image is larger than 64 Mpixels";
       return std::nullopt;

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <new>
 #include <string>
@@ -135,6 +136,20 @@ int vtkRadiositySceneReader::RequestData(
     return 0;
   }
 
+  for (const auto& material : scene.materials)
+  {
+    for (const double radiance : material.radiance)
+    {
+      if (!std::isfinite(vtkMath::Pi() * radiance))
+      {
+        vtkErrorMacro(<< "the material '" << material.name << "' of '" << path
+                      << "' has an emission too large to represent (" << radiance
+                      << " per steradian): give its Ke or emissive factor in W/sr/m^2, "
+                         "below 1e300");
+        return 0;
+      }
+    }
+  }
   const vtkIdType cells = scene.polygons->GetNumberOfCells();
   vtkNew<vtkDoubleArray> reflectance;
   reflectance->SetName("Reflectance");
