@@ -3,8 +3,10 @@
 // byte modulo 8, in that order; .obj and .ply by our vtkRadiositySceneReader with their
 // materials, as the command line reads them) -> the vtkMovingLightRadiosity filter with a fixed
 // light and a 2-frame trajectory, few paths and a small memory limit. The first byte's last two
-// values (6, 7) make a photometric file instead (.ies, .ldt) read by mlr::readPhotometricFile,
-// whose distribution must then be finite and sample where its density is positive.
+// values 6 and 7 make a photometric file instead (.ies, .ldt) read by mlr::readPhotometricFile,
+// whose distribution must then be finite and sample where its density is positive. Values 8
+// and 9 (first byte modulo 10) make a .gltf or .glb file read by vtkRadiositySceneReader in
+// this process, as ParaView runs it: a crash there is a finding, not a refusal.
 //
 // A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
 // out of time in its child process; mlr::Error for a photometric file) or a filter error is a
@@ -21,6 +23,7 @@
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkExecutive.h"
 #include "vtkLogger.h"
 #include "vtkMovingLightRadiosity.h"
 #include "vtkNew.h"
@@ -131,26 +134,38 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 {
   static Setup setup;
   static const char* const extensions[] = { ".vtp", ".obj", ".ply", ".stl", ".vtu", ".vtk", ".ies",
-    ".ldt" };
+    ".ldt", ".gltf", ".glb" };
   if (size == 0)
   {
     return 0;
   }
-  const unsigned kind = data[0] % 8;
+  const unsigned kind = data[0] % 10;
   const fs::path path = setup.directory / (std::string("scene") + extensions[kind]);
   {
     std::ofstream file(path, std::ios::binary | std::ios::trunc);
     file.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
   }
-  if (kind >= 6)
+  if (kind == 6 || kind == 7)
   {
     checkPhotometricFile(path);
     return 0;
   }
 
   vtkSmartPointer<vtkPolyData> scene;
-  try
+  if (kind >= 8)
   {
+    vtkNew<vtkRadiositySceneReader> reader;
+    reader->SetFileName(path.string().c_str());
+    if (!reader->GetExecutive()->Update())
+    {
+      return 0;
+    }
+    scene = reader->GetOutput();
+  }
+  else
+  {
+    try
+    {
     mlr::guarded::ReadLimits limits;
     limits.time.baseSeconds = 1;
     scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits,
@@ -161,9 +176,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
       });
   }
-  catch (const mlr::guarded::InputError&)
-  {
-    return 0;
+    catch (const mlr::guarded::InputError&)
+    {
+      return 0;
+    }
   }
 
   vtkNew<vtkMovingLightRadiosity> filter;

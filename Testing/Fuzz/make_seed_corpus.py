@@ -245,10 +245,40 @@ def photometric_seeds():
     yield "ldt_bad_symmetry", 7, good.replace(b"Seed\r\n1\r\n0\r\n", b"Seed\r\n1\r\n7\r\n", 1)
 
 
+def gltf_seeds():
+    """A triangle with a material as .gltf (its buffer a data: URI) and as .glb (a BIN chunk)."""
+    import base64
+    import json
+    data = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<3H", 0, 1, 2) + b"\0\0"
+
+    def document(buffer):
+        return {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+                "nodes": [{"mesh": 0, "translation": [0, 0, 1]}],
+                "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.6, 0.7, 1]},
+                               "emissiveFactor": [0.1, 0.1, 0.1]}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
+                                            "material": 0}]}],
+                "buffers": [buffer],
+                "bufferViews": [{"buffer": 0, "byteLength": 36},
+                                {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
+                               "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                              {"bufferView": 1, "componentType": 5123, "count": 3,
+                               "type": "SCALAR"}]}
+    uri = "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+    yield "gltf_triangle", 8, json.dumps(
+        document({"byteLength": len(data), "uri": uri})).encode()
+    text = json.dumps(document({"byteLength": len(data)})).encode()
+    text += b" " * (-len(text) % 4)
+    body = (struct.pack("<I4s", len(text), b"JSON") + text +
+            struct.pack("<I4s", len(data), b"BIN\0") + data)
+    yield "glb_triangle", 9, struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
+
+
 def main():
     for target, seeds in (("solve", ((n, b) for n, b in solve_seeds())),
                           ("readers", ((n, bytes([k]) + b) for seeds in
-                                       (reader_seeds(), photometric_seeds())
+                                       (reader_seeds(), photometric_seeds(), gltf_seeds())
                                        for n, k, b in seeds))):
         directory = os.path.join(HERE, "corpus", target)
         os.makedirs(directory, exist_ok=True)
