@@ -166,16 +166,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   {
     try
     {
-    mlr::guarded::ReadLimits limits;
-    limits.time.baseSeconds = 1;
-    scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits,
-      [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
-      {
-        auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
-        reader->SetFileName(file.c_str());
-        return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
-      });
-  }
+      mlr::guarded::ReadLimits limits;
+      limits.time.baseSeconds = 1;
+      scene = mlr::guarded::readSurfaceFile(path.string(), "scene", limits,
+        [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
+        {
+          auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+          reader->SetFileName(file.c_str());
+          return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
+        });
+    }
     catch (const mlr::guarded::InputError&)
     {
       return 0;
