@@ -7,6 +7,8 @@
 #include "vtkRadiositySceneReader.h"
 #include "vtkXMLPolyDataReader.h"
 
+#include <algorithm>
+
 namespace mlr::cli
 {
 
@@ -38,11 +40,13 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
 vtkSmartPointer<vtkPolyData> readSceneFile(const std::string& path, std::uint64_t memoryLimitBytes)
 {
   return guardedRead(path, "scene", memoryLimitBytes,
-    [](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
+    [memoryLimitBytes](const std::string& file, const std::string&) -> vtkSmartPointer<vtkAlgorithm>
     {
       // Formats with materials (.obj, .gltf, .glb, .ply): our reader; VTK's for the rest.
       auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
       reader->SetFileName(file.c_str());
+      reader->SetMemoryLimit(
+        static_cast<int>(std::min<std::uint64_t>(memoryLimitBytes >> 20, VTK_INT_MAX)));
       return vtkRadiositySceneReader::CanReadFile(file.c_str()) ? reader : nullptr;
     });
 }

@@ -240,10 +240,14 @@ std::vector<std::string> mtllibFiles(const std::string& rest, const std::filesys
 }
 } // namespace
 
-Scene readObj(const std::string& path, const Warn& warn, const Progress& progress)
+Scene readObj(
+  const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget)
 {
   std::ifstream in = openFile(path, "OBJ file");
   const std::uintmax_t size = std::max<std::uintmax_t>(1, fileSize(path));
+  // OBJ declares no counts: its lines, about 16 bytes each in files written by modellers, are
+  // the estimate, each taken as a vertex and a triangle.
+  checkOutputSize(path, "OBJ", size / 16, size / 16, budget);
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   ProgressPoll poll(progress, 0.0, 0.9);
 

@@ -169,7 +169,8 @@ double plyColour(double value, const std::string& type)
 }
 } // namespace
 
-Scene readPly(const std::string& path, const Warn& warn, const Progress& progress)
+Scene readPly(
+  const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget)
 {
   std::ifstream in = openFile(path, "PLY file");
   ProgressPoll poll(progress, 0.0, 0.9);
@@ -261,7 +262,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
     if (element.count > 0 && element.properties.empty())
     {
       fail("declares " + std::to_string(element.count) + " rows of the element '" +
-        printable(element.name) + "' but no properties: give the element its properties or "
+        printable(element.name) +
+        "' but no properties: give the element its properties or "
         "a count of 0");
     }
     if (element.count > fileBytes)
@@ -283,6 +285,7 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
   {
     fail("has no element 'vertex' with properties x, y and z");
   }
+  checkOutputSize(path, "PLY", vertex->count, face ? face->count : 0, budget);
   int indexProperty = face ? face->find("vertex_indices") : -1;
   if (face && indexProperty < 0)
   {
@@ -384,8 +387,8 @@ Scene readPly(const std::string& path, const Warn& warn, const Progress& progres
             {
               std::ostringstream text;
               text << value;
-              fail("names vertex " + text.str() + " in " + what +
-                " but has " + std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
+              fail("names vertex " + text.str() + " in " + what + " but has " +
+                std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
             }
             ids.push_back(static_cast<vtkIdType>(value));
           }

@@ -1,5 +1,7 @@
 #include "RadiositySceneFormats.h"
 
+#include "SceneText.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -38,6 +40,22 @@ std::array<double, 3> checkedReflectance(
     }
   }
   return rgb;
+}
+
+void checkOutputSize(const std::string& path, const std::string& format, std::uint64_t points,
+  std::uint64_t triangles, const MemoryBudget& budget)
+{
+  // A point is three doubles; a triangle three ids, an offset, a material id, a reflectance
+  // and an emission (doubles), with a margin for the cell array's growth.
+  constexpr std::uint64_t BytesPerPoint = 24, BytesPerTriangle = 112;
+  const std::uint64_t bytes = saturatingSum(
+    saturatingProduct(points, BytesPerPoint), saturatingProduct(triangles, BytesPerTriangle));
+  if (!budget.fits(bytes))
+  {
+    throw FileError(budget.overLimitMessage(bytes, "the " + format + " file " + named(path),
+      std::to_string(points) + " points, " + std::to_string(triangles) + " triangles",
+      "simplify the model, or raise the reader's MemoryLimit"));
+  }
 }
 
 } // namespace mlr::scenefile

@@ -4,9 +4,12 @@
 // the helpers of SceneText.h and SceneTextures.h. Private to the Filters module.
 #pragma once
 
+#include "MemoryBudget.h"
+
 #include "vtkSmartPointer.h"
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -75,7 +78,8 @@ std::array<double, 3> checkedReflectance(
 /// texture that cannot be read or decoded is a warning. A missing MTL file or material falls back
 /// to grey FallbackReflectance with a warning naming it. Points (p) and lines (l) are skipped with
 /// a warning. FileError when the file cannot be read, is malformed, or has no faces.
-Scene readObj(const std::string& path, const Warn& warn, const Progress& progress);
+Scene readObj(
+  const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget);
 
 /// glTF 2.0, .gltf (JSON, buffers embedded as data: URIs or in files beside it) or .glb, with
 /// every index and accessor checked against the file before use. The default scene's meshes
@@ -85,7 +89,8 @@ Scene readObj(const std::string& path, const Warn& warn, const Progress& progres
 /// KHR_materials_emissive_strength times the mean of its emissive texture the radiance.
 /// COLOR_0 multiplies the reflectance per cell (mean over the cell's vertices). FileError
 /// when the file cannot be read, is malformed, or has no triangles.
-Scene readGltf(const std::string& path, const Warn& warn, const Progress& progress);
+Scene readGltf(
+  const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget);
 
 /// PLY (ASCII or binary), element vertex (x, y, z, optional red/green/blue or
 /// diffuse_red/...), element face (vertex_indices or vertex_index, optional red/green/blue).
@@ -93,6 +98,13 @@ Scene readGltf(const std::string& path, const Warn& warn, const Progress& progre
 /// is the cell's reflectance, else the mean of its vertices' colours, else grey with a
 /// warning. One material named after the file. FileError when the file cannot be read, is
 /// malformed, or has no faces.
-Scene readPly(const std::string& path, const Warn& warn, const Progress& progress);
+Scene readPly(
+  const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget);
+
+/// The output's estimated bytes for `points` points and `triangles` triangles (coordinates,
+/// connectivity and the per-cell arrays), checked against `budget` before reading them:
+/// FileError naming `path` and the estimate when it does not fit.
+void checkOutputSize(const std::string& path, const std::string& format, std::uint64_t points,
+  std::uint64_t triangles, const MemoryBudget& budget);
 
 } // namespace mlr::scenefile

@@ -2,6 +2,8 @@
 
 #include "RadiositySceneFormats.h"
 
+#include "MemoryBudget.h"
+
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
@@ -91,20 +93,21 @@ int vtkRadiositySceneReader::RequestData(
     this->UpdateProgress(0.9 * fraction);
     return !this->CheckAbort();
   };
+  const mlr::MemoryBudget budget(static_cast<std::uint64_t>(this->MemoryLimit) << 20);
   sf::Scene scene;
   try
   {
     if (extension == ".obj")
     {
-      scene = sf::readObj(path, warn, progress);
+      scene = sf::readObj(path, warn, progress, budget);
     }
     else if (extension == ".gltf" || extension == ".glb")
     {
-      scene = sf::readGltf(path, warn, progress);
+      scene = sf::readGltf(path, warn, progress, budget);
     }
     else if (extension == ".ply")
     {
-      scene = sf::readPly(path, warn, progress);
+      scene = sf::readPly(path, warn, progress, budget);
     }
     else
     {
@@ -200,5 +203,6 @@ void vtkRadiositySceneReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB (0: half of physical memory)\n";
   os << indent << "Aborted: " << (this->Aborted ? "yes" : "no") << "\n";
 }

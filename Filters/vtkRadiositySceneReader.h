@@ -82,6 +82,18 @@ public:
   vtkGetFilePathMacro(FileName);
   ///@}
 
+  ///@{
+  /**
+   * Largest memory, in MiB, the output may be estimated to need. The estimate is made from
+   * the file's declared counts (glTF: every mesh instance the node hierarchy draws; PLY: the
+   * header's vertex and face counts; OBJ: the file's size) before anything proportional to
+   * them is allocated, and a file over the limit is an error naming the estimate. The same
+   * policy as vtkMovingLightRadiosity's MemoryLimit. Default: 0, half of the physical memory.
+   */
+  vtkSetClampMacro(MemoryLimit, int, 0, VTK_INT_MAX);
+  vtkGetMacro(MemoryLimit, int);
+  ///@}
+
   /**
    * Whether the extension of `fileName` is one this reader reads (.obj, .gltf, .glb, .ply).
    * The file itself is not opened.
@@ -99,6 +111,7 @@ private:
   void operator=(const vtkRadiositySceneReader&) = delete;
 
   char* FileName = nullptr;
+  int MemoryLimit = 0;
   /// The last update stopped on AbortExecute, which this VTK does not clear by itself.
   bool Aborted = false;
 };

@@ -68,6 +68,8 @@ def strings(data, name):
 
 
 reader = RadiositySceneReader(FileName=os.path.join(folder, "room.obj"))  # noqa: F405
+check(reader.GetProperty("MemoryLimit") is not None and reader.MemoryLimit == 0,
+      "the reader has no MemoryLimit property defaulting to 0 (half of the physical memory)")
 reader.UpdatePipeline()
 data = servermanager.Fetch(reader)
 check(data.GetNumberOfCells() == 4, f"room.obj gave {data.GetNumberOfCells()} cells, expected 4")

@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 using namespace mlr::testing;
@@ -28,10 +29,11 @@ struct Outcome
   std::string errors, warnings;
 };
 
-Outcome readScene(const fs::path& path)
+Outcome readScene(const fs::path& path, int memoryLimitMiB = 0)
 {
   auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
   reader->SetFileName(path.string().c_str());
+  reader->SetMemoryLimit(memoryLimitMiB);
   auto messages = vtkSmartPointer<MessageRecorder>::New();
   messages->watch(reader);
   Outcome outcome;
@@ -61,6 +63,24 @@ struct TestFolder
   }
   const fs::path path;
 };
+
+/// A glTF file with one triangle mesh (its buffer a data: URI) and the JSON array `nodes`,
+/// some of which draw mesh 0; `sceneNodes` lists the roots.
+std::string gltfWithNodes(const std::string& nodes, const std::string& sceneNodes)
+{
+  // Three float VEC3 positions (0,0,0) (1,0,0) (0,1,0), then uint16 indices 0 1 2 and padding.
+  const std::string buffer = "data:application/octet-stream;base64,"
+                             "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=";
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + sceneNodes +
+    R"(}], "nodes": )" + nodes +
+    R"(, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    "buffers": [{"byteLength": 44, "uri": ")" +
+    buffer + R"("}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36,
+    "byteLength": 6}], "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
+    "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}, {"bufferView": 1,
+    "componentType": 5123, "count": 3, "type": "SCALAR"}]})";
+}
 
 void expectRefused(const std::string& file, const std::string& reason)
 {
@@ -145,4 +165,50 @@ TEST(HostileSceneFiles, AnEmissionBeyondDoubleIsRefusedNotInfinite)
   const Outcome outcome = readScene(folder.path / "hot.obj");
   EXPECT_FALSE(outcome.read);
   EXPECT_NE(outcome.errors.find("emission too large"), std::string::npos) << outcome.errors;
+}
+
+TEST(HostileSceneFiles, InstancesBeyondTheMemoryLimitAreRefusedBeforeDrawing)
+{
+  // One root with 100,000 children, each drawing the mesh: 100,000 triangles, an estimated
+  // 18 MiB, over a limit of 8 MiB and within the default.
+  constexpr int Instances = 100000;
+  std::ostringstream nodes;
+  nodes << "[{\"children\": [";
+  for (int i = 1; i <= Instances; ++i)
+  {
+    nodes << (i > 1 ? "," : "") << i;
+  }
+  nodes << "]}";
+  for (int i = 1; i <= Instances; ++i)
+  {
+    nodes << ",{\"mesh\": 0}";
+  }
+  nodes << "]";
+  TestFolder folder("instances");
+  const fs::path gltf = folder.path / "instances.gltf";
+  std::ofstream(gltf) << gltfWithNodes(nodes.str(), "[0]");
+  const Outcome limited = readScene(gltf, 8);
+  EXPECT_FALSE(limited.read);
+  EXPECT_NE(limited.errors.find("100000 triangles"), std::string::npos) << limited.errors;
+  EXPECT_NE(limited.errors.find("memory limit"), std::string::npos) << limited.errors;
+  EXPECT_TRUE(readScene(gltf).read);
+}
+
+TEST(HostileSceneFiles, ALongNodeChainIsCheckedInLinearTime)
+{
+  // 200,000 nodes, each the parent of the next, the mesh at the end: climbing the chain once
+  // from every node (2 x 10^10 steps) would run into the test's timeout.
+  constexpr int Chain = 200000;
+  std::ostringstream nodes;
+  nodes << "[";
+  for (int i = 0; i < Chain - 1; ++i)
+  {
+    nodes << "{\"children\": [" << i + 1 << "]},";
+  }
+  nodes << "{\"mesh\": 0}]";
+  TestFolder folder("chain");
+  const fs::path gltf = folder.path / "chain.gltf";
+  std::ofstream(gltf) << gltfWithNodes(nodes.str(), "[0]");
+  const Outcome outcome = readScene(gltf);
+  EXPECT_TRUE(outcome.read) << outcome.errors;
 }
