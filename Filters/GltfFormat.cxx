@@ -1,6 +1,7 @@
 // glTF 2.0, .gltf and .glb (readGltf).
 #include "RadiositySceneFormats.h"
 
+#include "CheckedArithmetic.h"
 #include "SceneText.h"
 #include "SceneTextures.h"
 
@@ -241,8 +242,7 @@ public:
       const std::int64_t length = this->integer(view, "byteLength", where);
       const std::int64_t stride = this->integer(view, "byteStride", where, 0);
       const std::int64_t bufferBytes = this->BufferBytes[static_cast<std::size_t>(buffer)];
-      // Compared by subtraction: offset + length can overflow 64 bits in a hostile file.
-      if (offset < 0 || length < 0 || length > bufferBytes || offset > bufferBytes - length)
+      if (!spanFits(offset, 1, 0, length, bufferBytes))
       {
         this->fail(where + " (" + std::to_string(length) + " bytes from byte " +
           std::to_string(offset) + ") does not fit in buffer " + std::to_string(buffer) + " (" +
@@ -282,10 +282,7 @@ public:
       const std::int64_t element = bytes * components;
       const std::int64_t stride = std::max(this->integer(view, "byteStride", where, 0), element);
       const std::int64_t available = view["byteLength"].get<std::int64_t>();
-      // count is bounded before it multiplies, and offset is compared by subtraction, so
-      // nothing here overflows.
-      if (count > INT32_MAX / stride || offset > available ||
-        (count - 1) * stride + element > available - offset)
+      if (count > INT32_MAX / stride || !spanFits(offset, count, stride, element, available))
       {
         this->fail(where + " (" + std::to_string(count) + " elements of " +
           std::to_string(element) + " bytes from byte " + std::to_string(offset) +
