@@ -891,17 +891,28 @@ public:
     }
     else
     {
-      const Json& source = this->Root["images"][entry["source"].get<std::size_t>()];
-      std::string bytes;
-      if (source.contains("bufferView"))
+      // Each image is decoded once, however many textures and materials name it.
+      const std::size_t image = entry["source"].get<std::size_t>();
+      auto known = this->ImageMeans.find(image);
+      if (known == this->ImageMeans.end())
       {
-        bytes = this->view(source["bufferView"].get<std::size_t>());
+        const Json& source = this->Root["images"][image];
+        std::string bytes;
+        if (source.contains("bufferView"))
+        {
+          bytes = this->view(source["bufferView"].get<std::size_t>());
+        }
+        else
+        {
+          bytes = this->resource(source["uri"].get<std::string>(), what + "'s image");
+        }
+        std::string imageProblem;
+        std::optional<std::array<double, 3>> imageMeanColour = imageMean(bytes, imageProblem);
+        known =
+          this->ImageMeans.emplace(image, std::make_pair(imageMeanColour, imageProblem)).first;
       }
-      else
-      {
-        bytes = this->resource(source["uri"].get<std::string>(), what + "'s image");
-      }
-      mean = imageMean(bytes, problem);
+      mean = known->second.first;
+      problem = known->second.second;
     }
     if (!mean)
     {
@@ -980,6 +991,9 @@ private:
   std::string Path;
   std::filesystem::path Folder;
   std::vector<std::shared_ptr<const std::string>> Buffers;
+  /// Decoded images' mean colours (or why there is none), by image index.
+  mutable std::map<std::size_t, std::pair<std::optional<std::array<double, 3>>, std::string>>
+    ImageMeans;
 };
 
 std::array<double, 16> multiply(const std::array<double, 16>& a, const std::array<double, 16>& b)

@@ -393,8 +393,14 @@ Scene readObj(
   // Materials: Kd and Ke from the libraries.
   std::map<std::string, MtlMaterial> library;
   bool allLibrariesRead = !libraries.empty();
+  // A library named on many lines is read once: a file can repeat one mtllib line without end.
+  std::set<std::string> librariesSeen;
   for (const auto& [file, lineNumber] : libraries)
   {
+    if (!librariesSeen.insert(file).second)
+    {
+      continue;
+    }
     std::error_code error;
     if (!std::filesystem::is_regular_file(file, error))
     {

@@ -212,3 +212,26 @@ TEST(HostileSceneFiles, ALongNodeChainIsCheckedInLinearTime)
   const Outcome outcome = readScene(gltf);
   EXPECT_TRUE(outcome.read) << outcome.errors;
 }
+
+TEST(HostileSceneFiles, AMaterialLibraryNamedOnManyLinesIsReadOnce)
+{
+  // 20,000 mtllib lines name one library that does not exist: one warning, not 20,000
+  // (and for a library that exists, one reading).
+  TestFolder folder("mtllib");
+  std::ofstream obj(folder.path / "many.obj");
+  for (int i = 0; i < 20000; ++i)
+  {
+    obj << "mtllib missing.mtl\n";
+  }
+  obj << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  obj.close();
+  const Outcome outcome = readScene(folder.path / "many.obj");
+  EXPECT_TRUE(outcome.read) << outcome.errors;
+  std::size_t warnings = 0;
+  for (std::size_t at = outcome.warnings.find("missing.mtl"); at != std::string::npos;
+       at = outcome.warnings.find("missing.mtl", at + 1))
+  {
+    ++warnings;
+  }
+  EXPECT_EQ(warnings, 1u) << outcome.warnings.substr(0, 2000);
+}
