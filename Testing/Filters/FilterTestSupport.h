@@ -7,6 +7,7 @@
 #include "vtkCommand.h"
 #include "vtkSmartPointer.h"
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,24 @@ class vtkPolyData;
 
 namespace mlr::testing
 {
+
+/// A fresh folder for one test's files (named after `name`, which tests keep distinct),
+/// removed with them at the end of the test.
+struct TestFolder
+{
+  explicit TestFolder(const std::string& name)
+    : path(std::filesystem::temp_directory_path() / ("mlr-test-" + name))
+  {
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TestFolder()
+  {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  const std::filesystem::path path;
+};
 
 /// Core's patch mesh as the filter's Scene input: triangles with a cell array Reflectance.
 vtkSmartPointer<vtkPolyData> scenePolyData(const PatchMesh& mesh);

@@ -35,23 +35,6 @@ namespace
 namespace fs = std::filesystem;
 constexpr double Pi = 3.14159265358979323846;
 
-/// A fresh folder for one test's files, removed with them at the end of the test.
-struct TestFolder
-{
-  explicit TestFolder(const std::string& name)
-    : path(fs::temp_directory_path() / ("mlr-scene-reader-" + name))
-  {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TestFolder()
-  {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  const fs::path path;
-};
-
 void writeFile(const fs::path& path, const std::string& text)
 {
   std::ofstream out(path, std::ios::binary);

@@ -48,22 +48,6 @@ fs::path hostile(const std::string& name)
   return fs::path(MLR_HOSTILE_DIR) / name;
 }
 
-struct TestFolder
-{
-  explicit TestFolder(const std::string& name)
-    : path(fs::temp_directory_path() / ("mlr-hostile-" + name))
-  {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TestFolder()
-  {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  const fs::path path;
-};
-
 /// A glTF file with one triangle mesh (its buffer a data: URI) and the JSON array `nodes`,
 /// some of which draw mesh 0; `sceneNodes` lists the roots.
 std::string gltfWithNodes(const std::string& nodes, const std::string& sceneNodes)
