@@ -3,6 +3,7 @@
 
 #include "SceneText.h"
 #include "SceneTextures.h"
+#include "TextLines.h"
 
 #include "vtkCellArray.h"
 #include "vtkPoints.h"
@@ -23,51 +24,6 @@ namespace mlr::scenefile
 
 namespace
 {
-/// The logical lines of an OBJ or MTL file: a line ending in a backslash continues on the next.
-class LogicalLines
-{
-public:
-  explicit LogicalLines(std::istream& in)
-    : In(in)
-  {
-  }
-
-  bool next(std::string& line)
-  {
-    line.clear();
-    std::string part;
-    bool any = false;
-    while (std::getline(this->In, part))
-    {
-      any = true;
-      ++this->Number;
-      if (!part.empty() && part.back() == '\r')
-      {
-        part.pop_back();
-      }
-      if (!part.empty() && part.back() == '\\')
-      {
-        part.back() = ' ';
-        line += part;
-        continue;
-      }
-      line += part;
-      return true;
-    }
-    return any;
-  }
-
-  std::size_t number() const { return this->Number; }
-  std::uintmax_t position()
-  {
-    return static_cast<std::uintmax_t>(std::max<std::streamoff>(0, this->In.tellg()));
-  }
-
-private:
-  std::istream& In;
-  std::size_t Number = 0;
-};
-
 /// The keyword of a line and the rest of it, without a trailing comment.
 void splitKeyword(const std::string& line, std::string& keyword, std::string& rest)
 {
@@ -278,7 +234,8 @@ Scene readObj(
   {
     if (lines.number() % 65536 == 0)
     {
-      poll(static_cast<double>(lines.position()) / static_cast<double>(size));
+      poll(
+        static_cast<double>(std::max<std::streamoff>(0, in.tellg())) / static_cast<double>(size));
     }
     splitKeyword(line, keyword, rest);
     auto where = [&]()

@@ -16,16 +16,6 @@ std::string named(const std::string& text)
   return "'" + text + "'";
 }
 
-std::string printable(const std::string& text)
-{
-  std::string shown = text.substr(0, 60);
-  for (char& c : shown)
-  {
-    c = static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
-  }
-  return text.size() > 60 ? shown + "..." : shown;
-}
-
 std::string trim(const std::string& text)
 {
   const auto first = text.find_first_not_of(" \t\r\n\f\v");

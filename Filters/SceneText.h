@@ -4,6 +4,7 @@
 #pragma once
 
 #include "RadiositySceneFormats.h"
+#include "TextLines.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -16,9 +17,6 @@ namespace mlr::scenefile
 
 /// `text` in quotes, as messages name files and materials.
 std::string named(const std::string& text);
-
-/// A piece of a file as messages show it: at most 60 characters, control bytes as '?'.
-std::string printable(const std::string& text);
 
 std::string trim(const std::string& text);
 

@@ -2,6 +2,7 @@
 
 #include "GuardedRead.h"
 #include "MemoryBudget.h"
+#include "TextLines.h"
 
 #include <algorithm>
 #include <cctype>
@@ -17,57 +18,22 @@ namespace mlr::guarded
 
 namespace
 {
-/// The logical lines of an OBJ file: a line ending in a backslash continues on the next.
+/// An OBJ file's logical lines, read from its path.
 class ObjLines
 {
 public:
   explicit ObjLines(const std::string& path)
-    : In(path, std::ios::binary)
+    : File(path, std::ios::binary)
+    , Lines(File)
   {
   }
-
-  bool next(std::string& line)
-  {
-    line.clear();
-    std::string part;
-    bool any = false;
-    while (std::getline(this->In, part))
-    {
-      any = true;
-      ++this->Number;
-      if (!part.empty() && part.back() == '\r')
-      {
-        part.pop_back();
-      }
-      if (!part.empty() && part.back() == '\\')
-      {
-        part.back() = ' ';
-        line += part;
-        continue;
-      }
-      line += part;
-      return true;
-    }
-    return any;
-  }
-
-  std::size_t number() const { return this->Number; }
+  bool next(std::string& line) { return this->Lines.next(line); }
+  std::size_t number() const { return this->Lines.number(); }
 
 private:
-  std::ifstream In;
-  std::size_t Number = 0;
+  std::ifstream File;
+  LogicalLines Lines;
 };
-
-/// A line of a file as messages show it: at most 60 characters, control bytes as '?'.
-std::string printable(const std::string& line)
-{
-  std::string text = line.substr(0, 60);
-  for (char& c : text)
-  {
-    c = static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
-  }
-  return line.size() > 60 ? text + "..." : text;
-}
 
 /// One index of an OBJ reference (v, vt or vn): 1-based, or negative from the last defined.
 bool parseIndex(const std::string& text, long long& value)
