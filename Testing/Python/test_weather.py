@@ -180,3 +180,17 @@ def test_the_filter_takes_the_sun_and_sky_of_each_hour_and_its_date():
     refused.AddObserver("ErrorEvent", record)
     assert not refused.UpdateTimeStep(0.0)
     assert any("DayOfYear has 400" in e for e in errors), errors
+
+
+def test_a_sun_path_dates_its_frames_too():
+    # 2024 is a leap year: June 21 is day 31 + 29 + 31 + 30 + 31 + 21 = 173, which the Perez
+    # sky then takes for its extraterrestrial irradiance.
+    source = vtkSunPathSource()
+    source.SetStartTime(10)
+    source.SetEndTime(12)
+    source.SetStepMinutes(60)
+    source.Update()
+    path = source.GetOutput()
+    assert point_array(path, "Time") == [10, 11, 12]
+    assert point_array(path, "DayOfYear") == [173, 173, 173]
+    assert path.GetPointData().GetArray("DirectNormalIrradiance") is None
