@@ -139,6 +139,69 @@ SunPathSpec parseSunPath(const std::string& option, const std::string& text)
   return spec;
 }
 
+/// --dates MM-DD,MM-DD: both days included.
+std::array<int, 4> parseDates(const std::string& option, const std::string& text)
+{
+  static const int days[] = { 31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31 };
+  const std::vector<std::string> fields = split(text);
+  std::array<int, 4> dates{};
+  for (std::size_t k = 0; k < 2 && fields.size() == 2; ++k)
+  {
+    char dash = 0;
+    std::istringstream in(fields[k]);
+    in >> dates[2 * k] >> dash >> dates[2 * k + 1];
+    const int month = dates[2 * k], day = dates[2 * k + 1];
+    if (!in || dash != '-' || in.peek() != std::char_traits<char>::eof() || fields[k].size() != 5 ||
+      month < 1 || month > 12 || day < 1 || day > days[month - 1])
+    {
+      throw UsageError(option + " has the date '" + fields[k] +
+        "': give MM-DD,MM-DD, days that exist (e.g. 06-01,08-31; 12-01,02-28 wraps over the "
+        "new year)");
+    }
+  }
+  if (fields.size() != 2)
+  {
+    throw UsageError(option + " is '" + text + "': give the first and last days, MM-DD,MM-DD");
+  }
+  return dates;
+}
+
+/// --hours H-H: clock hours 0 to 23, each the hour starting then.
+std::array<int, 2> parseHours(const std::string& option, const std::string& text)
+{
+  const std::size_t dash = text.find('-');
+  const auto hour = [&](const std::string& part)
+  {
+    const long long h = dash == std::string::npos || part.empty() || part.size() > 2 ||
+        part.find_first_not_of("0123456789") != std::string::npos
+      ? -1
+      : std::stoll(part);
+    if (h < 0 || h > 23)
+    {
+      throw UsageError(option + " is '" + text +
+        "': give FIRST-LAST, clock hours from 0 to 23, each the hour that starts then (8-16 "
+        "is 08:00 to 17:00)");
+    }
+    return static_cast<int>(h);
+  };
+  const std::array<int, 2> hours = { hour(text.substr(0, dash)),
+    hour(dash == std::string::npos ? "" : text.substr(dash + 1)) };
+  if (hours[0] > hours[1])
+  {
+    throw UsageError(option + " is '" + text + "': give the first hour first (8-16)");
+  }
+  return hours;
+}
+
+std::string parseWeather(const std::string& option, const std::string& text)
+{
+  if (!endsWith(text, ".epw"))
+  {
+    throw UsageError(option + " is '" + text + "': give an EnergyPlus weather file (.epw)");
+  }
+  return text;
+}
+
 std::string asGiven(const std::string&, const std::string& text)
 {
   return text;
@@ -225,6 +288,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   app.set_help_flag();
   const CLI::Option* help = app.add_flag("-h,--help", o.help);
   const CLI::Option* point = app.add_flag("--point-light", o.pointLight);
+  const CLI::Option* night = app.add_flag("--night", o.night);
   // Unknown options, arguments and repeated options are reported below, in the project's words.
   app.allow_extras();
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -269,6 +333,9 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--up", "X,Y,Z", o.up, parseTriple);
   option("--sky", "uniform|cie-overcast|cie-clear|perez", o.sky, asGiven);
   option("--sky-diffuse-horizontal", "W_PER_M2", o.skyDiffuseHorizontal, parseNumber);
+  option("--weather", "FILE.epw", o.weather, parseWeather);
+  option("--dates", "MM-DD,MM-DD", o.dates, parseDates);
+  option("--hours", "FIRST-LAST", o.hours, parseHours);
   option("--light-power", "R,G,B", o.lightPower, parsePower);
   option("--light-distribution", "FILE.ies|FILE.ldt", o.lightDistribution, parseDistribution);
   option("--spot", "HALF_ANGLE_DEG[,SOFT_EDGE_DEG]", o.spot, parseSpot);
@@ -292,7 +359,7 @@ Options parseCommandLine(int argc, const char* const* argv)
     const std::string arg = argv[i];
     const std::string name = arg.substr(0, arg.find('='));
     const CLI::Option* given = app.get_option_no_throw(name);
-    if ((given == help || given == point) && name.size() < arg.size())
+    if ((given == help || given == point || given == night) && name.size() < arg.size())
     {
       throw UsageError(name + " takes no value");
     }
@@ -325,7 +392,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   for (const CLI::Option* given : app.get_options())
   {
-    if (given->count() > 1 && given != help && given != point)
+    if (given->count() > 1 && given != help && given != point && given != night)
     {
       throw UsageError(given->get_name() + " is given twice");
     }
@@ -378,12 +445,33 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("give either --sun-directions FILE or --sun-path ..., not both");
   }
+  if (!o.weather.empty())
+  {
+    if (!o.sunDirections.empty() || o.sunPath)
+    {
+      throw UsageError("--weather gives the sun of its hours: give it without --sun-directions "
+                       "and --sun-path");
+    }
+    if (o.timeZone || o.sunIrradiance || o.skyDiffuseHorizontal)
+    {
+      throw UsageError("--weather gives its time zone and each hour's irradiances: give it "
+                       "without --time-zone, --sun-irradiance and --sky-diffuse-horizontal");
+    }
+    if (!o.sky)
+    {
+      o.sky = "perez";
+    }
+  }
+  else if (o.dates || o.hours || o.night)
+  {
+    throw UsageError("--dates, --hours and --night choose the hours of --weather FILE.epw");
+  }
   if (o.usesSun())
   {
     if (!o.light.empty() || !o.trajectory.empty() || o.from || o.to || o.aim || o.lightPower)
     {
-      throw UsageError("the sun replaces the light: --sun-directions and --sun-path go without "
-                       "--light, --trajectory, --from/--to, --aim and --light-power");
+      throw UsageError("the sun replaces the light: --sun-directions, --sun-path and --weather "
+                       "go without --light, --trajectory, --from/--to, --aim and --light-power");
     }
     if (o.usesEmbeddedScene())
     {
@@ -394,13 +482,13 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--sun-irradiance needs --sun-directions FILE or --sun-path ...");
   }
-  if (!o.sunPath && (o.timeZone || o.north))
+  if (!o.sunPath && o.weather.empty() && (o.timeZone || o.north))
   {
-    throw UsageError("--time-zone and --north need --sun-path ...");
+    throw UsageError("--time-zone and --north need --sun-path ... (--north also --weather)");
   }
   if (!o.sunPath && !o.sky && o.up)
   {
-    throw UsageError("--up needs --sun-path ... or --sky MODEL");
+    throw UsageError("--up needs --sun-path ..., --weather FILE.epw or --sky MODEL");
   }
   if (o.sunIrradiance && !(*o.sunIrradiance >= 0 && std::isfinite(*o.sunIrradiance)))
   {
@@ -416,8 +504,8 @@ Options parseCommandLine(int argc, const char* const* argv)
       !o.usesSun())
     {
       throw UsageError("--sky " + *o.sky +
-        " follows the sun: give --sun-directions FILE or --sun-path ..., or choose --sky "
-        "uniform or cie-overcast");
+        " follows the sun: give --sun-directions FILE, --sun-path ... or --weather FILE.epw, or "
+        "choose --sky uniform or cie-overcast");
     }
     if (o.usesEmbeddedScene())
     {
@@ -667,7 +755,8 @@ Light path (the positions of the light's area centroid, one per frame):
   --from X,Y,Z --to X,Y,Z [--frames N]
                         a straight path in N frames (default 30)
   --aim X,Y,Z           in every frame, turn the light to face this point
-The sun (a directional light, instead of --light; needs --scene):
+The sun (a directional light, instead of --light; needs --scene; --north and --up also
+apply to --weather):
   --sun-directions FILE the points of a file are directions towards the sun, one per frame
                         (any length but 0); point arrays Time and Power as above
   --sun-path LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES
@@ -681,6 +770,18 @@ The sun (a directional light, instead of --light; needs --scene):
   --up X,Y,Z            the scene's zenith, also the sky's (default 0,0,1)
   --sun-irradiance W/m2 on a surface facing the sun (default 1000; 0: no direct sun, the
                         frames and the sky's sun kept)
+  --weather FILE.epw    the hours of an EnergyPlus weather file as frames: the sun at the
+                        file's place, in its time zone, at the middle of each hour, with
+                        the hour's direct normal irradiance, and a Perez sky (unless --sky
+                        says otherwise) of its diffuse horizontal irradiance and date. The
+                        series' times are hours of the year: 0 is January 1 00:00-01:00
+  --dates MM-DD,MM-DD   the first and last days of --weather, both included; 12-01,01-31
+                        wraps over the new year, January counting on from 8760 (default
+                        01-01,12-31)
+  --hours FIRST-LAST    the clock hours of each day, 0 to 23, each the hour starting then:
+                        8-16 is 08:00 to 17:00 (default 0-23)
+  --night               also the hours whose sun is below the horizon at their middle
+                        (left out by default), dark but for the sky
 The sky (beside the sun or alone; needs --scene; nothing lights from below the horizon):
   --sky MODEL           uniform, cie-overcast, cie-clear or perez; cie-clear (CIE type 12)
                         and perez (Perez all-weather) follow each frame's sun, perez from

@@ -54,6 +54,11 @@ struct Options
   std::optional<Triple> north, up;            ///< the scene's north and zenith (--sun-path, --sky)
   std::optional<std::string> sky;             ///< uniform, cie-overcast, cie-clear or perez
   std::optional<double> skyDiffuseHorizontal; ///< W/m^2
+  /// A weather file's hours as frames (sun and Perez sky): --weather, --dates, --hours, --night.
+  std::string weather;                     ///< FILE.epw
+  std::optional<std::array<int, 4>> dates; ///< first month, day, last month, day
+  std::optional<std::array<int, 2>> hours; ///< first and last clock hour, 0 to 23
+  bool night = false;
 
   std::optional<Triple> lightPower;
 
@@ -79,7 +84,10 @@ struct Options
   std::string png;    ///< DIR, or empty for no pictures
 
   bool usesEmbeddedScene() const { return this->scene.empty(); }
-  bool usesSun() const { return !this->sunDirections.empty() || this->sunPath.has_value(); }
+  bool usesSun() const
+  {
+    return !this->sunDirections.empty() || this->sunPath.has_value() || !this->weather.empty();
+  }
   /// A scene given without any light: its own emissive surfaces (and the sky) light it.
   bool sceneLightsItself() const
   {

@@ -101,6 +101,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     ? options.trajectory
     : (options.from                        ? "straight line"
           : options.sunPath                ? "sun path"
+          : !options.weather.empty()       ? "weather " + options.weather
           : !options.sunDirections.empty() ? options.sunDirections
                                            : (options.scene.empty() ? builtIn : ""));
   if (options.sky)

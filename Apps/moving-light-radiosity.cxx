@@ -205,6 +205,40 @@ vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
   return path;
 }
 
+/// The hours of --weather as frames: the sun at their middle, Time the hour of the year.
+vtkSmartPointer<vtkPolyData> weatherTrajectory(const Options& options)
+{
+  vtkNew<vtkSunPathSource> source;
+  source->SetWeatherFile(options.weather.c_str());
+  const std::array<int, 4> dates = options.dates.value_or(std::array<int, 4>{ 1, 1, 12, 31 });
+  source->SetFirstDate(dates[0], dates[1]);
+  source->SetLastDate(dates[2], dates[3]);
+  const std::array<int, 2> hours = options.hours.value_or(std::array<int, 2>{ 0, 23 });
+  source->SetHours(hours[0], hours[1]);
+  source->SetIncludeNight(options.night);
+  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
+  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
+  source->SetNorth(north.data());
+  source->SetUp(up.data());
+  std::string error;
+  vtkNew<vtkCallbackCommand> onError;
+  onError->SetClientData(&error);
+  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message)
+    { *static_cast<std::string*>(into) = static_cast<const char*>(message); });
+  source->AddObserver(vtkCommand::ErrorEvent, onError);
+  source->Update();
+  if (!error.empty())
+  {
+    const std::size_t colon = error.find("): ");
+    std::string reason = colon == std::string::npos ? error : error.substr(colon + 3);
+    reason.erase(reason.find_last_not_of(" \n") + 1);
+    // The file's errors are input errors (exit 1), not the command line's.
+    throw InputError("--weather: " + reason);
+  }
+  vtkSmartPointer<vtkPolyData> path = source->GetOutput();
+  return path;
+}
+
 int run(int argc, char** argv)
 {
   const Clock::time_point started = Clock::now();
@@ -246,6 +280,10 @@ int run(int argc, char** argv)
   if (options.sunPath)
   {
     trajectory = sunPathTrajectory(options);
+  }
+  else if (!options.weather.empty())
+  {
+    trajectory = weatherTrajectory(options);
   }
   else if (!options.sunDirections.empty())
   {

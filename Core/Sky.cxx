@@ -86,9 +86,14 @@ double perezSunZenith(const Vec3& sunLocal)
   return std::acos(std::clamp(sunLocal.z, 0.0, 1.0));
 }
 
-/// Sky clearness epsilon and brightness Delta (Perez 1990) of E_dh and E_dn at sun zenith Z,
-/// clamped to the ranges the model was fitted on (gendaylit refuses values outside them).
-void perezIndices(double diffuse, double direct, double Z, double& epsilon, double& delta)
+/// The day gendaylit assumes when it is given none.
+constexpr int DefaultDayOfYear = 150;
+
+/// Sky clearness epsilon and brightness Delta (Perez 1990) of E_dh and E_dn at sun zenith Z
+/// on a day of the year (0: not known), clamped to the ranges the model was fitted on
+/// (gendaylit refuses values outside them).
+void perezIndices(
+  double diffuse, double direct, double Z, int dayOfYear, double& epsilon, double& delta)
 {
   if (!(diffuse > 0))
   {
@@ -100,8 +105,10 @@ void perezIndices(double diffuse, double direct, double Z, double& epsilon, doub
   epsilon = ((diffuse + std::max(direct, 0.0)) / diffuse + z3) / (1 + z3);
   const double zenithDegrees = Z * 180 / M_PI;
   const double airMass = 1.0 / (std::cos(Z) + 0.15 * std::pow(93.885 - zenithDegrees, -1.253));
-  // The extraterrestrial irradiance of day 150, gendaylit's default: the frames carry no date.
-  const double dayAngle = 2 * M_PI * (150 - 1) / 365.0;
+  // The extraterrestrial irradiance varies by 3.3 % either way over the year with the
+  // Earth-sun distance.
+  const int day = dayOfYear > 0 ? dayOfYear : DefaultDayOfYear;
+  const double dayAngle = 2 * M_PI * (day - 1) / 365.0;
   const double eccentricity = 1.00011 + 0.034221 * std::cos(dayAngle) +
     0.00128 * std::sin(dayAngle) + 0.000719 * std::cos(2 * dayAngle) +
     0.000077 * std::sin(2 * dayAngle);
@@ -114,7 +121,7 @@ constexpr double PrecipitableWater = 2.0; // cm
 }
 
 SkyDistribution::SkyDistribution(
-  SkyModel model, const Vec3& sun, double diffuseHorizontal, double directNormal)
+  SkyModel model, const Vec3& sun, double diffuseHorizontal, double directNormal, int dayOfYear)
   : Model(model)
   , Sun(normalize(sun))
 {
@@ -124,7 +131,7 @@ SkyDistribution::SkyDistribution(
   }
   const double Z = perezSunZenith(this->Sun);
   double epsilon, delta;
-  perezIndices(diffuseHorizontal, directNormal, Z, epsilon, delta);
+  perezIndices(diffuseHorizontal, directNormal, Z, dayOfYear, epsilon, delta);
   this->Clearness = epsilon;
   this->Brightness = delta;
   if (epsilon > 1.065 && epsilon < 2.8)
@@ -177,7 +184,7 @@ DaylightEfficacy perezEfficacy(const SkyFrame& frame, const Vec3& up)
 {
   const double Z = perezSunZenith({ 0, 0, dot(normalize(frame.sun), normalize(up)) });
   double epsilon, delta;
-  perezIndices(frame.diffuseHorizontal, frame.directNormal, Z, epsilon, delta);
+  perezIndices(frame.diffuseHorizontal, frame.directNormal, Z, frame.dayOfYear, epsilon, delta);
   const int bin = clearnessBin(epsilon);
   static constexpr double da[8] = { 97.24, 107.22, 104.97, 102.39, 100.71, 106.42, 141.88, 152.23 };
   static constexpr double db[8] = { -0.46, 1.15, 2.96, 5.59, 5.94, 3.83, 1.90, 0.35 };
@@ -212,7 +219,7 @@ bool sameSky(SkyModel model, const SkyFrame& a, const SkyFrame& b)
     return true;
   }
   return a.sun.x == b.sun.x && a.sun.y == b.sun.y && a.sun.z == b.sun.z &&
-    (model != SkyModel::Perez || a.directNormal == b.directNormal);
+    (model != SkyModel::Perez || (a.directNormal == b.directNormal && a.dayOfYear == b.dayOfYear));
 }
 }
 
@@ -248,6 +255,11 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames)
         << ": give W/m^2, 0 or above";
       throw Error(s.str());
     }
+    if (frames[f].dayOfYear < 0 || frames[f].dayOfYear > 366)
+    {
+      throw Error("the day of the year of frame " + std::to_string(f) + " is " +
+        std::to_string(frames[f].dayOfYear) + ": give 1 to 366, or 0 when the date is not known");
+    }
     if ((model == SkyModel::CieClear || model == SkyModel::Perez) && !(length(frames[f].sun) > 0))
     {
       throw Error("the sun direction of frame " + std::to_string(f) + " is zero");
@@ -266,8 +278,8 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames)
   for (std::size_t k = 0; k < positions; ++k)
   {
     const SkyFrame& frame = this->Frames[k];
-    const SkyDistribution f(
-      model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal, frame.directNormal);
+    const SkyDistribution f(model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
+      frame.directNormal, frame.dayOfYear);
     double horizontal = 0, total = 0;
     for (int r = 0; r < Rings; ++r)
     {
@@ -352,8 +364,8 @@ double Sky::modelRadiance(std::size_t position, const Vec3& towardsSky) const
     return 0;
   }
   const SkyFrame& frame = this->Frames[position];
-  const SkyDistribution f(
-    this->Model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal, frame.directNormal);
+  const SkyDistribution f(this->Model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
+    frame.directNormal, frame.dayOfYear);
   return this->Scale[position] * f(v);
 }
 

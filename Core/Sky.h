@@ -25,13 +25,16 @@ SkyModel parseSkyModel(const std::string& name);
 std::string skyModelName(SkyModel model);
 
 /// One frame's sky: the unit direction towards the sun (any, also below the horizon, for the
-/// models that ignore it), the diffuse horizontal irradiance E_dh and the direct normal
-/// irradiance (W/m^2; only the Perez model reads it).
+/// models that ignore it), the diffuse horizontal irradiance E_dh, the direct normal
+/// irradiance (W/m^2) and the day of the year (1 to 366; 0 when the date is not known, then
+/// day 150, as gendaylit takes it), which set the extraterrestrial irradiance. Only the Perez
+/// model reads the last two.
 struct SkyFrame
 {
   Vec3 sun{ 0, 0, 1 };
   double diffuseHorizontal = 0;
   double directNormal = 0;
+  int dayOfYear = 0;
 };
 
 /**
@@ -41,7 +44,8 @@ struct SkyFrame
 class SkyDistribution
 {
 public:
-  SkyDistribution(SkyModel model, const Vec3& sun, double diffuseHorizontal, double directNormal);
+  SkyDistribution(SkyModel model, const Vec3& sun, double diffuseHorizontal, double directNormal,
+    int dayOfYear = 0);
   /// At the unit direction `towardsSky` (z >= 0).
   double operator()(const Vec3& towardsSky) const;
   /// The Perez sky clearness epsilon and brightness Delta (1 and 0 for the other models).
@@ -77,7 +81,8 @@ public:
   static constexpr int Sectors = 120;
   static constexpr std::size_t Cells = std::size_t(Rings) * Sectors;
 
-  /// Throws mlr::Error on an E_dh below 0 or not finite, a zero `up`, or no frames.
+  /// Throws mlr::Error on an E_dh below 0 or not finite, a day of the year outside 0 to 366,
+  /// a zero `up`, or no frames.
   Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames);
 
   SkyModel model() const { return this->Model; }

@@ -40,6 +40,58 @@ int daysIn(int year, int month)
 }
 }
 
+Horizon horizonOf(const Vec3& north, const Vec3& up)
+{
+  const double upLength = length(up);
+  if (!isFinite(up) || !(upLength > 0))
+  {
+    throw Error("the up direction must be finite and not zero");
+  }
+  Horizon h;
+  h.up = up / upLength;
+  const Vec3 northInPlane = north - h.up * dot(north, h.up);
+  if (!isFinite(north) || !(length(northInPlane) > 1e-6 * std::max(1.0, length(north))))
+  {
+    throw Error("the north direction must be finite and not parallel to up");
+  }
+  if (std::abs(dot(normalize(north), h.up)) > 1e-6)
+  {
+    throw Error("the north direction must be horizontal: perpendicular to the up direction");
+  }
+  h.north = normalize(northInPlane);
+  h.east = cross(h.north, h.up);
+  return h;
+}
+
+SunPosition sunAt(double latitude, double longitude, int year, int month, int day,
+  double clockHours, double timeZoneHours, const Horizon& horizon)
+{
+  ln_date midnight{};
+  midnight.years = year;
+  midnight.months = month;
+  midnight.days = day;
+  // Local midnight, in UTC.
+  const double julianMidnight = ln_get_julian_day(&midnight) - timeZoneHours / 24.0;
+  SunPosition p;
+  p.clockHours = clockHours;
+  sunAzimuthElevation(
+    latitude, longitude, julianMidnight + clockHours / 24.0, p.azimuthDegrees, p.elevationDegrees);
+  const double az = p.azimuthDegrees * M_PI / 180, el = p.elevationDegrees * M_PI / 180;
+  p.direction = (horizon.north * std::cos(az) + horizon.east * std::sin(az)) * std::cos(el) +
+    horizon.up * std::sin(el);
+  return p;
+}
+
+int dayOfYear(int year, int month, int day)
+{
+  int days = day;
+  for (int m = 1; m < month; ++m)
+  {
+    days += daysIn(year, m);
+  }
+  return days;
+}
+
 std::vector<SunPosition> sunPath(const SunPathRequest& r)
 {
   if (!(r.latitude >= -90 && r.latitude <= 90))
@@ -79,30 +131,7 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
     throw Error("the time zone is " + std::to_string(r.timeZoneHours) +
       " hours from UTC: give an offset from -14 to 14");
   }
-  const double upLength = length(r.up);
-  if (!isFinite(r.up) || !(upLength > 0))
-  {
-    throw Error("the up direction must be finite and not zero");
-  }
-  const Vec3 up = r.up / upLength;
-  const Vec3 northInPlane = r.north - up * dot(r.north, up);
-  if (!isFinite(r.north) || !(length(northInPlane) > 1e-6 * std::max(1.0, length(r.north))))
-  {
-    throw Error("the north direction must be finite and not parallel to up");
-  }
-  if (std::abs(dot(normalize(r.north), up)) > 1e-6)
-  {
-    throw Error("the north direction must be horizontal: perpendicular to the up direction");
-  }
-  const Vec3 north = normalize(northInPlane);
-  const Vec3 east = cross(north, up);
-
-  ln_date midnight{};
-  midnight.years = r.year;
-  midnight.months = r.month;
-  midnight.days = r.day;
-  // Local midnight, in UTC.
-  const double julianMidnight = ln_get_julian_day(&midnight) - r.timeZoneHours / 24.0;
+  const Horizon horizon = horizonOf(r.north, r.up);
 
   std::vector<SunPosition> path;
   const double step = r.stepMinutes / 60.0;
@@ -110,13 +139,8 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
     static_cast<long long>(std::floor((r.endHour - r.startHour) / step + 1e-9)) + 1;
   for (long long i = 0; i < frames; ++i)
   {
-    SunPosition p;
-    p.clockHours = r.startHour + static_cast<double>(i) * step;
-    sunAzimuthElevation(r.latitude, r.longitude, julianMidnight + p.clockHours / 24.0,
-      p.azimuthDegrees, p.elevationDegrees);
-    const double az = p.azimuthDegrees * M_PI / 180, el = p.elevationDegrees * M_PI / 180;
-    p.direction = (north * std::cos(az) + east * std::sin(az)) * std::cos(el) + up * std::sin(el);
-    path.push_back(p);
+    path.push_back(sunAt(r.latitude, r.longitude, r.year, r.month, r.day,
+      r.startHour + static_cast<double>(i) * step, r.timeZoneHours, horizon));
   }
   return path;
 }

@@ -34,6 +34,27 @@ struct SunPosition
 void sunAzimuthElevation(double latitude, double longitude, double julianDay,
   double& azimuthDegrees, double& elevationDegrees);
 
+/// The scene's horizontal north and east and its zenith, unit vectors.
+struct Horizon
+{
+  Vec3 north, east, up;
+};
+
+/// The horizon of a scene's north and up: throws mlr::Error for an up that is zero or not
+/// finite and a north that is not finite or not horizontal.
+Horizon horizonOf(const Vec3& north, const Vec3& up);
+
+/**
+ * The sun at a local clock time (hours from the day's midnight, any value: 25 is 01:00 of the
+ * next day) of a date, the clock `timeZoneHours` ahead of UTC, as sunPath computes it. Checks
+ * nothing: callers check the place and the date.
+ */
+SunPosition sunAt(double latitude, double longitude, int year, int month, int day,
+  double clockHours, double timeZoneHours, const Horizon& horizon);
+
+/// 1 to 366: the day of the year of a date, January 1 being 1.
+int dayOfYear(int year, int month, int day);
+
 /**
  * One position every stepMinutes from startHour to endHour (both included when the step
  * lands on it) on the given day. Frames with the sun below the horizon are kept: their

@@ -2,12 +2,17 @@
 sun position, written as a .pvd/.vtu series with one picture per time step.
 
     xvfb-run -a pvpython Examples/sun_town_block.py [--plugin PATH] [--output DIR] [--paths N]
+        [--weather [FILE.epw]]
 
 The block is a ground square with five box buildings of different heights and colours. Sources >
 Sun Path gives the directions towards the sun for Paris on 21 June 2024 from 05:00 to 22:00
 summer time (UTC+2) every 30 minutes; Moving Light Radiosity with Light Type Directional
 solves every time step at once (paths reused over the sun's directions). Night steps are kept,
-dark, so that the series' times are the clock hours. Writes
+dark, so that the series' times are the clock hours. With --weather (default file
+Data/paris_synthetic.epw, an EnergyPlus weather file) Sun Path reads the hours 06:00 to 20:00
+of 21 June from the file instead, each hour's sun at its middle with the file's direct normal
+irradiance, and a Perez sky of its diffuse horizontal irradiance lights the block too; the
+series' times are then the hours of the year (4110 is 06:00-07:00 on 21 June). Writes
 
   DIR/town.pvd + DIR/town/*.vtu    the Elements of every time step (Radiosity in W/m^2,
                                    DirectRadiosity, IndirectRadiosity, field data SunAzimuth and
@@ -32,6 +37,11 @@ parser.add_argument("--paths", type=int, default=600000,
                     help="effective paths per time step (default: %(default)s)")
 parser.add_argument("--step", type=float, default=30, help="minutes between time steps (default: 30)")
 parser.add_argument("--size", type=int, default=640, help="picture size in pixels (default: 640)")
+parser.add_argument("--weather", nargs="?", metavar="FILE.epw",
+                    const=os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "Data",
+                                       "paris_synthetic.epw"),
+                    help="the hours of 21 June from an EnergyPlus weather file, with a Perez sky "
+                         "(default file: Data/paris_synthetic.epw)")
 args = parser.parse_args()
 if args.paths < 1 or args.size < 16 or not args.step > 0:
     parser.error("--paths must be >= 1, --size >= 16 and --step > 0")
@@ -65,14 +75,22 @@ for source, rho in parts:
                                   Function=f"{rho[0]}*iHat+{rho[1]}*jHat+{rho[2]}*kHat"))
 town = pv.ExtractSurface(registrationName="Town", Input=pv.AppendDatasets(Input=coloured))
 
-sun = pv.SunPath(registrationName="SunPath", Latitude=48.85, Longitude=2.35, Year=2024, Month=6,
-                 Day=21, StartTime=5, EndTime=22, StepMinutes=args.step, TimeZone=2)
+if args.weather:
+    sun = pv.SunPath(registrationName="SunPath", WeatherFile=os.path.abspath(args.weather),
+                     FirstDate=[6, 21], LastDate=[6, 21], Hours=[6, 19])
+    sky = {"SkyModel": "Perez"}
+else:
+    sun = pv.SunPath(registrationName="SunPath", Latitude=48.85, Longitude=2.35, Year=2024,
+                     Month=6, Day=21, StartTime=5, EndTime=22, StepMinutes=args.step, TimeZone=2)
+    sky = {}
 radiosity = pv.MovingLightRadiosity(registrationName="MovingLightRadiosity", Scene=town,
                                     Trajectory=sun, LightType="Directional", SunIrradiance=1000,
-                                    NumberOfPaths=args.paths)
+                                    NumberOfPaths=args.paths, **sky)
 
 started = time.time()
-radiosity.UpdatePipeline(time=5.0)
+radiosity.UpdatePipelineInformation()
+first = list(radiosity.TimestepValues)[:1] or [0.0]
+radiosity.UpdatePipeline(time=first[0])
 if radiosity.GetDataInformation().GetNumberOfCells() == 0:
     sys.exit("the filter produced nothing: see the error above")
 times = list(radiosity.TimestepValues)

@@ -492,6 +492,41 @@ std::vector<PoseInput> poseInputsOf(vtkPointSet* trajectory, const std::vector<v
 }
 
 /// The times of the points `ids`, from the point array Time, or 0, 1, ...
+/// The per-frame point arrays of the points `ids` (one per frame) into `result`.
+void perFrameArrays(vtkPointSet* trajectory, const std::vector<vtkIdType>& ids, Trajectory& result)
+{
+  const std::pair<const char*, std::vector<double>*> arrays[] = {
+    { "SunAzimuth", &result.sunAzimuth }, { "SunElevation", &result.sunElevation },
+    { "SkyDiffuseHorizontal", &result.skyDiffuseHorizontal },
+    { "DirectNormalIrradiance", &result.directNormal }
+  };
+  for (const auto& [name, into] : arrays)
+  {
+    if (vtkDataArray* values = pointArray(trajectory, name, 1))
+    {
+      for (vtkIdType id : ids)
+      {
+        into->push_back(values->GetComponent(id, 0));
+      }
+    }
+  }
+  if (vtkDataArray* days = pointArray(trajectory, "DayOfYear", 1))
+  {
+    for (vtkIdType id : ids)
+    {
+      const double day = days->GetComponent(id, 0);
+      if (!(day >= 1 && day <= 366) || day != std::floor(day))
+      {
+        std::ostringstream s;
+        s << "the Trajectory's point array DayOfYear has " << day << " at point " << id
+          << ": give whole days from 1 (January 1) to 366, or remove the array";
+        throw Error(s.str());
+      }
+      result.dayOfYear.push_back(static_cast<int>(day));
+    }
+  }
+}
+
 std::vector<double> timesOf(vtkPointSet* trajectory, const std::vector<vtkIdType>& ids)
 {
   const std::size_t n = ids.size();
@@ -588,28 +623,7 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
     {
       frames = count;
       result.times = timesOf(trajectory, perLight[l]);
-      for (const char* name : { "SunAzimuth", "SunElevation" })
-      {
-        if (vtkDataArray* angles = pointArray(trajectory, name, 1))
-        {
-          auto& into = name[3] == 'A' ? result.sunAzimuth : result.sunElevation;
-          for (vtkIdType id : perLight[l])
-          {
-            into.push_back(angles->GetComponent(id, 0));
-          }
-        }
-      }
-      for (const char* name : { "SkyDiffuseHorizontal", "DirectNormalIrradiance" })
-      {
-        if (vtkDataArray* values = pointArray(trajectory, name, 1))
-        {
-          auto& into = name[0] == 'S' ? result.skyDiffuseHorizontal : result.directNormal;
-          for (vtkIdType id : perLight[l])
-          {
-            into.push_back(values->GetComponent(id, 0));
-          }
-        }
-      }
+      perFrameArrays(trajectory, perLight[l], result);
     }
     else if (count > 1 && count != frames)
     {
@@ -622,6 +636,7 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
   if (frames == 0)
   {
     result.times = timesOf(trajectory, { perLight[0].front() });
+    perFrameArrays(trajectory, { perLight[0].front() }, result);
   }
   return result;
 }

@@ -72,6 +72,8 @@ struct Trajectory
   /// Per frame, from the point arrays SkyDiffuseHorizontal and DirectNormalIrradiance (W/m^2)
   /// when present.
   std::vector<double> skyDiffuseHorizontal, directNormal;
+  /// Per frame, from the point array DayOfYear (1 to 366) when present: the Perez sky's date.
+  std::vector<int> dayOfYear;
 };
 
 /**

@@ -236,6 +236,10 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
     {
       frames[f].directNormal = trajectory.directNormal[f];
     }
+    if (f < trajectory.dayOfYear.size())
+    {
+      frames[f].dayOfYear = trajectory.dayOfYear[f];
+    }
   }
   rig.skies.emplace_back(model, up, frames);
   for (const mlr::SkyFrame& frame : frames)
@@ -680,10 +684,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         directions.push_back(in.position);
         factors.push_back(in.power);
       }
+      // A weather file's sun: its direct normal irradiance per frame, not SunIrradiance.
+      const bool perFrame = !trajectory.directNormal.empty();
+      for (std::size_t f = 0; perFrame && f < factors.size(); ++f)
+      {
+        factors[f] =
+          factors[f] * trajectory.directNormal[std::min(f, trajectory.directNormal.size() - 1)];
+      }
       // 0 is no direct sun; anything else (NaN too) is the DirectionalLight's to check.
       if (!(this->SunIrradiance == 0))
       {
-        rig.directionalLights.emplace_back(directions, mlr::Rgb(this->SunIrradiance), factors);
+        rig.directionalLights.emplace_back(
+          directions, mlr::Rgb(perFrame ? 1.0 : this->SunIrradiance), factors);
       }
       else
       {

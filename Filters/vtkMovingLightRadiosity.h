@@ -33,7 +33,9 @@
  *   that frame, 0 is off). With LightType Directional the points are the directions towards
  *   the light (the sun), one per frame, of any length but 0; `Power` scales SunIrradiance
  *   (clouds, night); `SunAzimuth` and `SunElevation` (degrees), if present, are passed to the
- *   outputs' field data. Without this input the light moves in a straight line from
+ *   outputs' field data; `DirectNormalIrradiance` (W/m^2) replaces SunIrradiance per frame,
+ *   and `SkyDiffuseHorizontal` (W/m^2) and `DayOfYear` (1 to 366, the Perez sky's date) set
+ *   the sky per frame. Without this input the light moves in a straight line from
  *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does);
  *   with neither a Light nor a LightMaterial, the scene's own emissive surfaces light it in
  *   one frame.
@@ -279,7 +281,9 @@ public:
   ///@{
   /**
    * Irradiance of the directional light on a surface facing it, W/m^2 (before the
-   * Trajectory's Power factor). Default 1000 (the sun at noon on a clear day).
+   * Trajectory's Power factor). A Trajectory with the point array DirectNormalIrradiance (a
+   * weather file's, from vtkSunPathSource) gives it per frame instead, and SunIrradiance 0
+   * still turns the direct sun off. Default 1000 (the sun at noon on a clear day).
    */
   vtkSetClampMacro(SunIrradiance, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(SunIrradiance, double);

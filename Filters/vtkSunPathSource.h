@@ -13,8 +13,22 @@
  * refraction) and `Power` (1 with the sun above the horizon, 0 below: night frames are kept,
  * dark, so that the frames match the clock times).
  *
+ * With a WeatherFile (an EnergyPlus weather file, .epw) the frames are instead the hours of
+ * its year from FirstDate to LastDate and within Hours, with the sun at the file's place and
+ * in its time zone at the middle of each hour; the hours with the sun below the horizon
+ * there are left out unless IncludeNight. Latitude, Longitude, the date, the times and
+ * TimeZone are then not used. `Time` is the hour of the year at the start of each hour (0 is
+ * January 1 00:00 to 01:00; after a selection that wraps over the new year, January's hours
+ * count on from the year's last, 8760 and up), and the point arrays also hold what
+ * vtkMovingLightRadiosity reads per frame: `DirectNormalIrradiance` and
+ * `SkyDiffuseHorizontal` (W/m^2, the file's hourly means), and `GlobalHorizontalIrradiance`
+ * (W/m^2, the file's, NaN where it is missing), `ClockHour` (0 to 23, the clock time the
+ * hour starts at) beside them. Both modes give `DayOfYear` (1 to 366), the date of the Perez
+ * sky's extraterrestrial irradiance.
+ *
  * Bad input (a latitude outside +-90, a date that does not exist, an end before the start, a
- * north that is not horizontal, ...) gives an error naming what to fix and an empty output.
+ * north that is not horizontal, a weather file that cannot be read, naming its line, ...)
+ * gives an error naming what to fix and an empty output.
  */
 
 #ifndef vtkSunPathSource_h
@@ -22,6 +36,8 @@
 
 #include "MovingLightRadiosityFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
+
+#include <string> // For WeatherFile
 
 class MOVINGLIGHTRADIOSITYFILTERS_EXPORT vtkSunPathSource : public vtkPolyDataAlgorithm
 {
@@ -84,6 +100,45 @@ public:
   vtkGetVector3Macro(Up, double);
   ///@}
 
+  ///@{
+  /**
+   * An EnergyPlus weather file (.epw) whose hours become the frames instead of one day of
+   * the place above. Default empty (none).
+   */
+  vtkSetStdStringFromCharMacro(WeatherFile);
+  vtkGetCharFromStdStringMacro(WeatherFile);
+  ///@}
+
+  ///@{
+  /**
+   * The first and last days of the weather file's hours, each (month, day), both included;
+   * a last day before the first wraps over the new year. Defaults (1, 1) and (12, 31).
+   */
+  vtkSetVector2Macro(FirstDate, int);
+  vtkGetVector2Macro(FirstDate, int);
+  vtkSetVector2Macro(LastDate, int);
+  vtkGetVector2Macro(LastDate, int);
+  ///@}
+
+  ///@{
+  /**
+   * The first and last clock hours of each day of the weather file, 0 to 23, each naming
+   * the hour that starts then: (8, 16) is 08:00 to 17:00. Default (0, 23).
+   */
+  vtkSetVector2Macro(Hours, int);
+  vtkGetVector2Macro(Hours, int);
+  ///@}
+
+  ///@{
+  /**
+   * Keep the weather file's hours whose sun is below the horizon at their middle (dark for
+   * the sun, Power 0). Default off.
+   */
+  vtkSetMacro(IncludeNight, bool);
+  vtkGetMacro(IncludeNight, bool);
+  vtkBooleanMacro(IncludeNight, bool);
+  ///@}
+
 protected:
   vtkSunPathSource();
   ~vtkSunPathSource() override = default;
@@ -102,6 +157,11 @@ protected:
   double TimeZone;
   double North[3];
   double Up[3];
+  std::string WeatherFile;
+  int FirstDate[2];
+  int LastDate[2];
+  int Hours[2];
+  bool IncludeNight;
 
 private:
   vtkSunPathSource(const vtkSunPathSource&) = delete;

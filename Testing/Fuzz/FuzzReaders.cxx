@@ -6,7 +6,9 @@
 // values 6 and 7 make a photometric file instead (.ies, .ldt) read by mlr::readPhotometricFile,
 // whose distribution must then be finite and sample where its density is positive. Values 8
 // and 9 (first byte modulo 10) make a .gltf or .glb file read by vtkRadiositySceneReader in
-// this process, as ParaView runs it: a crash there is a finding, not a refusal.
+// this process, as ParaView runs it: a crash there is a finding, not a refusal. Value 10 (first
+// byte modulo 11) makes an EnergyPlus weather file (.epw) read by mlr::readWeatherFile, whose
+// hours must then make frames with finite suns and irradiances.
 //
 // A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
 // out of time in its child process; mlr::Error for a photometric file) or a filter error is a
@@ -19,6 +21,7 @@
 #include "Error.h"
 #include "GuardedRead.h"
 #include "Photometry.h"
+#include "WeatherFile.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -128,18 +131,59 @@ void checkPhotometricFile(const fs::path& path)
     }
   }
 }
+
+/// A weather file that reads has a whole year, and its hours make finite frames.
+void checkWeatherFile(const fs::path& path)
+{
+  mlr::WeatherFile file;
+  try
+  {
+    file = mlr::readWeatherFile(path.string());
+  }
+  catch (const mlr::Error&)
+  {
+    return;
+  }
+  if (file.hours.size() != 8760 && file.hours.size() != 8784)
+  {
+    finding("a weather file read with other than a year of hours");
+  }
+  mlr::WeatherSelection selection;
+  selection.firstMonth = 12;
+  selection.firstDay = 30;
+  selection.lastMonth = 1;
+  selection.lastDay = 2;
+  selection.includeNight = true;
+  std::vector<mlr::WeatherFrame> frames;
+  try
+  {
+    frames = mlr::weatherFrames(file, selection);
+  }
+  catch (const mlr::Error&)
+  {
+    return;
+  }
+  for (const mlr::WeatherFrame& f : frames)
+  {
+    if (!mlr::isFinite(f.sun.direction) || std::abs(mlr::length(f.sun.direction) - 1) > 1e-9 ||
+      !(f.directNormal >= 0) || !(f.diffuseHorizontal >= 0) || f.dayOfYear < 1 || f.dayOfYear > 366)
+    {
+      finding("a weather file's hour made a frame with a bad sun, irradiance or day");
+    }
+  }
+}
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
   static Setup setup;
   static const char* const extensions[] = { ".vtp", ".obj", ".ply", ".stl", ".vtu", ".vtk", ".ies",
-    ".ldt", ".gltf", ".glb" };
+    ".ldt", ".gltf", ".glb", ".epw" };
   if (size == 0)
   {
     return 0;
   }
-  const unsigned kind = data[0] % 10;
+  const unsigned kind = data[0] % 11;
   const fs::path path = setup.directory / (std::string("scene") + extensions[kind]);
   {
     std::ofstream file(path, std::ios::binary | std::ios::trunc);
@@ -148,6 +192,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (kind == 6 || kind == 7)
   {
     checkPhotometricFile(path);
+    return 0;
+  }
+  if (kind == 10)
+  {
+    checkWeatherFile(path);
     return 0;
   }
 

@@ -5,9 +5,11 @@ solve:   byte strings that FuzzSolve.cxx decodes into small valid scenes (boxes,
          an L-shaped pair of walls) with a light, a trajectory and options; the fuzzer mutates
          them into everything else.
 readers: a first byte choosing the extension (0 .vtp, 1 .obj, 2 .ply, 3 .stl, 4 .vtu, 5 .vtk,
-         6 .ies, 7 .ldt, as in FuzzReaders.cxx), then a small file of that format: a box with a
-         cell array Reflectance, in every encoding the writers offer (ASCII, binary, appended,
-         zlib); photometric files of every symmetry each format has, and a few malformed ones.
+         6 .ies, 7 .ldt, 8 .gltf, 9 .glb, 10 .epw, as in FuzzReaders.cxx), then a small file of
+         that format: a box with a cell array Reflectance, in every encoding the writers offer
+         (ASCII, binary, appended, zlib); photometric files of every symmetry each format has,
+         and a few malformed ones; a whole year of weather (EPW, its lines cut after the
+         diffuse horizontal irradiance) and weather files cut short or wrong in one field.
 
 Run with Debian's Python (VTK from python3-paraview): /usr/bin/python3 make_seed_corpus.py
 """
@@ -275,10 +277,41 @@ def gltf_seeds():
     yield "glb_triangle", 9, struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
 
 
+EPW_HEADER = ("LOCATION,Paris,IDF,FRA,seed,071560,48.85,2.35,1.0,35.0\n"
+              "DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\n"
+              "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,seed\nCOMMENTS 2,seed\n"
+              "DATA PERIODS,1,1,Data,Sunday,1/1,12/31\n")
+
+
+def epw_hours(leap=False, count=None):
+    """Hourly lines of a year to field 16: a sun from 6 to 18 with DNI 600 and DHI 100."""
+    days = [31, 29 if leap else 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31]
+    lines = []
+    for month, n in enumerate(days, start=1):
+        for day in range(1, n + 1):
+            for hour in range(1, 25):
+                up = 7 <= hour <= 18
+                lines.append("%d,%d,%d,%d,60,*9,10,5,70,101325,0,0,300,%d,%d,%d\n" % (
+                    2024 if leap else 2023, month, day, hour, 400 if up else 0,
+                    600 if up else 0, 100 if up else 0))
+    return lines[:count] if count is not None else lines
+
+
+def weather_seeds():
+    yield "epw_year", 10, (EPW_HEADER + "".join(epw_hours())).encode()
+    yield "epw_header_only", 10, EPW_HEADER.encode()
+    yield "epw_two_days", 10, (EPW_HEADER + "".join(epw_hours(count=48))).encode()
+    broken = epw_hours(count=48)
+    broken[30] = broken[30].replace(",600,", ",-600,")
+    yield "epw_negative_dni", 10, (EPW_HEADER + "".join(broken)).encode()
+    yield "epw_no_location", 10, EPW_HEADER.replace("LOCATION", "PLACE").encode()
+
+
 def main():
     for target, seeds in (("solve", ((n, b) for n, b in solve_seeds())),
                           ("readers", ((n, bytes([k]) + b) for seeds in
-                                       (reader_seeds(), photometric_seeds(), gltf_seeds())
+                                       (reader_seeds(), photometric_seeds(), gltf_seeds(),
+                                        weather_seeds())
                                        for n, k, b in seeds))):
         directory = os.path.join(HERE, "corpus", target)
         os.makedirs(directory, exist_ok=True)

@@ -194,3 +194,26 @@ def test_material_scenes_example(tmp_path):
                 seen = share(p, channel, over)
                 assert seen > 0.015, f"{name}/{picture.name}: the {colour} covers {100 * seen:.1f}% of the picture"
         assert abs(first - last).mean() > 2, f"{name}: the first and last pictures are the same: the lamp did not move"
+
+
+def test_sun_example_reads_a_weather_file(tmp_path):
+    """Examples/sun_town_block.py --weather: the hours 06:00 to 20:00 of 21 June from
+    Data/paris_synthetic.epw, with a Perez sky. The series' times are the hours of the year
+    (day 172 of 2023 starts at hour 4104); every hour is lit, by the sky at least."""
+    output = tmp_path / "weather"
+    run_example("sun_town_block.py", output, ["--paths", "50000", "--size", "64", "--weather"])
+    entries = [(float(e.get("timestep")), e.get("file"))
+               for e in ElementTree.parse(output / "town.pvd").getroot().iter("DataSet")]
+    assert [t for t, _ in entries] == [171 * 24 + h for h in range(6, 20)], entries
+    assert len(sorted((output / "png").glob("frame_*.png"))) == 14
+
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+    for _, name in (entries[0], entries[-1]):
+        reader = vtkXMLUnstructuredGridReader()
+        reader.SetFileName(str(output / name))
+        reader.Update()
+        frame = reader.GetOutput()
+        assert frame.GetFieldData().GetArray("SunElevation").GetValue(0) > 0
+        assert vtk_to_numpy(frame.GetCellData().GetArray("Irradiance")).max() > 50
+

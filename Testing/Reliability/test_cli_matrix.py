@@ -21,7 +21,7 @@ from typing import Callable, Optional
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
-from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
+from cli_support import CLI, DATA, FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
 
 from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
 from vtkmodules.vtkCommonCore import vtkPoints
@@ -258,6 +258,19 @@ ROWS = [
         "--memory-limit is 0"),
     Row("memory_limit_refuses_the_solve", lambda directory: None,
         scene_args(SCENE) + ["--memory-limit", "1"], 1, "over the memory limit of 0.000977 GiB"),
+    # Weather files (Core's reader): a pipe is not read (it could block forever), a file cut
+    # short is named with its last hour, a file of another format is named at its first line.
+    Row("weather_file_is_a_pipe", lambda directory: os.mkfifo(directory / "w.epw"),
+        ["--scene", SCENE, "--weather", "w.epw"] + FAST, 1,
+        "the weather file w.epw is not a regular file", seconds=20),
+    Row("weather_file_cut_short", text("w.epw", "".join(
+        open(os.path.join(DATA, "paris_synthetic.epw")).readlines()[:5008])),
+        ["--scene", SCENE, "--weather", "w.epw"] + FAST, 1,
+        "has 5000 hourly lines (lines 9 to 5008), the last July 28 hour 8", seconds=20),
+    Row("weather_file_is_a_scene", copy_as("w.epw", SCENE), ["--scene", SCENE, "--weather",
+                                                             "w.epw"] + FAST, 1,
+        "the weather file w.epw, line 1: starts with '<?xml version=\"1.0\"?>', not LOCATION",
+        seconds=20),
 ]
 
 

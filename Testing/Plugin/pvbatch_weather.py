@@ -1,0 +1,62 @@
+"""The plugin's Sun Path source reads a weather file as ParaView users meet it, in pvbatch:
+its WeatherFile, FirstDate, LastDate, Hours and IncludeNight properties (documented, with
+the VTK source's defaults), the hours it makes (the time steps of Moving Light Radiosity are
+the hours of the year), and the filter lit by that sun and a Perez sky.
+
+    pvbatch --force-offscreen-rendering pvbatch_weather.py --plugin MovingLightRadiosity.so
+
+MLR_DATA_DIR names Data/ (paris_synthetic.epw)."""
+import os
+
+import plugin_test_support as support
+
+args = support.parse_arguments(__doc__.splitlines()[0])
+
+from paraview import servermanager
+from paraview.simple import *  # noqa: F401,F403 (LoadPlugin adds the sources here)
+
+support.load_plugin(args.plugin, globals())
+checks = support.Checks("Plugin.Weather")
+check = checks.check
+
+weather = os.path.join(os.environ["MLR_DATA_DIR"], "paris_synthetic.epw")
+sun = SunPath()  # noqa: F405
+proxy = sun.SMProxy
+for name, default in (("WeatherFile", [""]), ("FirstDate", [1, 1]), ("LastDate", [12, 31]),
+                      ("Hours", [0, 23]), ("IncludeNight", [0])):
+    prop = proxy.GetProperty(name)
+    if not check(prop is not None, f"Sun Path has no property {name}"):
+        continue
+    documentation = prop.GetDocumentation()
+    check(documentation is not None and "Default" in documentation.GetDescription(),
+          f"{name} has no documentation naming its default")
+    value = sun.GetPropertyValue(name)
+    value = list(value) if isinstance(value, (list, tuple)) or hasattr(value, "__len__") and \
+        not isinstance(value, str) else [value]
+    check(value == default, f"{name} is {value} by default, expected {default}")
+
+sun.WeatherFile = weather
+sun.FirstDate = [6, 21]
+sun.LastDate = [6, 21]
+sun.Hours = [9, 11]
+sun.UpdatePipeline()
+path = servermanager.Fetch(sun)
+check(path.GetNumberOfPoints() == 3, f"{path.GetNumberOfPoints()} points for three hours")
+for name in ("Time", "DayOfYear", "ClockHour", "DirectNormalIrradiance", "SkyDiffuseHorizontal",
+             "GlobalHorizontalIrradiance", "SunElevation", "Power"):
+    check(path.GetPointData().GetArray(name) is not None, f"no point array {name}")
+
+ground = Plane()  # noqa: F405
+radiosity = MovingLightRadiosity(Scene=ground, Trajectory=sun,  # noqa: F405
+                                 LightType="Directional", SkyModel="Perez", NumberOfPaths=5000)
+radiosity.UpdatePipelineInformation()
+steps = list(radiosity.TimestepValues)
+expected = [171 * 24 + h for h in (9, 10, 11)]
+check(steps == expected, f"time steps {steps}, expected the hours of the year {expected}")
+radiosity.UpdatePipeline(expected[1])
+elements = servermanager.Fetch(radiosity)
+irradiance = elements.GetCellData().GetArray("Irradiance")
+check(irradiance is not None and irradiance.GetRange(0)[1] > 100,
+      "no Irradiance from the weather file's sun and sky at June 21 10:00-11:00")
+
+checks.finish()
