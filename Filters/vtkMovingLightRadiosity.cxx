@@ -290,8 +290,8 @@ std::optional<mlr::Luminaire> luminaireOf(vtkMovingLightRadiosity* self)
   {
     // Named before the file is read: the conflict is the thing to fix, whatever the file.
     std::ostringstream message;
-    message << "both a LightDistributionFile and a spot (SpotHalfAngle "
-            << self->GetSpotHalfAngle() << " degrees) are set: give one of them";
+    message << "both a LightDistributionFile and a spot (SpotHalfAngle " << self->GetSpotHalfAngle()
+            << " degrees) are set: give one of them";
     throw mlr::Error(message.str());
   }
   return mlr::readPhotometricFile(file);

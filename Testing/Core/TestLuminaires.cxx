@@ -1,5 +1,6 @@
 // Luminaires: point and area lights with intensity distributions (Lambertian, spot, table),
-// moving and turning across frames.
+// moving and turning across frames; the TILT=INCLUDE factor of each pose's tilt, by the lamp's
+// geometry, reaching the floor through the pose's power factor.
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "LightSource.h"

@@ -1,8 +1,9 @@
 // Luminous intensity distributions and the photometric files: each kind's density integrates
 // to 1, sample() draws from density() (a chi-square bound on a histogram, fixed seeds), the
 // IES and EULUMDAT readers give the flux of the distribution they describe, their symmetric
-// forms equal the full table, C = 90 lies towards +y, and bad files are refused with the
-// line and field to fix.
+// forms equal the full table, C = 90 lies towards +y, types B and A follow their own axes, the
+// TILT=INCLUDE table and the luminous opening's shape are read, and bad files (malformed TILT
+// blocks among them) are refused with the line and field to fix.
 #include "CoreChecks.h"
 #include "Photometry.h"
 #include "Random.h"
