@@ -1101,6 +1101,16 @@ TEST(Photometry, IesLuminousOpeningShapes)
   EXPECT_EQ(circle.openingName, "circle");
   EXPECT_NEAR(circle.length, 0.25, 1e-15);
   EXPECT_NEAR(circle.width, 0.25, 1e-15);
+  EXPECT_TRUE(circle.warnings.empty());
+  // No luminous area: the luminaire's own outline (600 mm round), with a warning.
+  std::string body = ldt;
+  const std::string sizes = "\n600\n0\n80\n500\n300\n";
+  body.replace(body.find(sizes), sizes.size(), "\n600\n0\n80\n0\n0\n");
+  const Luminaire outline = parseEulumdat(body, "b.ldt");
+  EXPECT_EQ(outline.opening, OpeningShape::Ellipse);
+  EXPECT_NEAR(outline.length, 0.6, 1e-15);
+  ASSERT_EQ(outline.warnings.size(), 1u);
+  EXPECT_NE(outline.warnings[0].find("no luminous area"), std::string::npos);
 }
 
 TEST(Photometry, OpeningPolygonsFaceTheNadirWithTheirAreas)

@@ -229,19 +229,21 @@ def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):
     normals.InsertNextTuple((0, 0, -1))
     normals.InsertNextTuple((math.sin(tilt), 0, -math.cos(tilt)))
     trajectory.GetPointData().AddArray(normals)
-    runs = {}
-    for name, block in (("none", "TILT=NONE"), ("tilt", "TILT=INCLUDE\n1\n2\n0 90\n1 0.5")):
-        radiosity = radiosity_filter(LightType=vtkMovingLightRadiosity.POINT_LIGHT,
-                                     LightDistributionFile=ies_file(tmp_path / f"{name}.ies",
-                                                                    tilt=block))
-        radiosity.SetTrajectoryData(trajectory)
-        runs[name] = [direct(radiosity, t)[1] for t in (0.0, 1.0)]
-    for frame, factor in ((0, 1.0), (1, 1 - 0.5 * 60 / 90)):
-        lit = runs["none"][frame] > 0
-        assert lit.any()
-        ratio = runs["tilt"][frame][lit] / runs["none"][frame][lit]
-        # The arrays are float32: a few ulps.
-        assert abs(ratio - factor).max() < 1e-6, (frame, ratio.min(), ratio.max())
+    # The point light, and the luminaire of the file's 0.4 by 0.8 m opening (an area light).
+    for kind in (vtkMovingLightRadiosity.POINT_LIGHT, vtkMovingLightRadiosity.LUMINAIRE_LIGHT):
+        runs = {}
+        for name, block in (("none", "TILT=NONE"), ("tilt", "TILT=INCLUDE\n1\n2\n0 90\n1 0.5")):
+            radiosity = radiosity_filter(LightType=kind,
+                                         LightDistributionFile=ies_file(tmp_path / f"{name}.ies",
+                                                                        tilt=block))
+            radiosity.SetTrajectoryData(trajectory)
+            runs[name] = [direct(radiosity, t)[1] for t in (0.0, 1.0)]
+        for frame, factor in ((0, 1.0), (1, 1 - 0.5 * 60 / 90)):
+            lit = runs["none"][frame] > 0
+            assert lit.any()
+            ratio = runs["tilt"][frame][lit] / runs["none"][frame][lit]
+            # The arrays are float32: a few ulps.
+            assert abs(ratio - factor).max() < 1e-6, (kind, frame, ratio.min(), ratio.max())
     # Tilted beyond the table: the end factor, with a warning naming the position.
     normals.SetTuple3(1, 0, 0, 1)  # aimed straight up: 180 degrees
     normals.Modified()
