@@ -278,7 +278,9 @@ IntensityDistribution typeA(
     // One plane stands for every H: rotationally symmetric about the vertical axis.
     return IntensityDistribution::tabulated(std::move(gammas), { 0.0 }, std::move(candela));
   }
-  if (near(horizontal.front(), 0))
+  // From 0 to at most 180 is one side of a laterally symmetric table; a table from 0 over
+  // more than half the turn is taken as given.
+  if (near(horizontal.front(), 0) && horizontal.back() <= 180 + 1e-6)
   {
     mirrorLaterally(horizontal, candela, nV);
   }
@@ -489,7 +491,7 @@ Luminaire parseIes(const std::string& text, const std::string& name)
       1, 3);
     luminaire.tilt.geometry = static_cast<TiltTable::Geometry>(geometry);
     const std::size_t n = tokens.count("the number of tilt angles", 1, MaximumAngles);
-    luminaire.tilt.angles = readAngles(tokens, n, "tilt angle", -180, 180);
+    luminaire.tilt.angles = readAngles(tokens, n, "tilt angle", -360, 360);
     luminaire.tilt.factors.resize(n);
     for (std::size_t i = 0; i < n; ++i)
     {

@@ -819,8 +819,8 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(
     e.find("line 6: tilt angle 3 of 3 is 30 degrees, not above the previous 45"), std::string::npos)
     << e;
-  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n2\n0 200\n1 1"));
-  EXPECT_NE(e.find("line 6: tilt angle 2 of 2 is 200 degrees"), std::string::npos) << e;
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n2\n0 400\n1 1"));
+  EXPECT_NE(e.find("line 6: tilt angle 2 of 2 is 400 degrees"), std::string::npos) << e;
   e = error(with("TILT=NONE", "TILT=INCLUDE\n2\n2\n0 90\n1 x"));
   EXPECT_NE(
     e.find("line 7: tilt multiplying factor 2 of 2 is 'x', not a finite number"), std::string::npos)
@@ -1026,6 +1026,11 @@ TEST(Photometry, IesTypeAHasVerticalPlanesCountedClockwise)
     "turn.ies");
   const Luminaire typeC = parseIes(iesFile(degrees(0, 180, 15), degrees(0, 360, 30), c), "c.ies");
   EXPECT_LT(densityDifference(turn.distribution, typeC.distribution), 1e-9);
+  // The same turn from 0 to 360 is taken as given, not mirrored.
+  const Luminaire fromZero = parseIes(
+    typeAFile(vertical, degrees(0, 360, 30), [&](double h, double v) { return c(90 + v, -h); }),
+    "zero.ies");
+  EXPECT_LT(densityDifference(fromZero.distribution, typeC.distribution), 1e-9);
 }
 
 TEST(Photometry, IesLuminousOpeningShapes)
