@@ -289,6 +289,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   const CLI::Option* help = app.add_flag("-h,--help", o.help);
   const CLI::Option* point = app.add_flag("--point-light", o.pointLight);
   const CLI::Option* night = app.add_flag("--night", o.night);
+  const CLI::Option* luminaire = app.add_flag("--luminaire", o.luminaire);
   // Unknown options, arguments and repeated options are reported below, in the project's words.
   app.allow_extras();
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -359,7 +360,8 @@ Options parseCommandLine(int argc, const char* const* argv)
     const std::string arg = argv[i];
     const std::string name = arg.substr(0, arg.find('='));
     const CLI::Option* given = app.get_option_no_throw(name);
-    if ((given == help || given == point || given == night) && name.size() < arg.size())
+    if ((given == help || given == point || given == night || given == luminaire) &&
+      name.size() < arg.size())
     {
       throw UsageError(name + " takes no value");
     }
@@ -392,7 +394,8 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   for (const CLI::Option* given : app.get_options())
   {
-    if (given->count() > 1 && given != help && given != point && given != night)
+    if (given->count() > 1 && given != help && given != point && given != night &&
+      given != luminaire)
     {
       throw UsageError(given->get_name() + " is given twice");
     }
@@ -419,6 +422,16 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--point-light is a light of its own: give it without --light, "
                      "--light-material, --sun-directions and --sun-path");
+  }
+  if (o.luminaire && (o.pointLight || !o.light.empty() || o.lightMaterial || o.usesSun()))
+  {
+    throw UsageError("--luminaire is a light of its own: give it without --point-light, "
+                     "--light, --light-material, --sun-directions and --sun-path");
+  }
+  if (o.luminaire && o.lightDistribution.empty())
+  {
+    throw UsageError("--luminaire emits from a photometric file's luminous opening: give "
+                     "--light-distribution FILE.ies|FILE.ldt");
   }
   if (o.usesSun() && (!o.lightDistribution.empty() || o.spot || o.lightLumens))
   {
@@ -486,9 +499,10 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--time-zone and --north need --sun-path ... (--north also --weather)");
   }
-  if (!o.sunPath && !o.sky && o.up)
+  if (!o.sunPath && !o.sky && o.lightDistribution.empty() && o.up)
   {
-    throw UsageError("--up needs --sun-path ..., --weather FILE.epw or --sky MODEL");
+    throw UsageError("--up needs --sun-path ..., --weather FILE.epw, --sky MODEL or "
+                     "--light-distribution FILE (whose TILT table it sets the vertical of)");
   }
   if (o.sunIrradiance && !(*o.sunIrradiance >= 0 && std::isfinite(*o.sunIrradiance)))
   {
@@ -587,6 +601,14 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   if (o.pointLight)
   {
     filter->SetLightTypeToPoint();
+  }
+  if (o.luminaire)
+  {
+    filter->SetLightTypeToLuminaire();
+  }
+  if (o.up && !o.lightDistribution.empty())
+  {
+    filter->SetUp(o.up->data());
   }
   if (!o.lightDistribution.empty())
   {
@@ -736,7 +758,12 @@ Scene and light:
                         LM-63 or EULUMDAT), its nadir along an area light's normal (C = 0
                         along its first edge) or a point light's -z (C = 0 along +x);
                         without --light-lumens or --light-power the light emits the file's
-                        own flux, else only its shape is used (default: diffuse, Lambertian)
+                        own flux, else only its shape is used (default: diffuse, Lambertian).
+                        An IES TILT=INCLUDE table scales each position's power by its factor
+                        at that position's tilt from straight down (-up, see --up)
+  --luminaire           the --light-distribution file's luminaire as an area light of its
+                        luminous opening (seen from below), placed and turned as
+                        --point-light is; a file without an opening gives a point light
   --spot HALF_ANGLE_DEG[,SOFT_EDGE_DEG]
                         a spot instead: uniform within the half angle of the nadir, falling
                         to zero over the soft edge beyond it (default soft edge 0)
@@ -767,7 +794,8 @@ apply to --weather):
                         are the clock times in hours
   --time-zone HOURS     the clock times' offset from UTC (default 0: UTC; e.g. 2 for CEST)
   --north X,Y,Z         the scene's north (default 0,1,0)
-  --up X,Y,Z            the scene's zenith, also the sky's (default 0,0,1)
+  --up X,Y,Z            the scene's zenith, also the sky's and the vertical a TILT table
+                        measures the luminaire's tilt from (default 0,0,1)
   --sun-irradiance W/m2 on a surface facing the sun (default 1000; 0: no direct sun, the
                         frames and the sky's sun kept)
   --weather FILE.epw    the hours of an EnergyPlus weather file as frames: the sun at the

@@ -65,6 +65,7 @@ struct Options
   /// Luminaires: a point light instead of polygons, and the intensity distribution and flux
   /// of every light.
   bool pointLight = false;
+  bool luminaire = false;                    ///< an area light of the file's luminous opening
   std::string lightDistribution;             ///< FILE.ies or FILE.ldt
   std::optional<std::array<double, 2>> spot; ///< half angle and soft edge, degrees
   std::optional<double> lightLumens;         ///< lm
@@ -92,7 +93,7 @@ struct Options
   bool sceneLightsItself() const
   {
     return !this->usesEmbeddedScene() && !this->usesSun() && this->light.empty() &&
-      !this->lightMaterial && !this->pointLight;
+      !this->lightMaterial && !this->pointLight && !this->luminaire;
   }
 };
 

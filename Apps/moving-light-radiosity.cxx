@@ -271,7 +271,7 @@ int run(int argc, char** argv)
   }
   vtkSmartPointer<vtkPolyData> light;
   if (!options.usesSun() && !options.lightMaterial && !options.sceneLightsItself() &&
-    !options.pointLight)
+    !options.pointLight && !options.luminaire)
   {
     light = options.light.empty() ? readEmbeddedFile("cornell_light.vtp")
                                   : readSurfaceFile(options.light, "light", memoryLimit);

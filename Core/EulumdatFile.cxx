@@ -139,13 +139,13 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
   fields.text("the luminaire number");
   fields.text("the file name");
   fields.text("the date and user");
-  fields.number("the length or diameter of the luminaire (mm)");
-  fields.number("the width of the luminaire (mm)");
+  const double bodyLength = fields.number("the length or diameter of the luminaire (mm)");
+  const double bodyWidth = fields.number("the width of the luminaire (mm)");
   fields.number("the height of the luminaire (mm)");
   // The luminous area: its length along C0-C180, its width (0 for a round one) along
   // C90-C270, its heights towards C0, C90, C180 and C270.
-  const double areaLength = fields.number("the length or diameter of the luminous area (mm)");
-  const double areaWidth = fields.number("the width of the luminous area (mm)");
+  double areaLength = fields.number("the length or diameter of the luminous area (mm)");
+  double areaWidth = fields.number("the width of the luminous area (mm)");
   double areaHeight = 0;
   for (const char* plane : { "C0", "C90", "C180", "C270" })
   {
@@ -153,9 +153,28 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
       std::abs(
         fields.number(std::string("the height of the luminous area in ") + plane + " (mm)")));
   }
+  if (areaLength == 0 && areaWidth == 0 && bodyLength != 0)
+  {
+    // No luminous area: the luminaire's own outline is the nearest thing to it.
+    areaLength = bodyLength;
+    areaWidth = bodyWidth;
+    luminaire.warnings.push_back(
+      name + ": no luminous area is given; an area luminaire emits from the luminaire's outline");
+  }
   luminaire.length = std::abs(areaLength) / 1000;
   luminaire.width = (areaWidth == 0 ? std::abs(areaLength) : std::abs(areaWidth)) / 1000;
   luminaire.height = areaHeight / 1000;
+  if (luminaire.length > 0 && luminaire.width > 0)
+  {
+    luminaire.opening = areaWidth == 0 ? OpeningShape::Ellipse : OpeningShape::Rectangle;
+    luminaire.openingName = areaWidth == 0 ? "circle" : "rectangle";
+    if (areaHeight > 0)
+    {
+      luminaire.openingName += " with luminous sides";
+      luminaire.warnings.push_back(
+        name + ": the luminous area has luminous sides, emitted from its outline seen from below");
+    }
+  }
   fields.number("the downward flux fraction DFF (%)");
   fields.number("the light output ratio LORL (%)");
   double conversion = fields.number("the conversion factor for luminous intensities");

@@ -1,5 +1,6 @@
-// The IES LM-63 reader (1986, 1991, 1995, 2002 and 2019 editions), photometric types C and B. Its
-// keyword handling, multipliers and symmetries follow Radiance's ies2rad.
+// The IES LM-63 reader (1986, 1991, 1995, 2002 and 2019 editions), photometric types C, B and A,
+// the TILT=INCLUDE table and the luminous opening. Its keyword handling, multipliers, symmetries
+// and opening shapes follow Radiance's ies2rad.
 #include "Error.h"
 #include "PhotometricParsing.h"
 #include "Photometry.h"
@@ -176,6 +177,22 @@ bool near(double a, double b)
 
 constexpr double Degree = 3.14159265358979323846 / 180;
 
+/// Mirrors a laterally symmetric table of types A and B (its first horizontal angle 0):
+/// H -> -H, so that the planes run from -last to last.
+void mirrorLaterally(std::vector<double>& horizontal, std::vector<double>& candela, std::size_t nV)
+{
+  std::vector<double> angles, values;
+  for (std::size_t h = horizontal.size(); h-- > 1;)
+  {
+    angles.push_back(-horizontal[h]);
+    values.insert(values.end(), candela.begin() + h * nV, candela.begin() + (h + 1) * nV);
+  }
+  angles.insert(angles.end(), horizontal.begin(), horizontal.end());
+  values.insert(values.end(), candela.begin(), candela.end());
+  horizontal = std::move(angles);
+  candela = std::move(values);
+}
+
 /**
  * A type B table (angles in degrees, candela[h * vertical + v]) in the light's frame. Type B's
  * polar axis is the luminaire's lateral axis, C = 90 (+y): the horizontal angle H turns a
@@ -212,16 +229,7 @@ IntensityDistribution typeB(
   if (near(horizontal.front(), 0))
   {
     // Laterally symmetric: H -> -H mirrors the half-planes about the vertical plane of the beam.
-    std::vector<double> angles, values;
-    for (std::size_t h = horizontal.size(); h-- > 1;)
-    {
-      angles.push_back(-horizontal[h]);
-      values.insert(values.end(), candela.begin() + h * nV, candela.begin() + (h + 1) * nV);
-    }
-    angles.insert(angles.end(), horizontal.begin(), horizontal.end());
-    values.insert(values.end(), candela.begin(), candela.end());
-    horizontal = std::move(angles);
-    candela = std::move(values);
+    mirrorLaterally(horizontal, candela, nV);
   }
   const double h0 = horizontal.front(), span = horizontal.back() - h0;
   if (span > 360 + 1e-6)
@@ -246,6 +254,168 @@ IntensityDistribution typeB(
   const PhotometricFrame axes{ { s, 0, c }, { c, 0, -s }, { 0, 1, 0 } };
   return IntensityDistribution::tabulatedInAxes(
     std::move(gammas), std::move(planes), std::move(values), axes, near(span, 360));
+}
+/**
+ * A type A table (angles in degrees, candela[h * vertical + v]) in the light's frame. LM-63-2002
+ * puts type A's planes through the vertical axis, as type C's, but counts its horizontal
+ * angle H clockwise seen from above and its vertical angle V from the horizontal (V = -90 is
+ * the nadir, H = 0 with V = 0 the photometric horizontal +x). So the direction of (H, V) is
+ * cos V (cos H, -sin H, 0) + sin V (0, 0, -1): gamma = 90 + V and C = -H. The planes, taken in
+ * ascending C (descending H), form a C-gamma table in axes turned to the last H, and the
+ * interpolation stays bilinear in the file's own angles.
+ */
+IntensityDistribution typeA(
+  std::vector<double> vertical, std::vector<double> horizontal, std::vector<double> candela)
+{
+  const std::size_t nV = vertical.size();
+  std::vector<double> gammas(nV);
+  for (std::size_t v = 0; v < nV; ++v)
+  {
+    gammas[v] = (90 + vertical[v]) * Degree;
+  }
+  if (horizontal.size() == 1)
+  {
+    // One plane stands for every H: rotationally symmetric about the vertical axis.
+    return IntensityDistribution::tabulated(std::move(gammas), { 0.0 }, std::move(candela));
+  }
+  // From 0 to at most 180 is one side of a laterally symmetric table; a table from 0 over
+  // more than half the turn is taken as given.
+  if (near(horizontal.front(), 0) && horizontal.back() <= 180 + 1e-6)
+  {
+    mirrorLaterally(horizontal, candela, nV);
+  }
+  const double last = horizontal.back(), span = last - horizontal.front();
+  if (span > 360 + 1e-6)
+  {
+    throw Error("the type A horizontal angles span " + formatNumber(span) +
+      " degrees, more than the whole turn");
+  }
+  const std::size_t nH = horizontal.size();
+  std::vector<double> planes(nH), values(candela.size());
+  for (std::size_t i = 0; i < nH; ++i)
+  {
+    const std::size_t h = nH - 1 - i;
+    planes[i] = (last - horizontal[h]) * Degree;
+    std::copy(candela.begin() + h * nV, candela.begin() + (h + 1) * nV, values.begin() + i * nV);
+  }
+  const double s = std::sin(last * Degree), c = std::cos(last * Degree);
+  // C' = 0 along C = -last; C' = 90 along C = 90 - last; the pole is the nadir.
+  const PhotometricFrame axes{ { c, -s, 0 }, { s, c, 0 }, { 0, 0, 1 } };
+  return IntensityDistribution::tabulatedInAxes(
+    std::move(gammas), std::move(planes), std::move(values), axes, near(span, 360));
+}
+
+/**
+ * The luminous opening from the signed width, length and height of an IES file (metres), by
+ * the sign patterns of LM-63-1986/1991, 1995 and 2002/2019 (the 2019 edition keeps 2002's):
+ * positive sizes are rectangular, negative ones round (diameters). Every shape is kept as its
+ * outline seen from below (what a downlight shows its work plane), with a warning for those
+ * whose sides or volume that outline leaves out.
+ */
+void readOpening(Luminaire& luminaire, double width, double length, double height, int year,
+  const std::string& name)
+{
+  const int edition = year <= 1991 ? 1986 : year == 1995 ? 1995 : 2002;
+  const double w = std::abs(width), l = std::abs(length), h = std::abs(height);
+  auto sign = [](double x) { return x < 0 ? -1 : x > 0 ? 1 : 0; };
+  const int sw = sign(width), sl = sign(length), sh = sign(height);
+  auto is = [&](int a, int b, int c) { return sw == a && sl == b && sh == c; };
+  auto set = [&](OpeningShape shape, const char* what, double alongX, double alongY)
+  {
+    luminaire.opening = shape;
+    luminaire.openingName = what;
+    luminaire.length = alongX;
+    luminaire.width = alongY;
+    luminaire.height = h;
+  };
+  auto outline = [&](const char* what, const char* from)
+  {
+    luminaire.warnings.push_back(name + ": the luminous opening is a " + std::string(what) +
+      ", emitted from its outline seen from below (" + from + ")");
+  };
+  luminaire.opening = OpeningShape::None;
+  luminaire.openingName = "point";
+  luminaire.width = w;
+  luminaire.length = l;
+  luminaire.height = h;
+  if (is(0, 0, 0))
+  {
+    return;
+  }
+  if (is(1, 1, 0))
+  {
+    set(OpeningShape::Rectangle, "rectangle", l, w);
+  }
+  else if (sw >= 0 && sl >= 0 && sh > 0)
+  {
+    if (w > 0 && l > 0)
+    {
+      set(OpeningShape::Rectangle, "rectangle with luminous sides", l, w);
+      outline("rectangle with luminous sides", "its bottom rectangle");
+    }
+    else
+    {
+      luminaire.openingName = "vertical rectangle";
+      luminaire.warnings.push_back(name +
+        ": the luminous opening is a vertical rectangle, which has no extent seen from below: "
+        "the luminaire is a point");
+    }
+  }
+  else if (is(-1, 0, 0) || (edition == 2002 && is(-1, -1, 0) && std::abs(w - l) <= 1e-9 * w))
+  {
+    set(OpeningShape::Ellipse, "circle", w, w);
+  }
+  else if ((edition == 2002 && is(-1, -1, 0)) || (edition == 1986 && is(-1, 1, 0)))
+  {
+    set(OpeningShape::Ellipse, "ellipse", l, w);
+  }
+  else if (is(-1, 0, 1))
+  {
+    set(OpeningShape::Ellipse, "vertical cylinder", w, w);
+    outline("vertical cylinder", "its bottom disc");
+  }
+  else if ((edition == 2002 && is(-1, -1, 1)) ||
+    (edition == 1995 && (is(1, -1, 1) || is(-1, 1, 1))))
+  {
+    const bool round = std::abs(w - l) <= 1e-9 * w;
+    set(OpeningShape::Ellipse, round ? "vertical cylinder" : "vertical elliptical cylinder", l, w);
+    outline(luminaire.openingName.c_str(), round ? "its bottom disc" : "its bottom ellipse");
+  }
+  else if ((edition == 2002 && is(-1, -1, -1)) || (edition == 1995 && is(-1, 0, -1)) ||
+    (edition == 1995 && (is(1, -1, -1) || is(-1, 1, -1))) || (edition == 1986 && is(-1, 1, 1)))
+  {
+    const double along = edition == 1995 && sl == 0 ? w : l;
+    const bool round = std::abs(w - along) <= 1e-9 * w && std::abs(w - h) <= 1e-9 * w;
+    set(OpeningShape::Ellipse, round ? "sphere" : "ellipsoid", along, w);
+    outline(luminaire.openingName.c_str(), "its equator");
+  }
+  else if ((edition == 2002 && is(-1, 1, -1)) || (edition == 1995 && is(0, 1, -1)))
+  {
+    // Along the photometric horizontal: its length along x, its diameter across.
+    set(OpeningShape::Rectangle, "horizontal cylinder along the photometric horizontal", l,
+      w > 0 ? w : h);
+    outline("horizontal cylinder", "the rectangle of its length by its diameter");
+  }
+  else if ((edition == 2002 && is(1, -1, -1)) || (edition == 1995 && is(1, 0, -1)))
+  {
+    set(OpeningShape::Rectangle, "horizontal cylinder across the photometric horizontal",
+      l > 0 ? l : h, w);
+    outline("horizontal cylinder", "the rectangle of its length by its diameter");
+  }
+  else if (edition == 2002 && is(0, -1, -1))
+  {
+    luminaire.openingName = "vertical disc facing the photometric horizontal";
+    luminaire.warnings.push_back(name +
+      ": the luminous opening is a vertical disc, which has no extent seen from below: the "
+      "luminaire is a point");
+  }
+  else
+  {
+    luminaire.openingName = "unknown shape";
+    luminaire.warnings.push_back(name + ": the luminous opening (width " + formatNumber(width) +
+      ", length " + formatNumber(length) + ", height " + formatNumber(height) +
+      " m) is none of LM-63-" + std::to_string(edition) + "'s shapes: the luminaire is a point");
+  }
 }
 } // namespace
 
@@ -312,46 +482,27 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   tilt = photometry::trim(tilt.substr(1));
   Tokens tokens(lines, tiltLine + 1, name);
-  double tiltFactor = 1;
   if (tilt == "INCLUDE")
   {
-    // The tilt table scales the candela with the luminaire's tilt from its photometered
-    // position. The scene does not say which way is up for a light, so the luminaire is taken
-    // as photometered: the factor at 0 degrees.
-    tokens.count("the lamp-to-luminaire geometry (TILT=INCLUDE)", 1, 3);
+    // The table is kept whole: the factor is the tilt of each pose's luminaire, which only the
+    // light's poses know (Core/LuminaireTilt.h).
+    const std::size_t geometry = tokens.count("the lamp-to-luminaire geometry (TILT=INCLUDE: 1 "
+                                              "vertical lamp, 2 or 3 horizontal lamp)",
+      1, 3);
+    luminaire.tilt.geometry = static_cast<TiltTable::Geometry>(geometry);
     const std::size_t n = tokens.count("the number of tilt angles", 1, MaximumAngles);
-    const std::vector<double> angles = readAngles(tokens, n, "tilt angle", -360, 360);
-    std::vector<double> factors(n);
+    luminaire.tilt.angles = readAngles(tokens, n, "tilt angle", -360, 360);
+    luminaire.tilt.factors.resize(n);
     for (std::size_t i = 0; i < n; ++i)
     {
       const std::string field =
         "tilt multiplying factor " + std::to_string(i + 1) + " of " + std::to_string(n);
-      factors[i] = tokens.number(field);
-      if (factors[i] < 0)
+      const double factor = tokens.number(field);
+      if (factor < 0)
       {
-        tokens.fail(field + " is " + formatNumber(factors[i]) + ": factors must be >= 0");
+        tokens.fail(field + " is " + formatNumber(factor) + ": factors must be >= 0");
       }
-    }
-    const std::size_t above = std::upper_bound(angles.begin(), angles.end(), 0.0) - angles.begin();
-    if (above == 0)
-    {
-      tiltFactor = factors.front();
-    }
-    else if (above == n)
-    {
-      tiltFactor = factors.back();
-    }
-    else
-    {
-      const double t = (0 - angles[above - 1]) / (angles[above] - angles[above - 1]);
-      tiltFactor = (1 - t) * factors[above - 1] + t * factors[above];
-    }
-    if (std::any_of(factors.begin(), factors.end(), [&](double f) { return f != factors[0]; }))
-    {
-      luminaire.warnings.push_back(name +
-        ": the TILT=INCLUDE factors vary with the tilt; the "
-        "luminaire is taken as photometered (factor " +
-        formatNumber(tiltFactor) + " at 0 degrees)");
+      luminaire.tilt.factors[i] = factor;
     }
   }
   else if (tilt != "NONE")
@@ -389,21 +540,13 @@ Luminaire parseIes(const std::string& text, const std::string& name)
       "truncated");
   }
   const std::size_t type = tokens.count("the photometric type", 1, 3);
-  if (type == 3)
-  {
-    tokens.fail("the photometric type is 3 (type A, for automotive lamps), which is not read: "
-                "only types C (1) and B (2) are");
-  }
-  const bool typeBFile = type == 2;
+  const bool typeBFile = type == 2, typeAFile = type == 3;
   const std::size_t units = tokens.count("the units type (1 feet, 2 metres)", 1, 2);
   const double toMetres = units == 1 ? 0.3048 : 1;
-  // Negative sizes stand for round openings, by their diameters: in both width and length
-  // since LM-63-2002, in the width alone (length 0) before.
   const double width = tokens.number("the width of the luminous opening");
   const double length = tokens.number("the length of the luminous opening");
-  luminaire.width = std::abs(width) * toMetres;
-  luminaire.length = (width < 0 && length == 0 ? std::abs(width) : std::abs(length)) * toMetres;
-  luminaire.height = std::abs(tokens.number("the height of the luminous opening")) * toMetres;
+  const double height = tokens.number("the height of the luminous opening");
+  readOpening(luminaire, width * toMetres, length * toMetres, height * toMetres, year, name);
   const double ballast = tokens.number("the ballast factor");
   if (!(ballast > 0))
   {
@@ -423,16 +566,18 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   tokens.number("the input watts");
 
-  const std::vector<double> vertical = typeBFile ? readAngles(tokens, nV, "vertical angle", -90, 90)
-                                                 : readAngles(tokens, nV, "vertical angle", 0, 180);
-  const std::vector<double> horizontal = typeBFile
-    ? readAngles(tokens, nH, "horizontal angle", -180, 360)
-    : readAngles(tokens, nH, "horizontal angle", 0, 360);
+  const bool typeC = !typeBFile && !typeAFile;
+  const std::vector<double> vertical = typeC ? readAngles(tokens, nV, "vertical angle", 0, 180)
+                                             : readAngles(tokens, nV, "vertical angle", -90, 90);
+  const std::vector<double> horizontal = typeC
+    ? readAngles(tokens, nH, "horizontal angle", 0, 360)
+    : readAngles(tokens, nH, "horizontal angle", -180, 360);
   photometry::PlaneSymmetry symmetry = photometry::PlaneSymmetry::None;
   const double h0 = horizontal.front(), h1 = horizontal.back();
-  if (typeBFile)
+  if (!typeC)
   {
-    // typeB() reads its own symmetries: 0 (about the beam), 0 to 90 (lateral), or as given.
+    // typeB() and typeA() read their own symmetries: one angle, 0 to 90 (lateral), or as
+    // given.
   }
   else if (nH == 1)
   {
@@ -456,7 +601,7 @@ Luminaire parseIes(const std::string& text, const std::string& name)
       " degrees: type C tables run 0 to 0, 90, 180 or 360, or 90 to 270");
   }
 
-  const double scale = multiplier * ballast * photometricFactor * tiltFactor;
+  const double scale = multiplier * ballast * photometricFactor;
   std::vector<double> candela(nV * nH);
   bool anyLight = false;
   for (std::size_t h = 0; h < nH; ++h)
@@ -490,9 +635,9 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   try
   {
-    luminaire.distribution = typeBFile
-      ? typeB(vertical, horizontal, candela)
-      : photometry::fullTurn(vertical, horizontal, candela, symmetry);
+    luminaire.distribution = typeBFile ? typeB(vertical, horizontal, candela)
+      : typeAFile                      ? typeA(vertical, horizontal, candela)
+                  : photometry::fullTurn(vertical, horizontal, candela, symmetry);
   }
   catch (const Error& e)
   {

@@ -64,6 +64,9 @@ public:
   std::size_t frameCount() const { return this->Poses.size(); }
   const LightPose& pose(std::size_t frame) const { return this->Poses[frame]; }
   const std::vector<LightPose>& poses() const { return this->Poses; }
+  /// Replaces the poses (e.g. with their TILT factors, Core/LuminaireTilt.h). Throws
+  /// mlr::Error as the constructor does for bad poses.
+  void setPoses(const std::vector<LightPose>& poses);
   /// How far frame `frame` moves the centroid: p_k - c.
   Vec3 translation(std::size_t frame) const { return this->Poses[frame].position - this->Centroid; }
   /// Frame `frame` as a rigid motion x -> R x + t of a point x of the light as given: this
@@ -113,8 +116,6 @@ private:
   bool Rotates = false;
   IntensityDistribution Distribution = IntensityDistribution::lambertian();
   PhotometricFrame OwnFrame;
-
-  void setPoses(const std::vector<LightPose>& poses);
 };
 
 /// Throws mlr::Error when a light's power is negative or not finite.

@@ -510,6 +510,61 @@ IntensityDistribution IntensityDistribution::tabulatedInAxes(std::vector<double>
   return d;
 }
 
+double TiltTable::factor(double degrees) const
+{
+  if (this->angles.empty())
+  {
+    return 1;
+  }
+  const std::size_t n = this->angles.size();
+  const std::size_t above =
+    std::upper_bound(this->angles.begin(), this->angles.end(), degrees) - this->angles.begin();
+  if (above == 0)
+  {
+    return this->factors.front();
+  }
+  if (above == n)
+  {
+    return this->factors.back();
+  }
+  const double t =
+    (degrees - this->angles[above - 1]) / (this->angles[above] - this->angles[above - 1]);
+  return (1 - t) * this->factors[above - 1] + t * this->factors[above];
+}
+
+bool TiltTable::varies() const
+{
+  return std::any_of(this->factors.begin(), this->factors.end(),
+    [&](double f) { return f != this->factors.front(); });
+}
+
+std::vector<Vec3> openingPolygon(const Luminaire& luminaire)
+{
+  const double a = luminaire.length / 2, b = luminaire.width / 2;
+  if (luminaire.opening == OpeningShape::None || !(a > 0) || !(b > 0))
+  {
+    throw Error("the luminaire has no luminous opening to emit from (its " + luminaire.openingName +
+      " has no extent seen from below)");
+  }
+  if (luminaire.opening == OpeningShape::Rectangle)
+  {
+    // Clockwise seen from above, so that the right-hand normal is the nadir -z.
+    return { { -a, b, 0 }, { a, b, 0 }, { a, -b, 0 }, { -a, -b, 0 } };
+  }
+  // A regular polygon stretched to the ellipse, of the ellipse's area (the polygon of radius r
+  // has (n / 2) r^2 sin(2 pi / n)), its first edge along +x: vertices at pi / 2 + pi / n and on,
+  // clockwise.
+  constexpr int n = 48;
+  const double scale = std::sqrt(Pi / (0.5 * n * std::sin(TwoPi / n)));
+  std::vector<Vec3> polygon;
+  for (int i = 0; i < n; ++i)
+  {
+    const double phi = Pi / 2 + Pi / n - TwoPi * i / n;
+    polygon.emplace_back(a * scale * std::cos(phi), b * scale * std::sin(phi), 0);
+  }
+  return polygon;
+}
+
 namespace photometry
 {
 

@@ -115,21 +115,79 @@ private:
   std::shared_ptr<const Table> Data;
 };
 
+/**
+ * LM-63's TILT=INCLUDE table: a factor on the luminaire's output for the angle it is tilted by
+ * from its photometered position (aimed straight down), linear between the tabulated angles
+ * and clamped at the ends. How the tilt is measured depends on how the lamp sits in the
+ * luminaire (the geometry); see Core/LuminaireTilt.h.
+ */
+struct TiltTable
+{
+  /// LM-63's lamp-to-luminaire geometry.
+  enum class Geometry
+  {
+    /// 1: the lamp's axis is the luminaire's nadir axis (vertical, base up or down, when the
+    /// luminaire is aimed straight down).
+    Vertical = 1,
+    /// 2: the lamp lies along the photometric horizontal (C0-C180, x) and stays horizontal
+    /// when the luminaire turns about that axis: it only rolls about its own axis.
+    HorizontalAlongC0 = 2,
+    /// 3: the lamp lies across it (along C90-C270, y) and tilts when the luminaire turns
+    /// about the photometric horizontal.
+    HorizontalAlongC90 = 3
+  };
+  Geometry geometry = Geometry::Vertical;
+  std::vector<double> angles;  ///< degrees, strictly ascending (empty: TILT=NONE)
+  std::vector<double> factors; ///< one per angle, >= 0
+
+  bool empty() const { return this->angles.empty(); }
+  /// The factor at `degrees`: linear between the tabulated angles, the end factor beyond.
+  double factor(double degrees) const;
+  /// True when the factors differ.
+  bool varies() const;
+};
+
+/// The shapes of LM-63-2002's and EULUMDAT's luminous openings an area luminaire emits from:
+/// the opening seen from below, along the nadir.
+enum class OpeningShape
+{
+  None,      ///< no opening given (a point), or one with no extent seen from below
+  Rectangle, ///< length (x) by width (y)
+  Ellipse    ///< diameters length (x) and width (y): a circle when they are equal
+};
+
 /// A luminaire read from a photometric file.
 struct Luminaire
 {
   IntensityDistribution distribution;
   /// The luminous flux the file's photometry gives (lm): the integral of its candela, times
-  /// the candela multiplier and ballast factor.
+  /// the candela multiplier and ballast factor, before any tilt factor (which is the pose's).
   double lumens = 0;
   /// The luminous opening in metres (0 when not given): an area luminaire emits from it.
-  /// length runs along C0-C180 (x of the frame), width along C90-C270 (y); a round opening
-  /// has its diameter in both.
+  /// length runs along C0-C180 (x of the frame), width along C90-C270 (y): the extents of the
+  /// opening seen from below (a round opening has its diameter in both); height is its
+  /// vertical extent (luminous sides, a cylinder's or a sphere's height).
   double width = 0, length = 0, height = 0;
-  /// What was read but not applied (a TILT=INCLUDE table that varies, values after the table,
-  /// an unknown edition, several lamp sets), one sentence each naming the file.
+  OpeningShape opening = OpeningShape::None;
+  /// The file's own name of the shape ("rectangle", "circle", "vertical cylinder", ...; "point"
+  /// when none is given), for messages.
+  std::string openingName = "point";
+  /// TILT=INCLUDE's table (empty for TILT=NONE and EULUMDAT).
+  TiltTable tilt;
+  /// What was read but not applied (values after the table, an unknown edition, several lamp
+  /// sets, an opening shape emitted from its outline seen from below), one sentence each naming
+  /// the file.
   std::vector<std::string> warnings;
 };
+
+/**
+ * The emitting polygon of a luminaire's opening in the light's own frame of a point light:
+ * centred on the origin in the plane z = 0, facing -z (its nadir), its first edge along +x
+ * (C = 0), so that an area light made of it has the photometric frame of a point light. A
+ * rectangle is itself; an ellipse a 48-gon of its area. Throws mlr::Error when the shape is
+ * None.
+ */
+std::vector<Vec3> openingPolygon(const Luminaire& luminaire);
 
 /// Reads an IES LM-63 (.ies) or EULUMDAT (.ldt) file, chosen by its extension. Throws
 /// mlr::Error naming the file, line and field to fix.

@@ -32,6 +32,13 @@ public:
   std::size_t frameCount() const { return this->Poses.size(); }
   const LightPose& pose(std::size_t frame) const { return this->Poses[frame]; }
   const std::vector<LightPose>& poses() const { return this->Poses; }
+  /// Replaces the poses (e.g. with their TILT factors, Core/LuminaireTilt.h). Throws
+  /// mlr::Error for bad poses.
+  void setPoses(const std::vector<LightPose>& poses)
+  {
+    checkPoses(poses);
+    this->Poses = poses;
+  }
   const Vec3& position(std::size_t frame) const { return this->Poses[frame].position; }
   /// The photometric frame before posing.
   const PhotometricFrame& ownPhotometricFrame() const { return this->OwnFrame; }

@@ -7,6 +7,7 @@
 
 #include "Animation.h"
 #include "Error.h"
+#include "LuminaireTilt.h"
 #include "MovingLight.h"
 #include "Photometry.h"
 #include "PointLight.h"
@@ -281,22 +282,41 @@ mlr::vtkinputs::Trajectory trajectoryOf(
   return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0), lights);
 }
 
-/// The distribution every area and point light emits with: LightDistributionFile's, a spot,
-/// or Lambertian.
-mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
+/// The LightDistributionFile's luminaire, read once per solve; none without a file.
+std::optional<mlr::Luminaire> luminaireOf(vtkMovingLightRadiosity* self)
 {
   const std::string file = self->GetLightDistributionFile();
+  if (file.empty())
+  {
+    return std::nullopt;
+  }
+  if (self->GetSpotHalfAngle() > 0)
+  {
+    // Named before the file is read: the conflict is the thing to fix, whatever the file.
+    std::ostringstream message;
+    message << "both a LightDistributionFile and a spot (SpotHalfAngle " << self->GetSpotHalfAngle()
+            << " degrees) are set: give one of them";
+    throw mlr::Error(message.str());
+  }
+  return mlr::readPhotometricFile(file);
+}
+
+/// The distribution every area and point light emits with: the file's, a spot, or
+/// Lambertian.
+mlr::IntensityDistribution lightDistribution(
+  vtkMovingLightRadiosity* self, const std::optional<mlr::Luminaire>& luminaire)
+{
   const double half = self->GetSpotHalfAngle(), soft = self->GetSpotSoftEdge();
   std::ostringstream message;
-  if (!file.empty() && half > 0)
+  if (luminaire && half > 0)
   {
     message << "both a LightDistributionFile and a spot (SpotHalfAngle " << half
             << " degrees) are set: give one of them";
     throw mlr::Error(message.str());
   }
-  if (!file.empty())
+  if (luminaire)
   {
-    return mlr::readPhotometricFile(file).distribution;
+    return luminaire->distribution;
   }
   if (half > 0)
   {
@@ -313,13 +333,13 @@ mlr::IntensityDistribution lightDistribution(vtkMovingLightRadiosity* self)
 
 /// A light's power: `colour` itself (W), or with LightFluxLumens (or LightFluxFromFile, the
 /// file's own flux) that colour scaled to those lumens / LuminousEfficacy watts of luminance.
-mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour)
+mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour,
+  const std::optional<mlr::Luminaire>& luminaire)
 {
   double lumens = self->GetLightFluxLumens();
-  const std::string file = self->GetLightDistributionFile();
-  if (!(lumens > 0) && self->GetLightFluxFromFile() && !file.empty())
+  if (!(lumens > 0) && self->GetLightFluxFromFile() && luminaire)
   {
-    lumens = mlr::readPhotometricFile(file).lumens;
+    lumens = luminaire->lumens;
   }
   if (!(lumens > 0))
   {
@@ -334,6 +354,48 @@ mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour)
     throw mlr::Error(message.str());
   }
   return colour * (lumens / self->GetLuminousEfficacy() / luminance);
+}
+
+/// Warns when area light `index`'s extent along its C0-C180 and C90-C270 axes differs by more
+/// than a quarter from the file's luminous opening: the light keeps its polygons, but the
+/// file's near field came from the other size (or the light's first edge, which sets C = 0,
+/// runs along the file's width).
+void compareWithOpening(const mlr::MovingLight& light, std::size_t index,
+  const mlr::Luminaire& luminaire, const std::string& file, std::vector<std::string>& warnings)
+{
+  if (luminaire.opening == mlr::OpeningShape::None)
+  {
+    return;
+  }
+  const mlr::PhotometricFrame& frame = light.ownPhotometricFrame();
+  double low[2] = { 1e300, 1e300 }, high[2] = { -1e300, -1e300 };
+  for (const std::vector<mlr::Vec3>& polygon : light.polygons())
+  {
+    for (const mlr::Vec3& p : polygon)
+    {
+      const double along[2] = { mlr::dot(p, frame.x), mlr::dot(p, frame.y) };
+      for (int a = 0; a < 2; ++a)
+      {
+        low[a] = std::min(low[a], along[a]);
+        high[a] = std::max(high[a], along[a]);
+      }
+    }
+  }
+  const double extent[2] = { high[0] - low[0], high[1] - low[1] };
+  const double opening[2] = { luminaire.length, luminaire.width };
+  auto differs = [](double a, double b) { return a > 1.25 * b || b > 1.25 * a; };
+  if (differs(extent[0], opening[0]) || differs(extent[1], opening[1]))
+  {
+    std::ostringstream s;
+    s.precision(3);
+    s << "light " << index << " is " << extent[0] << " m along its C0-C180 axis (its first edge) "
+      << "by " << extent[1] << " m across, but " << file << "'s luminous opening (a "
+      << luminaire.openingName << ") is " << opening[0] << " by " << opening[1]
+      << " m: the light emits from its own polygons; give polygons of the opening's size (or "
+      << "LightType Luminaire, which emits from the opening), or turn the polygon's first edge "
+      << "to the opening's length";
+    warnings.push_back(s.str());
+  }
 }
 
 /// A triangle facing -z: its mean normal is a point light's nadir before posing, so that
@@ -675,6 +737,14 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
 
     // The lights and the options are checked before remeshing, which may take a while.
     mlr::LightRig rig;
+    // The photometric file is read once: its distribution, flux, TILT table and opening.
+    const std::optional<mlr::Luminaire> luminaire =
+      this->SkyModel != NO_SKY ? std::nullopt : luminaireOf(this);
+    if (luminaire)
+    {
+      warnings.insert(warnings.end(), luminaire->warnings.begin(), luminaire->warnings.end());
+    }
+    const mlr::Vec3 up(this->Up[0], this->Up[1], this->Up[2]);
     if (directional)
     {
       std::vector<mlr::Vec3> directions;
@@ -709,7 +779,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     {
       addSky(this, trajectory, directional, rig, cache.DaylightEfficacy);
     }
-    else if (this->LightType == POINT_LIGHT)
+    else if (this->LightType == POINT_LIGHT || this->LightType == LUMINAIRE_LIGHT)
     {
       std::vector<mlr::PoseInput> inputs = trajectory.lights.front();
       const mlr::Vec3 aim(this->AimPoint[0], this->AimPoint[1], this->AimPoint[2]);
@@ -722,10 +792,48 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
             "off");
         }
       }
-      rig.pointLights.emplace_back(
-        luminairePower(
-          this, mlr::Rgb(this->LightPower[0], this->LightPower[1], this->LightPower[2])),
-        mlr::posesFromInputs(PointLightNadir, inputs, warnings), lightDistribution(this));
+      const mlr::Rgb power = luminairePower(
+        this, mlr::Rgb(this->LightPower[0], this->LightPower[1], this->LightPower[2]), luminaire);
+      const mlr::IntensityDistribution distribution = lightDistribution(this, luminaire);
+      bool fromOpening = false;
+      if (this->LightType == LUMINAIRE_LIGHT)
+      {
+        if (!luminaire)
+        {
+          throw mlr::Error("LightType Luminaire emits from a photometric file's luminous "
+                           "opening: give its LightDistributionFile (.ies or .ldt)");
+        }
+        fromOpening = luminaire->opening != mlr::OpeningShape::None;
+        if (!fromOpening)
+        {
+          warnings.push_back(this->LightDistributionFile + " gives no luminous opening (its " +
+            luminaire->openingName + "): the luminaire is a point light");
+        }
+      }
+      if (fromOpening)
+      {
+        const std::vector<std::vector<mlr::Vec3>> opening = { mlr::openingPolygon(*luminaire) };
+        rig.areaLights.emplace_back(
+          opening, power, mlr::posesFromInputs(opening, inputs, warnings));
+        mlr::MovingLight& light = rig.areaLights.back();
+        light.setDistribution(distribution);
+        if (!luminaire->tilt.empty())
+        {
+          light.setPoses(mlr::tiltPoses(luminaire->tilt, light.ownPhotometricFrame(), light.poses(),
+            up, this->LightDistributionFile, warnings));
+        }
+      }
+      else
+      {
+        rig.pointLights.emplace_back(
+          power, mlr::posesFromInputs(PointLightNadir, inputs, warnings), distribution);
+        mlr::PointLight& light = rig.pointLights.back();
+        if (luminaire && !luminaire->tilt.empty())
+        {
+          light.setPoses(mlr::tiltPoses(luminaire->tilt, light.ownPhotometricFrame(), light.poses(),
+            up, this->LightDistributionFile, warnings));
+        }
+      }
     }
     else if (fromMaterial || (lightData && lightData->GetNumberOfCells() > 0))
     {
@@ -760,12 +868,23 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         const std::vector<mlr::LightPose> poses =
           mlr::posesFromInputs(lights[i].polygons, inputs, warnings);
         rig.areaLights.emplace_back(lights[i].polygons,
-          luminairePower(this, lights[i].hasPower ? lights[i].power : defaultPower), poses);
+          luminairePower(this, lights[i].hasPower ? lights[i].power : defaultPower, luminaire),
+          poses);
       }
-      const mlr::IntensityDistribution distribution = lightDistribution(this);
-      for (mlr::MovingLight& light : rig.areaLights)
+      const mlr::IntensityDistribution distribution = lightDistribution(this, luminaire);
+      for (std::size_t i = 0; i < rig.areaLights.size(); ++i)
       {
+        mlr::MovingLight& light = rig.areaLights[i];
         light.setDistribution(distribution);
+        if (luminaire)
+        {
+          compareWithOpening(light, i, *luminaire, this->LightDistributionFile, warnings);
+          if (!luminaire->tilt.empty())
+          {
+            light.setPoses(mlr::tiltPoses(luminaire->tilt, light.ownPhotometricFrame(),
+              light.poses(), up, this->LightDistributionFile, warnings));
+          }
+        }
       }
     }
     for (const std::string& warning : warnings)
@@ -952,9 +1071,10 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
   os << indent << "LightType: "
-     << (this->LightType == DIRECTIONAL_LIGHT ? "Directional"
-            : this->LightType == POINT_LIGHT  ? "Point"
-                                              : "Area")
+     << (this->LightType == DIRECTIONAL_LIGHT    ? "Directional"
+            : this->LightType == POINT_LIGHT     ? "Point"
+            : this->LightType == LUMINAIRE_LIGHT ? "Luminaire"
+                                                 : "Area")
      << "\n";
   os << indent << "SunIrradiance: " << this->SunIrradiance << " W/m^2\n";
   os << indent << "SkyModel: " << this->SkyModel << "\n";

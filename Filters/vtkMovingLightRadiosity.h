@@ -259,7 +259,8 @@ public:
   {
     AREA_LIGHT = 0,
     DIRECTIONAL_LIGHT = 1,
-    POINT_LIGHT = 2
+    POINT_LIGHT = 2,
+    LUMINAIRE_LIGHT = 3
   };
 
   ///@{
@@ -269,13 +270,18 @@ public:
    * not needed and SunIrradiance replaces LightPower. Point: one point light at the
    * Trajectory's points (or from PathStart to PathEnd) of power LightPower, emitting with the
    * light distribution (see LightDistributionFile) about its nadir, -z unless a Normal or
-   * Orientation turns it; the Light input is not needed. Default Area.
+   * Orientation turns it; the Light input is not needed. Luminaire: the LightDistributionFile's
+   * luminaire as an area light of its luminous opening (a rectangle, or a polygon of an
+   * ellipse's or a circle's area: the opening seen from below), centred on the Trajectory's
+   * points and posed as the point light is (nadir -z, C = 0 along +x); a file that gives no
+   * opening makes it a point light, with a warning. Default Area.
    */
-  vtkSetClampMacro(LightType, int, AREA_LIGHT, POINT_LIGHT);
+  vtkSetClampMacro(LightType, int, AREA_LIGHT, LUMINAIRE_LIGHT);
   vtkGetMacro(LightType, int);
   void SetLightTypeToArea() { this->SetLightType(AREA_LIGHT); }
   void SetLightTypeToDirectional() { this->SetLightType(DIRECTIONAL_LIGHT); }
   void SetLightTypeToPoint() { this->SetLightType(POINT_LIGHT); }
+  void SetLightTypeToLuminaire() { this->SetLightType(LUMINAIRE_LIGHT); }
   ///@}
 
   ///@{
@@ -323,7 +329,8 @@ public:
   ///@}
 
   ///@{
-  /// The zenith of the sky, any length but 0. Default 0, 0, 1.
+  /// The zenith of the sky, and the vertical a LightDistributionFile's TILT=INCLUDE table
+  /// measures each pose's tilt from; any length but 0. Default 0, 0, 1.
   vtkSetVector3Macro(Up, double);
   vtkGetVector3Macro(Up, double);
   ///@}
@@ -354,7 +361,11 @@ public:
    * the nadir (gamma 0) is an area light's emission normal (its first polygon's) or a point
    * light's -z, C = 0 is along an area light's first edge or a point light's +x; the frame
    * turns with the light. The power is LightFluxLumens, LightPower or, with
-   * LightFluxFromFile, the file's own flux. Default "" (diffuse, Lambertian, emitters).
+   * LightFluxFromFile, the file's own flux. An IES file's TILT=INCLUDE table multiplies each
+   * pose's power by its factor at that pose's tilt from straight down (-Up). An area light
+   * whose extent differs from the file's luminous opening by more than a quarter is warned
+   * of (LightType Luminaire emits from the opening itself). Default "" (diffuse, Lambertian,
+   * emitters).
    */
   vtkSetStdStringFromCharMacro(LightDistributionFile);
   vtkGetCharFromStdStringMacro(LightDistributionFile);

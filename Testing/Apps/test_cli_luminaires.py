@@ -1,5 +1,6 @@
-"""The command line's luminaires: --point-light, --spot, --light-distribution (IES LM-63)
-and --light-lumens, each checked against the closed form of its direct light on a floor, and
+"""The command line's luminaires: --point-light, --spot, --light-distribution (IES LM-63),
+--luminaire (an area light of the file's opening), a TILT=INCLUDE table against --up, and
+--light-lumens, each checked against the closed form of its direct light on a floor, and
 their bad values refused with a message naming the option.
 
 A point light of power Phi with the normalised intensity distribution f lights a floor
@@ -139,7 +140,50 @@ def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):
     assert numpy.all(coloured[:, 2] == 0)
 
 
+def test_luminaire_emits_from_its_opening_like_the_point_light_far_off(tmp_path):
+    # A 0.2 m square opening 1 m up: beyond a few opening sizes it lights the floor as the
+    # point light of its distribution does (the near field's correction, of order
+    # (0.1 / 1)^2, is within DISCRETISATION).
+    ies = "opening.ies"
+    (tmp_path / ies).write_text("IESNA:LM-63-2002\n[TEST] uniform downlight\nTILT=NONE\n"
+                                "1 -1 1 3 1 1 2 0.2 0.2 0\n1 1 0\n0 45 90\n0\n"
+                                "1000 1000 1000\n")
+    base = ["--scene", write_floor(tmp_path), "--luminaire", "--light-distribution", ies,
+            "--light-power", "100", "--from", f"0,0,{HEIGHT}", "--to", f"0,0,{HEIGHT}",
+            "--frames", "1"]
+    (_, frame), = solve(tmp_path, base, "luminaire/s.pvd", PATHS)
+    uniform = lambda c: numpy.full_like(c, 1 / (2 * math.pi))  # noqa: E731
+    assert_point_light(frame, disc(frame, 0, 0), (0, 0, HEIGHT), uniform)
+    assert_point_light(frame, ring(frame, 0.9, 1.1), (0, 0, HEIGHT), uniform)
+
+
+def test_tilt_table_scales_the_light_by_the_tilt_from_up(tmp_path):
+    # A luminaire aimed along -z is untilted with the default up (+z) and tilted 90 degrees
+    # with --up 0,1,0: a TILT table of 1 at 0 and 0.4 at 90 degrees gives it 1 and 0.4 of the
+    # TILT=NONE light, along the same paths.
+    def write(name, tilt):
+        (tmp_path / name).write_text("IESNA:LM-63-2002\n[TEST] tilt\n" + tilt + "\n"
+                                     "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0 45 90\n0\n"
+                                     "1000 1000 1000\n")
+        return name
+    plain = write("plain.ies", "TILT=NONE")
+    tilted = write("tilted.ies", "TILT=INCLUDE\n1\n2\n0 90\n1 0.4")
+    runs = {}
+    for key, ies, extra in (("plain", plain, []), ("down", tilted, []),
+                            ("sideways", tilted, ["--up", "0,1,0"])):
+        runs[key] = point_run(tmp_path, ["--light-distribution", ies, "--light-power", "100"] +
+                              extra, f"{key}/s.pvd", 20000)[0][1].cells("DirectRadiosity")
+    lit = runs["plain"] > 0
+    assert lit.any()
+    assert runs["down"][lit] / runs["plain"][lit] == pytest.approx(1.0, rel=1e-6)
+    assert runs["sideways"][lit] / runs["plain"][lit] == pytest.approx(0.4, rel=1e-6)
+
+
 @pytest.mark.parametrize("args, words", [
+    (["--luminaire"], "--luminaire"),
+    (["--luminaire=yes"], "--luminaire"),
+    (["--luminaire", "--point-light", "--light-distribution", "a.ies"], "--luminaire"),
+    (["--up", "0,1,0"], "--up"),
     (["--spot", "0"], "--spot"),
     (["--spot", "200"], "--spot"),
     (["--spot", "30,-1"], "--spot"),

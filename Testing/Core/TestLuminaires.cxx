@@ -1,8 +1,10 @@
 // Luminaires: point and area lights with intensity distributions (Lambertian, spot, table),
-// moving and turning across frames.
+// moving and turning across frames; the TILT=INCLUDE factor of each pose's tilt, by the lamp's
+// geometry, reaching the floor through the pose's power factor.
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "LightSource.h"
+#include "LuminaireTilt.h"
 #include "RayTracer.h"
 #include "Solver.h"
 
@@ -178,13 +180,14 @@ void expectInverseSquare(const PointLight& light, bool reuse, std::uint64_t seed
       }
       for (int c = 0; c < 3; ++c)
       {
-        const double scale = rho * light.power()[c] / area;
+        // Frame f emits its pose's power factor (a TILT factor among them) times Phi.
+        const double scale = rho * light.power()[c] * light.pose(f).power[c] / area;
         const double value = solution.direct(f, e, Side::Front)[c];
-        total += value * area / (rho * light.power()[c]);
+        total += value * area / (rho * light.power()[c] * light.pose(f).power[c]);
         if (!(variance > 0))
         {
           // The quadrature misses the beam's edge where it cuts a corner of an element.
-          outside += value * area / (rho * light.power()[c]);
+          outside += value * area / (rho * light.power()[c] * light.pose(f).power[c]);
           continue;
         }
         lit += mean;
@@ -408,4 +411,110 @@ TEST(Luminaires, PointKernelIsTheFirstHitDensityAndSeesEveryPosition)
       EXPECT_TRUE(scratch.visible[s]) << "nothing stands between the floor and the light";
     }
   }
+}
+
+namespace
+{
+/// The photometric frame of a point light before posing (nadir -z, C = 0 along +x) turned by
+/// `pose`.
+PhotometricFrame posedFrame(const LightPose& pose)
+{
+  const PhotometricFrame own;
+  return { pose.rotation.apply(own.x), pose.rotation.apply(own.y), pose.rotation.apply(own.z) };
+}
+}
+
+TEST(Luminaires, TiltAnglesFollowTheLampGeometry)
+{
+  using G = TiltTable::Geometry;
+  const Vec3 up(0, 0, 1), at(0, 0, 2);
+  auto tilt = [&](G g, const Vec3& axis, double degrees)
+  { return luminaireTilt(g, posedFrame(turned(at, axis, degrees)), up); };
+  // A vertical lamp tilts with the nadir, whatever the plane: 35 degrees about a horizontal
+  // axis, none about the vertical, 150 (aimed nearly up).
+  EXPECT_NEAR(tilt(G::Vertical, { 1, 2, 0 }, 35).angle, 35, 1e-9);
+  EXPECT_NEAR(tilt(G::Vertical, { 0, 0, 1 }, 70).angle, 0, 1e-6);
+  EXPECT_NEAR(tilt(G::Vertical, { 1, 0, 0 }, 150).angle, 150, 1e-9);
+  EXPECT_EQ(tilt(G::Vertical, { 1, 2, 0 }, 35).untabulated, 0);
+  // Turning +30 about the photometric horizontal (+x) swings the nadir towards +y.
+  const PhotometricFrame swung = posedFrame(turned(at, { 1, 0, 0 }, 30));
+  EXPECT_GT(swung.z.y, 0.49);
+  // Geometry 3 (lamp along y): that turn tilts the lamp 30 degrees; a turn about y leaves it
+  // horizontal; a turn about the vertical too.
+  EXPECT_NEAR(tilt(G::HorizontalAlongC90, { 1, 0, 0 }, 30).angle, 30, 1e-9);
+  EXPECT_NEAR(tilt(G::HorizontalAlongC90, { 1, 0, 0 }, -20).angle, -20, 1e-9);
+  EXPECT_NEAR(tilt(G::HorizontalAlongC90, { 0, 1, 0 }, 40).angle, 0, 1e-9);
+  EXPECT_NEAR(tilt(G::HorizontalAlongC90, { 0, 0, 1 }, 60).angle, 0, 1e-9);
+  EXPECT_EQ(tilt(G::HorizontalAlongC90, { 0, 1, 0 }, 40).untabulated, 0);
+  // Geometry 2 (lamp along x): the turn about x is the lamp's roll; a turn about y leans the
+  // lamp's axis, which the table does not give.
+  const LuminaireTilt roll = tilt(G::HorizontalAlongC0, { 1, 0, 0 }, 30);
+  EXPECT_NEAR(roll.angle, 30, 1e-9);
+  EXPECT_NEAR(roll.untabulated, 0, 1e-9);
+  EXPECT_NEAR(tilt(G::HorizontalAlongC0, { 1, 0, 0 }, 120).angle, 120, 1e-9);
+  const LuminaireTilt lean = tilt(G::HorizontalAlongC0, { 0, 1, 0 }, 40);
+  EXPECT_NEAR(lean.angle, 0, 1e-9);
+  EXPECT_NEAR(lean.untabulated, 40, 1e-9);
+  // The vertical is the scene's: with +y up, a luminaire aimed along -z is tilted 90 degrees.
+  EXPECT_NEAR(luminaireTilt(G::Vertical, PhotometricFrame(), { 0, 3, 0 }).angle, 90, 1e-9);
+  EXPECT_NE(checks::errorOf([] { luminaireTilt(G::Vertical, PhotometricFrame(), Vec3()); })
+              .find("up direction (0, 0, 0) must be finite and not zero"),
+    std::string::npos);
+}
+
+TEST(Luminaires, TiltFactorsScaleThePosesAndTheirIrradiance)
+{
+  // A vertical lamp losing output as it tilts: the four poses tilt it 0, 25, 40 and 0 degrees
+  // (the last only turns about the nadir), so they emit 1, 1 - 0.2 (25 / 30), 0.8 - 0.3 (10 /
+  // 30) and 1 times their own power factors.
+  TiltTable table;
+  table.geometry = TiltTable::Geometry::Vertical;
+  table.angles = { 0, 30, 60, 90 };
+  table.factors = { 1, 0.8, 0.5, 0.2 };
+  std::vector<LightPose> poses = movingAndTurning({ 0, 0, 1 });
+  poses[1].power = Rgb(0.5, 1, 2);
+  std::vector<std::string> warnings;
+  const std::vector<LightPose> tilted =
+    tiltPoses(table, PhotometricFrame(), poses, { 0, 0, 1 }, "lamp.ies", warnings);
+  EXPECT_TRUE(warnings.empty());
+  const double expected[] = { 1, 1 - 0.2 * 25 / 30, 0.8 - 0.3 * 10 / 30, 1 };
+  for (std::size_t k = 0; k < poses.size(); ++k)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_NEAR(tilted[k].power[c], poses[k].power[c] * expected[k], 1e-12) << "pose " << k;
+    }
+    EXPECT_EQ(tilted[k].position, poses[k].position);
+  }
+  // The factors reach the floor as Phi s_k f p_k(y): the inverse-square law, classic and with
+  // reuse, whose mixture weights stay those of the unit-power kernels.
+  const PointLight light(Rgb(30, 20, 10), tilted, asymmetricTable());
+  expectInverseSquare(light, false, 77);
+  expectInverseSquare(light, true, 78);
+
+  // Poses beyond the table take its end factor, with a warning naming the first of them.
+  const std::vector<LightPose> beyond = tiltPoses(table, PhotometricFrame(),
+    { turned({ 0, 0, 1 }, { 1, 0, 0 }, 120), turned({ 0, 0, 1 }, { 1, 0, 0 }, 10) }, { 0, 0, 1 },
+    "lamp.ies", warnings);
+  EXPECT_NEAR(beyond[0].power.r, 0.2, 1e-12);
+  EXPECT_NEAR(beyond[1].power.r, 1 - 0.2 / 3, 1e-12);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("lamp.ies: light position 0 tilts the luminaire by 120 degrees, "
+                             "outside the TILT table's 0 to 90 (1 of 2 positions are)"),
+    std::string::npos)
+    << warnings[0];
+  // A horizontal lamp's table of angles 0 and up is symmetric in the turn's sign; geometry 2
+  // warns of a lamp axis leaning out of the horizontal.
+  table.geometry = TiltTable::Geometry::HorizontalAlongC0;
+  warnings.clear();
+  const std::vector<LightPose> rolled = tiltPoses(table, PhotometricFrame(),
+    { turned({ 0, 0, 1 }, { 1, 0, 0 }, -45), turned({ 0, 0, 1 }, { 0, 1, 0 }, 20) }, { 0, 0, 1 },
+    "lamp.ies", warnings);
+  EXPECT_NEAR(rolled[0].power.r, 0.65, 1e-12);
+  EXPECT_NEAR(rolled[1].power.r, 1, 1e-12);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("light position 1 leans the lamp axis (C0-C180, lamp-to-luminaire "
+                             "geometry 2) 20 degrees out of the horizontal"),
+    std::string::npos)
+    << warnings[0];
 }

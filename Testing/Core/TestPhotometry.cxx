@@ -1,8 +1,9 @@
 // Luminous intensity distributions and the photometric files: each kind's density integrates
 // to 1, sample() draws from density() (a chi-square bound on a histogram, fixed seeds), the
 // IES and EULUMDAT readers give the flux of the distribution they describe, their symmetric
-// forms equal the full table, C = 90 lies towards +y, and bad files are refused with the
-// line and field to fix.
+// forms equal the full table, C = 90 lies towards +y, types B and A follow their own axes, the
+// TILT=INCLUDE table and the luminous opening's shape are read, and bad files (malformed TILT
+// blocks among them) are refused with the line and field to fix.
 #include "CoreChecks.h"
 #include "Photometry.h"
 #include "Random.h"
@@ -640,11 +641,21 @@ TEST(Photometry, IesCosinePowerGivesTheAnalyticFlux)
   EXPECT_EQ(up.distribution.density({ 0, 0, 1 }), 0);
   EXPECT_NEAR(up.distribution.density({ 0.3, 0, -1 }), 1 / (2 * Pi), 1e-12);
 
-  // TILT=INCLUDE: the factor at 0 degrees scales the candela.
+  // TILT=INCLUDE: the table is kept for the poses; the photometered flux is the candela's.
   const std::string tilt = "TILT=INCLUDE\n1\n3\n0 45 90\n0.5 0.7 0.9";
   const Luminaire tilted = parseIes(iesFile(vertical, { 0 }, f, 1, 1, tilt), "tilt.ies");
-  EXPECT_NEAR(tilted.lumens, 0.25 * exact, 2e-4 * exact);
-  EXPECT_EQ(tilted.warnings.size(), 1u);
+  EXPECT_NEAR(tilted.lumens, exact / 2, 2e-4 * exact);
+  EXPECT_TRUE(tilted.warnings.empty());
+  EXPECT_EQ(tilted.tilt.geometry, TiltTable::Geometry::Vertical);
+  EXPECT_EQ(tilted.tilt.angles, (std::vector<double>{ 0, 45, 90 }));
+  EXPECT_EQ(tilted.tilt.factors, (std::vector<double>{ 0.5, 0.7, 0.9 }));
+  EXPECT_DOUBLE_EQ(tilted.tilt.factor(0), 0.5);
+  EXPECT_DOUBLE_EQ(tilted.tilt.factor(22.5), 0.6);
+  EXPECT_DOUBLE_EQ(tilted.tilt.factor(60), 0.7 + 0.2 * 15 / 45);
+  EXPECT_DOUBLE_EQ(tilted.tilt.factor(120), 0.9); // clamped at the ends
+  EXPECT_DOUBLE_EQ(tilted.tilt.factor(-5), 0.5);
+  EXPECT_TRUE(l.tilt.empty());
+  EXPECT_DOUBLE_EQ(l.tilt.factor(30), 1);
 }
 
 TEST(Photometry, IesSymmetricFormsEqualTheFullTable)
@@ -788,8 +799,8 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(e.find("line 3: TILT=lamp.tlt refers to a separate tilt file"), std::string::npos) << e;
   e = error(with("TILT=NONE", "[MORE] no tilt"));
   EXPECT_NE(e.find("no TILT= line"), std::string::npos) << e;
-  e = error(with(" 1 2 0.6", " 3 2 0.6"));
-  EXPECT_NE(e.find("line 4: the photometric type is 3 (type A"), std::string::npos) << e;
+  e = error(with(" 1 2 0.6", " 4 2 0.6"));
+  EXPECT_NE(e.find("line 4: the photometric type is 4"), std::string::npos) << e;
   e = error(with(" 1 2 0.6", " 1 3 0.6"));
   EXPECT_NE(e.find("the units type"), std::string::npos) << e;
   e = error(with("\n1 1 40", "\n0 1 40"));
@@ -798,6 +809,26 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(e.find("every candela value is 0"), std::string::npos) << e;
   e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n2\n0 90\n1 -1"));
   EXPECT_NE(e.find("line 7: tilt multiplying factor 2 of 2 is -1"), std::string::npos) << e;
+  // Malformed TILT=INCLUDE blocks, each named by its line.
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n4\n2\n0 90\n1 1"));
+  EXPECT_NE(e.find("line 4: the lamp-to-luminaire geometry"), std::string::npos) << e;
+  EXPECT_NE(e.find("is 4: it must be a whole number from 1 to 3"), std::string::npos) << e;
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n0\n\n"));
+  EXPECT_NE(e.find("line 5: the number of tilt angles is 0"), std::string::npos) << e;
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n3\n0 45 30\n1 1 1"));
+  EXPECT_NE(
+    e.find("line 6: tilt angle 3 of 3 is 30 degrees, not above the previous 45"), std::string::npos)
+    << e;
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n2\n0 400\n1 1"));
+  EXPECT_NE(e.find("line 6: tilt angle 2 of 2 is 400 degrees"), std::string::npos) << e;
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n2\n2\n0 90\n1 x"));
+  EXPECT_NE(
+    e.find("line 7: tilt multiplying factor 2 of 2 is 'x', not a finite number"), std::string::npos)
+    << e;
+  e = error("IESNA:LM-63-2002\nTILT=INCLUDE\n1\n3\n0 45 90\n1 0.9");
+  EXPECT_NE(e.find("bad.ies: the file ends (after line 6) before tilt multiplying factor 3 of 3"),
+    std::string::npos)
+    << e;
   // Horizontal angles that are no LM-63 symmetry.
   const std::string odd = iesFile({ 0, 45, 90 }, { 0, 45, 120 }, f);
   e = error(odd);
@@ -914,11 +945,216 @@ TEST(Photometry, IesTypeBFollowsItsLateralAxis)
   EXPECT_EQ(back.distribution.intensity(typeBDirection(0, 0)), 0);
   EXPECT_NEAR(back.distribution.intensity(typeBDirection(180, 0)), g(180, 0), 1e-9 * g(180, 0));
   EXPECT_NEAR(sphereIntegral(back.distribution), 1, 2e-3);
+}
 
-  // Type A stays refused by name.
-  std::string a = typeBFile(vertical, horizontal, f);
-  a.replace(a.find(" 2 2 0 0 0"), 10, " 3 2 0 0 0");
-  EXPECT_NE(checks::errorOf([&] { parseIes(a, "a.ies"); }).find("type A"), std::string::npos);
+/// An IES LM-63-2002 type A file of the candela f(H, V) at the given angles (degrees).
+std::string typeAFile(const std::vector<double>& vertical, const std::vector<double>& horizontal,
+  const std::function<double(double, double)>& f)
+{
+  std::string text = typeBFile(vertical, horizontal, f);
+  text.replace(text.find(" 2 2 0 0 0"), 10, " 3 2 0 0 0");
+  return text;
+}
+
+/// The light-frame direction of type A angles (degrees): planes through the vertical axis, H
+/// clockwise seen from above from C = 0 (+x), V the elevation (-90 the nadir, +z of the frame).
+Vec3 typeADirection(double h, double v)
+{
+  const double hr = h * Pi / 180, vr = v * Pi / 180;
+  return Vec3(std::cos(vr) * std::cos(hr), -std::cos(vr) * std::sin(hr), -std::sin(vr));
+}
+
+TEST(Photometry, IesTypeAHasVerticalPlanesCountedClockwise)
+{
+  // An asymmetric headlamp-like beam about the photometric horizontal: every table point comes
+  // back in the direction LM-63-2002's definitions give it, and the density integrates to 1.
+  const std::vector<double> vertical = degrees(-90, 90, 15), horizontal = degrees(-90, 90, 30);
+  auto f = [](double h, double v)
+  {
+    const double hr = h * Pi / 180, vr = v * Pi / 180;
+    return (100 + 60 * std::sin(hr) + 30 * std::sin(vr)) * std::cos(hr) * std::cos(vr) + 2;
+  };
+  const Luminaire a = parseIes(typeAFile(vertical, horizontal, f), "a.ies");
+  EXPECT_TRUE(a.warnings.empty());
+  for (double h : horizontal)
+  {
+    for (double v : vertical)
+    {
+      if (std::abs(v) == 90)
+      {
+        continue; // the poles are one direction for every H
+      }
+      EXPECT_NEAR(a.distribution.intensity(typeADirection(h, v)), f(h, v), 1e-9 * f(h, v))
+        << "H " << h << ", V " << v;
+    }
+  }
+  EXPECT_NEAR(sphereIntegral(a.distribution), 1, 2e-3);
+  // Between the table's angles the interpolation is bilinear in H and V.
+  EXPECT_NEAR(a.distribution.intensity(typeADirection(15, 7.5)),
+    0.25 * (f(0, 0) + f(30, 0) + f(0, 15) + f(30, 15)), 1e-9 * f(15, 7.5));
+  // Positive H turns clockwise seen from above (towards -y), V = -90 is the nadir.
+  EXPECT_GT(a.distribution.intensity(normalize(Vec3(1, -0.5, 0))),
+    a.distribution.intensity(normalize(Vec3(1, 0.5, 0))));
+  EXPECT_NEAR(a.distribution.intensity(Vec3(0, 0, 1)), f(0, -90), 1e-9);
+  // Behind the lamp (|H| > 90) the file says nothing: no light there.
+  EXPECT_EQ(a.distribution.intensity(typeADirection(150, 10)), 0);
+  expectSamplesFollowDensity(a.distribution, -1, 37);
+
+  // Lateral symmetry (H from 0 to 90) equals its mirrored full table.
+  auto g = [](double h, double v)
+  { return (100 + 40 * std::cos(2 * h * Pi / 180)) * (95 - v) / 95; };
+  const Luminaire half = parseIes(typeAFile(vertical, degrees(0, 90, 30), g), "half.ies");
+  const Luminaire full = parseIes(typeAFile(vertical, horizontal, g), "full.ies");
+  EXPECT_LT(densityDifference(half.distribution, full.distribution), 1e-12);
+  EXPECT_NEAR(half.lumens, full.lumens, 1e-12 * full.lumens);
+
+  // One horizontal angle: the same in every vertical plane. 100 cd from V = -90 to 90 is the
+  // uniform sphere, 400 pi lm.
+  const Luminaire round =
+    parseIes(typeAFile(vertical, { 0 }, [](double, double) { return 100.0; }), "round.ies");
+  EXPECT_NEAR(round.lumens, 400 * Pi, 1e-9 * 400 * Pi);
+  // A whole turn of H (-180 to 180) is the whole sphere, and equals type C with gamma = 90 + V
+  // and C = -H.
+  auto c = [](double gamma, double cc)
+  {
+    return 50 +
+      30 * std::cos(gamma * Pi / 180) *
+      (1 + 0.5 * std::cos(cc * Pi / 180) + 0.3 * std::sin(cc * Pi / 180));
+  };
+  const Luminaire turn = parseIes(
+    typeAFile(vertical, degrees(-180, 180, 30), [&](double h, double v) { return c(90 + v, -h); }),
+    "turn.ies");
+  const Luminaire typeC = parseIes(iesFile(degrees(0, 180, 15), degrees(0, 360, 30), c), "c.ies");
+  EXPECT_LT(densityDifference(turn.distribution, typeC.distribution), 1e-9);
+  // The same turn from 0 to 360 is taken as given, not mirrored.
+  const Luminaire fromZero = parseIes(
+    typeAFile(vertical, degrees(0, 360, 30), [&](double h, double v) { return c(90 + v, -h); }),
+    "zero.ies");
+  EXPECT_LT(densityDifference(fromZero.distribution, typeC.distribution), 1e-9);
+}
+
+TEST(Photometry, IesLuminousOpeningShapes)
+{
+  // The signed width, length and height of each edition's shapes, in metres (units 2).
+  struct Case
+  {
+    const char* edition;
+    double w, l, h;
+    OpeningShape shape;
+    const char* name;
+    double alongX, alongY;
+    bool warns;
+  };
+  const Case cases[] = {
+    { "IESNA:LM-63-2002", 0, 0, 0, OpeningShape::None, "point", 0, 0, false },
+    { "IESNA:LM-63-2002", 0.3, 1.2, 0, OpeningShape::Rectangle, "rectangle", 1.2, 0.3, false },
+    { "IESNA:LM-63-2002", 0.3, 1.2, 0.1, OpeningShape::Rectangle, "rectangle with luminous sides",
+      1.2, 0.3, true },
+    { "IESNA:LM-63-2002", -0.2, -0.2, 0, OpeningShape::Ellipse, "circle", 0.2, 0.2, false },
+    { "IESNA:LM-63-1995", -0.2, 0, 0, OpeningShape::Ellipse, "circle", 0.2, 0.2, false },
+    { "IESNA:LM-63-2002", -0.2, -0.4, 0, OpeningShape::Ellipse, "ellipse", 0.4, 0.2, false },
+    { "IESNA:LM-63-2002", -0.2, -0.2, 0.3, OpeningShape::Ellipse, "vertical cylinder", 0.2, 0.2,
+      true },
+    { "IESNA:LM-63-2002", -0.2, -0.2, -0.2, OpeningShape::Ellipse, "sphere", 0.2, 0.2, true },
+    { "IESNA:LM-63-1995", -0.2, 0, -0.2, OpeningShape::Ellipse, "sphere", 0.2, 0.2, true },
+    { "IESNA:LM-63-2002", -0.1, 0.8, -0.1, OpeningShape::Rectangle,
+      "horizontal cylinder along the photometric horizontal", 0.8, 0.1, true },
+    { "IESNA:LM-63-2002", 0.8, -0.1, -0.1, OpeningShape::Rectangle,
+      "horizontal cylinder across the photometric horizontal", 0.1, 0.8, true },
+    { "IESNA:LM-63-2002", 0, -0.2, -0.2, OpeningShape::None,
+      "vertical disc facing the photometric horizontal", 0, 0, true },
+    { "IESNA:LM-63-2002", 0.2, -0.2, 0, OpeningShape::None, "unknown shape", 0, 0, true },
+  };
+  const auto f = [](double g, double) { return 100 * cosPower(g, 1); };
+  for (const Case& c : cases)
+  {
+    std::string text = iesFile({ 0, 45, 90 }, { 0 }, f);
+    text.replace(0, text.find('\n'), c.edition);
+    std::ostringstream sizes;
+    sizes << " 1 2 " << c.w << " " << c.l << " " << c.h << "\n";
+    text.replace(text.find(" 1 2 0.6 1.2 0\n"), 15, sizes.str());
+    const Luminaire l = parseIes(text, "shape.ies");
+    EXPECT_EQ(l.opening, c.shape) << c.name;
+    EXPECT_EQ(l.openingName, c.name);
+    if (c.shape != OpeningShape::None)
+    {
+      EXPECT_NEAR(l.length, c.alongX, 1e-15) << c.name;
+      EXPECT_NEAR(l.width, c.alongY, 1e-15) << c.name;
+    }
+    EXPECT_EQ(!l.warnings.empty(), c.warns) << c.name;
+  }
+  // Feet: a 2 by 4 foot troffer.
+  std::string feet = iesFile({ 0, 45, 90 }, { 0 }, f);
+  feet.replace(feet.find(" 1 2 0.6 1.2 0\n"), 15, " 1 1 2 4 0\n");
+  const Luminaire troffer = parseIes(feet, "troffer.ies");
+  EXPECT_EQ(troffer.opening, OpeningShape::Rectangle);
+  EXPECT_NEAR(troffer.length, 4 * 0.3048, 1e-15);
+  EXPECT_NEAR(troffer.width, 2 * 0.3048, 1e-15);
+
+  // EULUMDAT: the luminous area (mm), round when its width is 0.
+  const std::vector<double> gammas = degrees(0, 90, 30);
+  const std::string ldt = ldtFile(1, 90, gammas, f);
+  const Luminaire rectangle = parseEulumdat(ldt, "r.ldt");
+  EXPECT_EQ(rectangle.opening, OpeningShape::Rectangle);
+  EXPECT_NEAR(rectangle.length, 0.5, 1e-15);
+  EXPECT_NEAR(rectangle.width, 0.3, 1e-15);
+  std::string disc = ldt;
+  const std::string area = "\n500\n300\n0\n";
+  disc.replace(disc.find(area), area.size(), "\n250\n0\n0\n");
+  const Luminaire circle = parseEulumdat(disc, "c.ldt");
+  EXPECT_EQ(circle.opening, OpeningShape::Ellipse);
+  EXPECT_EQ(circle.openingName, "circle");
+  EXPECT_NEAR(circle.length, 0.25, 1e-15);
+  EXPECT_NEAR(circle.width, 0.25, 1e-15);
+  EXPECT_TRUE(circle.warnings.empty());
+  // No luminous area: the luminaire's own outline (600 mm round), with a warning.
+  std::string body = ldt;
+  const std::string sizes = "\n600\n0\n80\n500\n300\n";
+  body.replace(body.find(sizes), sizes.size(), "\n600\n0\n80\n0\n0\n");
+  const Luminaire outline = parseEulumdat(body, "b.ldt");
+  EXPECT_EQ(outline.opening, OpeningShape::Ellipse);
+  EXPECT_NEAR(outline.length, 0.6, 1e-15);
+  ASSERT_EQ(outline.warnings.size(), 1u);
+  EXPECT_NE(outline.warnings[0].find("no luminous area"), std::string::npos);
+}
+
+TEST(Photometry, OpeningPolygonsFaceTheNadirWithTheirAreas)
+{
+  auto check = [](const Luminaire& l, double area)
+  {
+    const std::vector<Vec3> polygon = openingPolygon(l);
+    Vec3 twice, centroid;
+    for (std::size_t i = 0; i < polygon.size(); ++i)
+    {
+      twice += cross(polygon[i], polygon[(i + 1) % polygon.size()]);
+      centroid += polygon[i];
+      EXPECT_EQ(polygon[i].z, 0);
+    }
+    // The right-hand normal is the nadir -z, the first edge C = 0 (+x).
+    EXPECT_NEAR(twice.z / 2, -area, 1e-12 * area);
+    EXPECT_NEAR(polygon[1].y - polygon[0].y, 0, 1e-15);
+    EXPECT_GT(polygon[1].x - polygon[0].x, 0);
+    EXPECT_NEAR(length(centroid / double(polygon.size())), 0, 1e-15);
+    double extentX = 0, extentY = 0;
+    for (const Vec3& p : polygon)
+    {
+      extentX = std::max(extentX, std::abs(p.x));
+      extentY = std::max(extentY, std::abs(p.y));
+    }
+    EXPECT_NEAR(2 * extentX, l.length, 0.01 * l.length);
+    EXPECT_NEAR(2 * extentY, l.width, 0.01 * l.width);
+  };
+  Luminaire rectangle;
+  rectangle.opening = OpeningShape::Rectangle;
+  rectangle.length = 1.2;
+  rectangle.width = 0.3;
+  check(rectangle, 1.2 * 0.3);
+  Luminaire ellipse = rectangle;
+  ellipse.opening = OpeningShape::Ellipse;
+  check(ellipse, Pi * 0.6 * 0.15);
+  Luminaire none;
+  EXPECT_NE(
+    checks::errorOf([&] { openingPolygon(none); }).find("no luminous opening"), std::string::npos);
 }
 
 TEST(Photometry, BadEulumdatFilesNameTheLineAndField)

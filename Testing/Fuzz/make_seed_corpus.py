@@ -172,7 +172,7 @@ def reader_seeds():
                                                legacy)
 
 
-# --- readers: photometric files (IES LM-63 type C, EULUMDAT) -------------------------------
+# --- readers: photometric files (IES LM-63 types C, B and A, TILT=INCLUDE, EULUMDAT) ----------
 def ies_text(vertical, horizontal, candela, header="IESNA:LM-63-2002", tilt="TILT=NONE",
              units=2, lamp_line=None):
     lines = [header, "[TEST] seed", "[MANUFAC] MovingLightRadiosity", tilt]
@@ -231,6 +231,25 @@ def photometric_seeds():
             b_vertical, planes, [[round(50 + 40 * math.cos(math.radians(v)), 3)
                                   for v in b_vertical] for _ in planes],
             lamp_line=f"1 -1 1 {len(b_vertical)} {len(planes)} 2 2 0.5 0.5 0")
+
+    # Type A (photometric type 3): planes through the vertical axis, H clockwise, V from -90.
+    for name, planes in (("type_a_lateral", [0, 45, 90]), ("type_a_full", [-90, 0, 90])):
+        yield "ies_" + name, 6, ies_text(
+            b_vertical, planes, [[round(60 + 30 * math.cos(math.radians(v)), 3)
+                                  for v in b_vertical] for _ in planes],
+            lamp_line=f"1 -1 1 {len(b_vertical)} {len(planes)} 3 2 0.5 0.5 0")
+    # TILT=INCLUDE tables that vary, for a horizontal lamp (geometry 2) and in feet with a
+    # round opening; a tilt block whose angles descend; a vertical cylinder's opening.
+    yield "ies_tilt_geometry2", 6, ies_text(
+        vertical, [0, 90, 180], [row(c) for c in (0, 90, 180)],
+        tilt="TILT=INCLUDE\n2\n7\n0 15 30 45 60 75 90\n1 0.98 0.94 0.9 0.85 0.8 0.76")
+    yield "ies_tilt_round_feet", 6, ies_text(
+        vertical, [0], [row(0)], tilt="TILT=INCLUDE\n3\n3\n-90 0 90\n0.8 1 0.8", units=1,
+        lamp_line=f"1 -1 1 {len(vertical)} 1 1 1 -0.5 -0.5 0")
+    yield "ies_tilt_descending", 6, ies_text(
+        vertical, [0], [row(0)], tilt="TILT=INCLUDE\n1\n3\n0 45 30\n1 1 1")
+    yield "ies_vertical_cylinder", 6, ies_text(
+        vertical, [0], [row(0)], lamp_line=f"1 -1 1 {len(vertical)} 1 1 2 -0.2 -0.2 0.3")
 
     gammas = [0, 30, 60, 90, 120, 150, 180]
 

@@ -1,11 +1,14 @@
 """Luminaires from Python: a point light without a Light input, spots on area and point
-lights, lumens, and the refusal of contradictory settings with messages naming them.
+lights, lumens, a luminaire emitting from its file's opening, TILT=INCLUDE factors per frame,
+and the refusal of contradictory settings with messages naming them.
 
 Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.txt), or by hand:
     PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
 """
 import math
 
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData, vtkPolyLine
 from vtkmodules.vtkFiltersCore import vtkCellCenters
 from vtkmodules.vtkFiltersSources import vtkPlaneSource
 from vtkmodules.util.misc import calldata_type
@@ -127,3 +130,128 @@ def test_print_self_lists_the_luminaire():
     for line in ("LightType: Point", "SpotHalfAngle: 30 degrees", "SpotSoftEdge: 0 degrees",
                  "LightFluxLumens: 800 lm", "LightDistributionFile: "):
         assert line in text, text
+
+
+def ies_file(path, opening="0.4 0.8 0", tilt="TILT=NONE"):
+    """A uniform 100 cd downlight (LM-63-2002, metres) with the given width, length and height
+    of its luminous opening and TILT block."""
+    path.write_text("IESNA:LM-63-2002\n[TEST] luminaire\n" + tilt + "\n"
+                    f"1 -1 1 3 1 1 2 {opening}\n1 1 20\n0 45 90\n0\n100 100 100\n")
+    return str(path)
+
+
+def warnings_of(radiosity):
+    warnings = []
+
+    @calldata_type(VTK_STRING)
+    def record(_caller, _event, message):
+        warnings.append(message)
+
+    radiosity.AddObserver("WarningEvent", record)
+    return warnings
+
+
+def polygon_area_and_bounds(light):
+    assert light.GetNumberOfCells() == 1
+    points = vtk_to_numpy(light.GetPoints().GetData())
+    area = 0.0
+    for i in range(len(points)):
+        a, b = points[i], points[(i + 1) % len(points)]
+        area += a[0] * b[1] - a[1] * b[0]
+    return abs(area) / 2, light.GetBounds()
+
+
+def test_luminaire_emits_from_the_files_opening(tmp_path):
+    # A 0.8 m (length, C0-C180, x) by 0.4 m (width) opening, centred on the path's points.
+    rectangle = radiosity_filter(LightType=vtkMovingLightRadiosity.LUMINAIRE_LIGHT,
+                                 LightDistributionFile=ies_file(tmp_path / "troffer.ies"))
+    for time, x in ((0.0, 0.0), (1.0, 1.0)):
+        rectangle.UpdateTimeStep(time)
+        area, bounds = polygon_area_and_bounds(rectangle.GetOutput(2))
+        assert abs(area - 0.32) < 1e-9, area
+        expected = (x - 0.4, x + 0.4, -0.2, 0.2, 1.0, 1.0)
+        assert all(abs(b - e) < 1e-9 for b, e in zip(bounds, expected)), bounds
+        _, values, _ = direct(rectangle, time)
+        assert values.max() > 0
+    # A round one (negative diameters, LM-63-2002): a polygon of the disc's area.
+    disc = radiosity_filter(LightType=vtkMovingLightRadiosity.LUMINAIRE_LIGHT,
+                            LightDistributionFile=ies_file(tmp_path / "disc.ies", "-0.3 -0.3 0"))
+    disc.UpdateTimeStep(0.0)
+    area, bounds = polygon_area_and_bounds(disc.GetOutput(2))
+    assert abs(area - math.pi * 0.15 ** 2) < 1e-9, area
+    assert abs(bounds[1] - bounds[0] - 0.3) < 0.01, bounds
+    # No opening: a point light, said so.
+    point = radiosity_filter(LightType=vtkMovingLightRadiosity.LUMINAIRE_LIGHT,
+                             LightDistributionFile=ies_file(tmp_path / "point.ies", "0 0 0"))
+    warnings = warnings_of(point)
+    point.UpdateTimeStep(0.0)
+    assert point.GetOutput(2).GetNumberOfCells() == 0
+    assert any("gives no luminous opening" in w and "point light" in w for w in warnings), warnings
+    # Without a file there is no opening to emit from.
+    assert "LightDistributionFile" in failure(
+        radiosity_filter(LightType=vtkMovingLightRadiosity.LUMINAIRE_LIGHT))
+
+
+def test_area_light_of_another_size_than_the_opening_is_warned_of(tmp_path):
+    big = radiosity_filter(LightDistributionFile=ies_file(tmp_path / "small.ies", "0.05 0.05 0"))
+    big.SetLightData(output(square_light((0, 0, 1), 0.5)))
+    warnings = warnings_of(big)
+    big.UpdateTimeStep(0.0)
+    assert any("luminous opening (a rectangle) is 0.05 by 0.05 m" in w for w in warnings), warnings
+    same = radiosity_filter(LightDistributionFile=ies_file(tmp_path / "same.ies", "0.5 0.5 0"))
+    same.SetLightData(output(square_light((0, 0, 1), 0.5)))
+    warnings = warnings_of(same)
+    same.UpdateTimeStep(0.0)
+    assert not any("luminous opening" in w for w in warnings), warnings
+
+
+def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):
+    # The same point light, aimed down in frame 0 and tilted 60 degrees in frame 1 (a Normal
+    # array), with and without a TILT table of factors 1 at 0 and 0.5 at 90 degrees: the same
+    # paths, so frame 1's light is exactly 1 - 0.5 (60 / 90) of the untilted one's, and
+    # frame 0's equal.
+    points = vtkPoints()
+    points.InsertNextPoint(0, 0, 1)
+    points.InsertNextPoint(0.5, 0, 1)
+    trajectory = vtkPolyData()
+    trajectory.SetPoints(points)
+    line = vtkPolyLine()
+    line.GetPointIds().SetNumberOfIds(2)
+    line.GetPointIds().SetId(0, 0)
+    line.GetPointIds().SetId(1, 1)
+    lines = vtkCellArray()
+    lines.InsertNextCell(line)
+    trajectory.SetLines(lines)
+    normals = vtkDoubleArray()
+    normals.SetName("Normal")
+    normals.SetNumberOfComponents(3)
+    tilt = math.radians(60)
+    normals.InsertNextTuple((0, 0, -1))
+    normals.InsertNextTuple((math.sin(tilt), 0, -math.cos(tilt)))
+    trajectory.GetPointData().AddArray(normals)
+    # The point light, and the luminaire of the file's 0.4 by 0.8 m opening (an area light).
+    for kind in (vtkMovingLightRadiosity.POINT_LIGHT, vtkMovingLightRadiosity.LUMINAIRE_LIGHT):
+        runs = {}
+        for name, block in (("none", "TILT=NONE"), ("tilt", "TILT=INCLUDE\n1\n2\n0 90\n1 0.5")):
+            radiosity = radiosity_filter(LightType=kind,
+                                         LightDistributionFile=ies_file(tmp_path / f"{name}.ies",
+                                                                        tilt=block))
+            radiosity.SetTrajectoryData(trajectory)
+            runs[name] = [direct(radiosity, t)[1] for t in (0.0, 1.0)]
+        for frame, factor in ((0, 1.0), (1, 1 - 0.5 * 60 / 90)):
+            lit = runs["none"][frame] > 0
+            assert lit.any()
+            ratio = runs["tilt"][frame][lit] / runs["none"][frame][lit]
+            # The arrays are float32: a few ulps.
+            assert abs(ratio - factor).max() < 1e-6, (kind, frame, ratio.min(), ratio.max())
+    # Tilted beyond the table: the end factor, with a warning naming the position.
+    normals.SetTuple3(1, 0, 0, 1)  # aimed straight up: 180 degrees
+    normals.Modified()
+    beyond = radiosity_filter(LightType=vtkMovingLightRadiosity.POINT_LIGHT,
+                              LightDistributionFile=ies_file(
+                                  tmp_path / "beyond.ies", tilt="TILT=INCLUDE\n1\n2\n0 90\n1 0.5"))
+    beyond.SetTrajectoryData(trajectory)
+    warnings = warnings_of(beyond)
+    beyond.UpdateTimeStep(0.0)
+    assert any("light position 1 tilts the luminaire by 180 degrees, outside the TILT table's "
+               "0 to 90" in w for w in warnings), warnings
