@@ -637,6 +637,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   {
     if (controller)
     {
+      // The solve's first collective would wait in silence for a rank that never comes.
+      mlr::vtkparallel::rendezvous(
+        controller, mlr::vtkparallel::rankWaitLimit(),
+        [this](const std::string& message) { vtkWarningMacro(<< message); },
+        [this](const std::string& message) { vtkErrorMacro(<< message); });
       // Every rank gets the whole Scene, Light and Trajectory, whatever pieces arrived.
       const auto start = std::chrono::steady_clock::now();
       const char* names[3] = { "Scene", "Light", "Trajectory" };

@@ -17,6 +17,8 @@ run_parallel.py compares. Cases:
   the proxy's UpdatePipeline (every port); every rank then updates again with nothing changed;
 - abortalone: the same abort, then rank 0 alone updates again and sets AbortExecute between
   updates; every rank then updates with a new NumberOfPaths;
+- waitlimit: a solve, then rank 0 alone sets a property and updates (run with
+  MLR_RANK_WAIT_LIMIT set: rank 0 names the ranks it waits for, then aborts the job);
 - bad: rank 1's Scene piece lacks the Reflectance array (the ranks' pieces disagree), then,
   with consistent pieces, rank 1 alone has a memory limit the solve does not fit in.
 """
@@ -29,7 +31,7 @@ import numpy as np
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--plugin", required=True)
-parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "bad"])
+parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "waitlimit", "bad"])
 parser.add_argument("--out", required=True, help="prefix of the .rank<r>.npz files written")
 parser.add_argument("--paths", type=int, default=20000)
 args = parser.parse_args()
@@ -181,6 +183,14 @@ elif args.case in ("abort", "abortalone"):
     # A change solves again, on every rank, once.
     radiosity.NumberOfPaths = 20000
     record("after_", 0.0)
+elif args.case == "waitlimit":
+    # A solve on every rank, then rank 0 alone changes a property and updates: it waits for
+    # the others, says which, and past MLR_RANK_WAIT_LIMIT aborts the job.
+    record("first_", 0.0)
+    if rank == 0:
+        radiosity.Seed = 2
+        radiosity.UpdatePipeline(time=0.0)
+        print("rank 0 solved alone", flush=True)
 elif args.case == "bad":
     record("bad_", 0.0)
     results["bad_errors"] = np.array(errors[:])

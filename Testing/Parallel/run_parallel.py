@@ -3,7 +3,7 @@
 ranks under mpiexec (pvbatch --symmetric), each bounded by a timeout, and compares what every
 rank wrote (pvbatch_parallel.py). Exits non-zero with one line per failed check.
 
-    run_parallel.py --case whole|split|time|abort|abortalone|bad --ranks R --mpiexec M --pvbatch P \
+    run_parallel.py --case whole|split|time|abort|abortalone|waitlimit|bad --ranks R --mpiexec M --pvbatch P \
         --plugin MovingLightRadiosity.so --work DIR
 
 whole: the union of the ranks' outputs is the serial output bit for bit, cell by cell, and
@@ -18,6 +18,9 @@ abort: rank 0 aborts mid-solve (plain SetAbortExecute, during the proxy's Update
 abortalone: the same abort, then rank 0 alone updates and sets AbortExecute between updates:
        rank 0 solves nothing alone (no rank hangs), and the next solve, on every rank, is
        aborted on every rank; a change then solves on every rank, once.
+waitlimit: after a solve, rank 0 alone sets a property and updates, under
+       MLR_RANK_WAIT_LIMIT=4: rank 0 reports the ranks it waits for, then aborts the job with
+       an error saying so, rather than hanging.
 bad:   rank 1's piece lacks Reflectance: every rank reports an error naming it; rank 1 alone
        over its memory limit: every rank reports the limit. No rank hangs (the timeout).
 """
@@ -37,10 +40,11 @@ SCRIPT = os.path.join(HERE, "pvbatch_parallel.py")
 TIMEOUT = 120
 
 
-def run(command, what, timeout=TIMEOUT):
-    """Runs `command` in its own process group, killing the group on timeout."""
+def run(command, what, timeout=TIMEOUT, env=None, may_fail=False):
+    """Runs `command` in its own process group, killing the group on timeout. Returns its
+    output, and with `may_fail` its exit code too instead of failing on a non-zero one."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               text=True, start_new_session=True)
+                               text=True, start_new_session=True, env=env)
     try:
         output, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -48,6 +52,8 @@ def run(command, what, timeout=TIMEOUT):
         output, _ = process.communicate()
         sys.exit(f"{what}: no answer within {timeout} s (a rank hangs?): {' '.join(command)}\n"
                  f"{(output or '')[-4000:]}")
+    if may_fail:
+        return output, process.returncode
     if process.returncode != 0:
         sys.exit(f"{what} exited with {process.returncode}:\n{output[-4000:]}")
     return output
@@ -120,6 +126,26 @@ def total_power(data, prefix):
     return float((data[prefix + "cell_Radiosity"].sum(axis=1) * areas).sum())
 
 
+def wait_limit(checks, args, command):
+    """waitlimit: rank 0 updates alone and, MLR_RANK_WAIT_LIMIT seconds on, aborts the job
+    with a message naming the ranks it waited for, after a report halfway."""
+    limit = 4
+    env = dict(os.environ, MLR_RANK_WAIT_LIMIT=str(limit))
+    output, code = run(command, f"{args.ranks} ranks", args.timeout, env=env, may_fail=True)
+    others = "rank 1" if args.ranks == 2 else "ranks " + ", ".join(map(str, range(1, args.ranks - 1))) + \
+        f" and {args.ranks - 1}"
+    waiting = f"rank 0 of {args.ranks} has waited"
+    checks.check(code != 0, f"the job exited with 0: rank 0 updating alone was not stopped\n{output[-3000:]}")
+    checks.check("rank 0 solved alone" not in output, "rank 0 solved alone")
+    checks.check(output.count(waiting) >= 2 and f"for {others} to start the solve" in output,
+                 f"no report and error naming {others} from rank 0:\n{output[-3000:]}")
+    checks.check(f"MLR_RANK_WAIT_LIMIT is {limit}" in output and "aborting the MPI job" in output,
+                 f"no error stating the wait limit:\n{output[-3000:]}")
+    solved = load(os.path.join(args.work, args.case))
+    checks.check(len(solved) >= args.ranks - 1 and all(int(r["first_solves"]) == 1 for r in solved),
+                 "the solve before rank 0 went alone did not succeed on every rank that wrote results")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--case", required=True)
@@ -142,6 +168,10 @@ def main():
            args.pvbatch, "--symmetric", "--force-offscreen-rendering", SCRIPT, "--plugin", args.plugin]
     out = os.path.join(args.work, args.case)
     extra = ["--paths", "400000"] if args.case.startswith("abort") else []
+    if args.case == "waitlimit":
+        wait_limit(checks, args, mpi + ["--case", args.case, "--out", out])
+        checks.finish(name)
+        return
     run(mpi + ["--case", args.case, "--out", out] + extra, f"{args.ranks} ranks", args.timeout)
     ranks = load(out)
     check(len(ranks) == args.ranks, f"{len(ranks)} ranks wrote results instead of {args.ranks}")
