@@ -10,9 +10,6 @@
 #include "vtkGenericCell.h"
 #include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
-#include "vtkMPI.h"
-#include "vtkMPICommunicator.h"
-#include "vtkMPIController.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -20,6 +17,12 @@
 #include "vtkPolyData.h"
 #include "vtkStaticCellLocator.h"
 #include "vtkUnsignedCharArray.h"
+
+#if VTK_MODULE_ENABLE_VTK_ParallelMPI
+#include "vtkMPI.h"
+#include "vtkMPICommunicator.h"
+#include "vtkMPIController.h"
+#endif
 
 #include <algorithm>
 #include <array>
@@ -354,6 +357,12 @@ void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
   const std::function<void(const std::string&)>& report,
   const std::function<void(const std::string&)>& fail)
 {
+#if !VTK_MODULE_ENABLE_VTK_ParallelMPI
+  (void)controller;
+  (void)limitSeconds;
+  (void)report;
+  (void)fail;
+#else
   vtkMPIController* mpi = vtkMPIController::SafeDownCast(controller);
   if (!mpi)
   {
@@ -403,13 +412,20 @@ void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
     const bool over = limitSeconds > 0 && waited >= limitSeconds;
     if (waited >= nextReport || over)
     {
+      // The first few by number: on many ranks the list could run to thousands.
+      constexpr std::size_t shown = 8;
+      const std::size_t listed = missing.size() > shown ? shown : missing.size();
       std::string names;
-      for (std::size_t k = 0; k < missing.size(); ++k)
+      for (std::size_t k = 0; k < listed; ++k)
       {
-        names += (k == 0                       ? ""
-                     : k + 1 == missing.size() ? " and "
-                                               : ", ") +
+        names += (k == 0                                           ? ""
+                     : k + 1 == listed && listed == missing.size() ? " and "
+                                                                   : ", ") +
           std::to_string(missing[k]);
+      }
+      if (listed < missing.size())
+      {
+        names += " and " + std::to_string(missing.size() - listed) + " more";
       }
       const std::string message = "rank " + std::to_string(rank) + " of " + std::to_string(ranks) +
         " has waited " + std::to_string(static_cast<long>(waited)) + " s for rank" +
@@ -447,6 +463,7 @@ void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
       sends[static_cast<std::size_t>(q)].Wait();
     }
   }
+#endif
 }
 
 /// Sums go in chunks: MPI counts are ints.
