@@ -89,7 +89,10 @@
  * solution bit for bit once the sums over ranks are done; each rank outputs the elements and
  * patches whose nearest input cell is its own, rank 0 the Light. An abort or an error on any
  * rank is reported on every rank, and leaves every rank in the same state, so that the next
- * request solves on every rank or on none. See README, "Running on a cluster".
+ * request solves on every rank or on none. A rank that comes to a solve alone names the ranks
+ * it waits for after 10 s; with the environment variable MLR_RANK_WAIT_LIMIT (seconds) it
+ * then aborts the MPI job with that error rather than wait for ever. See README, "Running on
+ * a cluster".
  *
  * @warning
  * The solve uses NumberOfThreads threads of its own (0: every core), whatever the
