@@ -18,10 +18,21 @@
 #include "vtkStaticCellLocator.h"
 #include "vtkUnsignedCharArray.h"
 
+#if VTK_MODULE_ENABLE_VTK_ParallelMPI
+#include "vtkMPI.h"
+#include "vtkMPICommunicator.h"
+#include "vtkMPIController.h"
+#endif
+
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
+#include <sstream>
+#include <thread>
 #include <tuple>
 
 namespace mlr::vtkparallel
@@ -328,6 +339,131 @@ vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controlle
     polyData.push_back(pd);
   }
   return joinPieces(polyData, pieceRanks, port, cellRanks);
+}
+
+double rankWaitLimit()
+{
+  const char* text = std::getenv("MLR_RANK_WAIT_LIMIT");
+  if (!text || !*text)
+  {
+    return 0;
+  }
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  return end && *end == '\0' && seconds > 0 ? seconds : 0;
+}
+
+void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
+  const std::function<void(const std::string&)>& report,
+  const std::function<void(const std::string&)>& fail)
+{
+#if !VTK_MODULE_ENABLE_VTK_ParallelMPI
+  (void)controller;
+  (void)limitSeconds;
+  (void)report;
+  (void)fail;
+#else
+  vtkMPIController* mpi = vtkMPIController::SafeDownCast(controller);
+  if (!mpi)
+  {
+    return;
+  }
+  // A tag of its own: VTK's and ParaView's messages (RMIs, data movers) never match it.
+  constexpr int Tag = 31553;
+  const int ranks = mpi->GetNumberOfProcesses();
+  const int rank = mpi->GetLocalProcessId();
+  int token = 1;
+  std::vector<int> received(static_cast<std::size_t>(ranks), 0);
+  std::vector<vtkMPICommunicator::Request> sends(received.size()), receives(received.size());
+  std::vector<bool> arrived(received.size(), false);
+  for (int q = 0; q < ranks; ++q)
+  {
+    if (q != rank)
+    {
+      const std::size_t i = static_cast<std::size_t>(q);
+      mpi->NoBlockSend(&token, 1, q, Tag, sends[i]);
+      mpi->NoBlockReceive(&received[i], 1, q, Tag, receives[i]);
+    }
+  }
+  arrived[static_cast<std::size_t>(rank)] = true;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  double nextReport = limitSeconds > 0 ? std::min(10.0, limitSeconds / 2) : 10.0;
+  for (;;)
+  {
+    std::vector<int> missing;
+    for (int q = 0; q < ranks; ++q)
+    {
+      const std::size_t i = static_cast<std::size_t>(q);
+      if (!arrived[i] && receives[i].Test())
+      {
+        arrived[i] = true;
+      }
+      if (!arrived[i])
+      {
+        missing.push_back(q);
+      }
+    }
+    if (missing.empty())
+    {
+      break;
+    }
+    const double waited = std::chrono::duration<double>(Clock::now() - start).count();
+    const bool over = limitSeconds > 0 && waited >= limitSeconds;
+    if (waited >= nextReport || over)
+    {
+      // The first few by number: on many ranks the list could run to thousands.
+      constexpr std::size_t shown = 8;
+      const std::size_t listed = missing.size() > shown ? shown : missing.size();
+      std::string names;
+      for (std::size_t k = 0; k < listed; ++k)
+      {
+        names += (k == 0                                           ? ""
+                     : k + 1 == listed && listed == missing.size() ? " and "
+                                                                   : ", ") +
+          std::to_string(missing[k]);
+      }
+      if (listed < missing.size())
+      {
+        names += " and " + std::to_string(missing.size() - listed) + " more";
+      }
+      const std::string message = "rank " + std::to_string(rank) + " of " + std::to_string(ranks) +
+        " has waited " + std::to_string(static_cast<long>(waited)) + " s for rank" +
+        (missing.size() > 1 ? "s " : " ") + names +
+        " to start the solve: every rank must update the filter together, with the same "
+        "properties (a script that updates or sets properties on some ranks only leaves "
+        "them waiting for each other for ever)";
+      if (over)
+      {
+        std::ostringstream limit;
+        limit << limitSeconds;
+        const std::string final =
+          message + "; MLR_RANK_WAIT_LIMIT is " + limit.str() + " s: aborting the MPI job";
+        fail(final);
+        // Also straight to stderr: an observer of the error (which keeps it from the output
+        // window) has no time to show it before the job is killed.
+        std::fprintf(stderr, "vtkMovingLightRadiosity: %s\n", final.c_str());
+        std::fflush(stderr);
+        vtkMPICommunicator* communicator = vtkMPICommunicator::SafeDownCast(mpi->GetCommunicator());
+        MPI_Abort(communicator && communicator->GetMPIComm()
+            ? *communicator->GetMPIComm()->GetHandle()
+            : MPI_COMM_WORLD,
+          1);
+      }
+      report(message);
+      nextReport = waited + 60;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  // Every token was received, so the sends are complete or about to be.
+  for (int q = 0; q < ranks; ++q)
+  {
+    if (q != rank)
+    {
+      sends[static_cast<std::size_t>(q)].Wait();
+    }
+  }
+#endif
 }
 
 /// Sums go in chunks: MPI counts are ints.

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,24 @@ vtkMultiProcessController* controller();
  */
 vtkSmartPointer<vtkDataObject> gatherPieces(vtkMultiProcessController* controller,
   vtkDataObject* piece, const std::string& port, std::vector<int>* cellRanks = nullptr);
+
+/**
+ * Waits until every rank has come to this point, by point-to-point messages rather than a
+ * collective, so that a rank that came alone (a script updating one rank only, or properties
+ * set on some ranks only) is told which ranks it waits for instead of hanging in silence:
+ * `report` gets that message after 10 s, then every minute. When `limitSeconds` > 0 and the
+ * ranks are still missing after it, the message goes to `fail` and the MPI job is aborted
+ * (MPI_Abort): giving up alone would leave this rank's message to be taken by the others'
+ * next solve, which would then wait for this rank in a collective. Every rank must call it
+ * as often as the others, as a collective; nothing is done without an MPI controller.
+ */
+void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
+  const std::function<void(const std::string&)>& report,
+  const std::function<void(const std::string&)>& fail);
+
+/// MLR_RANK_WAIT_LIMIT from the environment, in seconds (0, waiting without limit, when it
+/// is unset or not a positive number).
+double rankWaitLimit();
 
 /// Sets options.rank, ranks and the sums over ranks (the controller's AllReduce).
 void shareSolve(vtkMultiProcessController* controller, SolverOptions& options);

@@ -74,15 +74,21 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
+  /// Empties the result; the times of the last attempt are kept, as RequestData compares
+  /// them with the MTimes to tell a failed attempt asked again from a changed one.
   void Clear()
   {
-    const bool aborted = this->Aborted;
+    const vtkTimeStamp solveTime = this->SolveTime;
+    const vtkTimeStamp propertiesTime = this->PropertiesTime;
     *this = vtkInternals();
-    this->Aborted = aborted;
+    this->SolveTime = solveTime;
+    this->PropertiesTime = propertiesTime;
   }
 
-  /// The last solve stopped because AbortExecute was set (it stays set: see RequestData).
+  /// The last attempt failed (Failure says why), or was aborted on some rank (Aborted).
+  bool Failed = false;
   bool Aborted = false;
+  std::string Failure;
 
   // Several ranks: this rank outputs only the elements and patches that come from
   // its own input cells, and rank 0 the Light.
@@ -514,21 +520,32 @@ int vtkMovingLightRadiosity::RequestData(
       ? this->LuminousEfficacy
       : c.DaylightEfficacy[std::min(f, c.DaylightEfficacy.size() - 1)];
   };
-  if (cache.Aborted)
-  {
-    // This VTK no longer clears AbortExecute when an execution starts: the flag that stopped
-    // the previous solve must not stop this one. Cleared directly, as the executive used to,
-    // so that the MTime (and with it the cache key) does not change.
-    this->AbortExecute = 0;
-    cache.Aborted = false;
-  }
-  bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
-  for (int port = 0; current && port < this->GetNumberOfInputPorts(); ++port)
+  // Whether anything that decides the result changed since the last solve or attempt.
+  bool unchanged = this->GetMTime() <= cache.PropertiesTime.GetMTime();
+  for (int port = 0; unchanged && port < this->GetNumberOfInputPorts(); ++port)
   {
     vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
-    current = !input || input->GetMTime() <= cache.SolveTime.GetMTime();
+    unchanged = !input || input->GetMTime() <= cache.SolveTime.GetMTime();
   }
-  if (!current && !this->Solve(inputVector))
+  if (unchanged && cache.Failed)
+  {
+    // The executive runs the filter again for another time step, another port or piece:
+    // requests that need not reach every rank (a script may update one rank alone), so no
+    // solve may start here, as a solve waits for every rank. Properties and inputs change
+    // on every rank alike, and only their change solves again.
+    if (cache.Aborted)
+    {
+      vtkErrorMacro(<< "the last solve was aborted and nothing has changed since: change a "
+                       "property or an input, or call Modified() (on every rank), to solve "
+                       "again");
+    }
+    else
+    {
+      vtkErrorMacro(<< cache.Failure);
+    }
+    return 0;
+  }
+  if (!(unchanged && cache.HasResult) && !this->Solve(inputVector))
   {
     return 0;
   }
@@ -686,6 +703,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   {
     if (controller)
     {
+      // The solve's first collective would wait in silence for a rank that never comes.
+      mlr::vtkparallel::rendezvous(
+        controller, mlr::vtkparallel::rankWaitLimit(),
+        [this](const std::string& message) { vtkWarningMacro(<< message); },
+        [this](const std::string& message) { vtkErrorMacro(<< message); });
       // Every rank gets the whole Scene, Light and Trajectory, whatever pieces arrived.
       const auto start = std::chrono::steady_clock::now();
       const char* names[3] = { "Scene", "Light", "Trajectory" };
@@ -1034,6 +1056,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   {
     failure = std::string("the solve failed: ") + e.what();
   }
+  bool aborted = cancelled;
   if (controller && stage != Stage::Agreed)
   {
     const mlr::vtkparallel::Verdict verdict =
@@ -1042,11 +1065,37 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     {
       failure = verdict.message;
     }
+    // A rank that failed while another was aborted knows it from the verdict only: every
+    // rank must keep the same state, or their next requests would differ.
+    aborted = verdict.cancelled;
   }
   vtkErrorMacro(<< failure);
   cache.Clear();
-  cache.Aborted = cancelled;
+  cache.Failed = true;
+  cache.Aborted = aborted;
+  cache.Failure = failure;
+  // The abort is spent on every rank alike: AbortExecute is cleared directly (no MTime
+  // change), as this VTK's executive no longer does, and no output is marked ABORTED, which
+  // would make the executive run the filter again at the next request of any port on the
+  // rank whose CheckAbort fired, alone. SetAbortOutput moves the MTime: the attempt's
+  // PropertiesTime follows it, unless a property had changed during the attempt.
+  const bool propertiesAsAttempted = this->GetMTime() <= cache.PropertiesTime.GetMTime();
+  if (aborted)
+  {
+    this->AbortExecute = 0;
+  }
+  this->SetAbortOutput(false);
+  if (propertiesAsAttempted)
+  {
+    cache.PropertiesTime.Modified();
+  }
   return false;
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetAbortExecute(vtkTypeBool abort)
+{
+  this->AbortExecute = abort;
 }
 
 //------------------------------------------------------------------------------
@@ -1098,5 +1147,10 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LuminousEfficacy: " << this->LuminousEfficacy << " lm/W\n";
   os << indent
      << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
+     << "\n";
+  os << indent << "Last attempt: "
+     << (this->Internals->Aborted     ? "aborted"
+            : this->Internals->Failed ? "failed: " + this->Internals->Failure
+                                      : std::string("none failed"))
      << "\n";
 }

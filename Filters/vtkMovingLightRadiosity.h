@@ -78,9 +78,11 @@
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with
- * empty outputs and an error; the next update clears the flag and solves again. Bad input (NaN
- * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to fix
- * and empty outputs. An empty scene gives empty outputs and no error.
+ * empty outputs and an error, and clears the flag. An aborted or failed solve is not tried
+ * again until a property or an input changes (or Modified() is called): a request for another
+ * time step or output port meanwhile repeats the error without solving. Bad input (NaN
+ * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to
+ * fix and empty outputs. An empty scene gives empty outputs and no error.
  *
  * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
  * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
@@ -88,7 +90,11 @@
  * then cell order), traces its share of the paths and gathering rays, and holds the serial
  * solution bit for bit once the sums over ranks are done; each rank outputs the elements and
  * patches whose nearest input cell is its own, rank 0 the Light. An abort or an error on any
- * rank is reported on every rank. See README, "Running on a cluster".
+ * rank is reported on every rank, and leaves every rank in the same state, so that the next
+ * request solves on every rank or on none. A rank that comes to a solve alone names the ranks
+ * it waits for after 10 s; with the environment variable MLR_RANK_WAIT_LIMIT (seconds) it
+ * then aborts the MPI job with that error rather than wait for ever. See README, "Running on
+ * a cluster".
  *
  * @warning
  * The solve uses NumberOfThreads threads of its own (0: every core), whatever the
@@ -484,6 +490,13 @@ public:
    * Number of solves performed so far by this filter (new times do not solve again).
    */
   vtkGetMacro(SolveCount, vtkIdType);
+
+  /**
+   * Asks the solve under way (or the next one) to stop. Unlike vtkAlgorithm's setter this does
+   * not change the MTime: the flag decides no result, and on several ranks a rank whose
+   * MTime alone moved would solve again alone, waiting forever for the others.
+   */
+  void SetAbortExecute(vtkTypeBool abort) override;
 
 protected:
   vtkMovingLightRadiosity();

@@ -6,6 +6,7 @@
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
+#include "vtkInformation.h"
 #include "vtkMovingLightRadiosity.h"
 #include "vtkNew.h"
 #include "vtkPoints.h"
@@ -285,6 +286,86 @@ TEST(FilterBadInput, AbortStopsQuicklyWithEmptyOutputsAndRecovers)
   EXPECT_TRUE(again.succeeded) << again.messages->allErrors();
   EXPECT_GT(again.elements, 0);
   EXPECT_EQ(filter->GetSolveCount(), 1);
+}
+
+TEST(FilterBadInput, AnAbortHoldsUntilAPropertyChanges)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  filter->SetNumberOfPaths(50000000); // tens of seconds if anything solved it again
+  struct AbortState
+  {
+    vtkMovingLightRadiosity* filter;
+    bool aborted = false;
+  } state{ filter };
+  vtkNew<vtkCallbackCommand> abortMidway;
+  abortMidway->SetClientData(&state);
+  abortMidway->SetCallback(
+    [](vtkObject*, unsigned long, void* data, void*)
+    {
+      auto* s = static_cast<AbortState*>(data);
+      if (!s->aborted && s->filter->GetProgress() > 0.1)
+      {
+        s->aborted = true;
+        s->filter->SetAbortExecute(1);
+      }
+    });
+  filter->AddObserver(vtkCommand::ProgressEvent, abortMidway);
+  expectError(runFilter(filter), "aborted");
+  ASSERT_TRUE(state.aborted);
+  // The abort is spent: the flag is clear and no output is marked ABORTED, which would make
+  // the next request of any port run the solve again.
+  EXPECT_EQ(filter->GetAbortExecute(), 0);
+  for (int port = 0; port < filter->GetNumberOfOutputPorts(); ++port)
+  {
+    EXPECT_EQ(filter->GetOutputInformation(port)->Get(vtkAlgorithm::ABORTED()), 0) << port;
+  }
+
+  // Another port, as a proxy's UpdatePipeline asks next: nothing runs.
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(filter);
+  filter->Update(vtkMovingLightRadiosity::PATCHES_PORT);
+  EXPECT_TRUE(messages->errors.empty()) << messages->allErrors();
+  // Another time step runs the filter again, which repeats the abort and solves nothing.
+  const std::vector<double> steps = timeSteps(filter);
+  ASSERT_GT(steps.size(), 1u);
+  EXPECT_FALSE(filter->UpdateTimeStep(steps.back()));
+  EXPECT_NE(messages->allErrors().find("the last solve was aborted"), std::string::npos)
+    << messages->allErrors();
+  EXPECT_EQ(filter->GetOutput(0)->GetNumberOfCells(), 0);
+  EXPECT_EQ(filter->GetSolveCount(), 0);
+  filter->RemoveAllObservers();
+
+  // Asking to abort between updates does not move the MTime (on several ranks, that rank
+  // alone would solve again) and stops the next solve.
+  const vtkMTimeType before = filter->GetMTime();
+  filter->SetAbortExecute(1);
+  EXPECT_EQ(filter->GetMTime(), before);
+  filter->SetNumberOfPaths(20000);
+  expectError(runFilter(filter), "aborted");
+  EXPECT_EQ(filter->GetAbortExecute(), 0);
+  EXPECT_EQ(filter->GetSolveCount(), 0);
+
+  // A change solves again.
+  filter->SetNumberOfPaths(20001);
+  const FilterRun again = runFilter(filter);
+  EXPECT_TRUE(again.succeeded) << again.messages->allErrors();
+  EXPECT_GT(again.elements, 0);
+  EXPECT_EQ(filter->GetSolveCount(), 1);
+}
+
+TEST(FilterBadInput, AnErrorIsRepeatedWithoutSolvingUntilSomethingChanges)
+{
+  BoxSetup setup = closedBoxSetup(3);
+  setup.scene->GetCellData()->GetArray("Reflectance")->SetComponent(0, 0, 1.5);
+  auto filter = fastFilter(setup);
+  expectError(runFilter(filter), "Scene cell 0");
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(filter);
+  EXPECT_FALSE(filter->UpdateTimeStep(timeSteps(filter).back()));
+  EXPECT_NE(messages->allErrors().find("Scene cell 0"), std::string::npos) << messages->allErrors();
+  filter->RemoveAllObservers();
+  EXPECT_EQ(filter->GetSolveCount(), 0);
 }
 
 TEST(FilterBadInput, AFixedInputSolvesAfterAnError)

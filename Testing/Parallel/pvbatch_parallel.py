@@ -13,19 +13,25 @@ run_parallel.py compares. Cases:
   every rank holds some of its cells; each rank also writes how much farther its elements lie
   from its own piece of the scene than from the whole scene (0: they come from its cells);
 - time: steps through frames without a new solve (SolveCount), then a new Seed solves again;
-- abort: rank 0 sets AbortExecute from a progress event once the solve is under way;
+- abort: rank 0 sets AbortExecute from a progress event once the solve is under way, during
+  the proxy's UpdatePipeline (every port); every rank then updates again with nothing changed;
+- abortalone: the same abort, then rank 0 alone updates again and sets AbortExecute between
+  updates; every rank then updates with a new NumberOfPaths;
+- waitlimit: a solve, then rank 0 alone sets a property and updates (run with
+  MLR_RANK_WAIT_LIMIT set: rank 0 names the ranks it waits for, then aborts the job);
 - bad: rank 1's Scene piece lacks the Reflectance array (the ranks' pieces disagree), then,
   with consistent pieces, rank 1 alone has a memory limit the solve does not fit in.
 """
 import argparse
 import os
+import re
 import sys
 
 import numpy as np
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--plugin", required=True)
-parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "bad"])
+parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "waitlimit", "bad"])
 parser.add_argument("--out", required=True, help="prefix of the .rank<r>.npz files written")
 parser.add_argument("--paths", type=int, default=20000)
 args = parser.parse_args()
@@ -130,28 +136,61 @@ elif args.case == "time":
         record(f"s{step}_", f)
     radiosity.Seed = 2
     record("seed_", 14.0)
-elif args.case == "abort":
-    state = {"aborted": False}
+elif args.case in ("abort", "abortalone"):
+    state = {"armed": True}
 
     def on_progress(caller, event):
-        # Past remeshing (the first 5%): the solve's phases are running.
-        if rank == 0 and not state["aborted"] and caller.GetProgress() > 0.2:
-            state["aborted"] = True
-            # As ParaView aborts: without Modified(), which would make this rank solve again.
-            caller.SetAbortExecuteAndUpdateTime()
+        # Past remeshing (the first 5%): the solve's phases are running. The plain setter, as
+        # a script or a user's Abort does it.
+        if rank == 0 and state["armed"] and caller.GetProgress() > 0.2:
+            state["armed"] = False
+            caller.SetAbortExecute(1)
+
+    def outcome(prefix):
+        """What every port holds now, the solves so far and the errors since the last call."""
+        results[prefix + "errors"] = np.array(errors[:])
+        errors.clear()
+        # The client-side object is wrapped as its VTK base class here; PrintSelf has it all.
+        results[prefix + "solves"] = np.array(int(re.search(r"SolveCount: (\d+)", str(algorithm))[1]))
+        results[prefix + "abort_flag"] = np.array(algorithm.GetAbortExecute())
+        for port, name in enumerate(("e", "p", "light")):
+            results[f"{prefix}{name}_cells"] = np.array(
+                algorithm.GetOutputDataObject(port).GetNumberOfCells())
 
     observer = algorithm.AddObserver("ProgressEvent", on_progress)
-    # One update of the Elements port, as a view asks for it: a proxy's UpdatePipeline would
-    # go on to update the other ports, each solving again after the abort.
-    radiosity.UpdatePipelineInformation()
-    algorithm.UpdatePiece(rank, ranks, 0)
-    results["abort_errors"] = np.array(errors[:])
-    results["abort_e_cells"] = np.array(algorithm.GetOutputDataObject(0).GetNumberOfCells())
-    errors.clear()
+    # As ParaView's Apply: the proxy updates every output port, one after the other, so the
+    # ports after the aborted one ask again at once.
+    radiosity.UpdatePipeline(time=0.0)
     algorithm.RemoveObserver(observer)
-    # A new request solves again and succeeds on every rank.
+    outcome("abort_")
+    if args.case == "abort":
+        # Every rank asks again with nothing changed: the abort holds, on every rank alike.
+        radiosity.UpdatePipeline(time=14.0)
+        algorithm.UpdatePiece(rank, ranks, 0)
+        outcome("again_")
+    else:
+        # Rank 0 alone asks again, every port and another time, as a script that updates on
+        # one rank only; then, between updates, rank 0 alone sets AbortExecute (an abort with
+        # nothing running), which must stop the next solve on every rank, not rank 0 alone.
+        if rank == 0:
+            radiosity.UpdatePipeline(time=14.0)
+            algorithm.UpdatePiece(rank, ranks, 0)
+            algorithm.SetAbortExecute(1)
+        outcome("alone_")
+        radiosity.NumberOfPaths = 300000
+        radiosity.UpdatePipeline(time=0.0)
+        outcome("pending_")
+    # A change solves again, on every rank, once.
     radiosity.NumberOfPaths = 20000
     record("after_", 0.0)
+elif args.case == "waitlimit":
+    # A solve on every rank, then rank 0 alone changes a property and updates: it waits for
+    # the others, says which, and past MLR_RANK_WAIT_LIMIT aborts the job.
+    record("first_", 0.0)
+    if rank == 0:
+        radiosity.Seed = 2
+        radiosity.UpdatePipeline(time=0.0)
+        print("rank 0 solved alone", flush=True)
 elif args.case == "bad":
     record("bad_", 0.0)
     results["bad_errors"] = np.array(errors[:])

@@ -3,7 +3,7 @@
 ranks under mpiexec (pvbatch --symmetric), each bounded by a timeout, and compares what every
 rank wrote (pvbatch_parallel.py). Exits non-zero with one line per failed check.
 
-    run_parallel.py --case whole|split|time|abort|bad --ranks R --mpiexec M --pvbatch P \
+    run_parallel.py --case whole|split|time|abort|abortalone|waitlimit|bad --ranks R --mpiexec M --pvbatch P \
         --plugin MovingLightRadiosity.so --work DIR
 
 whole: the union of the ranks' outputs is the serial output bit for bit, cell by cell, and
@@ -12,8 +12,15 @@ split: the Scene is spread by RedistributeDataSet; every rank outputs cells, lyi
        piece of the scene; the union, sorted by cell, equals serial in every array, and the
        total power too.
 time:  five time requests and no new solve on any rank; a new Seed solves once more.
-abort: rank 0 aborts mid-solve: every rank reports the abort and outputs nothing, and the
-       next request solves on every rank.
+abort: rank 0 aborts mid-solve (plain SetAbortExecute, during the proxy's UpdatePipeline of
+       every port): every rank reports the abort, outputs nothing and has AbortExecute clear;
+       asking again with nothing changed solves on no rank; a change solves on every rank.
+abortalone: the same abort, then rank 0 alone updates and sets AbortExecute between updates:
+       rank 0 solves nothing alone (no rank hangs), and the next solve, on every rank, is
+       aborted on every rank; a change then solves on every rank, once.
+waitlimit: after a solve, rank 0 alone sets a property and updates, under
+       MLR_RANK_WAIT_LIMIT=4: rank 0 reports the ranks it waits for, then aborts the job with
+       an error saying so, rather than hanging.
 bad:   rank 1's piece lacks Reflectance: every rank reports an error naming it; rank 1 alone
        over its memory limit: every rank reports the limit. No rank hangs (the timeout).
 """
@@ -28,19 +35,25 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCRIPT = os.path.join(HERE, "pvbatch_parallel.py")
-TIMEOUT = 240
+# A case takes 10 to 20 s on the shared 2-core machine; a rank left waiting in a collective
+# waits forever, so the run is killed well before ctest's TIMEOUT, with what it printed.
+TIMEOUT = 120
 
 
-def run(command, what):
-    """Runs `command` in its own process group, killing the group on timeout."""
+def run(command, what, timeout=TIMEOUT, env=None, may_fail=False):
+    """Runs `command` in its own process group, killing the group on timeout. Returns its
+    output, and with `may_fail` its exit code too instead of failing on a non-zero one."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               text=True, start_new_session=True)
+                               text=True, start_new_session=True, env=env)
     try:
-        output, _ = process.communicate(timeout=TIMEOUT)
+        output, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         os.killpg(process.pid, signal.SIGKILL)
-        process.communicate()
-        sys.exit(f"{what}: no answer within {TIMEOUT} s (a rank hangs?): {' '.join(command)}")
+        output, _ = process.communicate()
+        sys.exit(f"{what}: no answer within {timeout} s (a rank hangs?): {' '.join(command)}\n"
+                 f"{(output or '')[-4000:]}")
+    if may_fail:
+        return output, process.returncode
     if process.returncode != 0:
         sys.exit(f"{what} exited with {process.returncode}:\n{output[-4000:]}")
     return output
@@ -113,6 +126,26 @@ def total_power(data, prefix):
     return float((data[prefix + "cell_Radiosity"].sum(axis=1) * areas).sum())
 
 
+def wait_limit(checks, args, command):
+    """waitlimit: rank 0 updates alone and, MLR_RANK_WAIT_LIMIT seconds on, aborts the job
+    with a message naming the ranks it waited for, after a report halfway."""
+    limit = 4
+    env = dict(os.environ, MLR_RANK_WAIT_LIMIT=str(limit))
+    output, code = run(command, f"{args.ranks} ranks", args.timeout, env=env, may_fail=True)
+    others = "rank 1" if args.ranks == 2 else "ranks " + ", ".join(map(str, range(1, args.ranks - 1))) + \
+        f" and {args.ranks - 1}"
+    waiting = f"rank 0 of {args.ranks} has waited"
+    checks.check(code != 0, f"the job exited with 0: rank 0 updating alone was not stopped\n{output[-3000:]}")
+    checks.check("rank 0 solved alone" not in output, "rank 0 solved alone")
+    checks.check(output.count(waiting) >= 2 and f"for {others} to start the solve" in output,
+                 f"no report and error naming {others} from rank 0:\n{output[-3000:]}")
+    checks.check(f"MLR_RANK_WAIT_LIMIT is {limit}" in output and "aborting the MPI job" in output,
+                 f"no error stating the wait limit:\n{output[-3000:]}")
+    solved = load(os.path.join(args.work, args.case))
+    checks.check(len(solved) >= args.ranks - 1 and all(int(r["first_solves"]) == 1 for r in solved),
+                 "the solve before rank 0 went alone did not succeed on every rank that wrote results")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--case", required=True)
@@ -121,6 +154,8 @@ def main():
     parser.add_argument("--pvbatch", required=True)
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--work", required=True)
+    parser.add_argument("--timeout", type=float, default=TIMEOUT,
+                        help="seconds the MPI run may take before it is killed as hung")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     for old in glob.glob(os.path.join(args.work, "*.npz")):
@@ -132,8 +167,12 @@ def main():
     mpi = [args.mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", str(args.ranks),
            args.pvbatch, "--symmetric", "--force-offscreen-rendering", SCRIPT, "--plugin", args.plugin]
     out = os.path.join(args.work, args.case)
-    extra = ["--paths", "400000"] if args.case == "abort" else []
-    run(mpi + ["--case", args.case, "--out", out] + extra, f"{args.ranks} ranks")
+    extra = ["--paths", "400000"] if args.case.startswith("abort") else []
+    if args.case == "waitlimit":
+        wait_limit(checks, args, mpi + ["--case", args.case, "--out", out])
+        checks.finish(name)
+        return
+    run(mpi + ["--case", args.case, "--out", out] + extra, f"{args.ranks} ranks", args.timeout)
     ranks = load(out)
     check(len(ranks) == args.ranks, f"{len(ranks)} ranks wrote results instead of {args.ranks}")
 
@@ -180,14 +219,48 @@ def main():
         first = union(ranks, "s0_", "e")
         check("cell_Radiosity" in mine and not np.array_equal(mine["cell_Radiosity"], first["cell_Radiosity"]),
               "frames 0 and 29 show the same radiosity")
-    elif args.case == "abort":
+    elif args.case in ("abort", "abortalone"):
+        def nothing_solved(prefix, r, data):
+            cells = [int(data[f"{prefix}{k}_cells"]) for k in ("e", "p", "light")]
+            check(cells == [0, 0, 0], f"rank {r}: {prefix}: Elements, Patches, Light cells {cells}, "
+                                      "expected none")
+            check(int(data[prefix + "solves"]) == 0, f"rank {r}: {prefix}: SolveCount "
+                                                     f"{int(data[prefix + 'solves'])}, expected 0")
+
+        def reports_abort(prefix, r, data):
+            errors = list(data[prefix + "errors"])
+            check(len(errors) > 0 and all("aborted" in e for e in errors),
+                  f"rank {r}: {prefix}: errors {errors}, expected only the abort's")
+
         for r, data in enumerate(ranks):
-            errors = list(data["abort_errors"])
-            check(any("aborted" in e for e in errors), f"rank {r}: no abort reported ({errors})")
-            check(int(data["abort_e_cells"]) == 0, f"rank {r}: {int(data['abort_e_cells'])} elements after the abort")
-            check(int(data["after_solves"]) == 1, f"rank {r}: SolveCount {data['after_solves']} after the abort, "
-                                                  "expected 1 (the aborted solve does not count)")
+            reports_abort("abort_", r, data)
+            nothing_solved("abort_", r, data)
+            check(int(data["abort_abort_flag"]) == 0, f"rank {r}: AbortExecute still set after the "
+                                                      "aborted solve")
+            if args.case == "abort":
+                nothing_solved("again_", r, data)
+                reports_abort("again_", r, data)
+            else:
+                nothing_solved("alone_", r, data)
+                if r == 0:
+                    reports_abort("alone_", r, data)
+                else:
+                    check(len(data["alone_errors"]) == 0,
+                          f"rank {r}: errors {list(data['alone_errors'])} while rank 0 updated alone")
+                check(int(data["alone_abort_flag"]) == (1 if r == 0 else 0),
+                      f"rank {r}: AbortExecute {int(data['alone_abort_flag'])} after rank 0 alone set it")
+                # Rank 0's abort, set between updates, stops the next solve on every rank.
+                reports_abort("pending_", r, data)
+                nothing_solved("pending_", r, data)
+                check(int(data["pending_abort_flag"]) == 0, f"rank {r}: AbortExecute still set after "
+                                                            "the aborted solve")
+            check(int(data["after_solves"]) == 1, f"rank {r}: SolveCount {data['after_solves']} after the "
+                                                  "abort, expected 1 (an aborted solve does not count)")
             check(len(data["errors"]) == 0, f"rank {r}: errors after the abort: {list(data['errors'])}")
+        # What every rank reported, it reported alike: no rank executed alone.
+        for prefix in ("abort_", "again_") if args.case == "abort" else ("abort_", "pending_"):
+            counts = [len(data[prefix + "errors"]) for data in ranks]
+            check(len(set(counts)) == 1, f"{prefix}: errors per rank {counts}: the ranks did not execute alike")
         check(sum(int(r["after_e_cells"]) for r in ranks) > 0, "no elements from the solve after the abort")
     elif args.case == "bad":
         for r, data in enumerate(ranks):
