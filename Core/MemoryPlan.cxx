@@ -1,5 +1,6 @@
 #include "MemoryPlan.h"
 
+#include "ErrorEstimate.h"
 #include "FixedPointAccumulator.h"
 
 #include "Parallel.h"
@@ -45,8 +46,10 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   // the shooting run's pose coefficients and path counts (112), measured.
   const std::uint64_t lightData =
     saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
-  const std::uint64_t base =
-    saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData));
+  plan.errorEstimate = errorEstimateBytes(patches, elements, frames, options);
+  const std::uint64_t base = saturatingSum(
+    saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData)),
+    plan.errorEstimate);
   plan.other = saturatingSum(base, reachability);
   const std::uint64_t gathering =
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
