@@ -777,9 +777,14 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
     solverOptions.threads = this->NumberOfThreads;
     solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
-    // Negative counts and NaN targets reach Core as they are, which names the property to fix.
-    solverOptions.errorBatches =
-      this->ErrorBatches < 0 ? 0 : static_cast<std::uint64_t>(this->ErrorBatches);
+    // Core refuses the other bad values (NaN targets included) naming the property to fix.
+    if (this->ErrorBatches < 0)
+    {
+      throw mlr::Error("the error batch count (ErrorBatches) is " +
+        std::to_string(this->ErrorBatches) + ": give 1 (no error estimate) up to " +
+        std::to_string(mlr::MaximumErrorBatches) + " (16 is typical)");
+    }
+    solverOptions.errorBatches = static_cast<std::uint64_t>(this->ErrorBatches);
     solverOptions.targetRelativeError = this->TargetRelativeError;
     solverOptions.timeLimitSeconds = this->TimeLimit;
     options.remeshing.targetEdgeLength = this->PatchSize;
