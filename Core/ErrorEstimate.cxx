@@ -163,7 +163,7 @@ void validateErrorOptions(const SolverOptions& options)
   {
     throw Error("the paths per frame, " + std::to_string(options.pathsPerFrame) + ", cannot make " +
       std::to_string(options.errorBatches) +
-      " error batches: every batch needs paths of its own; give more paths or fewer batches");
+      " error batches: give at least as many paths as batches, or fewer batches");
   }
   if (!(options.targetRelativeError >= 0) || !std::isfinite(options.targetRelativeError))
   {
