@@ -349,6 +349,9 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--seed", "S", o.seed, parseInteger);
   option("--threads", "T", o.threads, parseInteger);
   option("--memory-limit", "MIB", o.memoryLimit, parseInteger);
+  option("--error-batches", "B", o.errorBatches, parseInteger);
+  option("--target-error", "FRACTION", o.targetError, parseNumber);
+  option("--time-limit", "SECONDS", o.timeLimit, parseNumber);
   option("--luminous-efficacy", "LM_PER_W", o.luminousEfficacy, parseNumber);
   option("--output", "PATH.pvd", o.output, parseOutput);
   option("--stats", "FILE.json", o.stats, asGiven);
@@ -690,6 +693,41 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkRange<long long>("--memory-limit", *o.memoryLimit, 1, filter->GetMemoryLimitMaxValue());
     filter->SetMemoryLimit(static_cast<int>(*o.memoryLimit));
   }
+  if (o.errorBatches)
+  {
+    checkRange<long long>("--error-batches", *o.errorBatches, 1, 4096);
+    filter->SetErrorBatches(static_cast<int>(*o.errorBatches));
+  }
+  if (o.targetError)
+  {
+    if (!(*o.targetError == 0 || (*o.targetError >= 1e-4 && std::isfinite(*o.targetError))))
+    {
+      std::ostringstream s;
+      s << "--target-error is " << *o.targetError
+        << ": give the relative error to reach as a fraction, e.g. 0.02 for 2% (at least "
+           "0.0001), or 0 for none";
+      throw UsageError(s.str());
+    }
+    if (*o.targetError > 0 && o.errorBatches && *o.errorBatches < 2)
+    {
+      throw UsageError("--target-error needs an error estimate: give --error-batches 2 or more");
+    }
+    filter->SetTargetRelativeError(*o.targetError);
+  }
+  if (o.timeLimit)
+  {
+    if (!(*o.timeLimit >= 0 && std::isfinite(*o.timeLimit)))
+    {
+      std::ostringstream s;
+      s << "--time-limit is " << *o.timeLimit << ": give a number of seconds, or 0 for none";
+      throw UsageError(s.str());
+    }
+    if (!o.targetError || !(*o.targetError > 0))
+    {
+      throw UsageError("--time-limit bounds the rounds of --target-error: give a target too");
+    }
+    filter->SetTimeLimit(*o.timeLimit);
+  }
   if (o.luminousEfficacy)
   {
     // Above 0 and at most 683: range messages say "from ... to", which would let 0 through.
@@ -826,6 +864,15 @@ Solver:
   --threads T           worker threads, 0 for every core (default 0)
   --memory-limit MIB    refuse, before allocating, a solve (or reading a file) estimated to
                         need more memory than this (default: half the physical memory)
+  --error-batches B     solve as B independent batches of N/B paths: their spread gives
+                        every element's standard error, RadiosityStdError (default 16;
+                        1: no error estimate)
+  --target-error FRACTION
+                        add rounds of batches until the 95th percentile of the lit
+                        elements' relative error is at most this in every frame (0.02 is
+                        2%; default 0, off)
+  --time-limit SECONDS  with --target-error: start no more batches after this long (the
+                        result then depends on the machine's speed)
 Output:
   --luminous-efficacy LM_PER_W
                         lumens per watt of the light, which turn the Irradiance arrays

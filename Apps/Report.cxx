@@ -83,6 +83,37 @@ std::string summaryLine(vtkFieldData* statistics)
   return s.str();
 }
 
+std::string errorLine(vtkFieldData* statistics)
+{
+  vtkDataArray* p95 = statistics ? statistics->GetArray("RelativeErrorP95") : nullptr;
+  vtkDataArray* median = statistics ? statistics->GetArray("RelativeErrorMedian") : nullptr;
+  auto* stoppedBy =
+    statistics ? vtkStringArray::SafeDownCast(statistics->GetAbstractArray("StoppedBy")) : nullptr;
+  if (!p95 || !median || !stoppedBy || p95->GetNumberOfTuples() == 0 ||
+    median->GetNumberOfTuples() != p95->GetNumberOfTuples() || stoppedBy->GetNumberOfValues() == 0)
+  {
+    return {};
+  }
+  vtkIdType worst = 0;
+  for (vtkIdType f = 1; f < p95->GetNumberOfTuples(); ++f)
+  {
+    worst = p95->GetComponent(f, 0) > p95->GetComponent(worst, 0) ? f : worst;
+  }
+  double medianOfWorst = median->GetComponent(worst, 0);
+  const auto rounds = static_cast<long long>(value(statistics, "ErrorRounds"));
+  std::ostringstream s;
+  s << std::setprecision(3) << "relative error of the lit elements: median " << 100 * medianOfWorst
+    << "%, p95 " << 100 * p95->GetComponent(worst, 0) << "% (frame " << worst << ", the worst)";
+  const double target = value(statistics, "TargetRelativeError");
+  if (target > 0)
+  {
+    s << ", target " << 100 * target << "%";
+  }
+  s << ", " << static_cast<long long>(value(statistics, "ErrorBatches")) << " batches in " << rounds
+    << (rounds == 1 ? " round" : " rounds") << ", stopped by " << stoppedBy->GetValue(0);
+  return s.str();
+}
+
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
   vtkMovingLightRadiosity* filter, vtkFieldData* statistics, const std::vector<FrameRecord>& frames,
   const StageTimes& stages)
@@ -120,6 +151,9 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "seed", filter->GetSeed() },
     { "threads", filter->GetNumberOfThreads() },
     { "twoSided", filter->GetTwoSided() != 0 },
+    { "errorBatches", filter->GetErrorBatches() },
+    { "targetError", jsonNumber(filter->GetTargetRelativeError()) },
+    { "timeLimit", jsonNumber(filter->GetTimeLimit()) },
   };
 
   // Every statistic the filter reports, except those that describe one frame.
@@ -146,6 +180,20 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     }
   }
   json["statistics"] = values;
+  // The error estimate's figures per frame.
+  for (const char* name : { "RelativeErrorMedian", "RelativeErrorP95", "LitElements" })
+  {
+    if (vtkDataArray* array = statistics ? statistics->GetArray(name) : nullptr)
+    {
+      nlohmann::ordered_json perFrameValues = nlohmann::ordered_json::array();
+      for (vtkIdType f = 0; f < array->GetNumberOfTuples(); ++f)
+      {
+        perFrameValues.push_back(jsonNumber(array->GetComponent(f, 0),
+          array->GetDataType() != VTK_FLOAT && array->GetDataType() != VTK_DOUBLE));
+      }
+      json["errorEstimate"][name] = perFrameValues;
+    }
+  }
   json["timing"] = {
     { "secondsReading", jsonNumber(stages.reading) },
     { "secondsRemeshing", jsonNumber(stages.remeshing) },

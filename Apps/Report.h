@@ -38,6 +38,11 @@ struct StageTimes
 /// (...), predicted speed-up of reuse 2.4x" from the filter's statistics field data.
 std::string summaryLine(vtkFieldData* statistics);
 
+/// "relative error of the lit elements: median 0.81%, p95 2.3% (frame 4), 16 batches in 1
+/// round, stopped by batches": the worst frame's figures, from the error estimate's field data;
+/// empty without an error estimate.
+std::string errorLine(vtkFieldData* statistics);
+
 /// Writes the inputs, the filter's settings, the statistics, the stages' times and the frames
 /// as JSON.
 /// Throws std::runtime_error.

@@ -320,6 +320,15 @@ int run(int argc, char** argv)
       {
         algorithm->SetAbortExecute(1);
       }
+      // The error estimate's messages (rounds, estimates) as lines above the bar.
+      static std::string shown;
+      const char* text = algorithm->GetProgressText();
+      if (text && shown != text)
+      {
+        shown = text;
+        static_cast<ProgressBar*>(bar)->finish();
+        std::cout << shown << std::endl;
+      }
       static_cast<ProgressBar*>(bar)->show(algorithm->GetProgress(), "solving");
     });
   const unsigned long solving = filter->AddObserver(vtkCommand::ProgressEvent, onProgress);
@@ -443,8 +452,9 @@ int run(int argc, char** argv)
   output.commit();
   bar.finish();
 
-  std::cout << summaryLine(statistics) << "\nwrote " << collection.string() << " and "
-            << times.size() << " frames";
+  const std::string errors = errorLine(statistics);
+  std::cout << summaryLine(statistics) << (errors.empty() ? "" : "\n" + errors) << "\nwrote "
+            << collection.string() << " and " << times.size() << " frames";
   if (!options.png.empty())
   {
     std::cout << ", pictures in " << options.png;

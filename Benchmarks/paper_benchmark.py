@@ -132,6 +132,8 @@ def solve(inputs, config, paths, mode, seed=None):
     radiosity.SetReuseGathering(gathering)
     radiosity.SetSeed(config.seed if seed is None else seed)
     radiosity.SetNumberOfThreads(config.threads)
+    # The paper's method as one solve: the error batches' cost per batch is not the paper's.
+    radiosity.SetErrorBatches(1)
 
     frames = []
     for f in range(len(inputs.positions)):

@@ -1,5 +1,6 @@
 #include "MemoryPlan.h"
 
+#include "ErrorEstimate.h"
 #include "FixedPointAccumulator.h"
 
 #include "Parallel.h"
@@ -45,11 +46,18 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   // the shooting run's pose coefficients and path counts (112), measured.
   const std::uint64_t lightData =
     saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
-  const std::uint64_t base =
-    saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData));
+  // A batched solve's running mean and squared deviations live through every batch; its
+  // standard errors are allocated after the last batch, when no accumulators are left.
+  plan.errorEstimate = errorEstimateBytes(patches, elements, frames, options);
+  const std::uint64_t standardErrors =
+    plan.errorEstimate > 0 ? saturatingProduct({ frames, elements, 2, sizeof(PackedRgb) }) : 0;
+  const std::uint64_t base = saturatingSum(
+    saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData)),
+    plan.errorEstimate - standardErrors);
   plan.other = saturatingSum(base, reachability);
-  const std::uint64_t gathering =
-    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability));
+  const std::uint64_t gathering = saturatingSum(
+    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
+    standardErrors);
   const auto peakWith = [&](std::uint64_t copies)
   {
     return saturatingSum(

@@ -29,7 +29,10 @@ struct MemoryPlan
   std::uint64_t results = 0;      ///< direct and indirect irradiance, patch radiosity, per frame
   std::uint64_t accumulators = 0; ///< the shooting accumulators of one source, all copies
   std::uint64_t other = 0;        ///< per-thread scratch, the ray-tracing scene, reachability
-  std::uint64_t peak = 0;         ///< the estimate: the larger phase, shooting or gathering
+  /// A batched solve's mean and spread, on top of the batch being solved (errorEstimateBytes
+  /// of ErrorEstimate.h); 0 without batches. The rounds of a target add none.
+  std::uint64_t errorEstimate = 0;
+  std::uint64_t peak = 0; ///< the estimate: the larger phase, shooting or gathering
 };
 
 /// The plan of a solve of `frames` frames lit by `lights` light sources (area lights, scene

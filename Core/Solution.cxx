@@ -1,5 +1,7 @@
 #include "Solution.h"
 
+#include <algorithm>
+
 namespace mlr
 {
 
@@ -13,6 +15,13 @@ Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches
   , LitSide(elements, Side::Front)
   , PatchLitSide(patches, Side::Front)
 {
+}
+
+void Solution::clearRadiosity()
+{
+  std::fill(this->Direct.begin(), this->Direct.end(), PackedRgb());
+  std::fill(this->Patch.begin(), this->Patch.end(), PackedRgb());
+  std::vector<PackedRgb>().swap(this->Indirect);
 }
 
 void Solution::chooseLitSides()

@@ -53,6 +53,22 @@ struct SolverStatistics
   bool twoSided = true;
 };
 
+/// What the error estimate of a batched solve found (ErrorEstimate.h); empty without one.
+struct ErrorEstimateSummary
+{
+  std::uint64_t batches = 0;       ///< batches run, all rounds; 0 without an error estimate
+  std::uint64_t rounds = 0;        ///< rounds of batches (1 without a target)
+  std::uint64_t pathsPerFrame = 0; ///< N of all batches together
+  double target = 0;               ///< SolverOptions::targetRelativeError
+  /// What ended the batches: "batches" (the fixed count, no target), "target" (reached),
+  /// "time limit" or "path limit" (the target was not reached).
+  std::string stoppedBy;
+  /// Per frame, over the lit elements (ErrorEstimate.h): the median and the 95th
+  /// percentile of the relative error, and how many elements are lit.
+  std::vector<double> relativeErrorMedian, relativeErrorP95;
+  std::vector<std::uint64_t> litElements;
+};
+
 /**
  * Radiosity (W/m^2) of every element and patch side, for every frame, and the irradiance
  * of every element side it comes from.
@@ -126,7 +142,23 @@ public:
   /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete.
   void chooseLitSides();
 
+  /// Whether the solve estimated its error (SolverOptions::errorBatches > 1).
+  bool hasErrorEstimate() const { return !this->StdError.empty(); }
+  /// The standard error of irradiance() (W/m^2, RGB) from the spread of the batches, direct
+  /// and indirect light together; zero without an error estimate.
+  Rgb irradianceStdError(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->StdError.empty() ? Rgb()
+                                  : Rgb(this->StdError[this->elementIndex(frame, element, side)]);
+  }
+  /// The standard error of total(): the emission is exact, so rho_e times irradianceStdError().
+  Rgb radiosityStdError(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->Reflectance[element] * this->irradianceStdError(frame, element, side);
+  }
+
   SolverStatistics statistics;
+  ErrorEstimateSummary errorEstimate;
   std::vector<std::string> warnings;
 
   // Storage is element- (patch-) major with frames innermost: scoring one hit for all
@@ -146,6 +178,11 @@ public:
   /// shooting accumulators are freed, so that the two never take memory at once.
   std::vector<PackedRgb>& indirectData() { return this->Indirect; }
   void allocateIndirect() { this->Indirect.assign(this->Direct.size(), PackedRgb()); }
+  /// Zeroes the direct light and the patches and frees the indirect light, for the next
+  /// batch of a batched solve (the reflectance and emission stay).
+  void clearRadiosity();
+  /// The standard error of the irradiance of every element side and frame, or empty.
+  std::vector<PackedRgb>& stdErrorData() { return this->StdError; }
   std::vector<PackedRgb>& patchData() { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
@@ -157,7 +194,7 @@ public:
 
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
-  std::vector<PackedRgb> Direct, Indirect, Patch;
+  std::vector<PackedRgb> Direct, Indirect, Patch, StdError;
   std::vector<Rgb> Emission, Reflectance;
   std::vector<Side> LitSide, PatchLitSide;
 };

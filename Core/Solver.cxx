@@ -1,6 +1,7 @@
 #include "Solver.h"
 
 #include "Error.h"
+#include "ErrorEstimate.h"
 #include "Gathering.h"
 #include "Parallel.h"
 #include "RayTracer.h"
@@ -61,7 +62,8 @@ void finish(const Scene& scene, const SolverOptions& options, std::size_t frames
   stats.frames = frames;
   stats.patches = scene.patchCount();
   stats.elements = scene.elementCount();
-  stats.effectivePathsPerFrame = options.pathsPerFrame;
+  stats.effectivePathsPerFrame =
+    solution.hasErrorEstimate() ? solution.errorEstimate.pathsPerFrame : options.pathsPerFrame;
   stats.meanPathLength = stats.pathsCast > 0 ? 1.0 +
       (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) /
         options.firstBounceSurvival
@@ -104,6 +106,7 @@ void validateOptions(const SolverOptions& options)
   {
     throw Error("the number of paths per frame is 0: give at least 1 (600000 is typical)");
   }
+  validateErrorOptions(options);
   if (options.pathsPerFrame > MaximumPathsPerFrame)
   {
     throw Error("the number of paths per frame, " + std::to_string(options.pathsPerFrame) +
@@ -170,6 +173,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   std::optional<RayTracer> tracerStorage;
   Solution solution;
   double secondsReducing = 0;
+  const bool batched = estimatesError(options);
   agreeAcrossRanks(
     options,
     [&]
@@ -184,7 +188,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
       for (const LightSource& source : sources)
       {
-        checkPathsPerPosition(source, options);
+        checkBatchPathsPerPosition(source, options);
       }
       shares.emplace(scene, sources, frames, options);
       if (progress && !progress(0.0))
@@ -208,60 +212,92 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     },
     &secondsReducing);
   const RayTracer& tracer = *tracerStorage;
-  double progressBase = 0;
-  auto phaseTick = [&](double share)
-  {
-    const double base = progressBase;
-    progressBase += share;
-    return [&progress, base, share](double fraction)
-    { return !progress || progress(base + share * fraction); };
-  };
   SolverStatistics& stats = solution.statistics;
   stats.secondsSetup = secondsSince(start);
 
-  // Shooting, one source at a time: each has its own accumulators, added to the solution.
-  const auto shootingStart = Clock::now();
+  // One pass: shooting every source, then gathering, into `into`. A batched solve runs one per
+  // batch, sharing the scene, the tracer and the reachable sides (which do not depend on the
+  // seed).
   WorkerCounters rays;
-  for (std::size_t i = 0; i < sources.size(); ++i)
+  std::optional<std::vector<std::uint8_t>> reachable;
+  auto pass = [&](const SolverOptions& passOptions, Solution& into,
+                const std::function<bool(double)>& fraction)
   {
-    const ShootingResult shot = shoot(scene, sources[i], options, tracer, workers,
-      plan.accumulatorCopyPerWorker, phaseTick(shares->shooting[i]), secondsReducing, solution);
-    stats.pathsCast += shot.pathsCast;
-    stats.staticPathsCast += sources[i].isStatic() ? shot.pathsCast : 0;
-    rays += shot.counters;
-  }
-  stats.sources = sources.size();
-  stats.secondsShooting = secondsSince(shootingStart);
+    double progressBase = 0;
+    auto phaseTick = [&](double share)
+    {
+      const double base = progressBase;
+      progressBase += share;
+      return [&fraction, base, share](double f) { return !fraction || fraction(base + share * f); };
+    };
+    // Shooting, one source at a time: each has its own accumulators, added to the solution.
+    const auto shootingStart = Clock::now();
+    for (std::size_t i = 0; i < sources.size(); ++i)
+    {
+      const ShootingResult shot = shoot(scene, sources[i], passOptions, tracer, workers,
+        plan.accumulatorCopyPerWorker, phaseTick(shares->shooting[i]), secondsReducing, into);
+      stats.pathsCast += shot.pathsCast;
+      stats.staticPathsCast += sources[i].isStatic() ? shot.pathsCast : 0;
+      rays += shot.counters;
+    }
+    stats.secondsShooting += secondsSince(shootingStart);
 
-  // Final gathering, once, on the sum of every source's patch solution. The accumulators
-  // are gone: the indirect light takes their memory.
-  const auto gatheringStart = Clock::now();
-  solution.allocateIndirect();
-  if (options.gatheringRatio > 0)
-  {
-    // Deterministic and cheap: every rank probes every side.
-    std::vector<std::uint8_t> reachable;
-    const auto reachabilityTick = phaseTick(shares->reachability);
-    agreeAcrossRanks(
-      options,
-      [&]
+    // Final gathering, once, on the sum of every source's patch solution. The accumulators
+    // are gone: the indirect light takes their memory.
+    const auto gatheringStart = Clock::now();
+    into.allocateIndirect();
+    if (passOptions.gatheringRatio > 0)
+    {
+      // Deterministic and cheap: every rank probes every side.
+      const auto reachabilityTick = phaseTick(shares->reachability);
+      if (!reachable)
       {
-        reachable = reachableSides(
-          scene, tracer, sources, options, workers, reachabilityTick, stats.reachabilityRays);
+        agreeAcrossRanks(
+          passOptions,
+          [&]
+          {
+            reachable = reachableSides(scene, tracer, sources, passOptions, workers,
+              reachabilityTick, stats.reachabilityRays);
+          },
+          &secondsReducing);
+        stats.reachableSides =
+          static_cast<std::uint64_t>(std::count(reachable->begin(), reachable->end(), 1));
+      }
+      const GatheringResult gathered = gatherIndirect(scene, tracer, passOptions, *reachable,
+        workers, phaseTick(1.0 - progressBase), secondsReducing, into);
+      stats.gatheringSides = gathered.sides;
+      rays += gathered.counters;
+    }
+    else
+    {
+      indirectFromPatches(scene, into);
+    }
+    stats.secondsGathering += secondsSince(gatheringStart);
+  };
+
+  if (batched)
+  {
+    // The batches solve into one more Solution, with the same reflectance and emission,
+    // whose light is merged into `solution` after each.
+    Solution batch(frames, scene.elementCount(), scene.patchCount());
+    batch.reflectanceData() = solution.reflectanceData();
+    batch.emissionData() = solution.emissionData();
+    solveInBatches(
+      options,
+      [&](
+        const SolverOptions& batchOptions, const std::function<bool(double)>& fraction) -> Solution&
+      {
+        batch.clearRadiosity();
+        pass(batchOptions, batch, fraction);
+        return batch;
       },
-      &secondsReducing);
-    stats.reachableSides =
-      static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
-    const GatheringResult gathered = gatherIndirect(scene, tracer, options, reachable, workers,
-      phaseTick(1.0 - progressBase), secondsReducing, solution);
-    stats.gatheringSides = gathered.sides;
-    rays += gathered.counters;
+      progress, plan.peak, secondsReducing, solution);
   }
   else
   {
-    indirectFromPatches(scene, solution);
+    pass(options, solution, progress);
   }
-  stats.secondsGathering = secondsSince(gatheringStart);
+  stats.sources = sources.size();
   // The counters of the rays each rank traced (reachability's are every rank's own).
   std::uint64_t counts[7] = { rays.shootingRays, rays.shadowRays, rays.gatheringRays,
     rays.missedRays, rays.firstHits, rays.firstHitsOnBack, rays.shadowRaysBlocked };
@@ -272,7 +308,10 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   stats.missedRays = counts[3];
   stats.shadowRaysBlocked = counts[6];
   stats.secondsReducing = secondsReducing;
-  solution.chooseLitSides();
+  if (!batched)
+  {
+    solution.chooseLitSides();
+  }
   finish(scene, options, frames, plan, workers, counts[4], counts[5], solution);
   stats.secondsTotal = secondsSince(start);
   return solution;

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
 
 namespace mlr
 {
@@ -31,6 +32,18 @@ struct SolverOptions
   /// physical memory.
   std::uint64_t memoryLimitBytes = 0;
 
+  /// B: the solve runs as B independent batches of N/B paths per frame (and k N/B gathering
+  /// rays) whose mean is the result and whose spread gives every element's standard error
+  /// (ErrorEstimate.h). 1 is one solve without an error estimate.
+  std::uint64_t errorBatches = 1;
+  /// Above 0: add rounds of batches (of N/B paths each) until, in every frame, the 95th
+  /// percentile of the lit elements' relative error is at most this, or a limit stops it.
+  double targetRelativeError = 0;
+  /// With a target: start no more batches once this many seconds have passed (0: no limit).
+  /// The round count then depends on the machine's speed: the result is no longer
+  /// reproducible.
+  double timeLimitSeconds = 0;
+
   /// A solve shared by `ranks` processes (MPI ranks of pvbatch or pvserver), this one being
   /// `rank`. Every rank gives the same scene, rig and options; each traces a disjoint share
   /// of the shooting paths and gathering sides, keyed by their global index, and the sums are
@@ -41,10 +54,19 @@ struct SolverOptions
   /// rank calls it at the same points of the solve. Required when ranks > 1; Core has no MPI.
   std::function<void(std::int64_t* values, std::size_t count)> sumAcrossRanks;
   std::function<void(double* values, std::size_t count)> sumDoublesAcrossRanks;
+  /// Receives the solve's progress messages (the error estimate's rounds, its estimates of
+  /// memory and time); may be empty.
+  std::function<void(const std::string& message)> log;
 };
 
 /// The largest pathsPerFrame accepted: past it a solve would run for months.
 constexpr std::uint64_t MaximumPathsPerFrame = 100000000000ULL;
+
+/// The most batches ErrorEstimate accepts for the first round (SolverOptions::errorBatches).
+constexpr std::uint64_t MaximumErrorBatches = 4096;
+
+/// The smallest target relative error accepted: below it no solve would finish.
+constexpr double MinimumTargetRelativeError = 1e-4;
 
 /// The smallest lambda accepted (SolverOptions::firstBounceSurvival).
 constexpr double MinimumFirstBounceSurvival = 0.001;
@@ -69,8 +91,8 @@ template <typename Visitor>
 void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, reuseGathering,
-    twoSided, seed, threads, memoryLimitBytes, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks] =
-    options;
+    twoSided, seed, threads, memoryLimitBytes, errorBatches, targetRelativeError, timeLimitSeconds,
+    rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks, log] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -82,10 +104,16 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   // The limit decides whether a solve runs and how it holds its sums, never its result;
   // every rank checks its own.
   visit("memoryLimitBytes", memoryLimitBytes, OptionRole::PerRank);
+  visit("errorBatches", errorBatches, OptionRole::Result);
+  visit("targetRelativeError", targetRelativeError, OptionRole::Result);
+  // The ranks stop together (the first to run out of time stops all), so they must agree on
+  // the limit.
+  visit("timeLimitSeconds", timeLimitSeconds, OptionRole::Result);
   visit("rank", rank, OptionRole::PerRank);
   visit("ranks", ranks, OptionRole::Result);
   visit("sumAcrossRanks", sumAcrossRanks, OptionRole::Hook);
   visit("sumDoublesAcrossRanks", sumDoublesAcrossRanks, OptionRole::Hook);
+  visit("log", log, OptionRole::Hook);
 }
 
 } // namespace mlr

@@ -1,5 +1,7 @@
 #include "MovingLightRadiosityOutputs.h"
 
+#include "MovingLightRadiosityDisplay.h"
+
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
@@ -69,12 +71,13 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
   // coordinates, a ScenePointId and an inverse area, and 3 corner ids per element. Per
   // frame: Radiosity, Direct, Indirect, Front, Back and Irradiance (3 floats each),
   // Illuminance (a float) and Color (3 bytes) per element, point Radiosity, Irradiance,
-  // Illuminance and Color, and the patches' Radiosity.
+  // Illuminance and Color, and the patches' Radiosity; RadiosityStdError (3 floats) on cells
+  // and points, counted whether or not the solve estimates its error.
   const std::uint64_t e = elements, p = points;
   const std::uint64_t split = p + e / 4;
   const std::uint64_t meshes =
     p * 24 + split * (24 + 4 + 8) + e * (32 + 12 + 8 + 24) + e / 4 * (32 + 12);
-  const std::uint64_t frame = e * (6 * 12 + 4 + 3) + split * (12 + 12 + 4 + 3) + e / 4 * 12;
+  const std::uint64_t frame = e * (7 * 12 + 4 + 3) + split * (12 + 12 + 12 + 4 + 3) + e / 4 * 12;
   return meshes + frame;
 }
 
@@ -126,6 +129,63 @@ void addElementRadiosity(
     cellData->AddArray(front);
     cellData->AddArray(back);
   }
+}
+
+void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  vtkPointData* pointData, vtkCellData* cellData)
+{
+  if (!solution.hasErrorEstimate())
+  {
+    return;
+  }
+  const std::size_t n = solution.elementCount();
+  std::vector<Rgb> stdError(n);
+  auto cells = rgbArray("RadiosityStdError", n);
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    stdError[e] = solution.radiosityStdError(frame, e, solution.litSide(e));
+    setRgb(cells, e, stdError[e]);
+  }
+  const std::vector<Rgb> atPoints = pointMeans(shading, stdError);
+  auto points = rgbArray("RadiosityStdError", atPoints.size());
+  for (std::size_t p = 0; p < atPoints.size(); ++p)
+  {
+    setRgb(points, p, atPoints[p]);
+  }
+  cellData->AddArray(cells);
+  pointData->AddArray(points);
+}
+
+void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution)
+{
+  if (!solution.hasErrorEstimate())
+  {
+    return;
+  }
+  const ErrorEstimateSummary& summary = solution.errorEstimate;
+  for (const auto& [name, values] :
+    { std::make_pair("RelativeErrorMedian", &summary.relativeErrorMedian),
+      std::make_pair("RelativeErrorP95", &summary.relativeErrorP95) })
+  {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(name);
+    for (double v : *values)
+    {
+      array->InsertNextValue(v);
+    }
+    fieldData->AddArray(array);
+  }
+  vtkNew<vtkIdTypeArray> lit;
+  lit->SetName("LitElements");
+  for (std::uint64_t v : summary.litElements)
+  {
+    lit->InsertNextValue(static_cast<vtkIdType>(v));
+  }
+  fieldData->AddArray(lit);
+  addValue<vtkIdTypeArray>(fieldData, "ErrorBatches", static_cast<vtkIdType>(summary.batches));
+  addValue<vtkIdTypeArray>(fieldData, "ErrorRounds", static_cast<vtkIdType>(summary.rounds));
+  addValue<vtkDoubleArray>(fieldData, "TargetRelativeError", summary.target);
+  addValue<vtkStringArray>(fieldData, "StoppedBy", summary.stoppedBy);
 }
 
 std::vector<Side> patchLitSides(const Solution& solution)

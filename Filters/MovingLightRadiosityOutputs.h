@@ -65,6 +65,20 @@ vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCou
 void addElementRadiosity(
   const Solution& solution, std::size_t frame, bool twoSided, vtkCellData* cellData);
 
+struct SmoothShading;
+
+/// With an error estimate (Solution::hasErrorEstimate), adds `RadiosityStdError` (RGB,
+/// W/(scene unit)^2, the standard error of each element's lit-side Radiosity in `frame`) to the
+/// cells, and to the points as their area-weighted mean over the cells around each point (as
+/// point `Radiosity` is made); nothing without one.
+void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
+  vtkPointData* pointData, vtkCellData* cellData);
+
+/// With an error estimate, adds to `fieldData` the per-frame arrays (one value per solved frame)
+/// `RelativeErrorMedian`, `RelativeErrorP95` and `LitElements`, and `ErrorBatches`,
+/// `ErrorRounds`, `TargetRelativeError` and the string `StoppedBy`; nothing without one.
+void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution);
+
 /// The side of each patch that received more power over the animation, as the solve chose
 /// it (Solution::patchLitSide), for every patch.
 std::vector<Side> patchLitSides(const Solution& solution);

@@ -138,6 +138,9 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
+  this->ErrorBatches = 16;
+  this->TargetRelativeError = defaults.targetRelativeError;
+  this->TimeLimit = defaults.timeLimitSeconds;
 
   this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
@@ -579,6 +582,8 @@ int vtkMovingLightRadiosity::RequestData(
           output->GetCellData());
         mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
           efficacyOf(cache, frame), output->GetPointData(), output->GetCellData());
+        mlr::vtkoutputs::addStdErrorArrays(
+          cache.Solution, cache.Shading, solved, output->GetPointData(), output->GetCellData());
         if (cache.Distributed)
         {
           // Cut from the whole frame, so that the point arrays at the cut average over the
@@ -925,6 +930,16 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
     solverOptions.threads = this->NumberOfThreads;
     solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
+    // Core refuses the other bad values (NaN targets included) naming the property to fix.
+    if (this->ErrorBatches < 0)
+    {
+      throw mlr::Error("the error batch count (ErrorBatches) is " +
+        std::to_string(this->ErrorBatches) + ": give 1 (no error estimate) up to " +
+        std::to_string(mlr::MaximumErrorBatches) + " (16 is typical)");
+    }
+    solverOptions.errorBatches = static_cast<std::uint64_t>(this->ErrorBatches);
+    solverOptions.targetRelativeError = this->TargetRelativeError;
+    solverOptions.timeLimitSeconds = this->TimeLimit;
     options.remeshing.targetEdgeLength = this->PatchSize;
     // The outputs' estimate is linear in the counts; per item, rounded up.
     constexpr std::size_t many = std::size_t(1) << 20;
@@ -957,6 +972,17 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     }
     const bool reportsProgress = !controller || controller->GetLocalProcessId() == 0;
 
+    this->SetProgressText(nullptr);
+    if (reportsProgress)
+    {
+      // The error estimate's rounds and estimates: the progress text ParaView shows, and the
+      // debug output.
+      solverOptions.log = [this](const std::string& message)
+      {
+        this->SetProgressText(message.c_str());
+        vtkDebugMacro(<< message);
+      };
+    }
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
       [this, reportsProgress](double fraction)
       {
@@ -981,6 +1007,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
     cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
     cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
+    mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
     cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
     cache.Solution = std::move(solution);
     cache.TwoSided = solverOptions.twoSided;
@@ -1119,6 +1146,9 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << this->PathEnd[2] << ")\n";
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
+  os << indent << "ErrorBatches: " << this->ErrorBatches << "\n";
+  os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
+  os << indent << "TimeLimit: " << this->TimeLimit << " s\n";
   os << indent << "LightType: "
      << (this->LightType == DIRECTIONAL_LIGHT    ? "Directional"
             : this->LightType == POINT_LIGHT     ? "Point"

@@ -55,12 +55,18 @@
  *   points also carry `Irradiance` (3 components, W/m^2: the light arriving on the lit
  *   side, direct and indirect, the surface's own emission excluded, so that black surfaces
  *   have it too; at points averaged as `Radiosity`) and `Illuminance` (1 component, lx:
- *   LuminousEfficacy times the luminance of `Irradiance`). `Color` is the active scalars of
+ *   LuminousEfficacy times the luminance of `Irradiance`). With ErrorBatches above 1, cells
+ *   and points carry `RadiosityStdError` (3 components, W/m^2: the standard error of
+ *   `Radiosity`, at points averaged as `Radiosity`). `Color` is the active scalars of
  *   points and cells. Its field data holds the solver statistics (paths, rays by kind,
  *   seconds by phase, patches, elements, frames, reuse modes, predicted speed-up), the frame
  *   shown (`FrameIndex`), where the light is in it (`LightPosition`, its centroid, and
  *   `LightTranslation`, from the Light input), `SolveCount`, the exposure (`AutoExposure`,
- *   `Exposure`, `ExposureScale`) and `LuminousEfficacy`. Every output's field data states
+ *   `Exposure`, `ExposureScale`) and `LuminousEfficacy`; with an error estimate, one value per
+ *   frame of `RelativeErrorMedian`, `RelativeErrorP95` and `LitElements` (the relative error
+ *   over the lit elements, see ErrorBatches), `ErrorBatches` (batches run), `ErrorRounds`,
+ *   `TargetRelativeError` and the string `StoppedBy` ("batches", "target", "time limit" or
+ *   "path limit"). Every output's field data states
  *   the units: `PowerUnits` "W", `RadiosityUnits` and `IrradianceUnits` "W/(scene unit)^2"
  *   (W/m^2 for a scene in metres) and `IlluminanceUnits` "lm/(scene unit)^2" (lx for a
  *   scene in metres).
@@ -457,6 +463,47 @@ public:
   vtkGetMacro(MemoryLimit, int);
   ///@}
 
+  // ---------------------------------------------------------------- Error estimate
+  ///@{
+  /**
+   * The solve runs as this many independent batches of NumberOfPaths / ErrorBatches paths
+   * per frame (and as many gathering rays), the result is their mean, and the spread of the
+   * batch means gives every element's standard error: the arrays `RadiosityStdError` and the
+   * field data `RelativeErrorMedian` and `RelativeErrorP95` (Documentation/Method.md, section
+   * 17). 1 is one solve without an error estimate (and none of those arrays). From 1 to 4096,
+   * at most NumberOfPaths; other values make the update fail with an error naming
+   * ErrorBatches. Default 16.
+   */
+  vtkSetMacro(ErrorBatches, int);
+  vtkGetMacro(ErrorBatches, int);
+  ///@}
+
+  ///@{
+  /**
+   * A target accuracy: above 0, the solve adds rounds of batches (of NumberOfPaths /
+   * ErrorBatches paths per frame each) until, in every frame, the 95th percentile of the lit
+   * elements' relative error is at most this (0.02 is 2%), or TimeLimit stops it (field data
+   * `StoppedBy`, and a warning when the target was not reached). The result stays
+   * reproducible for a seed and thread count-independent, unless TimeLimit stops it. Needs
+   * ErrorBatches of 2 or more. 0 (off) or from 0.0001; negative values and NaN make the update
+   * fail with an error naming TargetRelativeError. Default 0.
+   */
+  vtkSetMacro(TargetRelativeError, double);
+  vtkGetMacro(TargetRelativeError, double);
+  ///@}
+
+  ///@{
+  /**
+   * With TargetRelativeError: start no more batches once the batches have taken this many
+   * seconds (the first round always completes); the round count then depends on the
+   * machine's speed, and the result is no longer reproducible. 0 is no limit. Negative values,
+   * NaN and infinity make the update fail with an error naming TimeLimit. Default 0.
+   */
+  vtkSetMacro(TimeLimit, double);
+  vtkGetMacro(TimeLimit, double);
+  ///@}
+  // -------------------------------------------------------- end of Error estimate block
+
   // ---------------------------------------------------------------- Display
   ///@{
   /**
@@ -540,6 +587,9 @@ protected:
   std::string EmissionArrayName;
   std::string LightMaterial;
   vtkTypeBool LightPowerFromMaterial;
+  int ErrorBatches;
+  double TargetRelativeError;
+  double TimeLimit;
   vtkIdType SolveCount;
   double Exposure;
   double LuminousEfficacy;

@@ -32,6 +32,14 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.threads = 3;
   else if (name == "memoryLimitBytes")
     options.memoryLimitBytes = 1 << 30;
+  else if (name == "errorBatches")
+    options.errorBatches = 16;
+  else if (name == "targetRelativeError")
+    options.targetRelativeError = 0.02;
+  else if (name == "timeLimitSeconds")
+    options.timeLimitSeconds = 60;
+  else if (name == "log")
+    options.log = [](const std::string&) {};
   else if (name == "rank")
     options.rank = 1;
   else if (name == "ranks")
@@ -61,7 +69,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 13u);
+  EXPECT_EQ(names.size(), 17u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

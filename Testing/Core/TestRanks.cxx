@@ -187,6 +187,39 @@ INSTANTIATE_TEST_SUITE_P(Modes, Ranks,
   ::testing::Values(std::make_tuple(true, true, 1.0), std::make_tuple(false, false, 1.0),
     std::make_tuple(true, false, 0.5), std::make_tuple(true, true, 0.0)));
 
+TEST(RanksWithErrorEstimate, BatchesAndRoundsGiveEveryRankTheSerialBits)
+{
+  // Every batch is summed over the ranks, and the rounds are decided from those bits: the
+  // same batches, the same mean and the same standard errors on every rank.
+  const Scene scene = boxScene();
+  const LightRig rig = twoLights();
+  SolverOptions options;
+  options.pathsPerFrame = 16000;
+  options.seed = 3;
+  options.errorBatches = 8;
+  options.targetRelativeError = 0.08;
+  options.threads = 1;
+  Solution serial = solve(scene, rig, options);
+  ASSERT_GT(serial.errorEstimate.rounds, 1u);
+  for (const auto& [ranks, threads] : { std::pair{ 2, 1 }, std::pair{ 3, 2 } })
+  {
+    options.threads = threads;
+    std::vector<RankResult> results = solveOnRanks(scene, rig, options, ranks);
+    for (int r = 0; r < ranks; ++r)
+    {
+      SCOPED_TRACE("rank " + std::to_string(r) + " of " + std::to_string(ranks));
+      const RankResult& result = results[static_cast<std::size_t>(r)];
+      ASSERT_TRUE(result.error.empty()) << result.error;
+      Solution s = result.solution;
+      EXPECT_EQ(serial.errorEstimate.batches, s.errorEstimate.batches);
+      EXPECT_TRUE(checks::sameBits(serial.directData(), s.directData()));
+      EXPECT_TRUE(checks::sameBits(serial.indirectData(), s.indirectData()));
+      EXPECT_TRUE(checks::sameBits(serial.stdErrorData(), s.stdErrorData()));
+      EXPECT_EQ(serial.errorEstimate.relativeErrorP95, s.errorEstimate.relativeErrorP95);
+    }
+  }
+}
+
 TEST(RankFailures, ACancelOnOneRankStopsEveryRank)
 {
   const Scene scene = boxScene();

@@ -77,12 +77,13 @@ for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False
           f"input {name} has no documentation")
 
 # --- Properties ---------------------------------------------------------------------------
-ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", "MemoryLimit"}
+ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", "MemoryLimit",
+            "ErrorBatches", "TimeLimit"}
 BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering", "AimAtPoint", "LightPowerFromMaterial"}
 # Free text (names of arrays and materials): no domain to check against.
 STRINGS = {"LightMaterial", "ReflectanceArrayName", "EmissionArrayName"}
 # Kept as given outside the domain, and refused by name at the update, never changed.
-REFUSED = {"LuminousEfficacy"}
+REFUSED = {"LuminousEfficacy", "ErrorBatches", "TargetRelativeError", "TimeLimit"}
 EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurvival",
             "ReuseShooting", "ReuseGathering", "PatchSize", "Seed", "NumberOfThreads",
             "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit", "Exposure",
@@ -95,6 +96,8 @@ EXPECTED |= {"LightDistributionFile", "SpotHalfAngle", "SpotSoftEdge", "LightFlu
              "LightFluxFromFile"}
 BOOLEANS |= {"LightFluxFromFile"}
 STRINGS |= {"LightDistributionFile"}
+# The error estimate's properties.
+EXPECTED |= {"ErrorBatches", "TargetRelativeError", "TimeLimit"}
 # The sky's properties.
 EXPECTED |= {"SkyModel", "SkyDiffuseHorizontal", "Up"}
 vtk_defaults = vtkMovingLightRadiosity()

@@ -1,0 +1,155 @@
+// The filter's error estimate: RadiosityStdError on cells and points, the per-frame relative
+// error in field data, a target reached with StoppedBy, none of it with one batch, and bad
+// ErrorBatches, TargetRelativeError and TimeLimit refused by name.
+#include "FilterTestSupport.h"
+
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkMovingLightRadiosity.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkStringArray.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace mlr;
+using namespace mlr::testing;
+
+namespace
+{
+constexpr std::size_t Frames = 3;
+
+std::string stringValue(vtkFieldData* data, const char* name)
+{
+  auto* strings = vtkStringArray::SafeDownCast(data->GetAbstractArray(name));
+  return strings && strings->GetNumberOfValues() > 0 ? strings->GetValue(0) : std::string();
+}
+
+/// The filter's error in an update that must fail, and that the outputs are empty.
+std::string failure(vtkMovingLightRadiosity* filter)
+{
+  vtkNew<MessageRecorder> messages;
+  messages->watch(filter);
+  EXPECT_EQ(filter->UpdateTimeStep(0), 0);
+  EXPECT_EQ(filter->GetOutput(0)->GetNumberOfCells(), 0);
+  filter->RemoveAllObservers();
+  return messages->allErrors();
+}
+}
+
+TEST(FilterErrorEstimate, StandardErrorArraysOnCellsAndPointsAndPerFrameFieldData)
+{
+  const BoxSetup setup = closedBoxSetup(Frames);
+  auto filter = fastFilter(setup);
+  EXPECT_EQ(filter->GetErrorBatches(), 16);
+  filter->SetErrorBatches(8);
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  vtkPolyData* out = filter->GetOutput(0);
+  vtkDataArray* cells = out->GetCellData()->GetArray("RadiosityStdError");
+  vtkDataArray* points = out->GetPointData()->GetArray("RadiosityStdError");
+  vtkDataArray* radiosity = out->GetCellData()->GetArray("Radiosity");
+  ASSERT_NE(cells, nullptr);
+  ASSERT_NE(points, nullptr);
+  EXPECT_EQ(cells->GetNumberOfComponents(), 3);
+  EXPECT_EQ(cells->GetNumberOfTuples(), out->GetNumberOfCells());
+  EXPECT_EQ(points->GetNumberOfTuples(), out->GetNumberOfPoints());
+  // Every lit cell has an error, smaller than its radiosity at 8 batches of 2500 paths, and
+  // the point values lie within the cells' range (they are means of them).
+  double cellMax = 0, pointMax = 0;
+  for (vtkIdType c = 0; c < out->GetNumberOfCells(); ++c)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      EXPECT_GT(cells->GetComponent(c, k), 0) << "cell " << c;
+      EXPECT_LT(cells->GetComponent(c, k), radiosity->GetComponent(c, k)) << "cell " << c;
+      cellMax = std::max(cellMax, cells->GetComponent(c, k));
+    }
+  }
+  for (vtkIdType p = 0; p < out->GetNumberOfPoints(); ++p)
+  {
+    pointMax = std::max(pointMax, points->GetComponent(p, 0));
+  }
+  EXPECT_LE(pointMax, cellMax * (1 + 1e-6));
+
+  vtkFieldData* field = out->GetFieldData();
+  vtkDataArray* median = field->GetArray("RelativeErrorMedian");
+  vtkDataArray* p95 = field->GetArray("RelativeErrorP95");
+  ASSERT_NE(median, nullptr);
+  ASSERT_NE(p95, nullptr);
+  ASSERT_EQ(p95->GetNumberOfTuples(), static_cast<vtkIdType>(Frames));
+  for (vtkIdType f = 0; f < p95->GetNumberOfTuples(); ++f)
+  {
+    EXPECT_GT(median->GetComponent(f, 0), 0);
+    EXPECT_LE(median->GetComponent(f, 0), p95->GetComponent(f, 0));
+    EXPECT_LT(p95->GetComponent(f, 0), 1);
+  }
+  EXPECT_EQ(fieldValue(out, "ErrorBatches"), 8);
+  EXPECT_EQ(fieldValue(out, "PathsPerFrame"), 20000);
+  EXPECT_EQ(stringValue(field, "StoppedBy"), "batches");
+}
+
+TEST(FilterErrorEstimate, OneBatchHasNoErrorArrays)
+{
+  const BoxSetup setup = closedBoxSetup(Frames);
+  auto filter = fastFilter(setup);
+  filter->SetErrorBatches(1);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  vtkPolyData* out = filter->GetOutput(0);
+  EXPECT_EQ(out->GetCellData()->GetArray("RadiosityStdError"), nullptr);
+  EXPECT_EQ(out->GetPointData()->GetArray("RadiosityStdError"), nullptr);
+  EXPECT_EQ(out->GetFieldData()->GetArray("RelativeErrorP95"), nullptr);
+}
+
+TEST(FilterErrorEstimate, TargetIsReachedInEveryFrame)
+{
+  const BoxSetup setup = closedBoxSetup(Frames);
+  auto filter = fastFilter(setup);
+  filter->SetNumberOfPaths(16000);
+  filter->SetTargetRelativeError(0.04);
+  vtkNew<MessageRecorder> messages;
+  messages->watch(filter);
+  ASSERT_TRUE(filter->UpdateTimeStep(0));
+  EXPECT_TRUE(messages->warnings.empty()) << messages->allWarnings();
+  vtkPolyData* out = filter->GetOutput(0);
+  EXPECT_EQ(stringValue(out->GetFieldData(), "StoppedBy"), "target");
+  EXPECT_GT(fieldValue(out, "ErrorBatches"), 16);
+  EXPECT_GT(fieldValue(out, "PathsPerFrame"), 16000);
+  vtkDataArray* p95 = out->GetFieldData()->GetArray("RelativeErrorP95");
+  ASSERT_NE(p95, nullptr);
+  for (vtkIdType f = 0; f < p95->GetNumberOfTuples(); ++f)
+  {
+    EXPECT_LE(p95->GetComponent(f, 0), 0.04) << "frame " << f;
+  }
+  // The last progress text is the last round's error.
+  ASSERT_NE(filter->GetProgressText(), nullptr);
+  EXPECT_NE(std::string(filter->GetProgressText()).find("reached"), std::string::npos)
+    << filter->GetProgressText();
+}
+
+TEST(FilterErrorEstimate, BadErrorPropertiesAreRefusedByName)
+{
+  const BoxSetup setup = closedBoxSetup(Frames);
+  auto filter = fastFilter(setup);
+  filter->SetErrorBatches(0);
+  EXPECT_NE(failure(filter).find("ErrorBatches"), std::string::npos);
+  filter->SetErrorBatches(-3);
+  EXPECT_NE(failure(filter).find("ErrorBatches) is -3"), std::string::npos);
+  filter->SetErrorBatches(100000);
+  EXPECT_NE(failure(filter).find("ErrorBatches"), std::string::npos);
+  filter->SetErrorBatches(16);
+  filter->SetTargetRelativeError(-0.02);
+  EXPECT_NE(failure(filter).find("TargetRelativeError"), std::string::npos);
+  filter->SetTargetRelativeError(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_NE(failure(filter).find("TargetRelativeError"), std::string::npos);
+  filter->SetTargetRelativeError(0.02);
+  filter->SetTimeLimit(-1);
+  EXPECT_NE(failure(filter).find("TimeLimit"), std::string::npos);
+  // Fixed, the same filter solves.
+  filter->SetTimeLimit(0);
+  filter->SetTargetRelativeError(0);
+  EXPECT_TRUE(filter->UpdateTimeStep(0));
+}
