@@ -225,6 +225,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   app.set_help_flag();
   const CLI::Option* help = app.add_flag("-h,--help", o.help);
   const CLI::Option* point = app.add_flag("--point-light", o.pointLight);
+  app.add_flag("--equal-shares", o.equalShares);
   // Unknown options, arguments and repeated options are reported below, in the project's words.
   app.allow_extras();
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -558,6 +559,10 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     filter->SetReuseShooting(*o.reuse == "shooting" || *o.reuse == "both");
     filter->SetReuseGathering(*o.reuse == "gathering" || *o.reuse == "both");
   }
+  if (o.equalShares)
+  {
+    filter->SetBalanceFrames(0);
+  }
   if (o.patchSize)
   {
     checkRange(
@@ -692,6 +697,8 @@ Solver:
   --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)
   --survival L          probability that a path continues after its first hit (default 0.25)
   --reuse MODE          none, gathering, shooting or both (default both)
+  --equal-shares        reused paths: as many from every light position, instead of more
+                        from the positions the others cover worst (the ends)
   --patch-size H        target patch edge length in scene units (default: about 3000 patches)
   --seed S              seed of the random numbers (default 0)
   --threads T           worker threads, 0 for every core (default 0)

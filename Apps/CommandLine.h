@@ -60,6 +60,8 @@ struct Options
   /// Luminaires: a point light instead of polygons, and the intensity distribution and flux
   /// of every light.
   bool pointLight = false;
+  /// Reused paths shared equally over the positions (no balancing of the frames).
+  bool equalShares = false;
   std::string lightDistribution;             ///< FILE.ies or FILE.ldt
   std::optional<std::array<double, 2>> spot; ///< half angle and soft edge, degrees
   std::optional<double> lightLumens;         ///< lm

@@ -26,6 +26,10 @@ struct ShootingResult
 {
   std::uint64_t pathsCast = 0;
   WorkerCounters counters;
+  /// Rays of the pilot that balanced the positions (the same on every rank).
+  std::uint64_t pilotRays = 0;
+  /// The fewest and most paths a position cast, over N/n; 1 and 1 unless reused and balanced.
+  double smallestShare = 1, largestShare = 1;
 };
 
 /**

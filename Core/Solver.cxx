@@ -228,6 +228,12 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       plan.accumulatorCopyPerWorker, phaseTick(shares->shooting[i]), secondsReducing, solution);
     stats.pathsCast += shot.pathsCast;
     stats.staticPathsCast += sources[i].isStatic() ? shot.pathsCast : 0;
+    stats.pilotRays += shot.pilotRays;
+    if (!sources[i].isStatic())
+    {
+      stats.smallestPositionShare = std::min(stats.smallestPositionShare, shot.smallestShare);
+      stats.largestPositionShare = std::max(stats.largestPositionShare, shot.largestShare);
+    }
     rays += shot.counters;
   }
   stats.sources = sources.size();
