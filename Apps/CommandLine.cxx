@@ -290,6 +290,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   const CLI::Option* point = app.add_flag("--point-light", o.pointLight);
   const CLI::Option* night = app.add_flag("--night", o.night);
   const CLI::Option* luminaire = app.add_flag("--luminaire", o.luminaire);
+  const CLI::Option* equalShares = app.add_flag("--equal-shares", o.equalShares);
   // Unknown options, arguments and repeated options are reported below, in the project's words.
   app.allow_extras();
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -363,7 +364,8 @@ Options parseCommandLine(int argc, const char* const* argv)
     const std::string arg = argv[i];
     const std::string name = arg.substr(0, arg.find('='));
     const CLI::Option* given = app.get_option_no_throw(name);
-    if ((given == help || given == point || given == night || given == luminaire) &&
+    if ((given == help || given == point || given == night || given == luminaire ||
+          given == equalShares) &&
       name.size() < arg.size())
     {
       throw UsageError(name + " takes no value");
@@ -398,7 +400,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   for (const CLI::Option* given : app.get_options())
   {
     if (given->count() > 1 && given != help && given != point && given != night &&
-      given != luminaire)
+      given != luminaire && given != equalShares)
     {
       throw UsageError(given->get_name() + " is given twice");
     }
@@ -671,6 +673,10 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     filter->SetReuseShooting(*o.reuse == "shooting" || *o.reuse == "both");
     filter->SetReuseGathering(*o.reuse == "gathering" || *o.reuse == "both");
   }
+  if (o.equalShares)
+  {
+    filter->SetBalanceFrames(0);
+  }
   if (o.patchSize)
   {
     checkRange(
@@ -859,6 +865,8 @@ Solver:
   --gather-ratio K      final-gathering rays per frame, as a multiple of N (default 1)
   --survival L          probability that a path continues after its first hit (default 0.25)
   --reuse MODE          none, gathering, shooting or both (default both)
+  --equal-shares        reused paths: as many from every light position, instead of more
+                        from the positions the others cover worst (the ends)
   --patch-size H        target patch edge length in scene units (default: about 3000 patches)
   --seed S              seed of the random numbers (default 0)
   --threads T           worker threads, 0 for every core (default 0)

@@ -65,7 +65,9 @@ struct Options
   /// Luminaires: a point light instead of polygons, and the intensity distribution and flux
   /// of every light.
   bool pointLight = false;
-  bool luminaire = false;                    ///< an area light of the file's luminous opening
+  bool luminaire = false; ///< an area light of the file's luminous opening
+  /// Reused paths shared equally over the positions (no balancing of the frames).
+  bool equalShares = false;
   std::string lightDistribution;             ///< FILE.ies or FILE.ldt
   std::optional<std::array<double, 2>> spot; ///< half angle and soft edge, degrees
   std::optional<double> lightLumens;         ///< lm

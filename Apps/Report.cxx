@@ -146,6 +146,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "gatherRatio", jsonNumber(filter->GetGatheringRatio()) },
     { "survival", jsonNumber(filter->GetFirstBounceSurvival()) },
     { "reuseShooting", filter->GetReuseShooting() != 0 },
+    { "balanceFrames", filter->GetBalanceFrames() != 0 },
     { "reuseGathering", filter->GetReuseGathering() != 0 },
     { "patchSize", jsonNumber(filter->GetPatchSize()) },
     { "seed", filter->GetSeed() },

@@ -335,11 +335,41 @@ struct ModeRun
 {
   std::string name;
   SolverStatistics stats;
-  double cpuSeconds = 0;   ///< median over the repeats
-  std::vector<double> mse; ///< at each reported frame
-  double meanMse = 0;      ///< over all frames
+  double cpuSeconds = 0;        ///< median over the repeats
+  std::vector<double> mse;      ///< at each reported frame
+  double meanMse = 0;           ///< over all frames
+  std::vector<double> frameMse; ///< every frame's
   int repeats = 1;
 };
+
+/// Every frame's MSE against classic's, for full reuse with the paths balanced over the
+/// positions and with equal shares: the curve that chose balancing (Documentation/Method.md).
+/// Printed, and returned as JSON members for report()'s extra.
+std::string frameRatios(const ModeRun& classic, const ModeRun& balanced, const ModeRun& equal)
+{
+  std::ostringstream json;
+  for (const ModeRun* m : { &balanced, &equal })
+  {
+    const std::vector<double>& e = m->frameMse;
+    std::size_t worst = 0;
+    json << ",\n    \"frame_mse_ratio_" << (m == &balanced ? "balanced" : "equal") << "\": [";
+    std::printf("MSE / classic, every frame, %s:", m->name.c_str());
+    for (std::size_t f = 0; f < e.size(); ++f)
+    {
+      const double ratio = e[f] / classic.frameMse[f];
+      worst = ratio > e[worst] / classic.frameMse[worst] ? f : worst;
+      std::printf(" %.2f", ratio);
+      json << (f ? ", " : "") << ratio;
+    }
+    json << "]";
+    std::printf(
+      "\n  worst frame %zu: %.2f; first %.2f, middle %.2f, last %.2f; %.2f s, CPU %.2f s\n",
+      worst + 1, e[worst] / classic.frameMse[worst], e.front() / classic.frameMse.front(),
+      e[e.size() / 2] / classic.frameMse[e.size() / 2], e.back() / classic.frameMse.back(),
+      m->stats.secondsTotal, m->cpuSeconds);
+  }
+  return json.str();
+}
 
 /// Solves in one mode; a solve under 3 s is timed as the median of three (same rays, same result).
 ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig, SolverOptions o,
@@ -373,7 +403,8 @@ ModeRun runMode(const std::string& name, const Scene& scene, const LightRig& rig
   }
   for (std::size_t f = 0; f < ref.frames; ++f)
   {
-    run.meanMse += meanSquaredError(scene, s, ref, f) / double(ref.frames);
+    run.frameMse.push_back(meanSquaredError(scene, s, ref, f));
+    run.meanMse += run.frameMse.back() / double(ref.frames);
   }
   return run;
 }
@@ -552,7 +583,11 @@ std::string runTurningLight(const RigCaseOptions& c)
     "frame " + std::to_string(at[1] + 1) };
   const ModeRun classic = runMode("classic", scene, rig, options, false, ref, at);
   const ModeRun full = runMode("full reuse", scene, rig, options, true, ref, at);
-  return report("Turning light", scene, c.frames, options, ref, at, labels, classic, full, "");
+  SolverOptions equalShares = options;
+  equalShares.balanceFrames = false;
+  const ModeRun equal = runMode("full reuse, equal shares", scene, rig, equalShares, true, ref, at);
+  const std::string curves = frameRatios(classic, full, equal);
+  return report("Turning light", scene, c.frames, options, ref, at, labels, classic, full, curves);
 }
 
 std::string runSunOverTown(const RigCaseOptions& c)
@@ -609,7 +644,11 @@ std::string runSunOverTown(const RigCaseOptions& c)
   const std::vector<std::string> labels = { clock(0), clock(highest), clock(sun.size() - 1) };
   const ModeRun classic = runMode("classic", scene, rig, options, false, ref, at);
   const ModeRun full = runMode("full reuse", scene, rig, options, true, ref, at);
+  SolverOptions equalShares = options;
+  equalShares.balanceFrames = false;
+  const ModeRun equal = runMode("full reuse, equal shares", scene, rig, equalShares, true, ref, at);
   std::ostringstream extra;
+  extra << frameRatios(classic, full, equal);
   extra << ",\n    \"sun_elevation_degrees\": [";
   for (std::size_t f = 0; f < sun.size(); ++f)
   {

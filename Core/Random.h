@@ -22,6 +22,8 @@ enum class StreamPurpose : std::uint64_t
   Gathering = 2,
   /// Probes that decide which sides light can reach: keyed by a fixed seed, never the solve's.
   Reachability = 3,
+  /// The pilot paths that choose how many paths each light position casts.
+  Pilot = 5,
 };
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state advanced by a Weyl step and

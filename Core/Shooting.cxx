@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "FixedPointAccumulator.h"
+#include "Parallel.h"
 #include "Random.h"
 #include "Ranks.h"
 #include "RayTracer.h"
@@ -27,6 +28,16 @@ constexpr int MaximumBounces = 1 << 24;
 constexpr std::uint64_t ReusedPathsPerTask = 256;
 constexpr std::uint64_t ClassicPathsPerTask = 2048;
 
+/// The pilot that balances the frames keeps one float per pilot and position: at most this
+/// many (32 MiB).
+constexpr std::uint64_t PilotValues = 1 << 23;
+/// Bounds on a position's share of the paths, in units of the equal share 1/n: the ends of
+/// an animation may take up to four times the middle's, and no position falls below a
+/// quarter, which keeps every frame's weights bounded.
+constexpr double BalanceLowest = 0.25;
+constexpr double BalanceHighest = 4.0;
+constexpr int BalanceIterations = 40;
+
 /// The rounding quantum of a fixed-point channel whose largest value per path is `scale`:
 /// one per channel, so that a channel 10^6 weaker than the others keeps its precision.
 double quantumFor(double scale)
@@ -34,12 +45,50 @@ double quantumFor(double scale)
   return scale > 0 && std::isfinite(scale) ? scale * 0x1.0p-40 : 1.0;
 }
 
+/// M_k for the k-th of `active` positions, adding up to N: equal counts for empty `shares`;
+/// else floor(alpha_k N), at least one, and the remainder to the largest fractions (the lower
+/// position first on a tie).
+std::vector<std::uint64_t> pathCounts(
+  const std::vector<double>& shares, std::size_t active, std::uint64_t N)
+{
+  std::vector<std::uint64_t> counts(active);
+  if (shares.empty())
+  {
+    for (std::uint64_t a = 0; a < active; ++a)
+    {
+      counts[a] = N / active + (a < N % active ? 1 : 0);
+    }
+    return counts;
+  }
+  std::uint64_t given = 0;
+  std::vector<std::pair<double, std::size_t>> fractions(active);
+  for (std::size_t a = 0; a < active; ++a)
+  {
+    const double exact = shares[a] * double(N);
+    counts[a] = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(exact));
+    fractions[a] = { exact - std::floor(exact), a };
+    given += counts[a];
+  }
+  std::stable_sort(fractions.begin(), fractions.end(),
+    [](const auto& x, const auto& y) { return x.first > y.first; });
+  for (std::size_t i = 0; given < N; i = (i + 1) % active, ++given)
+  {
+    ++counts[fractions[i].second];
+  }
+  while (given > N)
+  {
+    --*std::max_element(counts.begin(), counts.end());
+    --given;
+  }
+  return counts;
+}
+
 /// The shooting of one LightSource into its own accumulators, added to the solution at the end.
 class ShootingRun
 {
 public:
   ShootingRun(const Scene& scene, const LightSource& source, const SolverOptions& options,
-    const RayTracer& tracer, int workers, bool copyPerWorker)
+    const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares)
     : SceneRef(scene)
     , SourceRef(source)
     , Options(options)
@@ -62,15 +111,7 @@ public:
     // M_k paths start from active position k; they add up to N exactly. Positions that are
     // off cast nothing: their frames are zero, and every active frame j still has M_j > 0 in
     // its weights' denominator, so no light is lost.
-    const std::vector<std::size_t>& positions = source.activePositions();
-    const std::uint64_t active = positions.size();
-    const std::uint64_t N = options.pathsPerFrame;
-    this->PathsFromPosition.assign(this->Frames, 0.0);
-    for (std::uint64_t a = 0; a < active; ++a)
-    {
-      this->PathsFromPosition[positions[a]] =
-        static_cast<double>(N / active + (a < N % active ? 1 : 0));
-    }
+    this->setPathCounts(pathCounts(shares, source.activePositions().size(), options.pathsPerFrame));
   }
 
   bool reuses() const { return this->Reuse; }
@@ -94,18 +135,17 @@ public:
       this->Options, this->PatchPower.collapse(), this->PatchPower.copySize(), secondsReducing);
   }
 
-  /// Which active position path `path` of a reuse solve starts from.
+  /// Which active position path `path` of a reuse solve starts from: paths are numbered
+  /// position by position, M_k of them for the k-th active position.
   std::size_t positionOfPath(std::uint64_t path) const
   {
-    const std::vector<std::size_t>& active = this->SourceRef.activePositions();
-    const std::uint64_t n = active.size();
-    const std::uint64_t base = this->Options.pathsPerFrame / n;
-    const std::uint64_t extra = this->Options.pathsPerFrame % n;
-    const std::uint64_t firstBlock = extra * (base + 1);
-    const std::uint64_t index =
-      path < firstBlock ? path / (base + 1) : extra + (path - firstBlock) / base;
-    return active[static_cast<std::size_t>(index)];
+    const auto next = std::upper_bound(this->FirstPath.begin(), this->FirstPath.end(), path);
+    return this->SourceRef
+      .activePositions()[static_cast<std::size_t>(next - this->FirstPath.begin() - 1)];
   }
+
+  /// M_k of every position (0 for positions that are off).
+  const std::vector<double>& pathsFromPosition() const { return this->PathsFromPosition; }
 
 private:
   bool emit(RandomStream& random, std::size_t position, int worker, EmittedPath& path, RayHit& hit);
@@ -131,6 +171,20 @@ private:
   std::vector<WorkerCounters> Counters;
   std::vector<KernelScratch> Scratch;
   std::vector<double> PathsFromPosition;
+  /// The first path of each active position, and N at the end.
+  std::vector<std::uint64_t> FirstPath;
+
+  void setPathCounts(const std::vector<std::uint64_t>& counts)
+  {
+    const std::vector<std::size_t>& positions = this->SourceRef.activePositions();
+    this->PathsFromPosition.assign(this->Frames, 0.0);
+    this->FirstPath.assign(counts.size() + 1, 0);
+    for (std::size_t a = 0; a < counts.size(); ++a)
+    {
+      this->PathsFromPosition[positions[a]] = static_cast<double>(counts[a]);
+      this->FirstPath[a + 1] = this->FirstPath[a] + counts[a];
+    }
+  }
 };
 
 /**
@@ -301,6 +355,159 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
   this->scoreAndWalk(random, hit, kernel, 0, this->Frames, worker);
 }
 
+} // namespace
+
+std::vector<double> positionShares(const Scene& scene, const LightSource& source,
+  const SolverOptions& options, const RayTracer& tracer, int workers,
+  const std::function<bool(double fraction)>& fraction, std::uint64_t& pilotRays)
+{
+  const std::vector<std::size_t>& positions = source.activePositions();
+  const std::size_t n = positions.size();
+  const std::uint64_t N = options.pathsPerFrame;
+  // With a few paths per position there is nothing to move, and the pilot would cost more
+  // than the paths it places.
+  if (!options.reuseShooting || source.positions() < 2 || !options.balanceFrames || n < 3 ||
+    N < 8 * n)
+  {
+    return {};
+  }
+  // About N/32 pilots (at least 1,000 unless that is over N/4), and at most PilotValues values.
+  const std::size_t pilots =
+    static_cast<std::size_t>(std::min(std::max(N / 32, std::min<std::uint64_t>(N / 4, 1000)),
+      std::max<std::uint64_t>(1000, PilotValues / n)));
+
+  // u[s][a] = G_a(y_s) / sum_m G_m(y_s), with visibility: pilot s from the equal mixture
+  // (its position drawn uniformly, so the pilots are exact samples of it).
+  std::vector<float> u(pilots * n, 0.0f);
+  constexpr std::size_t PilotsPerTask = 64;
+  std::vector<std::uint64_t> rays(static_cast<std::size_t>(workers), 0);
+  std::vector<KernelScratch> scratches(static_cast<std::size_t>(workers));
+  for (KernelScratch& s : scratches)
+  {
+    s.resize(source.positions());
+  }
+  parallelFor((pilots + PilotsPerTask - 1) / PilotsPerTask, workers,
+    [&](std::size_t task, int worker)
+    {
+      KernelScratch& scratch = scratches[static_cast<std::size_t>(worker)];
+      std::uint64_t& traced = rays[static_cast<std::size_t>(worker)];
+      for (std::size_t s = task * PilotsPerTask; s < std::min(pilots, (task + 1) * PilotsPerTask);
+           ++s)
+      {
+        RandomStream random(options.seed, StreamPurpose::Pilot, s, source.stream());
+        const std::size_t origin =
+          positions[std::min(n - 1, static_cast<std::size_t>(random.uniform() * double(n)))];
+        EmittedPath emitted;
+        RayHit hit;
+        source.emit(origin, random, tracer.surfaceOffset(), emitted);
+        ++traced;
+        if (!tracer.intersect(emitted.start, emitted.direction, hit) ||
+          (!options.twoSided && hit.side == Side::Back))
+        {
+          continue; // scores nothing in any frame
+        }
+        const std::size_t shadowCount = source.kernel(emitted, hit.point,
+          scene.elementSideNormal(hit.element, hit.side), origin, tracer, scratch);
+        traced += shadowCount;
+        for (std::size_t r = 0; r < shadowCount; ++r)
+        {
+          if (!scratch.visible[r])
+          {
+            scratch.kernel[scratch.targetFrames[r]] = 0;
+          }
+        }
+        double sum = 0;
+        for (std::size_t a = 0; a < n; ++a)
+        {
+          sum += scratch.kernel[positions[a]];
+        }
+        if (sum > 0)
+        {
+          for (std::size_t a = 0; a < n; ++a)
+          {
+            u[s * n + a] = static_cast<float>(scratch.kernel[positions[a]] / sum);
+          }
+        }
+      }
+    },
+    [&](std::size_t) { return !fraction || fraction(0.0); });
+  for (std::uint64_t r : rays)
+  {
+    pilotRays += r;
+  }
+
+  // Frame j's variance against classic's at equal N, for shares alpha (sum 1): with paths
+  // drawn from q' = sum_a alpha_a q_a, R_j = E_q'[(q_j / q')^2] / c_j, c_j the share of
+  // frame j's own paths that hit the scene, estimated from the pilots by reweighting them
+  // from the equal mixture to q'. Shares move by the square root of R until every frame has
+  // the same; sums run in pilot order, so the choice does not depend on the threads.
+  std::vector<double> alpha(n, 1.0 / double(n)), denominator(pilots), ratio(n);
+  const double low = BalanceLowest / double(n), high = BalanceHighest / double(n);
+  for (int iteration = 0; iteration < BalanceIterations; ++iteration)
+  {
+    for (std::size_t s = 0; s < pilots; ++s)
+    {
+      double d = 0;
+      for (std::size_t a = 0; a < n; ++a)
+      {
+        d += alpha[a] * u[s * n + a];
+      }
+      denominator[s] = d;
+    }
+    std::vector<double> second(n, 0.0), first(n, 0.0);
+    for (std::size_t s = 0; s < pilots; ++s)
+    {
+      if (denominator[s] > 0)
+      {
+        for (std::size_t a = 0; a < n; ++a)
+        {
+          const double value = u[s * n + a];
+          second[a] += value * value / denominator[s];
+          first[a] += value;
+        }
+      }
+    }
+    double lowest = 1e300, highest = 0;
+    for (std::size_t a = 0; a < n; ++a)
+    {
+      ratio[a] = first[a] > 0 ? second[a] / first[a] : 0;
+      if (ratio[a] > 0)
+      {
+        lowest = std::min(lowest, ratio[a]);
+        highest = std::max(highest, ratio[a]);
+      }
+    }
+    if (!(highest > 0) || highest < 1.01 * lowest)
+    {
+      break;
+    }
+    double total = 0;
+    for (std::size_t a = 0; a < n; ++a)
+    {
+      // A frame no pilot reached keeps its share: nothing says how it fares.
+      alpha[a] *= ratio[a] > 0 ? std::sqrt(ratio[a]) : 1.0;
+      total += alpha[a];
+    }
+    for (std::size_t a = 0; a < n; ++a)
+    {
+      alpha[a] = std::clamp(alpha[a] / total, low, high);
+    }
+  }
+
+  double total = 0;
+  for (double a : alpha)
+  {
+    total += a;
+  }
+  for (double& a : alpha)
+  {
+    a /= total;
+  }
+  return alpha;
+}
+
+namespace
+{
 void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int worker)
 {
   RandomStream random(
@@ -394,10 +601,10 @@ double shootingCost(const LightSource& source, const SolverOptions& options)
 }
 
 ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
-  const RayTracer& tracer, int workers, bool copyPerWorker,
+  const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
 {
-  ShootingRun run(scene, source, options, tracer, workers, copyPerWorker);
+  ShootingRun run(scene, source, options, tracer, workers, copyPerWorker, shares);
   const std::uint64_t paths = options.pathsPerFrame;
   const std::vector<std::size_t>& positions = source.activePositions();
   ShootingResult result;
@@ -420,6 +627,13 @@ ShootingResult shoot(const Scene& scene, const LightSource& source, const Solver
       },
       fraction, secondsReducing);
     result.pathsCast = paths;
+    const double equal = double(paths) / double(positions.size());
+    result.smallestShare = 1e300;
+    for (std::size_t k : positions)
+    {
+      result.smallestShare = std::min(result.smallestShare, run.pathsFromPosition()[k] / equal);
+      result.largestShare = std::max(result.largestShare, run.pathsFromPosition()[k] / equal);
+    }
   }
   else
   {

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 namespace mlr
 {
@@ -26,16 +27,30 @@ struct ShootingResult
 {
   std::uint64_t pathsCast = 0;
   WorkerCounters counters;
+  /// The fewest and most paths a position cast, over N/n; 1 and 1 unless reused and balanced.
+  double smallestShare = 1, largestShare = 1;
 };
+
+/**
+ * The share of the reused paths each active position of `source` casts, balanced so that
+ * every frame is sampled as well as the others (Documentation/Method.md, "The ends of an
+ * animation"): from a pilot of reused paths, the same on every rank and for any thread
+ * count. Empty, meaning equal shares, when the source does not reuse, balancing is off or
+ * there are too few paths per position. `pilotRays` gets the pilot's rays added.
+ */
+std::vector<double> positionShares(const Scene& scene, const LightSource& source,
+  const SolverOptions& options, const RayTracer& tracer, int workers,
+  const std::function<bool(double fraction)>& fraction, std::uint64_t& pilotRays);
 
 /**
  * Shoots options.pathsPerFrame effective paths per frame from `source` (reused over its
  * positions, or classic: each position its own), shared by the ranks and summed over them,
  * and adds the source's radiosity to `solution`. `copyPerWorker`: one copy of the sums per
- * worker (MemoryPlan). `fraction` gets the share done; false cancels.
+ * worker (MemoryPlan). `shares`: positionShares(), for this or a larger N. `fraction` gets
+ * the share done; false cancels.
  */
 ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
-  const RayTracer& tracer, int workers, bool copyPerWorker,
+  const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing,
   Solution& solution);
 

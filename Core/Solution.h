@@ -33,6 +33,13 @@ struct SolverStatistics
   std::uint64_t reachableSides = 0;   ///< patch sides light can reach (the others stay dark)
   std::uint64_t sources = 0;          ///< lights shot: moving, static, directional, emitters
   std::uint64_t staticPathsCast = 0;  ///< of pathsCast, from sources solved once for all frames
+  /// Rays of the pilots that shared the paths out over a moving light's positions (traced
+  /// alike on every rank, counted once; in none of the counts above).
+  std::uint64_t pilotRays = 0;
+  /// Over the reused moving lights, the fewest and most paths a position cast, in units of
+  /// the equal share N/n: above 1 at the ends of a trajectory when the frames are balanced.
+  double smallestPositionShare = 1;
+  double largestPositionShare = 1;
   /// l of the paper: mean number of hits of a path without the lambda cut, from
   /// shootingRays / pathsCast = 1 + lambda (l - 1).
   double meanPathLength = 0;

@@ -215,6 +215,22 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   SolverStatistics& stats = solution.statistics;
   stats.secondsSetup = secondsSince(start);
 
+  // How each moving light's reused paths are shared over its positions: chosen once, from
+  // the whole solve's N and seed, for every batch and round.
+  std::vector<std::vector<double>> positionShare(sources.size());
+  agreeAcrossRanks(
+    options,
+    [&]
+    {
+      for (std::size_t i = 0; i < sources.size(); ++i)
+      {
+        positionShare[i] = positionShares(
+          scene, sources[i], options, tracer, workers,
+          [&](double) { return !progress || progress(0.0); }, stats.pilotRays);
+      }
+    },
+    &secondsReducing);
+
   // One pass: shooting every source, then gathering, into `into`. A batched solve runs one per
   // batch, sharing the scene, the tracer and the reachable sides (which do not depend on the
   // seed).
@@ -234,10 +250,16 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     const auto shootingStart = Clock::now();
     for (std::size_t i = 0; i < sources.size(); ++i)
     {
-      const ShootingResult shot = shoot(scene, sources[i], passOptions, tracer, workers,
-        plan.accumulatorCopyPerWorker, phaseTick(shares->shooting[i]), secondsReducing, into);
+      const ShootingResult shot =
+        shoot(scene, sources[i], passOptions, tracer, workers, plan.accumulatorCopyPerWorker,
+          positionShare[i], phaseTick(shares->shooting[i]), secondsReducing, into);
       stats.pathsCast += shot.pathsCast;
       stats.staticPathsCast += sources[i].isStatic() ? shot.pathsCast : 0;
+      if (!sources[i].isStatic())
+      {
+        stats.smallestPositionShare = std::min(stats.smallestPositionShare, shot.smallestShare);
+        stats.largestPositionShare = std::max(stats.largestPositionShare, shot.largestShare);
+      }
       rays += shot.counters;
     }
     stats.secondsShooting += secondsSince(shootingStart);

@@ -21,6 +21,12 @@ struct SolverOptions
   double firstBounceSurvival = 0.25;
   /// Cast M = N/n paths from each position and weight them for every frame.
   bool reuseShooting = true;
+  /// With shooting reuse, share the N paths unequally over the light's positions so that
+  /// every frame gets the same effective number of paths: a pilot of reused paths judges
+  /// how well the mixture samples each frame, and the ends of a trajectory, which the
+  /// mixture covers from one side only, get more (Documentation/Method.md, section 5).
+  /// False casts N/n from every position.
+  bool balanceFrames = true;
   /// Cast one set of gathering rays and use every ray for every frame.
   bool reuseGathering = true;
   /// Surfaces scatter light on both sides; when false, back faces absorb everything.
@@ -90,13 +96,14 @@ enum class OptionRole
 template <typename Visitor>
 void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
-  const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, reuseGathering,
-    twoSided, seed, threads, memoryLimitBytes, errorBatches, targetRelativeError, timeLimitSeconds,
-    rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks, log] = options;
+  const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
+    reuseGathering, twoSided, seed, threads, memoryLimitBytes, errorBatches, targetRelativeError,
+    timeLimitSeconds, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks, log] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
   visit("reuseShooting", reuseShooting, OptionRole::Result);
+  visit("balanceFrames", balanceFrames, OptionRole::Result);
   visit("reuseGathering", reuseGathering, OptionRole::Result);
   visit("twoSided", twoSided, OptionRole::Result);
   visit("seed", seed, OptionRole::Result);

@@ -229,6 +229,9 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("GatheringRays", statistics.gatheringRays);
   count("MissedRays", statistics.missedRays);
   count("GatheringSides", statistics.gatheringSides);
+  count("PilotRays", statistics.pilotRays);
+  real("SmallestPositionShare", statistics.smallestPositionShare);
+  real("LargestPositionShare", statistics.largestPositionShare);
   count("Threads", static_cast<std::uint64_t>(statistics.threads));
   count("MemoryEstimateBytes", statistics.memoryEstimateBytes);
   // The cost that limits users: bytes per element and frame (MemoryPlan).

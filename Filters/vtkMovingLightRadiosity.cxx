@@ -109,6 +109,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->GatheringRatio = defaults.gatheringRatio;
   this->FirstBounceSurvival = defaults.firstBounceSurvival;
   this->ReuseShooting = defaults.reuseShooting;
+  this->BalanceFrames = defaults.balanceFrames;
   this->ReuseGathering = defaults.reuseGathering;
   this->PatchSize = 0.0;
   this->Seed = static_cast<int>(defaults.seed);
@@ -925,6 +926,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.gatheringRatio = this->GatheringRatio;
     solverOptions.firstBounceSurvival = this->FirstBounceSurvival;
     solverOptions.reuseShooting = this->ReuseShooting != 0;
+    solverOptions.balanceFrames = this->BalanceFrames != 0;
     solverOptions.reuseGathering = this->ReuseGathering != 0;
     solverOptions.twoSided = this->TwoSided != 0;
     solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
@@ -1135,6 +1137,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GatheringRatio: " << this->GatheringRatio << "\n";
   os << indent << "FirstBounceSurvival: " << this->FirstBounceSurvival << "\n";
   os << indent << "ReuseShooting: " << (this->ReuseShooting ? "On" : "Off") << "\n";
+  os << indent << "BalanceFrames: " << (this->BalanceFrames ? "On" : "Off") << "\n";
   os << indent << "ReuseGathering: " << (this->ReuseGathering ? "On" : "Off") << "\n";
   os << indent << "PatchSize: " << this->PatchSize << "\n";
   os << indent << "Seed: " << this->Seed << "\n";

@@ -199,6 +199,18 @@ public:
 
   ///@{
   /**
+   * With ReuseShooting, share the paths unequally over the light's positions so that every
+   * frame is sampled as well as the others: a pilot of reused paths finds the frames the
+   * mixture covers worst (the ends of a trajectory) and gives their positions more paths.
+   * Unbiased either way. Default on; off casts the same number from every position.
+   */
+  vtkSetMacro(BalanceFrames, vtkTypeBool);
+  vtkGetMacro(BalanceFrames, vtkTypeBool);
+  vtkBooleanMacro(BalanceFrames, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Reuse one set of gathering rays for all frames (else each frame gathers its own).
    * Default on.
    */
@@ -562,6 +574,7 @@ protected:
   double GatheringRatio;
   double FirstBounceSurvival;
   vtkTypeBool ReuseShooting;
+  vtkTypeBool BalanceFrames;
   vtkTypeBool ReuseGathering;
   double PatchSize;
   int Seed;

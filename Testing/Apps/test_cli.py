@@ -172,9 +172,9 @@ def test_bad_syntax_fails_with_a_message_and_writes_nothing(tmp_path, args, mess
 
 def test_every_option_of_the_help_is_known(tmp_path):
     """Every option the help lists is registered: alone, it asks for its value (the flags
-    --help, --point-light, --night and --luminaire take none)."""
+    --help, --point-light, --night, --luminaire and --equal-shares take none)."""
     options = sorted(set(re.findall(r"--[a-z][a-z-]+", run(["--help"], tmp_path).stdout)) -
-                     {"--help", "--point-light", "--night", "--luminaire"})
+                     {"--help", "--point-light", "--night", "--luminaire", "--equal-shares"})
     assert len(options) == 38, options
     for option in options:
         result = run([option], tmp_path)

@@ -22,6 +22,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.firstBounceSurvival = 0.5;
   else if (name == "reuseShooting")
     options.reuseShooting = !options.reuseShooting;
+  else if (name == "balanceFrames")
+    options.balanceFrames = !options.balanceFrames;
   else if (name == "reuseGathering")
     options.reuseGathering = !options.reuseGathering;
   else if (name == "twoSided")
@@ -69,7 +71,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 17u);
+  EXPECT_EQ(names.size(), 18u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

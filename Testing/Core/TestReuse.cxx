@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 using namespace mlr;
 
@@ -149,6 +150,45 @@ TEST(Reuse, IdenticalPositionsGiveTheErrorOfClassic)
     }
   }
   EXPECT_NEAR(mse[1] / mse[0], 1.0, 0.2);
+  // Every frame is sampled alike: the pilot finds nothing to move.
+  const Solution balanced = solve(s.scene, light, modeOptions(true, 12000, 300));
+  EXPECT_EQ(balanced.statistics.smallestPositionShare, 1.0);
+  EXPECT_EQ(balanced.statistics.largestPositionShare, 1.0);
+  EXPECT_GT(balanced.statistics.pilotRays, 0u);
+}
+
+TEST(Reuse, BalancedSharesBringTheEndsErrorDown)
+{
+  // A light sweeping across the box: the end frames' mixture comes from one side only.
+  const BoxWithLight s;
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.15, 0.5, 0.9 }, { 0.85, 0.5, 0.9 }, 9));
+  const Solution reference = solve(s.scene, light, modeOptions(false, 1200000, 77));
+  double ends[2] = { 0, 0 }, middle[2] = { 0, 0 };
+  double smallest = 1, largest = 1;
+  for (int balanced = 0; balanced < 2; ++balanced)
+  {
+    for (int r = 0; r < 6; ++r)
+    {
+      SolverOptions o = modeOptions(true, 18000, 500 + r);
+      o.balanceFrames = balanced == 1;
+      const Solution solution = solve(s.scene, light, o);
+      ends[balanced] += meanSquareError(s.scene, solution, reference, 0) +
+        meanSquareError(s.scene, solution, reference, 8);
+      middle[balanced] += 2 * meanSquareError(s.scene, solution, reference, 4);
+      if (balanced == 1)
+      {
+        smallest = solution.statistics.smallestPositionShare;
+        largest = solution.statistics.largestPositionShare;
+      }
+    }
+  }
+  std::printf("end frames' MSE, balanced / equal: %.3f; middle frame's: %.3f; shares %.2f-%.2f\n",
+    ends[1] / ends[0], middle[1] / middle[0], smallest, largest);
+  EXPECT_LT(smallest, 1.0);
+  EXPECT_GT(largest, 1.2);
+  EXPECT_LT(ends[1], 0.9 * ends[0]);
+  EXPECT_LT(middle[1], 1.3 * middle[0]);
 }
 
 TEST(Reuse, CastsFewerRaysThanClassic)
