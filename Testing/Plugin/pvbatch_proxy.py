@@ -100,6 +100,10 @@ STRINGS |= {"LightDistributionFile"}
 EXPECTED |= {"ErrorBatches", "TargetRelativeError", "TimeLimit"}
 # The sky's properties.
 EXPECTED |= {"SkyModel", "SkyDiffuseHorizontal", "Up"}
+# The paths' shares over the light's positions.
+EXPECTED |= {"BalanceFrames"}
+BOOLEANS |= {"BalanceFrames"}
+ADVANCED |= {"BalanceFrames"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
