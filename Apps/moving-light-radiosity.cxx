@@ -32,6 +32,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 #include <thread>
@@ -168,6 +169,33 @@ void tripleOf(vtkFieldData* data, const char* name, double out[3])
   }
 }
 
+/// Runs the Sun Path source with the scene's north and up; its error, without VTK's location
+/// prefix (the source's message ends with what to fix), goes to `fail`, which throws.
+vtkSmartPointer<vtkPolyData> updatedSunPath(vtkSunPathSource* source, const Options& options,
+  const std::function<void(const std::string& reason)>& fail)
+{
+  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
+  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
+  source->SetNorth(north.data());
+  source->SetUp(up.data());
+  std::string error;
+  vtkNew<vtkCallbackCommand> onError;
+  onError->SetClientData(&error);
+  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message)
+    { *static_cast<std::string*>(into) = static_cast<const char*>(message); });
+  source->AddObserver(vtkCommand::ErrorEvent, onError);
+  source->Update();
+  if (!error.empty())
+  {
+    const std::size_t colon = error.find("): ");
+    std::string reason = colon == std::string::npos ? error : error.substr(colon + 3);
+    reason.erase(reason.find_last_not_of(" \n") + 1);
+    fail(reason);
+  }
+  vtkSmartPointer<vtkPolyData> path = source->GetOutput();
+  return path;
+}
+
 /// The sun's directions over the day of --sun-path, with the clock times as Time.
 vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
 {
@@ -182,27 +210,8 @@ vtkSmartPointer<vtkPolyData> sunPathTrajectory(const Options& options)
   source->SetEndTime(spec.endHour);
   source->SetStepMinutes(spec.stepMinutes);
   source->SetTimeZone(options.timeZone.value_or(0.0));
-  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
-  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
-  source->SetNorth(north.data());
-  source->SetUp(up.data());
-  std::string error;
-  vtkNew<vtkCallbackCommand> onError;
-  onError->SetClientData(&error);
-  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message)
-    { *static_cast<std::string*>(into) = static_cast<const char*>(message); });
-  source->AddObserver(vtkCommand::ErrorEvent, onError);
-  source->Update();
-  if (!error.empty())
-  {
-    // The source's message ends with what to fix; drop VTK's location prefix.
-    const std::size_t colon = error.find("): ");
-    std::string reason = colon == std::string::npos ? error : error.substr(colon + 3);
-    reason.erase(reason.find_last_not_of(" \n") + 1);
-    throw UsageError("--sun-path: " + reason);
-  }
-  vtkSmartPointer<vtkPolyData> path = source->GetOutput();
-  return path;
+  return updatedSunPath(
+    source, options, [](const std::string& reason) { throw UsageError("--sun-path: " + reason); });
 }
 
 /// The hours of --weather as frames: the sun at their middle, Time the hour of the year.
@@ -216,27 +225,9 @@ vtkSmartPointer<vtkPolyData> weatherTrajectory(const Options& options)
   const std::array<int, 2> hours = options.hours.value_or(std::array<int, 2>{ 0, 23 });
   source->SetHours(hours[0], hours[1]);
   source->SetIncludeNight(options.night);
-  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
-  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
-  source->SetNorth(north.data());
-  source->SetUp(up.data());
-  std::string error;
-  vtkNew<vtkCallbackCommand> onError;
-  onError->SetClientData(&error);
-  onError->SetCallback([](vtkObject*, unsigned long, void* into, void* message)
-    { *static_cast<std::string*>(into) = static_cast<const char*>(message); });
-  source->AddObserver(vtkCommand::ErrorEvent, onError);
-  source->Update();
-  if (!error.empty())
-  {
-    const std::size_t colon = error.find("): ");
-    std::string reason = colon == std::string::npos ? error : error.substr(colon + 3);
-    reason.erase(reason.find_last_not_of(" \n") + 1);
-    // The file's errors are input errors (exit 1), not the command line's.
-    throw InputError("--weather: " + reason);
-  }
-  vtkSmartPointer<vtkPolyData> path = source->GetOutput();
-  return path;
+  // The file's errors are input errors (exit 1), not the command line's.
+  return updatedSunPath(
+    source, options, [](const std::string& reason) { throw InputError("--weather: " + reason); });
 }
 
 int run(int argc, char** argv)

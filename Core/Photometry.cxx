@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "PhotometricParsing.h"
+#include "RegularFile.h"
 
 #include <algorithm>
 #include <cctype>
@@ -11,10 +12,6 @@
 #include <cstring>
 #include <sstream>
 #include <utility>
-
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace mlr
 {
@@ -709,68 +706,8 @@ IntensityDistribution fullTurn(const std::vector<double>& gammasDegrees,
 
 namespace
 {
-constexpr off_t MaximumFileSize = 16 << 20;
-
-std::string readRegularFile(const std::string& path)
-{
-  struct stat info;
-  if (::stat(path.c_str(), &info) != 0)
-  {
-    throw Error("cannot read the photometric file " + path + ": " + std::strerror(errno));
-  }
-  // A FIFO or device would block or never end: only regular files are read.
-  if (!S_ISREG(info.st_mode))
-  {
-    throw Error(
-      "the photometric file " + path + " is not a regular file: give an .ies or .ldt file");
-  }
-  if (info.st_size > MaximumFileSize)
-  {
-    throw Error("the photometric file " + path + " has " + std::to_string(info.st_size) +
-      " bytes, more than the 16 MiB any real IES or EULUMDAT file needs");
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0)
-  {
-    throw Error("cannot open the photometric file " + path + ": " + std::strerror(errno));
-  }
-  std::string text;
-  struct stat opened;
-  if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode))
-  {
-    ::close(fd);
-    throw Error(
-      "the photometric file " + path + " is not a regular file: give an .ies or .ldt file");
-  }
-  char buffer[65536];
-  for (;;)
-  {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR)
-    {
-      continue;
-    }
-    if (n < 0)
-    {
-      const int error = errno;
-      ::close(fd);
-      throw Error("cannot read the photometric file " + path + ": " + std::strerror(error));
-    }
-    if (n == 0)
-    {
-      break;
-    }
-    text.append(buffer, static_cast<std::size_t>(n));
-    if (text.size() > static_cast<std::size_t>(MaximumFileSize))
-    {
-      ::close(fd);
-      throw Error("the photometric file " + path +
-        " has more than the 16 MiB any real IES or EULUMDAT file needs");
-    }
-  }
-  ::close(fd);
-  return text;
-}
+const FileKind PhotometricFile{ "photometric file", "an .ies or .ldt file", 16u << 20,
+  "the 16 MiB any real IES or EULUMDAT file needs" };
 } // namespace
 
 Luminaire readPhotometricFile(const std::string& path)
@@ -783,11 +720,11 @@ Luminaire readPhotometricFile(const std::string& path)
   }
   if (extension == "ies")
   {
-    return parseIes(readRegularFile(path), path);
+    return parseIes(readRegularFile(path, PhotometricFile), path);
   }
   if (extension == "ldt")
   {
-    return parseEulumdat(readRegularFile(path), path);
+    return parseEulumdat(readRegularFile(path, PhotometricFile), path);
   }
   throw Error("the photometric file " + path + " must end in .ies (IES LM-63) or .ldt (EULUMDAT)");
 }

@@ -1,6 +1,7 @@
 #include "WeatherFile.h"
 
 #include "Error.h"
+#include "RegularFile.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -8,13 +9,10 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
 #include <limits>
 #include <sstream>
 #include <string_view>
-#include <sys/stat.h>
 #include <tuple>
-#include <unistd.h>
 
 namespace mlr
 {
@@ -347,61 +345,9 @@ WeatherFile parseWeatherFile(const std::string& text, const std::string& name)
 
 WeatherFile readWeatherFile(const std::string& path)
 {
-  struct stat info;
-  if (::stat(path.c_str(), &info) != 0)
-  {
-    throw Error("cannot read the weather file " + path + ": " + std::strerror(errno));
-  }
-  // A FIFO or device would block or never end: only regular files are read.
-  if (!S_ISREG(info.st_mode))
-  {
-    throw Error("the weather file " + path + " is not a regular file: give an .epw file");
-  }
-  if (static_cast<std::uint64_t>(info.st_size) > MaximumWeatherFileBytes)
-  {
-    throw Error("the weather file " + path + " has " + std::to_string(info.st_size) +
-      " bytes, more than the 32 MiB a year of hourly EPW records could need");
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0)
-  {
-    throw Error("cannot open the weather file " + path + ": " + std::strerror(errno));
-  }
-  struct stat opened;
-  if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode))
-  {
-    ::close(fd);
-    throw Error("the weather file " + path + " is not a regular file: give an .epw file");
-  }
-  std::string text;
-  char buffer[65536];
-  for (;;)
-  {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR)
-    {
-      continue;
-    }
-    if (n < 0)
-    {
-      const int error = errno;
-      ::close(fd);
-      throw Error("cannot read the weather file " + path + ": " + std::strerror(error));
-    }
-    if (n == 0)
-    {
-      break;
-    }
-    text.append(buffer, static_cast<std::size_t>(n));
-    // The file may grow while it is read.
-    if (text.size() > MaximumWeatherFileBytes)
-    {
-      ::close(fd);
-      throw Error("the weather file " + path +
-        " has more than the 32 MiB a year of hourly EPW records could need");
-    }
-  }
-  ::close(fd);
+  const std::string text = readRegularFile(path,
+    { "weather file", "an .epw file", MaximumWeatherFileBytes,
+      "the 32 MiB a year of hourly EPW records could need" });
   return parseWeatherFile(text, path);
 }
 
