@@ -22,6 +22,8 @@ enum class StreamPurpose : std::uint64_t
   Gathering = 2,
   /// Probes that decide which sides light can reach: keyed by a fixed seed, never the solve's.
   Reachability = 3,
+  /// The hemisphere rays and light samples of the sensors, keyed by the sensor.
+  Sensors = 4,
 };
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state advanced by a Weyl step and
