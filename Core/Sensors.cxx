@@ -33,6 +33,7 @@ struct SensorScratch
 {
   std::vector<Rgb> total, sun, gathered;
   std::vector<double> skySum;
+  std::vector<std::size_t> hits, cells;
   std::vector<float> dx, dy, dz;
   std::vector<std::uint8_t> visible;
   std::vector<Rgb> values;
@@ -123,6 +124,11 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   scratch.skySum.assign(skyPositions, 0.0);
   RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
   const std::uint32_t rays = sensorOptions.hemisphereRays;
+  // What each ray found, as keys: a patch side (2 patch + side), or an escaped ray's sky cell
+  // per sky. Sorted and counted, each distinct key costs one pass over the frames, however
+  // many rays found it, and the sums run in key order.
+  scratch.hits.clear();
+  scratch.cells.clear();
   for (std::uint32_t r = 0; r < rays; ++r)
   {
     const Vec3 direction = sampleCosineDirection(n, random);
@@ -132,29 +138,53 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
     {
       for (std::size_t k = 0; k < rig.skies.size(); ++k)
       {
-        const Sky& sky = rig.skies[k];
-        const std::size_t cell = sky.cell(direction);
+        const std::size_t cell = rig.skies[k].cell(direction);
         if (cell < Sky::Cells)
         {
-          const double* density = sky.densities(cell);
-          double* sum = scratch.skySum.data() + skyBase[k];
-          for (std::size_t j = 0; j < sky.positions(); ++j)
-          {
-            sum[j] += density[j];
-          }
+          scratch.cells.push_back(k * Sky::Cells + cell);
         }
       }
-      continue;
     }
-    if (!options.twoSided && side == Side::Back)
+    else if (options.twoSided || side == Side::Front)
     {
-      continue;
+      scratch.hits.push_back(2 * Scene::patchOfElement(element) + static_cast<std::size_t>(side));
     }
-    const std::size_t patch = Scene::patchOfElement(element);
+  }
+  std::sort(scratch.hits.begin(), scratch.hits.end());
+  std::sort(scratch.cells.begin(), scratch.cells.end());
+  for (std::size_t i = 0; i < scratch.hits.size();)
+  {
+    std::size_t end = i;
+    while (end < scratch.hits.size() && scratch.hits[end] == scratch.hits[i])
+    {
+      ++end;
+    }
+    const double count = static_cast<double>(end - i);
+    const std::size_t patch = scratch.hits[i] / 2;
+    const Side side = static_cast<Side>(scratch.hits[i] % 2);
     for (std::size_t f = 0; f < frames; ++f)
     {
-      scratch.gathered[f] += solution.patchRadiosity(f, patch, side);
+      scratch.gathered[f] += Rgb(solution.patchRadiosity(f, patch, side)) * count;
     }
+    i = end;
+  }
+  for (std::size_t i = 0; i < scratch.cells.size();)
+  {
+    std::size_t end = i;
+    while (end < scratch.cells.size() && scratch.cells[end] == scratch.cells[i])
+    {
+      ++end;
+    }
+    const double count = static_cast<double>(end - i);
+    const std::size_t k = scratch.cells[i] / Sky::Cells;
+    const Sky& sky = rig.skies[k];
+    const double* density = sky.densities(scratch.cells[i] % Sky::Cells);
+    double* sum = scratch.skySum.data() + skyBase[k];
+    for (std::size_t j = 0; j < sky.positions(); ++j)
+    {
+      sum[j] += density[j] * count;
+    }
+    i = end;
   }
   const double perRay = 1.0 / static_cast<double>(rays);
   for (std::size_t f = 0; f < frames; ++f)
