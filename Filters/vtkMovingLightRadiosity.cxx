@@ -829,6 +829,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         rig.areaLights.size() + rig.pointLights.size() + rig.directionalLights.size()));
       digest.add(static_cast<std::uint64_t>(trajectory.times.size()));
       digest.add(static_cast<std::uint64_t>(options.sensors.size()));
+      digest.add(static_cast<std::uint64_t>(this->SensorRays));
       const mlr::vtkparallel::Verdict verdict =
         mlr::vtkparallel::agree(controller, false, false, {}, digest.value);
       stage = verdict.failed ? Stage::Agreed : Stage::Solving;
