@@ -62,9 +62,13 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<double> DaylightEfficacy;
   /// Per frame with a sky: the Perez efficacy of the direct sun alone (lm/W).
   std::vector<double> SunEfficacy;
-  /// The Sensors output without its frame's arrays, and the sensors' solution.
+  /// The Sensors output without its frame's arrays (its metrics for SensorThreshold), the
+  /// sensors, their solution and the time steps the metrics count.
   vtkSmartPointer<vtkPolyData> SensorMesh;
+  double SensorThreshold = 0;
+  mlr::SensorSet SensorPoints;
   mlr::SensorSolution Sensors;
+  mlr::vtksensors::MetricSteps SensorSteps;
   // Display: what the colours of every frame need.
   mlr::vtkoutputs::SmoothShading Shading;
   double AutoExposure = 0;
@@ -160,6 +164,25 @@ void vtkMovingLightRadiosity::SetExposure(double exposure)
   vtkInternals& cache = *this->Internals;
   const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
   this->Exposure = exposure;
+  this->Modified();
+  if (current)
+  {
+    cache.PropertiesTime.Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetDaylightAutonomyThreshold(double threshold)
+{
+  threshold = threshold > 0 ? threshold : 0.0;
+  if (threshold == this->DaylightAutonomyThreshold)
+  {
+    return;
+  }
+  // As Exposure: the metrics are recomputed from the cached solve when the output is built.
+  vtkInternals& cache = *this->Internals;
+  const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
+  this->DaylightAutonomyThreshold = threshold;
   this->Modified();
   if (current)
   {
@@ -531,6 +554,13 @@ int vtkMovingLightRadiosity::RequestData(
       {
         if (cache.SensorMesh && cache.OutputsLight)
         {
+          if (cache.SensorThreshold != this->DaylightAutonomyThreshold)
+          {
+            cache.SensorSteps.autonomyThreshold = this->DaylightAutonomyThreshold;
+            cache.SensorMesh =
+              mlr::vtksensors::sensorMesh(cache.SensorPoints, cache.Sensors, cache.SensorSteps);
+            cache.SensorThreshold = this->DaylightAutonomyThreshold;
+          }
           output->ShallowCopy(cache.SensorMesh);
           mlr::vtksensors::addSensorArrays(
             cache.Sensors, solved, efficacyOf(cache, frame), output->GetPointData());
@@ -885,6 +915,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       }
       cache.Sensors = std::move(animation.sensors);
       cache.SensorMesh = mlr::vtksensors::sensorMesh(options.sensors, cache.Sensors, steps);
+      cache.SensorThreshold = steps.autonomyThreshold;
+      cache.SensorPoints = std::move(options.sensors);
+      cache.SensorSteps = std::move(steps);
     }
     cache.Solution = std::move(solution);
     cache.TwoSided = solverOptions.twoSided;

@@ -488,10 +488,11 @@ public:
 
   ///@{
   /**
-   * The illuminance (lx) a sensor's DaylightAutonomy counts the time steps of. From 0;
-   * default 300.
+   * The illuminance (lx) a sensor's DaylightAutonomy counts the time steps at or above.
+   * Changing it only recomputes the metrics from the cached solve: it never solves again.
+   * From 0 (NaN is taken as 0); default 300.
    */
-  vtkSetClampMacro(DaylightAutonomyThreshold, double, 0.0, VTK_DOUBLE_MAX);
+  void SetDaylightAutonomyThreshold(double threshold);
   vtkGetMacro(DaylightAutonomyThreshold, double);
   ///@}
 

@@ -1,7 +1,7 @@
 // The filter's Sensors input and output: the output follows the time step, the lamp's
 // direct light on a sensor below it is Lambert's form factor plus the room's light, the
-// metrics stay constant over time and follow DaylightAutonomyThreshold, and bad sensors are
-// refused with empty outputs.
+// metrics stay constant over time and follow DaylightAutonomyThreshold without solving again,
+// and bad sensors are refused with empty outputs.
 #include "FilterTestSupport.h"
 
 #include "FormFactor.h"
@@ -94,8 +94,9 @@ TEST(FilterSensors, TheSensorsFollowTheTimeStepAndReadTheLamp)
   EXPECT_EQ(autonomy, 1.0) << "a threshold of 0 lx";
   EXPECT_EQ(filter->GetSolveCount(), 1);
   filter->SetDaylightAutonomyThreshold(1e9);
-  filter->UpdateTimeStep(times[0]);
+  filter->UpdateTimeStep(times[1]);
   EXPECT_EQ(value(filter->GetOutput(3), "DaylightAutonomy", 0), 0.0);
+  EXPECT_EQ(filter->GetSolveCount(), 1) << "a new threshold only recomputes the metrics";
   std::ostringstream print;
   filter->Print(print);
   EXPECT_NE(print.str().find("DaylightAutonomyThreshold: 1e+09 lx"), std::string::npos);
