@@ -167,3 +167,20 @@ def test_bad_sensor_inputs(tmp_path):
     result = run(["--scene", write_wall(tmp_path), "--sky", "uniform", "--work-plane", "0.8,0.5"]
                  + FAST, tmp_path)
     assert result.returncode == 1 and "no polygon facing up" in result.stderr, result.stderr
+
+
+def test_work_plane_follows_up(tmp_path):
+    # The same 3 x 2 floor in the x-z plane, facing +y, with --up 0,1,0: 24 sensors 0.8 above
+    # it along y, facing +y; a ceiling-like face (facing -y) gets none.
+    floor = Polygons().add([(0, 0, 0), (0, 0, D), (W, 0, D), (W, 0, 0)])
+    floor.add([(0, 3, 0), (W, 3, 0), (W, 3, D), (0, 3, D)])
+    result = run(["--scene", floor.write(tmp_path / "floor.vtp"), "--sky", "uniform",
+                  "--up", "0,1,0", "--work-plane", f"{HEIGHT},{SPACING}",
+                  "--output", "out/room.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    sensors = read_sensor_series(tmp_path)[0][1]
+    assert sensors.GetNumberOfPoints() == 24
+    points = vtk_to_numpy(sensors.GetPoints().GetData())
+    assert numpy.allclose(points[:, 1], HEIGHT)
+    assert numpy.allclose(array(sensors, "Normals"), [0, 1, 0])
+    assert numpy.all((points[:, 0] > 0) & (points[:, 0] < W) & (points[:, 2] > 0) & (points[:, 2] < D))
