@@ -230,6 +230,24 @@ std::array<double, 2> parseSpot(const std::string& option, const std::string& te
     fields.size() == 2 ? parseNumber(option, fields[1]) : 0.0 };
 }
 
+/// HEIGHT,SPACING of --work-plane: a height of 0 or more and a spacing above 0.
+std::array<double, 2> parseWorkPlane(const std::string& option, const std::string& text)
+{
+  const std::vector<std::string> fields = split(text);
+  if (fields.size() != 2)
+  {
+    throw UsageError(option + " is '" + text + "': give HEIGHT,SPACING in scene units (0.8,0.5)");
+  }
+  const std::array<double, 2> plane = { parseNumber(option, fields[0]),
+    parseNumber(option, fields[1]) };
+  if (!(plane[0] >= 0) || !(plane[1] > 0))
+  {
+    throw UsageError(option + " is '" + text +
+      "': the height above the floor must be 0 or more and the spacing above 0");
+  }
+  return plane;
+}
+
 /// A photometric file, by its extension (the filter reads it).
 std::string parseDistribution(const std::string& option, const std::string& text)
 {
@@ -354,6 +372,9 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--target-error", "FRACTION", o.targetError, parseNumber);
   option("--time-limit", "SECONDS", o.timeLimit, parseNumber);
   option("--luminous-efficacy", "LM_PER_W", o.luminousEfficacy, parseNumber);
+  option("--sensors", "FILE.vtp", o.sensors, asGiven);
+  option("--work-plane", "HEIGHT,SPACING", o.workPlane, parseWorkPlane);
+  option("--da-threshold", "LX", o.daThreshold, parseNumber);
   option("--output", "PATH.pvd", o.output, parseOutput);
   option("--stats", "FILE.json", o.stats, asGiven);
   option("--png", "DIR", o.png, asGiven);
@@ -484,6 +505,15 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--dates, --hours and --night choose the hours of --weather FILE.epw");
   }
+  if (!o.sensors.empty() && o.workPlane)
+  {
+    throw UsageError("--sensors and --work-plane both give the sensors: give one of them");
+  }
+  if (o.daThreshold && !o.usesSensors())
+  {
+    throw UsageError("--da-threshold is for the sensors' DaylightAutonomy: give --sensors "
+                     "FILE.vtp or --work-plane HEIGHT,SPACING too");
+  }
   if (o.usesSun())
   {
     if (!o.light.empty() || !o.trajectory.empty() || o.from || o.to || o.aim || o.lightPower)
@@ -504,10 +534,11 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--time-zone and --north need --sun-path ... (--north also --weather)");
   }
-  if (!o.sunPath && !o.sky && o.lightDistribution.empty() && o.up)
+  if (!o.sunPath && !o.sky && o.lightDistribution.empty() && !o.workPlane && o.up)
   {
-    throw UsageError("--up needs --sun-path ..., --weather FILE.epw, --sky MODEL or "
-                     "--light-distribution FILE (whose TILT table it sets the vertical of)");
+    throw UsageError("--up needs --sun-path ..., --weather FILE.epw, --sky MODEL, "
+                     "--light-distribution FILE (whose TILT table it sets the vertical of) or "
+                     "--work-plane HEIGHT,SPACING");
   }
   if (o.sunIrradiance && !(*o.sunIrradiance >= 0 && std::isfinite(*o.sunIrradiance)))
   {
@@ -747,6 +778,11 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     }
     filter->SetLuminousEfficacy(*o.luminousEfficacy);
   }
+  if (o.daThreshold)
+  {
+    checkRange("--da-threshold", *o.daThreshold, 0.0, 1e9);
+    filter->SetDaylightAutonomyThreshold(*o.daThreshold);
+  }
   if (o.from)
   {
     checkRange<long long>("--frames", *o.frames, filter->GetNumberOfPositionsMinValue(),
@@ -881,6 +917,18 @@ Solver:
                         2%; default 0, off)
   --time-limit SECONDS  with --target-error: start no more batches after this long (the
                         result then depends on the machine's speed)
+Sensors (measuring points that receive light but neither block nor reflect it):
+  --sensors FILE.vtp    the points of a file, each with the point array Normals (the
+                        direction its measuring side faces)
+  --work-plane HEIGHT,SPACING
+                        a grid of sensors facing up over every upward-facing face (within
+                        5 degrees of --up: floors, and roofs), HEIGHT above it, SPACING
+                        apart on a lattice at (i + 1/2) SPACING, inside the polygons
+  --da-threshold LX     the illuminance DaylightAutonomy counts the frames at or above
+                        (default 300). The sensors' series is PATH_sensors.pvd with
+                        PATH_sensors_0000.vtp ... (point arrays Irradiance, Illuminance per
+                        frame; DaylightAutonomy, UDILow, UDIUseful, UDIHigh, DirectSunHours
+                        over all frames)
 Output:
   --luminous-efficacy LM_PER_W
                         lumens per watt of the light, which turn the Irradiance arrays

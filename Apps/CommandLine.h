@@ -85,6 +85,13 @@ struct Options
 
   std::optional<double> luminousEfficacy; ///< lm/W, for the Illuminance arrays
 
+  /// Sensors: points with Normals from a file, or a work-plane grid (height, spacing) over
+  /// every upward-facing floor; and the daylight autonomy threshold (lx).
+  std::string sensors;
+  std::optional<std::array<double, 2>> workPlane;
+  std::optional<double> daThreshold;
+  bool usesSensors() const { return !this->sensors.empty() || this->workPlane.has_value(); }
+
   std::string output; ///< PATH.pvd
   std::string stats;  ///< FILE.json, or empty
   std::string png;    ///< DIR, or empty for no pictures

@@ -7,6 +7,7 @@
 #include "OutputTransaction.h"
 #include "ProgressBar.h"
 #include "Report.h"
+#include "Sensors.h"
 #include "SeriesWriter.h"
 
 #include "vtkCallbackCommand.h"
@@ -288,8 +289,22 @@ int run(int argc, char** argv)
   {
     trajectory = readEmbeddedFile("cornell_trajectory.vtp");
   }
+  vtkSmartPointer<vtkPolyData> sensors;
+  if (!options.sensors.empty())
+  {
+    sensors = readSurfaceFile(options.sensors, "sensors", memoryLimit);
+  }
+  else if (options.workPlane)
+  {
+    sensors = workPlaneSensors(scene, options.up.value_or(Triple{ 0, 0, 1 }),
+      (*options.workPlane)[0], (*options.workPlane)[1]);
+  }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);
+  if (sensors)
+  {
+    filter->SetInputData(vtkMovingLightRadiosity::SENSORS_PORT, sensors);
+  }
   filter->SetInputData(vtkMovingLightRadiosity::SCENE_PORT, scene);
   if (light)
   {
@@ -351,6 +366,9 @@ int run(int argc, char** argv)
   OutputTransaction output;
   const fs::path collection = options.output;
   const SeriesNaming naming(collection, times.size());
+  const fs::path sensorCollection =
+    collection.parent_path() / (collection.stem().string() + "_sensors.pvd");
+  const SeriesNaming sensorNaming(sensorCollection, times.size());
   checkNotADirectory(collection, "output");
   prepareDirectory(output, naming.directory);
   if (!options.stats.empty())
@@ -383,6 +401,7 @@ int run(int argc, char** argv)
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<FrameRecord> records;
+  std::vector<std::pair<double, std::string>> sensorEntries;
   {
     // Destroyed before `output`: no frame is still being written when a failure rolls back.
     FrameWriter writer(writerThreads());
@@ -396,11 +415,23 @@ int run(int argc, char** argv)
       tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
       writer.write(elements, times[f], output.stage(naming.directory / record.file));
       records.push_back(record);
+      if (sensors)
+      {
+        // The update of the Elements serves the Sensors at that time too.
+        sensorEntries.emplace_back(times[f], sensorNaming.frameName(f, ".vtp"));
+        writeSensorFrame(filter->GetOutput(vtkMovingLightRadiosity::SENSORS_OUTPUT_PORT),
+          output.stage(naming.directory / sensorEntries.back().second));
+      }
       bar.show(double(f + 1) / double(times.size()), "writing frames");
     }
     writer.finish();
   }
   output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
+  if (sensors)
+  {
+    output.replaceSeries(naming.directory, sensorNaming.framePrefix(), ".vtp");
+    writeCollection(output.stage(sensorCollection), sensorEntries);
+  }
   stages.writing = secondsSince(writingStarted);
 
   if (!options.png.empty())
@@ -453,6 +484,11 @@ int run(int argc, char** argv)
   if (!options.stats.empty())
   {
     std::cout << ", statistics in " << options.stats;
+  }
+  if (sensors)
+  {
+    std::cout << ", " << sensors->GetNumberOfPoints() << " sensors in "
+              << sensorCollection.string();
   }
   std::cout << std::endl;
   return 0;

@@ -10,10 +10,17 @@ namespace
 /// Share of the progress given to remeshing; the solve takes the rest.
 constexpr double RemeshingShare = 0.05;
 
-std::uint64_t outputBytes(const AnimationOptions& options, std::size_t elements, std::size_t points)
+/// Share of the progress given to the sensors, when there are any.
+constexpr double SensorShare = 0.05;
+
+std::uint64_t outputBytes(
+  const AnimationOptions& options, std::size_t elements, std::size_t points, std::size_t frames)
 {
-  return saturatingSum(saturatingProduct(options.outputBytesPerElement, elements),
-    saturatingProduct(options.outputBytesPerPoint, points));
+  const std::size_t sensors = options.sensors.size();
+  return saturatingSum(saturatingSum(saturatingProduct(options.outputBytesPerElement, elements),
+                         saturatingProduct(options.outputBytesPerPoint, points)),
+    saturatingSum(estimateSensorMemory(sensors, frames),
+      saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
 }
 }
 
@@ -21,6 +28,10 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const AnimationOptions& options, const ProgressCallback& progress)
 {
   validateOptions(options.solver);
+  if (!options.sensors.empty())
+  {
+    checkSensors(options.sensors, options.sensorOptions);
+  }
   bool soupEmits = false;
   for (const Material& m : soup.materials)
   {
@@ -41,7 +52,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     const std::size_t patches = expected / 2;
     checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
                                      options.solver, lightCount),
-                       outputBytes(options, 4 * patches, 2 * patches)),
+                       outputBytes(options, 4 * patches, 2 * patches, frames)),
       frames, patches, 4 * patches, options.solver, true);
   };
   ProgressCallback remeshProgress;
@@ -63,20 +74,32 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       animation.patches = std::move(remeshed.mesh);
       const Scene& scene = animation.scene;
       checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
-                         outputBytes(options, scene.elementCount(), scene.points().size())),
+                         outputBytes(options, scene.elementCount(), scene.points().size(), frames)),
         frames, scene.patchCount(), scene.elementCount(), options.solver);
     });
   const Scene& scene = animation.scene;
 
+  const double sensorShare = options.sensors.empty() ? 0.0 : SensorShare;
+  const double solveShare = 1 - RemeshingShare - sensorShare;
   ProgressCallback solveProgress;
   if (progress)
   {
-    solveProgress = [&](double f) { return progress(RemeshingShare + (1 - RemeshingShare) * f); };
+    solveProgress = [&](double f) { return progress(RemeshingShare + solveShare * f); };
   }
   animation.solution = solve(scene, lights, options.solver, solveProgress);
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
     animation.solution.warnings.end());
+  if (!options.sensors.empty())
+  {
+    ProgressCallback sensorProgress;
+    if (progress)
+    {
+      sensorProgress = [&](double f) { return progress(1 - sensorShare + sensorShare * f); };
+    }
+    animation.sensors = solveSensors(scene, lights, animation.solution, options.sensors,
+      options.solver, options.sensorOptions, sensorProgress);
+  }
   return animation;
 }
 

@@ -4,6 +4,7 @@
 
 #include "Remeshing.h"
 #include "Scene.h"
+#include "Sensors.h"
 #include "Solver.h"
 
 #include <cstdint>
@@ -21,6 +22,11 @@ struct AnimationOptions
   /// mesh: counted in the one memory check, before remeshing and again before solving.
   std::uint64_t outputBytesPerElement = 0;
   std::uint64_t outputBytesPerPoint = 0;
+  /// Measuring points solved after the scene (none: no sensor work), their ray counts, and
+  /// what the caller will allocate per sensor and frame for their outputs.
+  SensorSet sensors;
+  SensorOptions sensorOptions;
+  std::uint64_t outputBytesPerSensorFrame = 0;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.
@@ -29,6 +35,8 @@ struct Animation
   PatchMesh patches;
   Scene scene;
   Solution solution;
+  /// The irradiance of options.sensors in every frame of the solution.
+  SensorSolution sensors;
   RemeshStatistics remeshing;
   /// Recoverable oddities from remeshing and solving, for the caller to show.
   std::vector<std::string> warnings;
@@ -40,7 +48,9 @@ struct Animation
  * limit of options.solver.memoryLimitBytes (0: half the physical memory) is checked before
  * remeshing allocates (from the patch count it expects) and again before solving, with the
  * caller's outputs included. Throws mlr::Error naming what to fix and mlr::Cancelled.
- * Progress: remeshing takes the first 5%, solving the rest.
+ * Progress: remeshing takes the first 5%, solving the rest (with sensors, the sensors take the
+ * last 5%). Sensors are checked before remeshing and solved once the scene is: they do not
+ * change its radiosity.
  */
 Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const AnimationOptions& options, const ProgressCallback& progress = {});

@@ -22,6 +22,8 @@ enum class StreamPurpose : std::uint64_t
   Gathering = 2,
   /// Probes that decide which sides light can reach: keyed by a fixed seed, never the solve's.
   Reachability = 3,
+  /// The hemisphere rays and light samples of the sensors, keyed by the sensor.
+  Sensors = 4,
   /// The pilot paths that choose how many paths each light position casts.
   Pilot = 5,
 };

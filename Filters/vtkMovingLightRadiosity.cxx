@@ -4,6 +4,7 @@
 #include "MovingLightRadiosityInputs.h"
 #include "MovingLightRadiosityOutputs.h"
 #include "MovingLightRadiosityParallel.h"
+#include "MovingLightRadiositySensors.h"
 
 #include "Animation.h"
 #include "Error.h"
@@ -60,6 +61,15 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<double> SunAzimuth, SunElevation;
   /// Per frame with a sky: the Perez efficacy of its daylight on a horizontal surface (lm/W).
   std::vector<double> DaylightEfficacy;
+  /// Per frame with a sky: the Perez efficacy of the direct sun alone (lm/W).
+  std::vector<double> SunEfficacy;
+  /// The Sensors output without its frame's arrays (its metrics for SensorThreshold), the
+  /// sensors, their solution and the time steps the metrics count.
+  vtkSmartPointer<vtkPolyData> SensorMesh;
+  double SensorThreshold = 0;
+  mlr::SensorSet SensorPoints;
+  mlr::SensorSolution Sensors;
+  mlr::vtksensors::MetricSteps SensorSteps;
   // Display: what the colours of every frame need.
   mlr::vtkoutputs::SmoothShading Shading;
   double AutoExposure = 0;
@@ -142,9 +152,11 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->ErrorBatches = 16;
   this->TargetRelativeError = defaults.targetRelativeError;
   this->TimeLimit = defaults.timeLimitSeconds;
+  this->DaylightAutonomyThreshold = 300.0;
+  this->SensorRays = static_cast<int>(mlr::SensorOptions().hemisphereRays);
 
-  this->SetNumberOfInputPorts(3);
-  this->SetNumberOfOutputPorts(3);
+  this->SetNumberOfInputPorts(4);
+  this->SetNumberOfOutputPorts(4);
 }
 
 //------------------------------------------------------------------------------
@@ -171,9 +183,28 @@ void vtkMovingLightRadiosity::SetExposure(double exposure)
 }
 
 //------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetDaylightAutonomyThreshold(double threshold)
+{
+  threshold = threshold > 0 ? threshold : 0.0;
+  if (threshold == this->DaylightAutonomyThreshold)
+  {
+    return;
+  }
+  // As Exposure: the metrics are recomputed from the cached solve when the output is built.
+  vtkInternals& cache = *this->Internals;
+  const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
+  this->DaylightAutonomyThreshold = threshold;
+  this->Modified();
+  if (current)
+  {
+    cache.PropertiesTime.Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* info)
 {
-  if (port == TRAJECTORY_PORT)
+  if (port == TRAJECTORY_PORT || port == SENSORS_PORT)
   {
     info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPointSet");
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
@@ -205,7 +236,8 @@ std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightI
 /// frame), E_dh and E_dn from the Trajectory's arrays or the properties, and per frame the
 /// Perez luminous efficacy of the daylight a horizontal surface receives into `efficacy`.
 void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& trajectory,
-  bool directional, mlr::LightRig& rig, std::vector<double>& efficacy)
+  bool directional, mlr::LightRig& rig, std::vector<double>& efficacy,
+  std::vector<double>& sunEfficacy)
 {
   static const mlr::SkyModel models[] = { mlr::SkyModel::Uniform, mlr::SkyModel::CieOvercast,
     mlr::SkyModel::CieClear, mlr::SkyModel::Perez };
@@ -262,6 +294,7 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
     const double total = direct + frame.diffuseHorizontal;
     efficacy.push_back(
       total > 0 ? (k.direct * direct + k.diffuse * frame.diffuseHorizontal) / total : k.diffuse);
+    sunEfficacy.push_back(k.direct);
   }
 }
 
@@ -602,6 +635,22 @@ int vtkMovingLightRadiosity::RequestData(
           output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedPatches));
         }
       }
+      else if (port == SENSORS_OUTPUT_PORT)
+      {
+        if (cache.SensorMesh && cache.OutputsLight)
+        {
+          if (cache.SensorThreshold != this->DaylightAutonomyThreshold)
+          {
+            cache.SensorSteps.autonomyThreshold = this->DaylightAutonomyThreshold;
+            cache.SensorMesh =
+              mlr::vtksensors::sensorMesh(cache.SensorPoints, cache.Sensors, cache.SensorSteps);
+            cache.SensorThreshold = this->DaylightAutonomyThreshold;
+          }
+          output->ShallowCopy(cache.SensorMesh);
+          mlr::vtksensors::addSensorArrays(
+            cache.Sensors, solved, efficacyOf(cache, frame), output->GetPointData());
+        }
+      }
       else if (cache.OutputsLight)
       {
         // Every area light, posed as in this frame, at this frame's power.
@@ -698,9 +747,10 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     Agreed
   };
   Stage stage = Stage::Reading;
-  vtkInformationVector* inputs[3] = { inputVector[0], inputVector[1], inputVector[2] };
-  vtkNew<vtkInformationVector> gathered[3];
-  vtkSmartPointer<vtkDataObject> wholeInputs[3];
+  vtkInformationVector* inputs[4] = { inputVector[0], inputVector[1], inputVector[2],
+    inputVector[3] };
+  vtkNew<vtkInformationVector> gathered[4];
+  vtkSmartPointer<vtkDataObject> wholeInputs[4];
   std::vector<int> cellRanks;
   double secondsGatheringInputs = 0;
   std::string failure;
@@ -716,8 +766,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         [this](const std::string& message) { vtkErrorMacro(<< message); });
       // Every rank gets the whole Scene, Light and Trajectory, whatever pieces arrived.
       const auto start = std::chrono::steady_clock::now();
-      const char* names[3] = { "Scene", "Light", "Trajectory" };
-      for (int port = 0; port < 3; ++port)
+      const char* names[4] = { "Scene", "Light", "Trajectory", "Sensors" };
+      for (int port = 0; port < 4; ++port)
       {
         if (inputVector[port]->GetNumberOfInformationObjects() == 0)
         {
@@ -805,7 +855,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.DaylightEfficacy.clear();
     if (this->SkyModel != NO_SKY)
     {
-      addSky(this, trajectory, directional, rig, cache.DaylightEfficacy);
+      addSky(this, trajectory, directional, rig, cache.DaylightEfficacy, cache.SunEfficacy);
     }
     else if (this->LightType == POINT_LIGHT || this->LightType == LUMINAIRE_LIGHT)
     {
@@ -950,6 +1000,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     options.outputBytesPerPoint =
       (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
     mlr::validateOptions(solverOptions);
+    options.sensors =
+      mlr::vtksensors::sensorsFromPoints(vtkPointSet::GetData(inputs[SENSORS_PORT], 0));
+    options.sensorOptions.hemisphereRays = static_cast<std::uint32_t>(this->SensorRays);
     if (controller)
     {
       // The ranks must solve the same thing: they compare a digest of the solve's settings
@@ -963,6 +1016,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       digest.add(static_cast<std::uint64_t>(
         rig.areaLights.size() + rig.pointLights.size() + rig.directionalLights.size()));
       digest.add(static_cast<std::uint64_t>(trajectory.times.size()));
+      digest.add(static_cast<std::uint64_t>(options.sensors.size()));
+      digest.add(static_cast<std::uint64_t>(this->SensorRays));
       const mlr::vtkparallel::Verdict verdict =
         mlr::vtkparallel::agree(controller, false, false, {}, digest.value);
       stage = verdict.failed ? Stage::Agreed : Stage::Solving;
@@ -1011,6 +1066,29 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
     mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
     cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
+    if (!options.sensors.empty())
+    {
+      // The metrics count every time step, each showing its solved frame (one for a scene
+      // lit by static lights), with the efficacy its Illuminance takes.
+      mlr::vtksensors::MetricSteps steps;
+      steps.hoursPerStep = mlr::hoursPerTimeStep(cache.Times);
+      steps.autonomyThreshold = this->DaylightAutonomyThreshold;
+      for (std::size_t t = 0; t < cache.Times.size(); ++t)
+      {
+        steps.frame.push_back(solution.frameCount() > 1 ? t : 0);
+        steps.efficacy.push_back(cache.DaylightEfficacy.empty()
+            ? this->LuminousEfficacy
+            : cache.DaylightEfficacy[std::min(t, cache.DaylightEfficacy.size() - 1)]);
+        steps.sunEfficacy.push_back(cache.SunEfficacy.empty()
+            ? this->LuminousEfficacy
+            : cache.SunEfficacy[std::min(t, cache.SunEfficacy.size() - 1)]);
+      }
+      cache.Sensors = std::move(animation.sensors);
+      cache.SensorMesh = mlr::vtksensors::sensorMesh(options.sensors, cache.Sensors, steps);
+      cache.SensorThreshold = steps.autonomyThreshold;
+      cache.SensorPoints = std::move(options.sensors);
+      cache.SensorSteps = std::move(steps);
+    }
     cache.Solution = std::move(solution);
     cache.TwoSided = solverOptions.twoSided;
     if (controller)
@@ -1178,6 +1256,8 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "LuminousEfficacy: " << this->LuminousEfficacy << " lm/W\n";
+  os << indent << "DaylightAutonomyThreshold: " << this->DaylightAutonomyThreshold << " lx\n";
+  os << indent << "SensorRays: " << this->SensorRays << "\n";
   os << indent
      << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
      << "\n";

@@ -39,6 +39,11 @@
  *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does);
  *   with neither a Light nor a LightMaterial, the scene's own emissive surfaces light it in
  *   one frame.
+ * - port 3, Sensors (optional): measuring points (any point set, e.g. a work-plane grid at
+ *   0.8 m or points on a facade) with the point array `Normals` (3 components, any length
+ *   but 0: the direction each sensor's measuring side faces). Sensors receive light but
+ *   neither block nor reflect it: the surfaces' radiosity is the same, bit for bit, with and
+ *   without them. Missing or zero normals, and NaN points, are refused by name.
  *
  * Outputs:
  * - port 0, Elements: the element mesh (triangles, four per patch) with the cell arrays
@@ -74,6 +79,14 @@
  *   the patch's lit side) and `Reflectance`.
  * - port 2, Light: the light's polygons where they are in the frame shown, with the cell
  *   array `Power` (RGB, W: each polygon's share of LightPower, by area).
+ * - port 3, Sensors: the sensor points as vertices with `Normals`, `Irradiance` (RGB, W/m^2)
+ *   and `Illuminance` (lx, with the efficacy of the element arrays) of the frame shown, and
+ *   the daylight metrics over all the time steps (constant over time): `DaylightAutonomy`
+ *   (share of steps with at least DaylightAutonomyThreshold), `UDILow` (below 100 lx),
+ *   `UDIUseful` (100 to 2000 lx), `UDIHigh` (above 2000 lx) and `DirectSunHours` (hours
+ *   whose direct sun alone gives over 1000 lx; a step lasts the median spacing of the
+ *   Trajectory's `Time`, in hours as vtkSunPathSource gives it, 1 hour with one step). Empty
+ *   without a Sensors input (Documentation/Method.md, "Sensors").
  *
  * Time: the outputs have one time step per light position (TIME_STEPS, TIME_RANGE). The
  * first update solves every frame at once and keeps the result; requests for other times
@@ -131,7 +144,8 @@ public:
   {
     SCENE_PORT = 0,
     LIGHT_PORT = 1,
-    TRAJECTORY_PORT = 2
+    TRAJECTORY_PORT = 2,
+    SENSORS_PORT = 3
   };
 
   /// The output ports, in order.
@@ -139,7 +153,8 @@ public:
   {
     ELEMENTS_PORT = 0,
     PATCHES_PORT = 1,
-    LIGHT_OUTPUT_PORT = 2
+    LIGHT_OUTPUT_PORT = 2,
+    SENSORS_OUTPUT_PORT = 3
   };
 
   ///@{
@@ -152,6 +167,8 @@ public:
   void SetSceneData(vtkDataObject* data) { this->SetInputData(0, data); }
   void SetLightData(vtkDataObject* data) { this->SetInputData(1, data); }
   void SetTrajectoryData(vtkDataObject* data) { this->SetInputData(2, data); }
+  void SetSensorsConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(3, output); }
+  void SetSensorsData(vtkDataObject* data) { this->SetInputData(3, data); }
   ///@}
 
   ///@{
@@ -545,6 +562,26 @@ public:
   ///@}
   // --------------------------------------------------------------- end of Display block
 
+  ///@{
+  /**
+   * The illuminance (lx) a sensor's DaylightAutonomy counts the time steps at or above.
+   * Changing it only recomputes the metrics from the cached solve: it never solves again.
+   * From 0 (NaN is taken as 0); default 300.
+   */
+  void SetDaylightAutonomyThreshold(double threshold);
+  vtkGetMacro(DaylightAutonomyThreshold, double);
+  ///@}
+
+  ///@{
+  /**
+   * Cosine-distributed rays each sensor casts over its hemisphere, once for all frames: the
+   * sky through those that escape, the surfaces' radiosity through those that hit. Their
+   * noise falls as one over the square root. From 1 to 1000000; default 512.
+   */
+  vtkSetClampMacro(SensorRays, int, 1, 1000000);
+  vtkGetMacro(SensorRays, int);
+  ///@}
+
   /**
    * Number of solves performed so far by this filter (new times do not solve again).
    */
@@ -606,6 +643,8 @@ protected:
   vtkIdType SolveCount;
   double Exposure;
   double LuminousEfficacy;
+  double DaylightAutonomyThreshold;
+  int SensorRays;
 
 private:
   vtkMovingLightRadiosity(const vtkMovingLightRadiosity&) = delete;

@@ -40,6 +40,7 @@ from paraview.simple import (ExtractSurface, LoadPlugin, PassArrays, Redistribut
                              XMLPolyDataReader)
 from vtkmodules.util.misc import calldata_type  # noqa: E402
 from parallel_support import record_mesh  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 from vtkmodules.util.vtkConstants import VTK_STRING  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator  # noqa: E402
 from vtkmodules.vtkParallelCore import vtkMultiProcessController  # noqa: E402
@@ -63,6 +64,15 @@ if args.case == "bad" and rank == 1:
 radiosity = MovingLightRadiosity(Scene=scene, Light=light, Trajectory=trajectory,  # noqa: F821
                                  PatchSize=0.12, NumberOfPaths=args.paths, NumberOfThreads=1,
                                  Seed=1)
+if args.case in ("whole", "split"):
+    # A grid of sensors facing up across the middle of the box (a Plane's Normals).
+    from paraview.simple import Plane
+    box.UpdatePipeline()
+    x0, x1, y0, y1, z0, z1 = box.GetDataInformation().GetBounds()
+    zc = 0.5 * (z0 + z1)
+    xm, ym = 0.1 * (x1 - x0), 0.1 * (y1 - y0)
+    radiosity.Sensors = Plane(Origin=[x0 + xm, y0 + ym, zc], Point1=[x1 - xm, y0 + ym, zc],
+                              Point2=[x0 + xm, y1 - ym, zc], XResolution=3, YResolution=3)
 algorithm = radiosity.GetClientSideObject()
 errors = []
 
@@ -89,6 +99,11 @@ def record(prefix, time):
     results[prefix + "solves"] = np.array(field(elements, "SolveCount"))
     results[prefix + "frame"] = np.array(field(elements, "FrameIndex"))
     results[prefix + "light_cells"] = np.array(algorithm.GetOutputDataObject(2).GetNumberOfCells())
+    sensors = algorithm.GetOutputDataObject(3)
+    results[prefix + "sensor_points"] = np.array(sensors.GetNumberOfPoints())
+    if sensors.GetNumberOfPoints() > 0:
+        for name in ("Irradiance", "DaylightAutonomy"):
+            results[prefix + "sensor_" + name] = vtk_to_numpy(sensors.GetPointData().GetArray(name))
     for name, data in (("e", elements), ("p", patches)):
         record_mesh(results, prefix + name, data)
     return elements

@@ -7,7 +7,7 @@ rank wrote (pvbatch_parallel.py). Exits non-zero with one line per failed check.
         --plugin MovingLightRadiosity.so --work DIR
 
 whole: the union of the ranks' outputs is the serial output bit for bit, cell by cell, and
-       rank 0 holds it all (the input was whole on rank 0).
+       rank 0 holds it all (the input was whole on rank 0), its Sensors too (also in split).
 split: the Scene is spread by RedistributeDataSet; every rank outputs cells, lying on its own
        piece of the scene; the union, sorted by cell, equals serial in every array, and the
        total power too.
@@ -192,6 +192,15 @@ def main():
             lights = [int(r[prefix + "light_cells"]) for r in ranks]
             check(lights[0] == int(reference[prefix + "light_cells"]) and sum(lights[1:]) == 0,
                   f"frame {f}: Light cells per rank {lights}: rank 0 outputs the light")
+            points = [int(r[prefix + "sensor_points"]) for r in ranks]
+            serial_points = int(reference[prefix + "sensor_points"])
+            check(serial_points == 16 and points[0] == serial_points and sum(points[1:]) == 0,
+                  f"frame {f}: sensors per rank {points}, serial {serial_points}: rank 0 outputs "
+                  "all 16")
+            for name in ("Irradiance", "DaylightAutonomy"):
+                key = prefix + "sensor_" + name
+                check(key in ranks[0] and np.array_equal(ranks[0][key], reference[key]),
+                      f"frame {f}: the sensors' {name} on rank 0 differs from the serial one")
             for r, data in enumerate(ranks):
                 check(int(data[prefix + "frame"]) == f, f"rank {r}: FrameIndex {data[prefix + 'frame']} at time {f}")
                 check(int(data[prefix + "solves"]) == 1, f"rank {r}: SolveCount {data[prefix + 'solves']}")

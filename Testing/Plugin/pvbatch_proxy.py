@@ -1,7 +1,7 @@
 """The plugin's proxy as ParaView users meet it, checked in pvbatch:
 
-- the menu hint (Filters > Radiosity), the input ports (Scene, Light, optional Trajectory)
-  and the data types they accept, the output port names (Elements, Patches, Light);
+- the menu hint (Filters > Radiosity), the input ports (Scene, Light, optional Trajectory and Sensors)
+  and the data types they accept, the output port names (Elements, Patches, Light, Sensors);
 - every property: a label that is also its paraview.simple name, documentation, a domain,
   the VTK filter's default, the filter's clamping range, advanced or not;
 - every property's documentation names its unit (or says it has none) and its effect on
@@ -36,7 +36,7 @@ check(proxy.GetXMLGroup() == "filters" and proxy.GetXMLLabel() == "Moving Light 
 menu = proxy.GetHints().FindNestedElementByName("ShowInMenu") if proxy.GetHints() else None
 check(menu is not None and menu.GetAttribute("category") == "Radiosity",
       "no <ShowInMenu category=\"Radiosity\"/> hint: the filter would not be in Filters > Radiosity")
-for port, name in enumerate(("Elements", "Patches", "Light")):
+for port, name in enumerate(("Elements", "Patches", "Light", "Sensors")):
     check(proxy.GetOutputPortName(port) == name,
           f"output port {port} is named {proxy.GetOutputPortName(port)!r}, expected {name!r}")
 
@@ -57,7 +57,8 @@ for candidate in candidates.values():
     candidate.UpdatePipeline()
 for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False),
                                                    ("Light", {"polydata"}, True),
-                                                   ("Trajectory", {"polydata", "tetrahedra"}, True))):
+                                                   ("Trajectory", {"polydata", "tetrahedra"}, True),
+                                                   ("Sensors", {"polydata", "tetrahedra"}, True))):
     prop = proxy.GetProperty(name)
     if not check(prop is not None and prop.IsA("vtkSMInputProperty"), f"no input property {name}"):
         continue
@@ -104,6 +105,8 @@ EXPECTED |= {"SkyModel", "SkyDiffuseHorizontal", "Up"}
 EXPECTED |= {"BalanceFrames"}
 BOOLEANS |= {"BalanceFrames"}
 ADVANCED |= {"BalanceFrames"}
+# The sensors' properties.
+EXPECTED |= {"DaylightAutonomyThreshold", "SensorRays"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy

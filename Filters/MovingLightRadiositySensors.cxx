@@ -1,0 +1,144 @@
+#include "MovingLightRadiositySensors.h"
+
+#include "MovingLightRadiosityDisplay.h"
+#include "MovingLightRadiosityOutputs.h"
+
+#include "Error.h"
+
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkFloatArray.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+
+#include <string>
+
+namespace mlr::vtksensors
+{
+
+SensorSet sensorsFromPoints(vtkPointSet* input)
+{
+  SensorSet sensors;
+  const vtkIdType n = input ? input->GetNumberOfPoints() : 0;
+  if (n == 0)
+  {
+    return sensors;
+  }
+  vtkDataArray* normals = input->GetPointData()->GetArray("Normals");
+  if (!normals)
+  {
+    normals = input->GetPointData()->GetNormals();
+  }
+  if (!normals)
+  {
+    throw Error("the Sensors input has no point array Normals: give every sensor point the "
+                "direction its measuring side faces (3 components; 0,0,1 for a work plane)");
+  }
+  if (normals->GetNumberOfComponents() != 3)
+  {
+    throw Error("the Sensors input's Normals has " +
+      std::to_string(normals->GetNumberOfComponents()) + " components: give 3 (x, y, z)");
+  }
+  sensors.points.resize(static_cast<std::size_t>(n));
+  sensors.normals.resize(static_cast<std::size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    double p[3], d[3];
+    input->GetPoint(i, p);
+    normals->GetTuple(i, d);
+    sensors.points[static_cast<std::size_t>(i)] = Vec3(p[0], p[1], p[2]);
+    sensors.normals[static_cast<std::size_t>(i)] = Vec3(d[0], d[1], d[2]);
+  }
+  try
+  {
+    checkSensors(sensors);
+  }
+  catch (const Error& e)
+  {
+    throw Error(std::string("the Sensors input: ") + e.what());
+  }
+  return sensors;
+}
+
+vtkSmartPointer<vtkPolyData> sensorMesh(
+  const SensorSet& given, const SensorSolution& solution, const MetricSteps& steps)
+{
+  const SensorSet sensors = normalizedSensors(given);
+  const std::size_t n = sensors.size();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(n));
+  vtkNew<vtkCellArray> vertices;
+  vtkNew<vtkFloatArray> normals;
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Vec3& p = sensors.points[i];
+    const Vec3& d = sensors.normals[i];
+    points->SetPoint(static_cast<vtkIdType>(i), p.x, p.y, p.z);
+    normals->SetTuple3(static_cast<vtkIdType>(i), d.x, d.y, d.z);
+    const vtkIdType id = static_cast<vtkIdType>(i);
+    vertices->InsertNextCell(1, &id);
+  }
+  auto mesh = vtkSmartPointer<vtkPolyData>::New();
+  mesh->SetPoints(points);
+  mesh->SetVerts(vertices);
+  mesh->GetPointData()->SetNormals(normals);
+
+  const char* names[5] = { "DaylightAutonomy", "UDILow", "UDIUseful", "UDIHigh", "DirectSunHours" };
+  vtkSmartPointer<vtkFloatArray> metrics[5];
+  for (int k = 0; k < 5; ++k)
+  {
+    metrics[k] = vtkSmartPointer<vtkFloatArray>::New();
+    metrics[k]->SetName(names[k]);
+    metrics[k]->SetNumberOfTuples(static_cast<vtkIdType>(n));
+    mesh->GetPointData()->AddArray(metrics[k]);
+  }
+  const std::size_t count = steps.frame.size();
+  std::vector<double> illuminance(count), sun(count);
+  for (std::size_t i = 0; i < n && solution.sensorCount() == n; ++i)
+  {
+    for (std::size_t t = 0; t < count; ++t)
+    {
+      illuminance[t] =
+        steps.efficacy[t] * vtkoutputs::luminance(solution.irradiance(steps.frame[t], i));
+      sun[t] =
+        steps.sunEfficacy[t] * vtkoutputs::luminance(solution.sunIrradiance(steps.frame[t], i));
+    }
+    const DaylightMetrics m = daylightMetrics(
+      illuminance.data(), sun.data(), count, steps.autonomyThreshold, steps.hoursPerStep);
+    const double values[5] = { m.autonomy, m.udiLow, m.udiUseful, m.udiHigh, m.directSunHours };
+    for (int k = 0; k < 5; ++k)
+    {
+      metrics[k]->SetValue(static_cast<vtkIdType>(i), static_cast<float>(values[k]));
+    }
+  }
+  return mesh;
+}
+
+void addSensorArrays(
+  const SensorSolution& solution, std::size_t frame, double efficacy, vtkPointData* pointData)
+{
+  const std::size_t n = solution.sensorCount();
+  auto irradiance = vtkoutputs::rgbArray("Irradiance", n);
+  vtkNew<vtkFloatArray> illuminance;
+  illuminance->SetName("Illuminance");
+  illuminance->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Rgb e = solution.irradiance(frame, i);
+    vtkoutputs::setRgb(irradiance, i, e);
+    illuminance->SetValue(
+      static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
+  }
+  pointData->AddArray(irradiance);
+  pointData->AddArray(illuminance);
+  pointData->SetActiveScalars("Illuminance");
+}
+
+} // namespace mlr::vtksensors

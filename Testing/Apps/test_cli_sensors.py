@@ -1,0 +1,186 @@
+"""The command line's sensors: --work-plane over a small open-top room lit by a uniform sky
+and a lamp (the grid count, heights and illuminance arrays), --sensors FILE.vtp,
+--da-threshold, and their bad inputs.
+
+The room is 3 x 2 (x, y) and 2.5 high, floor facing up. With SPACING 0.5 the lattice
+(i + 1/2) 0.5 puts 6 x 4 = 24 sensors inside the floor; the walls face inwards (never up) and
+there is no ceiling, so the floor is the only upward face.
+
+ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
+    MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
+"""
+import os
+import xml.etree.ElementTree as ElementTree
+
+import numpy
+import pytest
+
+from test_cli_rigs_and_sun import Polygons, run
+
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPolyDataWriter
+
+W, D, H = 3.0, 2.0, 2.5
+HEIGHT, SPACING = 0.8, 0.5
+EDH = 100.0
+FAST = ["--paths", "20000", "--threads", "2", "--patch-size", "0.5"]
+
+
+def write_room(directory, ceiling=False):
+    room = Polygons()
+    room.add([(0, 0, 0), (W, 0, 0), (W, D, 0), (0, D, 0)])          # floor, facing up
+    room.add([(0, 0, 0), (0, D, 0), (0, D, H), (0, 0, H)])          # x = 0, facing +x
+    room.add([(W, 0, 0), (W, 0, H), (W, D, H), (W, D, 0)])          # x = W, facing -x
+    room.add([(0, 0, 0), (0, 0, H), (W, 0, H), (W, 0, 0)])          # y = 0, facing +y
+    room.add([(0, D, 0), (W, D, 0), (W, D, H), (0, D, H)])          # y = D, facing -y
+    if ceiling:
+        room.add([(0, 0, H), (0, D, H), (W, D, H), (W, 0, H)])      # facing down
+    return room.write(directory / "room.vtp")
+
+
+def write_wall(directory):
+    return Polygons().add([(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)]).write(directory / "wall.vtp")
+
+
+def write_lamp(directory):
+    c = (1.5, 1.0, 2.4)
+    s = 0.2
+    return Polygons().add([(c[0] - s, c[1] - s, c[2]), (c[0] - s, c[1] + s, c[2]),
+                           (c[0] + s, c[1] + s, c[2]), (c[0] + s, c[1] - s, c[2])]).write(
+        directory / "lamp.vtp")
+
+
+def write_sensors(directory, points, normals, name="sensors.vtp"):
+    data = vtkPolyData()
+    pts = vtkPoints()
+    for p in points:
+        pts.InsertNextPoint(*p)
+    data.SetPoints(pts)
+    if normals is not None:
+        array = vtkFloatArray()
+        array.SetName("Normals")
+        array.SetNumberOfComponents(3)
+        for n in normals:
+            array.InsertNextTuple3(*n)
+        data.GetPointData().AddArray(array)
+    writer = vtkXMLPolyDataWriter()
+    writer.SetInputData(data)
+    writer.SetFileName(str(directory / name))
+    assert writer.Write()
+    return str(directory / name)
+
+
+def read_sensor_series(directory, collection="out/room_sensors.pvd"):
+    path = directory / collection
+    assert path.exists(), os.listdir(path.parent)
+    frames = []
+    for entry in ElementTree.parse(path).getroot().iter("DataSet"):
+        reader = vtkXMLPolyDataReader()
+        reader.SetFileName(str(path.parent / entry.get("file")))
+        reader.Update()
+        frames.append((float(entry.get("timestep")), reader.GetOutput()))
+    return frames
+
+
+def array(data, name):
+    return vtk_to_numpy(data.GetPointData().GetArray(name))
+
+
+def test_work_plane_under_the_sky_gives_the_grid_and_its_illuminance(tmp_path):
+    result = run(["--scene", write_room(tmp_path), "--sky", "uniform",
+                  "--sky-diffuse-horizontal", str(EDH), "--work-plane", f"{HEIGHT},{SPACING}",
+                  "--output", "out/room.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "24 sensors" in result.stdout
+    frames = read_sensor_series(tmp_path)
+    assert len(frames) == 1
+    sensors = frames[0][1]
+    assert sensors.GetNumberOfPoints() == 24
+    points = vtk_to_numpy(sensors.GetPoints().GetData())
+    assert numpy.allclose(points[:, 2], HEIGHT)
+    assert sorted(set(numpy.round(points[:, 0], 6))) == pytest.approx([0.25, 0.75, 1.25, 1.75, 2.25, 2.75])
+    assert sorted(set(numpy.round(points[:, 1], 6))) == pytest.approx([0.25, 0.75, 1.25, 1.75])
+    assert numpy.allclose(array(sensors, "Normals"), [0, 0, 1])
+    irradiance = array(sensors, "Irradiance")
+    lux = array(sensors, "Illuminance")
+    efficacy = sensors.GetFieldData().GetArray("LuminousEfficacy").GetValue(0)
+    assert lux == pytest.approx(efficacy * (irradiance @ [0.2126, 0.7152, 0.0722]), rel=1e-5)
+    # The sky through the open top, and the walls' light: less than E_dh, more than a tenth.
+    assert numpy.all(irradiance[:, 1] < EDH) and numpy.all(irradiance[:, 1] > 0.1 * EDH)
+    # The middle of the room sees more sky than its corners.
+    centre = numpy.argmin(numpy.hypot(points[:, 0] - 1.25, points[:, 1] - 0.75))
+    corner = numpy.argmin(numpy.hypot(points[:, 0] - 0.25, points[:, 1] - 0.25))
+    assert irradiance[centre, 1] > irradiance[corner, 1]
+    for name in ("DaylightAutonomy", "UDILow", "UDIUseful", "UDIHigh", "DirectSunHours"):
+        assert sensors.GetPointData().GetArray(name) is not None, name
+    shares = array(sensors, "UDILow") + array(sensors, "UDIUseful") + array(sensors, "UDIHigh")
+    assert numpy.allclose(shares, 1)
+    assert numpy.all(array(sensors, "DirectSunHours") == 0)
+
+
+def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
+    points = [(1.5, 1.0, 0.8), (0.5, 0.5, 0.8), (2.9, 1.0, 1.2)]
+    normals = [(0, 0, 1), (0, 0, 1), (-1, 0, 0)]
+    args = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
+            "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--frames", "3",
+            "--sensors", write_sensors(tmp_path, points, normals),
+            "--output", "out/room.pvd"] + FAST
+    result = run(args, tmp_path)
+    assert result.returncode == 0, result.stderr
+    frames = read_sensor_series(tmp_path)
+    assert len(frames) == 3
+    lux = numpy.array([array(f, "Illuminance") for _, f in frames])
+    assert numpy.all(lux > 0)
+    # The lamp moves away from the first sensor.
+    assert lux[0, 0] > lux[2, 0]
+    # A threshold below every frame's illuminance: DA 1; above: 0.
+    for threshold, expected in ((0.5 * lux.min(), 1.0), (2 * lux.max(), 0.0)):
+        result = run(args + ["--da-threshold", str(threshold)], tmp_path)
+        assert result.returncode == 0, result.stderr
+        da = array(read_sensor_series(tmp_path)[0][1], "DaylightAutonomy")
+        assert numpy.allclose(da, expected), (threshold, da)
+
+
+@pytest.mark.parametrize("extra,status,words", [
+    (["--work-plane", "0.8"], 2, "HEIGHT,SPACING"),
+    (["--work-plane", "0.8,0"], 2, "spacing above 0"),
+    (["--work-plane", "0.8,0.5", "--sensors", "s.vtp"], 2, "give one of them"),
+    (["--da-threshold", "300"], 2, "--da-threshold is for the sensors"),
+    (["--work-plane", "0.8,1e-7"], 2, "over the maximum"),
+])
+def test_bad_sensor_options(tmp_path, extra, status, words):
+    result = run(["--scene", write_room(tmp_path), "--sky", "uniform"] + extra + FAST, tmp_path)
+    assert result.returncode == status, result.stderr
+    assert words in result.stderr, result.stderr
+
+
+def test_bad_sensor_inputs(tmp_path):
+    base = ["--scene", write_room(tmp_path), "--sky", "uniform"] + FAST
+    no_normals = write_sensors(tmp_path, [(1, 1, 1)], None, "bare.vtp")
+    result = run(base + ["--sensors", no_normals], tmp_path)
+    assert result.returncode == 1 and "no point array Normals" in result.stderr, result.stderr
+    zero = write_sensors(tmp_path, [(1, 1, 1), (1, 1, 1)], [(0, 0, 1), (0, 0, 0)], "zero.vtp")
+    result = run(base + ["--sensors", zero], tmp_path)
+    assert result.returncode == 1 and "sensor 1 has a zero" in result.stderr, result.stderr
+    result = run(["--scene", write_wall(tmp_path), "--sky", "uniform", "--work-plane", "0.8,0.5"]
+                 + FAST, tmp_path)
+    assert result.returncode == 1 and "no polygon facing up" in result.stderr, result.stderr
+
+
+def test_work_plane_follows_up(tmp_path):
+    # The same 3 x 2 floor in the x-z plane, facing +y, with --up 0,1,0: 24 sensors 0.8 above
+    # it along y, facing +y; a ceiling-like face (facing -y) gets none.
+    floor = Polygons().add([(0, 0, 0), (0, 0, D), (W, 0, D), (W, 0, 0)])
+    floor.add([(0, 3, 0), (W, 3, 0), (W, 3, D), (0, 3, D)])
+    result = run(["--scene", floor.write(tmp_path / "floor.vtp"), "--sky", "uniform",
+                  "--up", "0,1,0", "--work-plane", f"{HEIGHT},{SPACING}",
+                  "--output", "out/room.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    sensors = read_sensor_series(tmp_path)[0][1]
+    assert sensors.GetNumberOfPoints() == 24
+    points = vtk_to_numpy(sensors.GetPoints().GetData())
+    assert numpy.allclose(points[:, 1], HEIGHT)
+    assert numpy.allclose(array(sensors, "Normals"), [0, 1, 0])
+    assert numpy.all((points[:, 0] > 0) & (points[:, 0] < W) & (points[:, 2] > 0) & (points[:, 2] < D))

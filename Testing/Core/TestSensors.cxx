@@ -1,0 +1,398 @@
+// Sensors: the sky, the sun, point and area lights and the scene's light on measuring points
+// against exact values, their independence from the thread count, the surfaces' radiosity
+// untouched by them, the daylight metrics and bad input.
+#include "Animation.h"
+#include "CoreChecks.h"
+#include "FormFactor.h"
+#include "GeneratedScenes.h"
+#include "Sensors.h"
+#include "Sky.h"
+#include "Solver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace mlr;
+using mlr::checks::expectError;
+using mlr::checks::sameBits;
+
+namespace
+{
+constexpr double Degree = M_PI / 180.0;
+
+Vec3 sunDirection(double elevation, double azimuth)
+{
+  const double e = elevation * Degree, a = azimuth * Degree;
+  return { std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e) };
+}
+
+Scene ground(double half = 1, const Rgb& rho = Rgb(0.5))
+{
+  PatchMesh mesh;
+  scenes::addGriddedQuad(
+    mesh, { -half, -half, 0 }, { 2 * half, 0, 0 }, { 0, 2 * half, 0 }, 4, 4, rho);
+  return Scene::fromPatchMesh(mesh);
+}
+
+SolverOptions quick(std::uint64_t paths = 20000, int threads = 0)
+{
+  SolverOptions options;
+  options.pathsPerFrame = paths;
+  options.gatheringRatio = 0.5;
+  options.seed = 7;
+  options.threads = threads;
+  return options;
+}
+
+SensorSet oneSensor(const Vec3& point, const Vec3& normal)
+{
+  SensorSet s;
+  s.points.push_back(point);
+  s.normals.push_back(normal);
+  return s;
+}
+
+/// The standard deviation of pi L(w) for cosine-distributed w (z up) over the tabulated sky,
+/// by midpoint quadrature in cos^2(theta) (uniform for that density) and phi.
+double skyEstimatorSigma(const Sky& sky, std::size_t position)
+{
+  const int n = 400;
+  double m1 = 0, m2 = 0;
+  for (int i = 0; i < n; ++i)
+  {
+    const double c2 = (i + 0.5) / n, cz = std::sqrt(c2), sz = std::sqrt(1 - c2);
+    for (int j = 0; j < n; ++j)
+    {
+      const double phi = 2 * M_PI * (j + 0.5) / n;
+      const double v =
+        M_PI * sky.radiance(position, { sz * std::cos(phi), sz * std::sin(phi), cz });
+      m1 += v;
+      m2 += v * v;
+    }
+  }
+  m1 /= double(n) * n;
+  m2 /= double(n) * n;
+  return std::sqrt(std::max(0.0, m2 - m1 * m1));
+}
+}
+
+TEST(Sensors, OpenGroundReadsTheDiffuseHorizontalOfEverySky)
+{
+  const Scene scene = ground();
+  const SensorSet sensors = oneSensor({ 0.1, -0.2, 0.8 }, { 0, 0, 2 });
+  SensorOptions counts;
+  counts.hemisphereRays = 4000;
+  for (SkyModel model :
+    { SkyModel::Uniform, SkyModel::CieOvercast, SkyModel::CieClear, SkyModel::Perez })
+  {
+    const std::vector<SkyFrame> frames = { { sunDirection(20, 10), 80, 300 },
+      { sunDirection(60, 140), 150, 700 } };
+    LightRig rig;
+    rig.skies.emplace_back(model, Vec3(0, 0, 1), frames);
+    const Solution solution = solve(scene, rig, quick());
+    const SensorSolution result = solveSensors(scene, rig, solution, sensors, quick(), counts);
+    ASSERT_EQ(result.frameCount(), 2u);
+    for (std::size_t f = 0; f < 2; ++f)
+    {
+      const double sigma = skyEstimatorSigma(rig.skies[0], f) / std::sqrt(4000.0);
+      const double e = result.irradiance(f, 0).g;
+      EXPECT_NEAR(e, frames[f].diffuseHorizontal, 4 * sigma + 1e-5 * frames[f].diffuseHorizontal)
+        << skyModelName(model) << " frame " << f;
+      EXPECT_EQ(result.sunIrradiance(f, 0).g, 0.0);
+    }
+    if (model == SkyModel::Uniform)
+    {
+      EXPECT_NEAR(skyEstimatorSigma(rig.skies[0], 0), 0.0, 1e-9) << "pi L is constant";
+    }
+  }
+}
+
+TEST(Sensors, LookingDownAtLitGroundGathersItsRadiosity)
+{
+  // A sensor just above a wide ground, facing it, sees (nearly) only the ground, whose
+  // radiosity under a uniform sky is rho E_dh.
+  const Scene scene = ground(20, Rgb(0.5));
+  LightRig rig;
+  rig.skies.emplace_back(SkyModel::Uniform, Vec3(0, 0, 1), std::vector<SkyFrame>{ { {}, 100, 0 } });
+  const Solution solution = solve(scene, rig, quick(100000));
+  SensorOptions counts;
+  counts.hemisphereRays = 2000;
+  const SensorSolution result = solveSensors(
+    scene, rig, solution, oneSensor({ 0.3, 0.2, 0.05 }, { 0, 0, -1 }), quick(), counts);
+  EXPECT_NEAR(result.irradiance(0, 0).r, 50.0, 2.5);
+}
+
+TEST(Sensors, TheSunGivesDniTimesTheSineOfItsElevationAndNothingInAShadow)
+{
+  PatchMesh mesh;
+  scenes::addGriddedQuad(mesh, { -2, -2, 0 }, { 4, 0, 0 }, { 0, 4, 0 }, 4, 4, Rgb(0.5));
+  // A black roof over (1, 0): it shades that point from a sun high in the south-west.
+  scenes::addGriddedQuad(mesh, { 0.6, -0.4, 1.0 }, { 0.8, 0, 0 }, { 0, 0.8, 0 }, 2, 2, Rgb(0.0));
+  const Scene scene = Scene::fromPatchMesh(mesh);
+  const std::vector<Vec3> sun = { sunDirection(30, 180), sunDirection(80, 180),
+    sunDirection(45, 90) };
+  const double dni = 800;
+  LightRig withSun, skyOnly;
+  withSun.directionalLights.emplace_back(sun, Rgb(dni));
+  const std::vector<SkyFrame> frames(3, SkyFrame{ { 0, 0, 1 }, 100, 0 });
+  withSun.skies.emplace_back(SkyModel::Uniform, Vec3(0, 0, 1), frames);
+  skyOnly.skies = withSun.skies;
+  SensorSet sensors = oneSensor({ -1, 0, 0.01 }, { 0, 0, 1 }); // open ground
+  sensors.points.push_back({ 1, 0, 0.01 });                    // under the roof
+  sensors.normals.push_back({ 0, 0, 1 });
+  const Solution lit = solve(scene, withSun, quick());
+  const SensorSolution a = solveSensors(scene, withSun, lit, sensors, quick());
+  const Solution dark = solve(scene, skyOnly, quick());
+  const SensorSolution b = solveSensors(scene, skyOnly, dark, sensors, quick());
+  for (std::size_t f = 0; f < 3; ++f)
+  {
+    const double expected = dni * sun[f].z;
+    EXPECT_NEAR(a.sunIrradiance(f, 0).r, expected, 1e-4 * expected) << "frame " << f;
+    // The roof shades (1, 0) from a sun at 80 degrees (the ray meets z = 1 at x = 0.82).
+    if (f == 1)
+    {
+      EXPECT_EQ(a.sunIrradiance(f, 1).r, 0.0);
+      // Only the sky, and the black roof reflects nothing: as without the sun, bit for bit.
+      EXPECT_EQ(a.irradiance(f, 1).r, b.irradiance(f, 1).r);
+      EXPECT_LT(a.irradiance(f, 1).r, 100.0);
+    }
+    // The open sensor sees all the sky but the roof's sliver, near the horizon.
+    const double sky = a.irradiance(f, 0).r - a.sunIrradiance(f, 0).r;
+    EXPECT_GT(sky, 98.0);
+    EXPECT_LE(sky, 100.0 + 1e-3);
+  }
+  EXPECT_NEAR(a.sunIrradiance(0, 1).r, dni * sun[0].z, 1e-4 * dni) << "a low sun reaches under";
+}
+
+TEST(Sensors, APointLightFollowsTheInverseSquareLaw)
+{
+  const Scene scene = ground(3);
+  const Rgb power(100, 50, 20);
+  std::vector<LightPose> poses(3);
+  poses[0].position = { 0, 0, 2 };
+  poses[1].position = { 0.5, 0.3, 1.5 };
+  poses[2].position = { -1, 0, 3 };
+  poses[2].power = Rgb(0.5);
+  LightRig rig;
+  rig.pointLights.emplace_back(power, poses);
+  const Solution solution = solve(scene, rig, quick());
+  const Vec3 point(0.2, -0.1, 0.5), normal = normalize(Vec3(0.3, 0.1, 1));
+  const SensorSolution result =
+    solveSensors(scene, rig, solution, oneSensor(point, normal), quick());
+  for (std::size_t f = 0; f < 3; ++f)
+  {
+    const Vec3 d = poses[f].position - point;
+    const double r2 = dot(d, d), r = std::sqrt(r2);
+    // Lambertian about the nadir (-z): I = Phi cos(gamma) / pi.
+    const double cosGamma = d.z / r, cosSensor = dot(normal, d) / r;
+    const double scale = poses[f].power.r * cosGamma / M_PI * cosSensor / r2;
+    // The ground below faces away from the sensor's hemisphere but for a sliver: its light
+    // is the only noise, bounded loosely.
+    const Rgb e = result.irradiance(f, 0);
+    EXPECT_NEAR(e.r, power.r * scale, 0.02 * power.r * scale) << "frame " << f;
+    EXPECT_NEAR(e.b / e.r, power.b / power.r, 0.02);
+  }
+}
+
+TEST(Sensors, AnAreaLightGivesLambertsFormFactor)
+{
+  // No surface reflects (a black floor): the sensor reads the light's direct irradiance,
+  // Phi / A times the point-to-polygon form factor.
+  const Scene scene = ground(1, Rgb(0.0));
+  const std::vector<std::vector<Vec3>> light = scenes::squareLightFacingDown({ 0, 0, 0.5 }, 0.3);
+  const Rgb power(10);
+  const std::vector<Vec3> moves = { { 0, 0, 0 }, { 0.2, 0.1, -0.1 } };
+  LightRig rig;
+  rig.areaLights.emplace_back(light, power, moves);
+  const Solution solution = solve(scene, rig, quick());
+  const Vec3 point(0.05, 0.02, 0.1), normal = normalize(Vec3(0.2, 0, 1));
+  SensorOptions counts;
+  counts.areaLightSamples = 4096;
+  const SensorSolution result =
+    solveSensors(scene, rig, solution, oneSensor(point, normal), quick(), counts);
+  const double area = 0.09;
+  for (std::size_t f = 0; f < 2; ++f)
+  {
+    std::vector<Vec3> polygon = light[0];
+    for (Vec3& v : polygon)
+    {
+      v += moves[f];
+    }
+    const double exact = power.r / area * pointToPolygonFormFactor(point, normal, polygon);
+    // The noise of S uniform samples of Phi cos cos / (pi r^2): its deviation by quadrature.
+    double m1 = 0, m2 = 0;
+    const int n = 64;
+    for (int i = 0; i < n; ++i)
+    {
+      for (int j = 0; j < n; ++j)
+      {
+        const Vec3 x =
+          Vec3(-0.15 + 0.3 * (i + 0.5) / n, -0.15 + 0.3 * (j + 0.5) / n, 0.5) + moves[f];
+        const Vec3 d = x - point;
+        const double r2 = dot(d, d);
+        const double v =
+          power.r * (d.z / std::sqrt(r2)) * dot(normal, d) / std::sqrt(r2) / (M_PI * r2);
+        m1 += v;
+        m2 += v * v;
+      }
+    }
+    m1 /= n * n;
+    m2 /= n * n;
+    const double sigma = std::sqrt(m2 - m1 * m1) / std::sqrt(4096.0);
+    EXPECT_NEAR(m1, exact, 1e-3 * exact) << "the quadrature agrees with Lambert";
+    EXPECT_NEAR(result.irradiance(f, 0).r, exact, 4 * sigma) << "frame " << f;
+    EXPECT_GT(sigma, 0);
+  }
+}
+
+namespace
+{
+/// A closed room with a light below its ceiling, and a grid of work-plane sensors.
+struct RoomCase
+{
+  PolygonSoup soup;
+  LightRig rig;
+  SensorSet sensors;
+};
+
+RoomCase room()
+{
+  RoomCase c;
+  c.soup =
+    scenes::boxOfQuads({ 0, 0, 0 }, { 3, 2, 2.5 }, std::vector<Rgb>(6, Rgb(0.6, 0.5, 0.4)), true);
+  c.rig.areaLights.emplace_back(scenes::squareLightFacingDown({ 1.5, 1, 2.4 }, 0.4), Rgb(200),
+    scenes::translationsAlong({ 1.5, 1, 2.4 }, { 0.8, 0.6, 2.4 }, { 2.2, 1.4, 2.3 }, 3));
+  for (int i = 0; i < 4; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      c.sensors.points.push_back({ 0.4 + 0.7 * i, 0.4 + 0.6 * j, 0.8 });
+      c.sensors.normals.push_back({ 0, 0, 1 });
+    }
+  }
+  return c;
+}
+
+AnimationOptions roomOptions(int threads, const SensorSet& sensors)
+{
+  AnimationOptions options;
+  options.remeshing.targetEdgeLength = 0.5;
+  options.solver = quick(20000, threads);
+  options.sensors = sensors;
+  options.sensorOptions.hemisphereRays = 64;
+  options.sensorOptions.areaLightSamples = 8;
+  return options;
+}
+}
+
+TEST(Sensors, SensorsDoNotChangeTheSurfacesRadiosityBitForBit)
+{
+  RoomCase c = room();
+  Animation without = solveAnimation(c.soup, c.rig, roomOptions(2, {}));
+  Animation with = solveAnimation(c.soup, c.rig, roomOptions(2, c.sensors));
+  EXPECT_EQ(without.sensors.sensorCount(), 0u);
+  ASSERT_EQ(with.sensors.sensorCount(), c.sensors.size());
+  EXPECT_TRUE(sameBits(without.solution.patchData(), with.solution.patchData()));
+  EXPECT_TRUE(sameBits(without.solution.directData(), with.solution.directData()));
+  EXPECT_TRUE(sameBits(without.solution.indirectData(), with.solution.indirectData()));
+  // And the sensors read light: the direct part of the lamp at least.
+  for (std::size_t s = 0; s < c.sensors.size(); ++s)
+  {
+    for (std::size_t f = 0; f < 3; ++f)
+    {
+      EXPECT_GT(with.sensors.irradiance(f, s).r, 0.0);
+    }
+  }
+}
+
+TEST(Sensors, TheThreadCountDoesNotChangeTheResultBitForBit)
+{
+  RoomCase c = room();
+  // A sun and a sky over the room's open top too: every estimator runs.
+  c.soup = scenes::boxOfQuads({ 0, 0, 0 }, { 3, 2, 2.5 }, std::vector<Rgb>(6, Rgb(0.6)), true);
+  c.soup.polygons.pop_back(); // no ceiling
+  c.soup.materials.pop_back();
+  c.rig.directionalLights.emplace_back(
+    std::vector<Vec3>{ sunDirection(70, 0), sunDirection(60, 30), sunDirection(50, 60) }, Rgb(500));
+  c.rig.skies.emplace_back(SkyModel::CieOvercast, Vec3(0, 0, 1),
+    std::vector<SkyFrame>{ { {}, 100, 0 }, { {}, 120, 0 }, { {}, 90, 0 } });
+  LightPose lamp;
+  lamp.position = { 1, 1, 2 };
+  c.rig.pointLights.emplace_back(Rgb(50), std::vector<LightPose>{ lamp });
+  const Animation one = solveAnimation(c.soup, c.rig, roomOptions(1, c.sensors));
+  const Animation three = solveAnimation(c.soup, c.rig, roomOptions(3, c.sensors));
+  SensorSolution a = one.sensors, b = three.sensors;
+  EXPECT_TRUE(sameBits(a.irradianceData(), b.irradianceData()));
+  EXPECT_TRUE(sameBits(a.sunData(), b.sunData()));
+  double sun = 0;
+  for (std::size_t s = 0; s < c.sensors.size(); ++s)
+  {
+    sun += a.sunIrradiance(0, s).r;
+  }
+  EXPECT_GT(sun, 0.0) << "some sensors see the sun";
+}
+
+TEST(Sensors, DaylightMetricsOfHandCheckedSeries)
+{
+  const double constant[4] = { 500, 500, 500, 500 }, none[4] = { 0, 0, 0, 0 };
+  DaylightMetrics m = daylightMetrics(constant, none, 4, 300, 1);
+  EXPECT_EQ(m.autonomy, 1.0);
+  EXPECT_EQ(m.udiUseful, 1.0);
+  EXPECT_EQ(m.udiLow, 0.0);
+  EXPECT_EQ(m.udiHigh, 0.0);
+  EXPECT_EQ(m.directSunHours, 0.0);
+
+  const double series[5] = { 50, 150, 300, 2500, 10000 };
+  const double sun[5] = { 0, 0, 0, 1500, 9000 };
+  m = daylightMetrics(series, sun, 5, 300, 0.5);
+  EXPECT_DOUBLE_EQ(m.autonomy, 3.0 / 5);
+  EXPECT_DOUBLE_EQ(m.udiLow, 1.0 / 5);
+  EXPECT_DOUBLE_EQ(m.udiUseful, 2.0 / 5);
+  EXPECT_DOUBLE_EQ(m.udiHigh, 2.0 / 5);
+  EXPECT_DOUBLE_EQ(m.directSunHours, 1.0);
+  EXPECT_DOUBLE_EQ(m.udiLow + m.udiUseful + m.udiHigh, 1.0);
+  m = daylightMetrics(series, sun, 5, 3000, 1);
+  EXPECT_DOUBLE_EQ(m.autonomy, 1.0 / 5);
+
+  EXPECT_EQ(hoursPerTimeStep({ 7.5 }), 1.0);
+  EXPECT_EQ(hoursPerTimeStep({ 8, 9, 10, 32, 33, 34 }), 1.0) << "a night skipped";
+  EXPECT_EQ(hoursPerTimeStep({ 12, 12.25, 12.5, 12.75 }), 0.25);
+  expectError([&] { daylightMetrics(series, sun, 5, -1, 1); }, "threshold");
+  expectError([&] { daylightMetrics(series, sun, 5, std::numeric_limits<double>::quiet_NaN(), 1); },
+    "threshold");
+}
+
+TEST(Sensors, BadSensorsAreRefusedByName)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  SensorSet noNormals;
+  noNormals.points = { { 0, 0, 1 } };
+  expectError([&] { checkSensors(noNormals); }, "Normals");
+  expectError([&] { checkSensors(oneSensor({ nan, 0, 1 }, { 0, 0, 1 })); }, "sensor 0");
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1e20 }, { 0, 0, 1 })); }, "finite");
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 0 })); }, "zero");
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, nan, 1 })); }, "normal");
+  SensorSet two = oneSensor({ 0, 0, 1 }, { 0, 0, 1 });
+  two.points.push_back({ 1, 0, 1 });
+  two.normals.push_back({ 0, 0, 0 });
+  expectError([&] { checkSensors(two); }, "sensor 1");
+  SensorOptions none;
+  none.hemisphereRays = 0;
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), none); }, "hemisphere rays");
+  SensorOptions many;
+  many.areaLightSamples = MaximumSensorRays + 1;
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), many); }, "area light");
+  // A unit normal of any length.
+  EXPECT_NEAR(normalizedSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1e300 })).normals[0].z, 1.0, 1e-15);
+  // Refused before remeshing, through the animation's entry point.
+  RoomCase c = room();
+  c.sensors.normals[5] = { 0, 0, 0 };
+  expectError([&] { solveAnimation(c.soup, c.rig, roomOptions(1, c.sensors)); }, "sensor 5");
+  // A sensor set too large for the memory limit is refused by the one memory check.
+  RoomCase big = room();
+  AnimationOptions options = roomOptions(1, big.sensors);
+  options.outputBytesPerSensorFrame = std::uint64_t(1) << 40;
+  expectError([&] { solveAnimation(big.soup, big.rig, options); }, "memory");
+}

@@ -1,0 +1,182 @@
+"""Sensors through the filter: a Sensors input of points with Normals over a ground plane
+under a sun and a uniform sky, the Sensors output's per-frame Irradiance and Illuminance and
+its daylight metrics, the surfaces' radiosity untouched by the sensors, the thread count
+without effect, and bad sensors refused by name.
+
+A uniform sky's estimator pi L is the same for every direction, so an up-facing sensor on
+open ground reads E_dh exactly (to single precision); the sun adds DNI sin(elevation).
+"""
+import math
+
+import pytest
+
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkFloatArray, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkPolyData
+from vtkmodules.util.misc import calldata_type
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.util.vtkConstants import VTK_STRING
+from vtkmodules.vtkFiltersSources import vtkPlaneSource
+
+from movinglightradiosity import vtkMovingLightRadiosity
+
+EDH = 10.0
+DNI = 500.0
+# Towards the sun: 45 degrees, the zenith, below the horizon (night for the direct sun).
+SUNS = ((1.0, 0.0, 1.0), (0.0, 0.0, 1.0), (1.0, 0.0, -0.2))
+HOURS = (8.0, 8.5, 9.0)
+
+
+def output(source):
+    source.Update()
+    return source.GetOutput()
+
+
+def sensors(points, normals, name="Normals"):
+    data = vtkPolyData()
+    pts = vtkPoints()
+    for p in points:
+        pts.InsertNextPoint(*p)
+    data.SetPoints(pts)
+    if normals is not None:
+        array = vtkFloatArray()
+        array.SetName(name)
+        array.SetNumberOfComponents(3)
+        for n in normals:
+            array.InsertNextTuple3(*n)
+        data.GetPointData().AddArray(array)
+    return data
+
+
+def trajectory():
+    data = vtkPolyData()
+    pts = vtkPoints()
+    for s in SUNS:
+        pts.InsertNextPoint(*s)
+    data.SetPoints(pts)
+    time = vtkDoubleArray()
+    time.SetName("Time")
+    for t in HOURS:
+        time.InsertNextValue(t)
+    data.GetPointData().AddArray(time)
+    return data
+
+
+def make_filter(sensor_data, threads=2):
+    ground = vtkPlaneSource()
+    ground.SetOrigin(-1, -1, 0)
+    ground.SetPoint1(1, -1, 0)
+    ground.SetPoint2(-1, 1, 0)
+    ground.SetResolution(4, 4)
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(output(ground))
+    radiosity.SetTrajectoryData(trajectory())
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetSunIrradiance(DNI)
+    radiosity.SetSkyModel(vtkMovingLightRadiosity.UNIFORM_SKY)
+    radiosity.SetSkyDiffuseHorizontal(EDH)
+    radiosity.SetNumberOfPaths(20000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetNumberOfThreads(threads)
+    if sensor_data is not None:
+        radiosity.SetSensorsData(sensor_data)
+    return radiosity
+
+
+UP = [(0.2, 0.1, 0.8), (-0.5, 0.3, 0.01), (0.0, 0.0, 0.4)]
+UP_NORMALS = [(0, 0, 1), (0, 0, 5), (0, 0, 1)]
+
+
+@pytest.fixture(scope="module")
+def run():
+    return make_filter(sensors(UP, UP_NORMALS))
+
+
+def test_sensors_read_the_sun_and_the_sky(run):
+    assert run.GetNumberOfOutputPorts() == 4
+    assert run.GetNumberOfInputPorts() == 4
+    for frame, t in enumerate(HOURS):
+        assert run.UpdateTimeStep(t)
+        out = run.GetOutput(vtkMovingLightRadiosity.SENSORS_OUTPUT_PORT)
+        assert out.GetNumberOfPoints() == 3
+        assert out.GetNumberOfVerts() == 3
+        irradiance = vtk_to_numpy(out.GetPointData().GetArray("Irradiance"))
+        lux = vtk_to_numpy(out.GetPointData().GetArray("Illuminance"))
+        s = SUNS[frame]
+        sine = max(0.0, s[2] / math.sqrt(sum(c * c for c in s)))
+        expected = EDH + DNI * sine
+        efficacy = out.GetFieldData().GetArray("LuminousEfficacy").GetValue(0)
+        for i in range(3):
+            assert irradiance[i][1] == pytest.approx(expected, rel=1e-5), (frame, i)
+            luminance = 0.2126 * irradiance[i][0] + 0.7152 * irradiance[i][1] + 0.0722 * irradiance[i][2]
+            assert lux[i] == pytest.approx(efficacy * luminance, rel=1e-5)
+        normals = vtk_to_numpy(out.GetPointData().GetArray("Normals"))
+        assert normals[1][2] == pytest.approx(1.0)
+
+
+def test_metrics_over_the_time_steps(run):
+    assert run.UpdateTimeStep(HOURS[0])
+    out = run.GetOutput(vtkMovingLightRadiosity.SENSORS_OUTPUT_PORT)
+    data = out.GetPointData()
+    lux = []
+    for t in HOURS:
+        run.UpdateTimeStep(t)
+        lux.append(vtk_to_numpy(run.GetOutput(3).GetPointData().GetArray("Illuminance"))[0])
+    assert all(e > 2000 for e in lux[:2]) and 100 <= lux[2] <= 2000, lux
+    value = lambda name: data.GetArray(name).GetValue(0)
+    assert value("DaylightAutonomy") == pytest.approx(1.0)
+    assert value("UDIHigh") == pytest.approx(2 / 3)
+    assert value("UDIUseful") == pytest.approx(1 / 3)
+    assert value("UDILow") == 0
+    # Two frames of direct sun, half an hour each (the Time spacing).
+    assert value("DirectSunHours") == pytest.approx(1.0)
+    run.SetDaylightAutonomyThreshold(lux[2] * 1.01)
+    run.UpdateTimeStep(HOURS[0])
+    assert run.GetOutput(3).GetPointData().GetArray("DaylightAutonomy").GetValue(0) == pytest.approx(2 / 3)
+    run.SetDaylightAutonomyThreshold(300)
+
+
+def test_sensors_change_no_radiosity_bit_for_bit(run):
+    plain = make_filter(None)
+    for t in HOURS:
+        assert plain.UpdateTimeStep(t) and run.UpdateTimeStep(t)
+        a = vtk_to_numpy(plain.GetOutput(0).GetCellData().GetArray("Radiosity"))
+        b = vtk_to_numpy(run.GetOutput(0).GetCellData().GetArray("Radiosity"))
+        assert a.tobytes() == b.tobytes()
+    assert plain.GetOutput(3).GetNumberOfPoints() == 0
+
+
+def test_thread_count_changes_no_sensor_bit():
+    # A wall beside the sensors' line of sight gives the hemisphere rays something to hit.
+    points = [(0.3 * i - 0.6, 0.1, 0.3) for i in range(5)]
+    normals = [(1, 0.2 * i, 0.5) for i in range(5)]
+    one = make_filter(sensors(points, normals), threads=1)
+    three = make_filter(sensors(points, normals), threads=3)
+    for t in HOURS:
+        assert one.UpdateTimeStep(t) and three.UpdateTimeStep(t)
+        for name in ("Irradiance", "Illuminance", "DirectSunHours", "UDIHigh"):
+            a = vtk_to_numpy(one.GetOutput(3).GetPointData().GetArray(name))
+            b = vtk_to_numpy(three.GetOutput(3).GetPointData().GetArray(name))
+            assert a.tobytes() == b.tobytes(), name
+
+
+@pytest.mark.parametrize(
+    "data,words",
+    [
+        (sensors(UP, None), "no point array Normals"),
+        (sensors(UP, [(0, 0, 1), (0, 0, 0), (0, 0, 1)]), "sensor 1 has a zero or non-finite normal"),
+        (sensors([(0, 0, 1), (float("nan"), 0, 1)], [(0, 0, 1), (0, 0, 1)]), "sensor 1 has a point"),
+    ],
+)
+def test_bad_sensors_are_refused_by_name(data, words):
+    radiosity = make_filter(data)
+    errors = []
+
+    @calldata_type(VTK_STRING)
+    def record(_caller, _event, message):
+        errors.append(message)
+
+    radiosity.AddObserver("ErrorEvent", record)
+    assert not radiosity.UpdateTimeStep(HOURS[0])
+    assert any(words in e and "Sensors" in e for e in errors), errors
+    assert radiosity.GetOutput(0).GetNumberOfCells() == 0
+    assert radiosity.GetOutput(3).GetNumberOfPoints() == 0
