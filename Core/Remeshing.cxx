@@ -431,6 +431,33 @@ void appendCgalPatches(
     out.emission.push_back(materials[cgal.material[i]].emission);
   }
 }
+/// `points` snapped to multiples of a power of two near 2^-40 of the scene's extent. Far
+/// below float precision for any real scene, it makes coordinates that differ only by
+/// subnormal amounts equal, so that CGAL sees exactly degenerate triangles, which its repair
+/// drops, rather than triangles of width 1e-38 in a scene of 1e11, which its constrained
+/// triangulation walks off (a null face: found by fuzzing).
+std::vector<Vec3> snappedPoints(const std::vector<Vec3>& points)
+{
+  double extent = 0;
+  for (const Vec3& p : points)
+  {
+    extent = std::max({ extent, std::abs(p.x), std::abs(p.y), std::abs(p.z) });
+  }
+  if (!(extent > 0))
+  {
+    return points;
+  }
+  const double quantum = std::ldexp(1.0, std::ilogb(extent) - 40);
+  std::vector<Vec3> snapped(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    const Vec3& p = points[i];
+    snapped[i] = Vec3(std::nearbyint(p.x / quantum) * quantum,
+      std::nearbyint(p.y / quantum) * quantum, std::nearbyint(p.z / quantum) * quantum);
+  }
+  return snapped;
+}
+
 /// Remeshes with CGAL (unless told not to) and refines what it refused, or everything.
 void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles,
   const std::vector<Material>& materials, double h, double expectedPatches,
@@ -445,8 +472,9 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     // Splitting at contacts adds triangles: the estimate checked before is checked again.
     settings.checkTriangleCount = [&](std::size_t split)
     { checkRemeshMemory(static_cast<double>(split), expectedPatches, h, options); };
-    const detail::CgalRemeshOutput cgal = detail::remeshWithCgal(soup.points, triangles, materials,
-      settings, [&](double f) { return !progress || progress(CgalShare * f); });
+    const detail::CgalRemeshOutput cgal =
+      detail::remeshWithCgal(snappedPoints(soup.points), triangles, materials, settings,
+        [&](double f) { return !progress || progress(CgalShare * f); });
     appendCgalPatches(cgal, materials, result.mesh);
     std::vector<std::size_t> refined(cgal.refineOnly.triangles.size());
     std::iota(refined.begin(), refined.end(), std::size_t(0));
