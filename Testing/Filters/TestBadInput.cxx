@@ -54,6 +54,37 @@ void expectError(const FilterRun& run, const std::string& expected)
   EXPECT_EQ(run.patches, 0);
 }
 
+/// Sets AbortExecute from the first progress event past 10%, as a user pressing Stop would
+/// once the solve is under way, and notes when.
+class AbortMidway
+{
+public:
+  using Clock = std::chrono::steady_clock;
+  explicit AbortMidway(vtkMovingLightRadiosity* filter)
+    : Filter(filter)
+  {
+    this->Command->SetClientData(this);
+    this->Command->SetCallback(
+      [](vtkObject*, unsigned long, void* data, void*)
+      {
+        auto* self = static_cast<AbortMidway*>(data);
+        if (!self->aborted && self->Filter->GetProgress() > 0.1)
+        {
+          self->aborted = true;
+          self->abortedAt = Clock::now();
+          self->Filter->SetAbortExecute(1);
+        }
+      });
+    filter->AddObserver(vtkCommand::ProgressEvent, this->Command);
+  }
+  bool aborted = false;
+  Clock::time_point abortedAt{};
+
+private:
+  vtkMovingLightRadiosity* Filter;
+  vtkNew<vtkCallbackCommand> Command;
+};
+
 void setReflectance(vtkPolyData* scene, vtkAbstractArray* array)
 {
   scene->GetCellData()->RemoveArray("Reflectance");
@@ -250,29 +281,10 @@ TEST(FilterBadInput, AbortStopsQuicklyWithEmptyOutputsAndRecovers)
   auto filter = fastFilter(setup);
   filter->SetNumberOfPaths(50000000); // tens of seconds if it ran to the end
 
-  using Clock = std::chrono::steady_clock;
-  struct AbortState
-  {
-    vtkMovingLightRadiosity* filter;
-    Clock::time_point abortedAt{};
-    bool aborted = false;
-  } state{ filter };
-  vtkNew<vtkCallbackCommand> abortMidway;
-  abortMidway->SetClientData(&state);
-  abortMidway->SetCallback(
-    [](vtkObject*, unsigned long, void* data, void*)
-    {
-      auto* s = static_cast<AbortState*>(data);
-      if (!s->aborted && s->filter->GetProgress() > 0.1)
-      {
-        s->aborted = true;
-        s->abortedAt = Clock::now();
-        s->filter->SetAbortExecute(1);
-      }
-    });
-  filter->AddObserver(vtkCommand::ProgressEvent, abortMidway);
+  AbortMidway state(filter);
   const FilterRun run = runFilter(filter);
-  const double seconds = std::chrono::duration<double>(Clock::now() - state.abortedAt).count();
+  const double seconds =
+    std::chrono::duration<double>(AbortMidway::Clock::now() - state.abortedAt).count();
   ASSERT_TRUE(state.aborted);
   // 0.5 s on a quiet machine; ten times that so that load cannot change the verdict.
   EXPECT_LT(seconds, 5.0);
@@ -293,24 +305,7 @@ TEST(FilterBadInput, AnAbortHoldsUntilAPropertyChanges)
   BoxSetup setup = closedBoxSetup(3);
   auto filter = fastFilter(setup);
   filter->SetNumberOfPaths(50000000); // tens of seconds if anything solved it again
-  struct AbortState
-  {
-    vtkMovingLightRadiosity* filter;
-    bool aborted = false;
-  } state{ filter };
-  vtkNew<vtkCallbackCommand> abortMidway;
-  abortMidway->SetClientData(&state);
-  abortMidway->SetCallback(
-    [](vtkObject*, unsigned long, void* data, void*)
-    {
-      auto* s = static_cast<AbortState*>(data);
-      if (!s->aborted && s->filter->GetProgress() > 0.1)
-      {
-        s->aborted = true;
-        s->filter->SetAbortExecute(1);
-      }
-    });
-  filter->AddObserver(vtkCommand::ProgressEvent, abortMidway);
+  AbortMidway state(filter);
   expectError(runFilter(filter), "aborted");
   ASSERT_TRUE(state.aborted);
   // The abort is spent: the flag is clear and no output is marked ABORTED, which would make
