@@ -417,7 +417,11 @@ int run(int argc, char** argv)
       records.push_back(record);
       if (sensors)
       {
-        // The update of the Elements serves the Sensors at that time too.
+        // The update of the Elements serves the Sensors at that time too. Their field data
+        // shares its arrays with the element frames in the writer threads, and an XML writer
+        // caches ranges and information in the arrays it writes: the element frames are
+        // written out first, so that two writers never touch the same array.
+        writer.finish();
         sensorEntries.emplace_back(times[f], sensorNaming.frameName(f, ".vtp"));
         writeSensorFrame(filter->GetOutput(vtkMovingLightRadiosity::SENSORS_OUTPUT_PORT),
           output.stage(naming.directory / sensorEntries.back().second));
