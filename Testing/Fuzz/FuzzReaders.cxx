@@ -1,14 +1,16 @@
-// libFuzzer target: arbitrary bytes -> a scene file read as the command line reads it, through
-// the guarded reading (Apps/GuardedRead: .vtp .obj .ply .stl .vtu .vtk, chosen by the first
-// byte modulo 8, in that order; .obj and .ply by our vtkRadiositySceneReader with their
-// materials, as the command line reads them) -> the vtkMovingLightRadiosity filter with a fixed
-// light and a 2-frame trajectory, few paths and a small memory limit. The first byte's last two
-// values 6 and 7 make a photometric file instead (.ies, .ldt) read by mlr::readPhotometricFile,
-// whose distribution must then be finite and sample where its density is positive. Values 8
-// and 9 (first byte modulo 10) make a .gltf or .glb file read by vtkRadiositySceneReader in
-// this process, as ParaView runs it: a crash there is a finding, not a refusal. Value 10 (first
-// byte modulo 11) makes an EnergyPlus weather file (.epw) read by mlr::readWeatherFile, whose
-// hours must then make frames with finite suns and irradiances.
+// libFuzzer target: arbitrary bytes -> one input file, its format chosen by the first byte
+// modulo 11 (or by MLR_FUZZ_FORMAT), in the order .vtp .obj .ply .stl .vtu .vtk .ies .ldt .gltf
+// .glb .epw:
+// - the six scene formats are read as the command line reads them, through the guarded reading
+//   (Apps/GuardedRead; .obj and .ply by our vtkRadiositySceneReader with their materials), and
+//   go to the vtkMovingLightRadiosity filter with a fixed light and a 2-frame trajectory, few
+//   paths and a small memory limit;
+// - .ies and .ldt are read by mlr::readPhotometricFile, whose distribution must then be finite
+//   and sample where its density is positive;
+// - .gltf and .glb are read by vtkRadiositySceneReader in this process, as ParaView runs it: a
+//   crash there is a finding, not a refusal;
+// - .epw is read by mlr::readWeatherFile, whose hours must then make frames with finite suns
+//   and irradiances.
 //
 // A refused file (mlr::guarded::InputError: checks, VTK's errors, a reader that crashed or ran
 // out of time in its child process; mlr::Error for a photometric file) or a filter error is a
@@ -183,7 +185,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   {
     return 0;
   }
-  const unsigned kind = data[0] % 11;
+  // MLR_FUZZ_FORMAT (an extension without its dot) fixes the format, so that a run spends its
+  // time on one reader; the first byte is still skipped, so the seeds read the same either way.
+  static const int forced = [] {
+    const char* format = std::getenv("MLR_FUZZ_FORMAT");
+    for (int k = 0; format && k < 11; ++k)
+    {
+      if (std::string(".") + format == extensions[k])
+      {
+        return k;
+      }
+    }
+    if (format)
+    {
+      finding(std::string("MLR_FUZZ_FORMAT=") + format + " is not one of vtp obj ply stl vtu vtk "
+                                                          "ies ldt gltf glb epw");
+    }
+    return -1;
+  }();
+  const unsigned kind = forced >= 0 ? unsigned(forced) : data[0] % 11;
   const fs::path path = setup.directory / (std::string("scene") + extensions[kind]);
   {
     std::ofstream file(path, std::ios::binary | std::ios::trunc);
