@@ -1,5 +1,6 @@
 // Reuse of paths is unbiased, converges like classic, and costs nothing in accuracy when
 // all positions coincide.
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -189,6 +190,81 @@ TEST(Reuse, BalancedSharesBringTheEndsErrorDown)
   EXPECT_GT(largest, 1.2);
   EXPECT_LT(ends[1], 0.9 * ends[0]);
   EXPECT_LT(middle[1], 1.3 * middle[0]);
+}
+
+TEST(Reuse, BalancedSharesMeanOverSeedsEqualsClassicPerFace)
+{
+  // The sweep whose ends the balancing favours: every run must really cast unequal counts,
+  // else this would only repeat MeanOverSeedsEqualsClassicMeanForEveryFrame. Weights that
+  // assumed equal counts while the ends cast up to 4 times more would put the end frames
+  // tens of percent off, far outside the tolerance.
+  const BoxWithLight s;
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.15, 0.5, 0.9 }, { 0.85, 0.5, 0.9 }, 7));
+  constexpr int runs = 40;
+  const std::size_t values = 6 * light.frameCount();
+  std::vector<double> sum[2], sumSquares[2];
+  for (int mode = 0; mode < 2; ++mode)
+  {
+    sum[mode].assign(values, 0.0);
+    sumSquares[mode].assign(values, 0.0);
+    for (int r = 0; r < runs; ++r)
+    {
+      SolverOptions o = modeOptions(mode == 1, 4000, 3000 + r + 100 * mode);
+      const Solution solution = solve(s.scene, light, o);
+      if (mode == 1)
+      {
+        ASSERT_GT(solution.statistics.largestPositionShare, 1.2) << "run " << r;
+        ASSERT_LT(solution.statistics.smallestPositionShare, 1.0) << "run " << r;
+      }
+      const std::vector<double> m = wallMeans(s, solution);
+      for (std::size_t i = 0; i < values; ++i)
+      {
+        sum[mode][i] += m[i];
+        sumSquares[mode][i] += m[i] * m[i];
+      }
+    }
+  }
+  double chiSquare = 0;
+  for (std::size_t i = 0; i < values; ++i)
+  {
+    double mean[2], variance[2];
+    for (int mode = 0; mode < 2; ++mode)
+    {
+      mean[mode] = sum[mode][i] / runs;
+      variance[mode] = (sumSquares[mode][i] / runs - mean[mode] * mean[mode]) * runs / (runs - 1);
+    }
+    // The difference of two means of 40 runs, over its standard error: |z| < 4 for each of
+    // the 42 face-frames fails by chance with probability about 42 x 6e-5.
+    const double z = (mean[1] - mean[0]) / std::sqrt((variance[0] + variance[1]) / runs);
+    EXPECT_LT(std::abs(z), 4.0) << "frame " << i / 6 << " wall " << i % 6 << ": classic " << mean[0]
+                                << " balanced reuse " << mean[1];
+    chiSquare += z * z;
+  }
+  // 42 squared z of unbiased estimates: their mean is 1 within 0.22 (1 sigma).
+  EXPECT_LT(chiSquare / double(values), 2.0);
+}
+
+TEST(Reuse, BalancedSharesAreTheSameForAnyThreadCount)
+{
+  // The pilot runs in parallel tasks; its sums run in pilot order, so the counts, and with
+  // them every bit of the result, do not depend on the threads.
+  const BoxWithLight s;
+  const MovingLight light(s.light, Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.15, 0.5, 0.9 }, { 0.85, 0.5, 0.9 }, 9));
+  SolverOptions one = modeOptions(true, 20000, 31), three = one;
+  one.threads = 1;
+  three.threads = 3;
+  Solution a = solve(s.scene, light, one);
+  Solution b = solve(s.scene, light, three);
+  EXPECT_GT(a.statistics.largestPositionShare, 1.2);
+  EXPECT_EQ(a.statistics.largestPositionShare, b.statistics.largestPositionShare);
+  EXPECT_EQ(a.statistics.smallestPositionShare, b.statistics.smallestPositionShare);
+  EXPECT_EQ(a.statistics.pilotRays, b.statistics.pilotRays);
+  EXPECT_EQ(a.statistics.shadowRays, b.statistics.shadowRays);
+  EXPECT_TRUE(checks::sameBits(a.directData(), b.directData()));
+  EXPECT_TRUE(checks::sameBits(a.indirectData(), b.indirectData()));
+  EXPECT_TRUE(checks::sameBits(a.patchData(), b.patchData()));
 }
 
 TEST(Reuse, CastsFewerRaysThanClassic)
