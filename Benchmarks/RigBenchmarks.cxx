@@ -723,4 +723,12 @@ std::string runPanningSpot(const RigCaseOptions& c)
   return json;
 }
 
+ReferenceRadiosity classicReference(const std::string& name, const PatchMesh& mesh,
+  const Scene& scene, const LightRig& rig, const SolverOptions& base, const RigCaseOptions& options)
+{
+  checkOptions(options);
+  Reference ref = referenceSolution(name, mesh, scene, rig, base, options);
+  return { ref.paths, std::move(ref.litSide), std::move(ref.radiosity) };
+}
+
 } // namespace mlr::bench

@@ -4,6 +4,15 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
+
+namespace mlr
+{
+struct PatchMesh;
+class Scene;
+struct LightRig;
+struct SolverOptions;
+}
 
 namespace mlr::bench
 {
@@ -44,5 +53,18 @@ std::string runSunOverTown(const RigCaseOptions& options);
  * solver's shadow-ray rate beside bare Embree's. Returns the results as JSON.
  */
 std::string runPanningSpot(const RigCaseOptions& options);
+
+/// A classic solution at options.referenceFactor x N paths per frame and its own seed, from
+/// the cache of the cases above when it holds it: every element's lit side and the total
+/// radiosity there, [frame][element][channel].
+struct ReferenceRadiosity
+{
+  std::uint64_t paths = 0;
+  std::vector<std::uint8_t> litSide;
+  std::vector<double> radiosity;
+};
+ReferenceRadiosity classicReference(const std::string& name, const PatchMesh& mesh,
+  const Scene& scene, const LightRig& rig, const SolverOptions& base,
+  const RigCaseOptions& options);
 
 } // namespace mlr::bench

@@ -2,6 +2,7 @@
 // with the measured speed-up beside the paper's eq. (4) and our ray rate beside bare
 // Embree's for the same ray kinds; then a turning light and the sun over a town block
 // (RigBenchmarks.h). Everything printed is measured in this one run.
+#include "AccuracyBenchmarks.h"
 #include "BareEmbree.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
@@ -36,7 +37,38 @@ struct Arguments
   int referenceFactor = 16;
   std::string cache = "output/benchmark-cache";
   std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
+  bool pathsGiven = false, referenceFactorGiven = false;
+  int seeds = 0;             ///< --seeds for ends and error-bars (0: their default)
+  double targetError = 0.02; ///< --target-error for target-error
 };
+
+/// The cases of AccuracyBenchmarks.h.
+bool isAccuracyCase(const std::string& which)
+{
+  return which == "ends" || which == "error-bars" || which == "target-error";
+}
+
+/// Runs an accuracy case: smaller default N than the others, so that each fits in minutes.
+std::string runAccuracyCase(const Arguments& args)
+{
+  bench::AccuracyCaseOptions o;
+  o.paths = args.pathsGiven ? args.paths : 100000;
+  o.frames = args.framesGiven ? args.frames : 0;
+  o.threads = args.threads;
+  o.seeds = args.seeds;
+  o.referenceFactor = args.referenceFactorGiven ? args.referenceFactor : 0;
+  o.target = args.targetError;
+  o.cacheDirectory = args.cache;
+  if (args.which == "ends")
+  {
+    return "  \"ends\": " + bench::runEnds(o);
+  }
+  if (args.which == "error-bars")
+  {
+    return "  \"error_bars\": " + bench::runErrorBars(o);
+  }
+  return "  \"target_error\": " + bench::runTargetError(o);
+}
 
 void usage()
 {
@@ -44,7 +76,8 @@ void usage()
     "usage: mlr-benchmark [--case all|paper|rotating|spotlight|sun|long|large|remesh] [--paths N]\n"
     "                     [--frames n] [--threads T] [--json FILE] [--reference-factor F]\n"
     "                     [--cache DIR] [--only classic|gathering|shooting|full]\n"
-    "                     [--memory-limit-mib M]\n"
+    "                     [--memory-limit-mib M] [--seeds S] [--target-error T]\n"
+    "                     [--case ends|error-bars|target-error]\n"
     "  paper:    the generated paper-scale room (about 2,800 patches, a small ceiling light on a\n"
     "            diagonal) in the four reuse modes, compared with bare Embree, and remeshing\n"
     "  rotating: a light turning 90 degrees in the same room\n"
@@ -66,7 +99,13 @@ void usage()
     "            and peak memory against the estimate (about 3 minutes, not in all)\n"
     "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half "
     "the\n"
-    "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n");
+    "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n"
+    "  ends:     every frame's MSE over classic's at equal N (default 200,000) for the paper "
+    "room,\n"
+    "            the turning light and the sun, in the end-of-animation schemes (--seeds, 2)\n"
+    "  error-bars: the paper room with 16 error batches over --seeds (20) seeds (N 100,000)\n"
+    "  target-error: the paper room, 10 frames, to --target-error T (0.02), first round N "
+    "100,000\n");
 }
 
 bool parse(int argc, char** argv, Arguments& a)
@@ -78,6 +117,7 @@ bool parse(int argc, char** argv, Arguments& a)
     if (flag == "--paths" && hasValue)
     {
       a.paths = std::strtoull(argv[++i], nullptr, 10);
+      a.pathsGiven = true;
     }
     else if (flag == "--frames" && hasValue)
     {
@@ -101,21 +141,30 @@ bool parse(int argc, char** argv, Arguments& a)
       a.which = argv[++i];
       if (a.which != "all" && a.which != "paper" && a.which != "rotating" &&
         a.which != "spotlight" && a.which != "sun" && a.which != "remesh" && a.which != "long" &&
-        a.which != "large")
+        a.which != "large" && !isAccuracyCase(a.which))
       {
         std::fprintf(stderr,
           "mlr-benchmark: --case must be all, paper, rotating, spotlight, sun, "
-          "remesh, long or large\n");
+          "remesh, long, large, ends, error-bars or target-error\n");
         return false;
       }
     }
     else if (flag == "--reference-factor" && hasValue)
     {
       a.referenceFactor = std::atoi(argv[++i]);
+      a.referenceFactorGiven = true;
     }
     else if (flag == "--memory-limit-mib" && hasValue)
     {
       a.memoryLimitMiB = std::strtoull(argv[++i], nullptr, 10);
+    }
+    else if (flag == "--seeds" && hasValue)
+    {
+      a.seeds = std::atoi(argv[++i]);
+    }
+    else if (flag == "--target-error" && hasValue)
+    {
+      a.targetError = std::atof(argv[++i]);
     }
     else if (flag == "--cache" && hasValue)
     {
@@ -343,6 +392,10 @@ int main(int argc, char** argv)
     if (args.which == "all" || args.which == "sun")
     {
       json.push_back("  \"sun_over_town\": " + bench::runSunOverTown(rigOptions));
+    }
+    if (isAccuracyCase(args.which))
+    {
+      json.push_back(runAccuracyCase(args));
     }
     if (args.which == "remesh")
     {
