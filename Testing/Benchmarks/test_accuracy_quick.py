@@ -1,0 +1,48 @@
+"""mlr-benchmark's accuracy cases (ends, error-bars, target-error) at a small size: each runs
+and writes JSON whose figures are finite. Figures at full size are in
+Documentation/Performance.md; none is asserted here.
+"""
+import json
+import math
+import os
+import subprocess
+
+import pytest
+
+
+def solve(tmp_path, case, *extra):
+    out = tmp_path / (case + ".json")
+    result = subprocess.run(
+        [os.environ["MLR_BENCHMARK"], "--case", case, "--paths", "3000", "--frames", "4",
+         "--reference-factor", "2", "--cache", "", "--json", str(out), *extra],
+        capture_output=True, text=True, timeout=280)
+    assert result.returncode == 0, result.stderr
+    with open(out) as f:
+        return json.load(f), result.stdout
+
+
+def test_ends(tmp_path):
+    data, text = solve(tmp_path, "ends")
+    for case in ("paper_room", "turning_light", "sun_over_town"):
+        schemes = data["ends"][case]["schemes"]
+        assert [s["name"].split(",")[0] for s in schemes][:3] == \
+            ["classic", "full reuse", "full reuse"]
+        for scheme in schemes:
+            assert all(math.isfinite(r) and r > 0 for r in scheme["mse_ratio"]), scheme["name"]
+    assert "First-hit variance factor" in text
+
+
+def test_error_bars(tmp_path):
+    data, _ = solve(tmp_path, "error-bars", "--seeds", "3")
+    frames = data["error_bars"]["per_frame"]
+    assert len(frames) == 4
+    for f in frames:
+        assert math.isfinite(f["ratio"]) and 0 <= f["coverage"] <= 1
+
+
+def test_target_error(tmp_path):
+    data, _ = solve(tmp_path, "target-error", "--target-error", "0.5")
+    t = data["target_error"]
+    assert t["stopped_by"] == "target"
+    assert t["paths_per_frame"] >= 3000
+    assert math.isfinite(t["achieved_p95"])
