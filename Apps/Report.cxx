@@ -80,6 +80,12 @@ std::string summaryLine(vtkFieldData* statistics)
     << seconds(value(statistics, "SecondsShooting")) << ", gathering "
     << seconds(value(statistics, "SecondsGathering")) << "), predicted speed-up of reuse "
     << std::fixed << std::setprecision(1) << value(statistics, "PredictedSpeedup") << "x";
+  if (statistics && statistics->GetArray("SensorGatheringRays"))
+  {
+    s << "; sensors " << millions(value(statistics, "SensorShadowRays")) << " shadow, "
+      << millions(value(statistics, "SensorGatheringRays")) << " gathering rays, "
+      << seconds(value(statistics, "SecondsSensors"));
+  }
   return s.str();
 }
 

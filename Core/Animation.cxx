@@ -13,13 +13,14 @@ constexpr double RemeshingShare = 0.05;
 /// Share of the progress given to the sensors, when there are any.
 constexpr double SensorShare = 0.05;
 
-std::uint64_t outputBytes(
-  const AnimationOptions& options, std::size_t elements, std::size_t points, std::size_t frames)
+std::uint64_t outputBytes(const AnimationOptions& options, const LightRig& lights, bool emits,
+  std::size_t elements, std::size_t points, std::size_t frames)
 {
   const std::size_t sensors = options.sensors.size();
   return saturatingSum(saturatingSum(saturatingProduct(options.outputBytesPerElement, elements),
                          saturatingProduct(options.outputBytesPerPoint, points)),
-    saturatingSum(estimateSensorMemory(sensors, frames),
+    saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, emits,
+                    options.solver, options.sensorOptions),
       saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
 }
 }
@@ -52,7 +53,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     const std::size_t patches = expected / 2;
     checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
                                      options.solver, lightCount),
-                       outputBytes(options, 4 * patches, 2 * patches, frames)),
+                       outputBytes(options, lights, soupEmits, 4 * patches, 2 * patches, frames)),
       frames, patches, 4 * patches, options.solver, true);
   };
   ProgressCallback remeshProgress;
@@ -74,7 +75,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       animation.patches = std::move(remeshed.mesh);
       const Scene& scene = animation.scene;
       checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
-                         outputBytes(options, scene.elementCount(), scene.points().size(), frames)),
+                         outputBytes(options, lights, soupEmits, scene.elementCount(),
+                           scene.points().size(), frames)),
         frames, scene.patchCount(), scene.elementCount(), options.solver);
     });
   const Scene& scene = animation.scene;

@@ -1,6 +1,7 @@
 #include "RayTracer.h"
 
 #include "Error.h"
+#include "MemoryBudget.h"
 
 #include <embree3/rtcore.h>
 
@@ -124,6 +125,11 @@ RayTracer::RayTracer(const Scene& scene)
 }
 
 RayTracer::~RayTracer() = default;
+
+std::uint64_t RayTracer::estimateMemory(std::size_t elements, std::size_t points)
+{
+  return saturatingSum(saturatingProduct({ elements, 256 }), saturatingProduct({ points, 16 }));
+}
 
 namespace
 {

@@ -7,6 +7,7 @@
 #include "RayTracer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -38,6 +39,43 @@ struct SensorScratch
   std::vector<std::uint8_t> visible;
   std::vector<Rgb> values;
   std::vector<std::uint32_t> targets;
+  std::vector<std::size_t> skyBase;
+  /// The rays this worker cast (SensorStatistics).
+  std::uint64_t shadowRays = 0, gatheringRays = 0;
+
+  /// Room for every sensor's work, so that no vector grows (and memory is what
+  /// estimateSensorMemory says): `batch` shadow rays at most per light.
+  void reserve(std::size_t frames, std::size_t skyPositions, std::size_t skies, std::size_t rays,
+    std::size_t batch)
+  {
+    for (std::vector<Rgb>* v : { &this->total, &this->sun, &this->gathered })
+    {
+      v->reserve(frames);
+    }
+    this->skySum.reserve(skyPositions);
+    this->hits.reserve(rays);
+    this->cells.reserve(rays * skies);
+    for (std::vector<float>* v : { &this->dx, &this->dy, &this->dz })
+    {
+      v->reserve(batch);
+    }
+    this->visible.reserve(batch);
+    this->values.reserve(batch);
+    this->targets.reserve(batch);
+    this->skyBase.reserve(skies);
+  }
+  /// The bytes reserve() takes.
+  static std::uint64_t bytes(std::size_t frames, std::size_t skyPositions, std::size_t skies,
+    std::size_t rays, std::size_t batch)
+  {
+    return saturatingSum(saturatingSum(saturatingProduct(3 * sizeof(Rgb), frames),
+                           saturatingProduct(sizeof(double), skyPositions)),
+      saturatingSum(saturatingProduct({ sizeof(std::size_t), rays, 1 + skies }),
+        saturatingSum(
+          saturatingProduct(
+            3 * sizeof(float) + sizeof(std::uint8_t) + sizeof(Rgb) + sizeof(std::uint32_t), batch),
+          saturatingProduct(sizeof(std::size_t), skies))));
+  }
 
   void clearRays()
   {
@@ -67,6 +105,7 @@ void traceShadows(const RayTracer& tracer, const Vec3& origin, bool toInfinity,
     return;
   }
   scratch.visible.assign(count, 0);
+  scratch.shadowRays += count;
   if (toInfinity)
   {
     tracer.visibleAlong(origin, scratch.dx.data(), scratch.dy.data(), scratch.dz.data(), count,
@@ -115,7 +154,8 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   // The hemisphere, once for all frames: sky visibility and the surface a ray reaches do not
   // depend on the frame, only the radiance found there does.
   std::size_t skyPositions = 0;
-  std::vector<std::size_t> skyBase;
+  std::vector<std::size_t>& skyBase = scratch.skyBase;
+  skyBase.clear();
   for (const Sky& sky : rig.skies)
   {
     skyBase.push_back(skyPositions);
@@ -124,6 +164,7 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   scratch.skySum.assign(skyPositions, 0.0);
   RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
   const std::uint32_t rays = sensorOptions.hemisphereRays;
+  scratch.gatheringRays += rays;
   // What each ray found, as keys: a patch side (2 patch + side), or an escaped ray's sky cell
   // per sky. Sorted and counted, each distinct key costs one pass over the frames, however
   // many rays found it, and the sums run in key order.
@@ -357,17 +398,65 @@ SensorSet normalizedSensors(const SensorSet& sensors, const SensorOptions& optio
   return unit;
 }
 
-std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames)
+namespace
 {
-  // The two results (a PackedRgb each) and the points and normals.
-  return saturatingSum(saturatingProduct({ 2 * sizeof(PackedRgb), sensors, frames }),
-    saturatingProduct(2 * sizeof(Vec3), sensors));
+/// The sky positions of a rig, all its skies together.
+std::size_t skyPositionsOf(const LightRig& rig)
+{
+  std::size_t positions = 0;
+  for (const Sky& sky : rig.skies)
+  {
+    positions += sky.positions();
+  }
+  return positions;
+}
+
+/// The most shadow rays one light casts from one sensor: one per frame for directional and
+/// point lights, one per sample and frame for area lights and the scene's emitters.
+std::size_t shadowBatch(
+  const LightRig& rig, bool sceneEmits, std::size_t frames, const SensorOptions& sensorOptions)
+{
+  std::size_t batch = 0;
+  if (!rig.directionalLights.empty() || !rig.pointLights.empty())
+  {
+    batch = frames;
+  }
+  if (!rig.areaLights.empty() || sceneEmits)
+  {
+    batch = std::max<std::size_t>(
+      batch, saturatingProduct(std::max<std::uint32_t>(sensorOptions.areaLightSamples, 1), frames));
+  }
+  return batch;
+}
+}
+
+std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std::size_t elements,
+  std::size_t points, const LightRig& rig, bool sceneEmits, const SolverOptions& options,
+  const SensorOptions& sensorOptions)
+{
+  if (sensors == 0)
+  {
+    return 0;
+  }
+  // The two results (a PackedRgb each) and the unit points and normals.
+  const std::uint64_t results =
+    saturatingSum(saturatingProduct({ 2 * sizeof(PackedRgb), sensors, frames }),
+      saturatingProduct(2 * sizeof(Vec3), sensors));
+  const auto workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
+  const std::uint64_t scratch = saturatingProduct(workers,
+    SensorScratch::bytes(frames, skyPositionsOf(rig), rig.skies.size(),
+      sensorOptions.hemisphereRays, shadowBatch(rig, sceneEmits, frames, sensorOptions)));
+  // The scene's emitters as area lights: their triangles, generously per element.
+  const std::uint64_t emitters = sceneEmits ? saturatingProduct(elements, 256) : 0;
+  return saturatingSum(saturatingSum(results, scratch),
+    saturatingSum(RayTracer::estimateMemory(elements, points), emitters));
 }
 
 SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solution& solution,
   const SensorSet& given, const SolverOptions& options, const SensorOptions& sensorOptions,
   const std::function<bool(double fraction)>& progress)
 {
+  const auto started = std::chrono::steady_clock::now();
   const SensorSet sensors = normalizedSensors(given, sensorOptions);
   const std::size_t frames = solution.frameCount();
   SensorSolution result(frames, sensors.size());
@@ -379,6 +468,12 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   const std::vector<MovingLight> emitters = sceneEmitters(scene);
   const int workers = resolveThreadCount(options.threads);
   std::vector<SensorScratch> scratch(static_cast<std::size_t>(workers));
+  const std::size_t batch = shadowBatch(rig, !emitters.empty(), frames, sensorOptions);
+  for (SensorScratch& worker : scratch)
+  {
+    worker.reserve(
+      frames, skyPositionsOf(rig), rig.skies.size(), sensorOptions.hemisphereRays, batch);
+  }
   const std::size_t tasks = (sensors.size() + SensorsPerTask - 1) / SensorsPerTask;
   parallelFor(
     tasks, workers,
@@ -393,6 +488,13 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
     },
     [&](std::size_t done)
     { return !progress || progress(static_cast<double>(done) / static_cast<double>(tasks)); });
+  for (const SensorScratch& worker : scratch)
+  {
+    result.statistics().shadowRays += worker.shadowRays;
+    result.statistics().gatheringRays += worker.gatheringRays;
+  }
+  result.statistics().seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 

@@ -54,6 +54,18 @@ void checkSensors(const SensorSet& sensors, const SensorOptions& options = {});
 /// The sensors with unit normals, after checkSensors().
 SensorSet normalizedSensors(const SensorSet& sensors, const SensorOptions& options = {});
 
+/// The rays the sensors cast, counted exactly, and the time they took.
+struct SensorStatistics
+{
+  /// Towards the directional, point and area lights (scene emitters included): one per
+  /// frame and light (per sample and frame for area lights) wherever the light can reach the
+  /// sensor's side, none where it cannot (behind the sensor, outside the light's beam, off).
+  std::uint64_t shadowRays = 0;
+  /// The hemisphere rays: sensors x SensorOptions::hemisphereRays, for all frames.
+  std::uint64_t gatheringRays = 0;
+  double seconds = 0;
+};
+
 /// Every sensor's irradiance (W/m^2, RGB) in every frame, and the part of it that comes
 /// straight from the sun (the directional lights), which DirectSunHours counts.
 class SensorSolution
@@ -83,14 +95,25 @@ public:
   /// Sensor-major with frames innermost, as Solution.
   std::vector<PackedRgb>& irradianceData() { return this->Irradiance; }
   std::vector<PackedRgb>& sunData() { return this->Sun; }
+  const SensorStatistics& statistics() const { return this->Statistics; }
+  SensorStatistics& statistics() { return this->Statistics; }
 
 private:
   std::size_t Frames = 0, Sensors = 0;
   std::vector<PackedRgb> Irradiance, Sun;
+  SensorStatistics Statistics;
 };
 
-/// Bytes solveSensors() allocates for `sensors` sensors over `frames` frames.
-std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames);
+/**
+ * Bytes solveSensors() allocates at its peak for `sensors` sensors over `frames` frames on a
+ * scene of `elements` elements on `points` points lit by `rig` (and by its own emitters when
+ * `sceneEmits`): the two results per sensor and frame, the unit sensors, the sensors' own ray
+ * tracer, and every worker's per-frame sums and shadow-ray batch (the longest: an area
+ * light's samples x frames).
+ */
+std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std::size_t elements,
+  std::size_t points, const LightRig& rig, bool sceneEmits, const SolverOptions& options,
+  const SensorOptions& sensorOptions);
 
 /**
  * The irradiance of every sensor in every frame of `solution` (solved on `scene` lit by

@@ -1,6 +1,7 @@
 #include "Sky.h"
 
 #include "Error.h"
+#include "Parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -223,7 +224,7 @@ bool sameSky(SkyModel model, const SkyFrame& a, const SkyFrame& b)
 }
 }
 
-Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames)
+Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, int threads)
   : Model(model)
   , FrameCount(frames.size())
 {
@@ -274,62 +275,89 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames)
   const std::size_t positions = this->Frames.size();
   this->Density.assign(Cells * positions, 0.0);
   this->Cdf.assign(Cells * positions, 0.0);
-  std::vector<double> mean(Cells);
+  this->Scale.assign(positions, 0.0);
+  this->Lambda.assign(positions, 0.0);
+  // Each position is tabulated alone, into its own entries: the bits do not depend on the
+  // workers. A dark sky is reported for the first such frame after the loop, whichever
+  // worker found it.
+  std::vector<std::uint8_t> dark(positions, 0);
+  const int workers = resolveThreadCount(threads);
+  std::vector<std::vector<double>> means(static_cast<std::size_t>(workers));
+  parallelFor(
+    positions, workers,
+    [&](std::size_t k, int worker)
+    {
+      std::vector<double>& mean = means[static_cast<std::size_t>(worker)];
+      mean.resize(Cells);
+      const SkyFrame& frame = this->Frames[k];
+      const SkyDistribution f(model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
+        frame.directNormal, frame.dayOfYear);
+      double horizontal = 0, total = 0;
+      for (int r = 0; r < Rings; ++r)
+      {
+        const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
+        const double solidAngle = SectorStep * (c0 - c1);
+        const double cosine = SectorStep * (c0 * c0 - c1 * c1) / 2;
+        for (int s = 0; s < Sectors; ++s)
+        {
+          // The cell's mean by the midpoint rule in cos(theta) and phi, which is uniform in
+          // solid angle: the paths draw directions uniformly within the cell.
+          double sum = 0;
+          for (int i = 0; i < SubSamples; ++i)
+          {
+            const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
+            const double sz = std::sqrt(std::max(0.0, 1 - cz * cz));
+            for (int j = 0; j < SubSamples; ++j)
+            {
+              const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
+              sum += f({ sz * std::cos(phi), sz * std::sin(phi), cz });
+            }
+          }
+          const double m = sum / (SubSamples * SubSamples);
+          mean[std::size_t(r) * Sectors + s] = m;
+          horizontal += m * cosine;
+          total += m * solidAngle;
+        }
+      }
+      if (!(horizontal > 0))
+      {
+        dark[k] = 1;
+        return;
+      }
+      const double scale = frame.diffuseHorizontal / horizontal;
+      this->Scale[k] = scale;
+      this->Lambda[k] = scale * total;
+      double cumulative = 0;
+      for (int r = 0; r < Rings; ++r)
+      {
+        const double solidAngle =
+          SectorStep * (std::cos(r * RingStep) - std::cos((r + 1) * RingStep));
+        for (int s = 0; s < Sectors; ++s)
+        {
+          const std::size_t c = std::size_t(r) * Sectors + s;
+          this->Density[c * positions + k] = mean[c] / total;
+          cumulative += mean[c] * solidAngle / total;
+          this->Cdf[k * Cells + c] = cumulative;
+        }
+      }
+      this->Cdf[k * Cells + Cells - 1] = 1.0;
+    },
+    [](std::size_t) { return true; });
   for (std::size_t k = 0; k < positions; ++k)
   {
-    const SkyFrame& frame = this->Frames[k];
-    const SkyDistribution f(model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
-      frame.directNormal, frame.dayOfYear);
-    double horizontal = 0, total = 0;
-    for (int r = 0; r < Rings; ++r)
-    {
-      const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
-      const double solidAngle = SectorStep * (c0 - c1);
-      const double cosine = SectorStep * (c0 * c0 - c1 * c1) / 2;
-      for (int s = 0; s < Sectors; ++s)
-      {
-        // The cell's mean by the midpoint rule in cos(theta) and phi, which is uniform in
-        // solid angle: the paths draw directions uniformly within the cell.
-        double sum = 0;
-        for (int i = 0; i < SubSamples; ++i)
-        {
-          const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
-          const double sz = std::sqrt(std::max(0.0, 1 - cz * cz));
-          for (int j = 0; j < SubSamples; ++j)
-          {
-            const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
-            sum += f({ sz * std::cos(phi), sz * std::sin(phi), cz });
-          }
-        }
-        const double m = sum / (SubSamples * SubSamples);
-        mean[std::size_t(r) * Sectors + s] = m;
-        horizontal += m * cosine;
-        total += m * solidAngle;
-      }
-    }
-    if (!(horizontal > 0))
+    if (dark[k])
     {
       throw Error("the " + skyModelName(model) + " sky of frame " + std::to_string(k) +
         " is dark everywhere: check its sun direction and irradiances");
     }
-    const double scale = frame.diffuseHorizontal / horizontal;
-    this->Scale.push_back(scale);
-    this->Lambda.push_back(scale * total);
-    double cumulative = 0;
-    for (int r = 0; r < Rings; ++r)
-    {
-      const double solidAngle =
-        SectorStep * (std::cos(r * RingStep) - std::cos((r + 1) * RingStep));
-      for (int s = 0; s < Sectors; ++s)
-      {
-        const std::size_t c = std::size_t(r) * Sectors + s;
-        this->Density[c * positions + k] = mean[c] / total;
-        cumulative += mean[c] * solidAngle / total;
-        this->Cdf[k * Cells + c] = cumulative;
-      }
-    }
-    this->Cdf[k * Cells + Cells - 1] = 1.0;
   }
+}
+
+std::uint64_t Sky::allocatedBytes() const
+{
+  return (this->Density.size() + this->Cdf.size() + this->Lambda.size() + this->Scale.size()) *
+    sizeof(double) +
+    this->Frames.size() * sizeof(SkyFrame);
 }
 
 std::size_t Sky::cell(const Vec3& towardsSky) const

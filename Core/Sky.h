@@ -6,6 +6,7 @@
 #include "Vec3.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -82,8 +83,10 @@ public:
   static constexpr std::size_t Cells = std::size_t(Rings) * Sectors;
 
   /// Throws mlr::Error on an E_dh below 0 or not finite, a day of the year outside 0 to 366,
-  /// a zero `up`, or no frames.
-  Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames);
+  /// a zero `up`, or no frames. The positions' tables are built on `threads` workers (0:
+  /// every core), the same bits for any count: a year of hourly Perez skies is half a
+  /// billion evaluations of the model.
+  Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, int threads = 0);
 
   SkyModel model() const { return this->Model; }
   const Vec3& up() const { return this->Up; }
@@ -111,6 +114,8 @@ public:
   Vec3 sample(std::size_t position, double u0, double u1, double u2) const;
   /// The model's own radiance, not tabulated, normalised the same way (for checks).
   double modelRadiance(std::size_t position, const Vec3& towardsSky) const;
+  /// The bytes of the tables: about 115 KB per position.
+  std::uint64_t allocatedBytes() const;
 
 private:
   Vec3 toLocal(const Vec3& v) const

@@ -7,7 +7,10 @@
 
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
+#include "vtkIdTypeArray.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
@@ -139,6 +142,15 @@ void addSensorArrays(
   pointData->AddArray(irradiance);
   pointData->AddArray(illuminance);
   pointData->SetActiveScalars("Illuminance");
+}
+
+void addSensorStatistics(vtkFieldData* fieldData, const SensorStatistics& statistics)
+{
+  vtkoutputs::addValue<vtkIdTypeArray>(
+    fieldData, "SensorShadowRays", static_cast<vtkIdType>(statistics.shadowRays));
+  vtkoutputs::addValue<vtkIdTypeArray>(
+    fieldData, "SensorGatheringRays", static_cast<vtkIdType>(statistics.gatheringRays));
+  vtkoutputs::addValue<vtkDoubleArray>(fieldData, "SecondsSensors", statistics.seconds);
 }
 
 } // namespace mlr::vtksensors

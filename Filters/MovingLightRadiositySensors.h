@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <vector>
 
+class vtkFieldData;
 class vtkPointData;
 class vtkPointSet;
 class vtkPolyData;
@@ -45,5 +46,9 @@ vtkSmartPointer<vtkPolyData> sensorMesh(
 /// luminance) of `frame`, Illuminance active.
 void addSensorArrays(
   const SensorSolution& solution, std::size_t frame, double efficacy, vtkPointData* pointData);
+
+/// Adds the sensors' ray counts and time: `SensorShadowRays`, `SensorGatheringRays` (counts)
+/// and `SecondsSensors`.
+void addSensorStatistics(vtkFieldData* fieldData, const SensorStatistics& statistics);
 
 } // namespace mlr::vtksensors

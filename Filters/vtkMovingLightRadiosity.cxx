@@ -284,7 +284,7 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
       frames[f].dayOfYear = trajectory.dayOfYear[f];
     }
   }
-  rig.skies.emplace_back(model, up, frames);
+  rig.skies.emplace_back(model, up, frames, self->GetNumberOfThreads());
   for (const mlr::SkyFrame& frame : frames)
   {
     const mlr::DaylightEfficacy k = mlr::perezEfficacy(frame, up);
@@ -1084,6 +1084,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
             : cache.SunEfficacy[std::min(t, cache.SunEfficacy.size() - 1)]);
       }
       cache.Sensors = std::move(animation.sensors);
+      mlr::vtksensors::addSensorStatistics(cache.Statistics, cache.Sensors.statistics());
       cache.SensorMesh = mlr::vtksensors::sensorMesh(options.sensors, cache.Sensors, steps);
       cache.SensorThreshold = steps.autonomyThreshold;
       cache.SensorPoints = std::move(options.sensors);

@@ -94,9 +94,13 @@ def test_work_plane_under_the_sky_gives_the_grid_and_its_illuminance(tmp_path):
                   "--output", "out/room.pvd"] + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
     assert "24 sensors" in result.stdout
+    # The sky alone: no shadow ray, 512 hemisphere rays per sensor (24 x 512 = 12,288).
+    assert "sensors 0.00 M shadow, 0.01 M gathering rays" in result.stdout, result.stdout
     frames = read_sensor_series(tmp_path)
     assert len(frames) == 1
     sensors = frames[0][1]
+    assert sensors.GetFieldData().GetArray("SensorShadowRays").GetValue(0) == 0
+    assert sensors.GetFieldData().GetArray("SensorGatheringRays").GetValue(0) == 24 * 512
     assert sensors.GetNumberOfPoints() == 24
     points = vtk_to_numpy(sensors.GetPoints().GetData())
     assert numpy.allclose(points[:, 2], HEIGHT)

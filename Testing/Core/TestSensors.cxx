@@ -247,6 +247,42 @@ TEST(Sensors, AnAreaLightGivesLambertsFormFactor)
   }
 }
 
+TEST(Sensors, TheStatisticsCountEveryRayCast)
+{
+  // One sensor faces up under every kind of light, one faces down and sees none of them: the
+  // shadow rays are the lights' frames (and samples) that reach the upward sensor's side.
+  const Scene scene = ground(3);
+  LightRig rig;
+  const std::vector<Vec3> sun = { sunDirection(30, 0), sunDirection(50, 90), sunDirection(70, 0) };
+  // Off in the middle frame: no ray there.
+  rig.directionalLights.emplace_back(sun, Rgb(500), std::vector<Rgb>{ Rgb(1), Rgb(0), Rgb(1) });
+  rig.skies.emplace_back(
+    SkyModel::Uniform, Vec3(0, 0, 1), std::vector<SkyFrame>(3, SkyFrame{ { 0, 0, 1 }, 100, 0 }));
+  std::vector<LightPose> poses(3);
+  for (LightPose& pose : poses)
+  {
+    pose.position = { 0.5, 0, 2 };
+  }
+  rig.pointLights.emplace_back(Rgb(50), poses);
+  rig.areaLights.emplace_back(
+    scenes::squareLightFacingDown({ 0, 0, 2 }, 0.5), Rgb(20), std::vector<Vec3>(3, Vec3(0, 0, 0)));
+  const Solution solution = solve(scene, rig, quick());
+  SensorSet sensors = oneSensor({ 0.1, 0.2, 0.5 }, { 0, 0, 1 });
+  sensors.points.push_back({ -0.3, 0.1, 0.5 });
+  sensors.normals.push_back({ 0, 0, -1 });
+  SensorOptions counts;
+  counts.hemisphereRays = 37;
+  counts.areaLightSamples = 5;
+  const SensorSolution result = solveSensors(scene, rig, solution, sensors, quick(), counts);
+  const std::uint64_t frames = 3;
+  EXPECT_EQ(result.statistics().gatheringRays, 2u * counts.hemisphereRays);
+  EXPECT_EQ(result.statistics().shadowRays,
+    (frames - 1) /* sun */ + frames /* point light */ + frames * counts.areaLightSamples);
+  EXPECT_GE(result.statistics().seconds, 0.0);
+  // Nothing to cast without sensors.
+  EXPECT_EQ(solveSensors(scene, rig, solution, {}, quick(), counts).statistics().shadowRays, 0u);
+}
+
 namespace
 {
 /// A closed room with a light below its ceiling, and a grid of work-plane sensors.

@@ -135,6 +135,17 @@ def test_metrics_over_the_time_steps(run):
     run.SetDaylightAutonomyThreshold(300)
 
 
+def test_the_field_data_counts_the_sensors_rays(run):
+    assert run.UpdateTimeStep(HOURS[0])
+    for port in (0, vtkMovingLightRadiosity.SENSORS_OUTPUT_PORT):
+        data = run.GetOutput(port).GetFieldData()
+        # One shadow ray towards the sun per sensor and frame above its horizon (two of the
+        # three), the hemisphere rays once for all frames.
+        assert data.GetArray("SensorShadowRays").GetValue(0) == 3 * 2
+        assert data.GetArray("SensorGatheringRays").GetValue(0) == 3 * run.GetSensorRays()
+        assert data.GetArray("SecondsSensors").GetValue(0) >= 0
+
+
 def test_sensors_change_no_radiosity_bit_for_bit(run):
     plain = make_filter(None)
     for t in HOURS:
