@@ -63,28 +63,37 @@ TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
   // copy between the workers (MemoryPlan); integer sums make that change no bit.
   const auto [shooting, gathering] = GetParam();
   const Scene scene = box();
+  Solution one = solveWith(1, 42, shooting, gathering);
+  // The plan counts accumulators for the sides light can reach (the inside of the box).
+  const std::uint64_t reachable = one.statistics.reachableSides;
+  EXPECT_EQ(reachable, scene.patchCount());
   SolverOptions o;
   o.threads = 3;
   o.memoryLimitBytes = std::uint64_t(1) << 40;
-  const MemoryPlan roomy =
-    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const auto plan = [&]
+  {
+    return planSolveMemory(
+      scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o, 1, reachable);
+  };
+  const MemoryPlan roomy = plan();
   ASSERT_TRUE(roomy.accumulatorCopyPerWorker);
   o.memoryLimitBytes = 2 * roomy.peak - 1;
-  const MemoryPlan tight =
-    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const MemoryPlan tight = plan();
   ASSERT_FALSE(tight.accumulatorCopyPerWorker);
-  // One copy instead of three, each buffer in whole pages: on a scene this small both fit
-  // in the same pages, so the shared copy saves nothing here, but it never costs more.
+  // One copy instead of three, each buffer in whole pages and with the index of the stored
+  // sides: on a scene this small both fit in the same pages, so the shared copy saves
+  // nothing here, but it never costs more.
   const auto copies = [&](int n)
   {
-    return FixedPointAccumulator<1>::allocatedBytes(n, scene.elementCount(), Frames) +
-      FixedPointAccumulator<3>::allocatedBytes(n, scene.patchCount(), Frames);
+    return FixedPointAccumulator<1>::allocatedStoredBytes(
+             n, scene.elementCount(), reachable * Scene::ElementsPerPatch, Frames) +
+      FixedPointAccumulator<3>::allocatedStoredBytes(n, scene.patchCount(), reachable, Frames) +
+      scene.elementCount() * 2;
   };
   EXPECT_EQ(tight.accumulators, copies(1));
   EXPECT_EQ(roomy.accumulators, copies(3));
   EXPECT_LE(tight.peak, roomy.peak);
 
-  Solution one = solveWith(1, 42, shooting, gathering);
   Solution shared = solveWith(3, 42, shooting, gathering, o.memoryLimitBytes);
   EXPECT_TRUE(one.statistics.accumulatorCopyPerWorker);
   EXPECT_FALSE(shared.statistics.accumulatorCopyPerWorker);
