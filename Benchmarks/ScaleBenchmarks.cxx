@@ -118,7 +118,8 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   std::printf("Large scene: the paper room in %zu patches, %zu elements, %zu frames, N = %llu, "
               "full reuse\n",
     scene.patchCount(), scene.elementCount(), frames, static_cast<unsigned long long>(paths));
-  std::printf("Memory estimate: %.2f GiB (%.1f bytes per element-frame): results %.2f GiB "
+  std::printf("Memory bound before reachability (every side): %.2f GiB (%.1f bytes per "
+              "element-frame): results %.2f GiB "
               "(single precision), shooting accumulators %.2f GiB (%s), other %.2f GiB\n",
     double(plan.peak) / GiB, double(plan.peak) / elementFrames, double(plan.results) / GiB,
     double(plan.accumulators) / GiB,
@@ -132,6 +133,16 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   const std::uint64_t peak = statusBytes("VmHWM");
   const std::uint64_t solvePeak = peak > before ? peak - before : 0;
   const double ratio = double(solvePeak) / double(s.memoryEstimateBytes);
+  const MemoryPlan reached = planSolveMemory(scene.patchCount(), scene.elementCount(),
+    scene.points().size(), frames, options, 1, s.reachableSides);
+  std::printf("Reachable patch sides: %llu of %zu (%.1f%%); sides without slots that paths hit "
+              "(overflow): %llu. Memory estimate with them: %.2f GiB (%.1f bytes per "
+              "element-frame): shooting accumulators %.2f GiB (%s)\n",
+    static_cast<unsigned long long>(s.reachableSides), 2 * scene.patchCount(),
+    100.0 * double(s.reachableSides) / double(2 * scene.patchCount()),
+    static_cast<unsigned long long>(s.overflowSides), double(reached.peak) / GiB,
+    double(reached.peak) / elementFrames, double(reached.accumulators) / GiB,
+    reached.accumulatorCopyPerWorker ? "a copy per worker" : "one copy shared by the workers");
   std::printf("Threads: %d. Solve %.1f s (%.0f ms per frame): shooting %.1f s, gathering %.1f s; "
               "%llu shadow rays, %llu nearest-hit rays, %llu gathering rays\n",
     s.threads, s.secondsTotal, 1000 * s.secondsTotal / frames, s.secondsShooting,
@@ -156,9 +167,11 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   out << "{\"frames\": " << frames << ", \"patches\": " << scene.patchCount()
       << ", \"elements\": " << scene.elementCount() << ", \"paths_per_frame\": " << paths
       << ", \"threads\": " << s.threads << ", \"seconds\": " << s.secondsTotal
-      << ", \"accumulator_copy_per_worker\": " << (plan.accumulatorCopyPerWorker ? "true" : "false")
+      << ", \"accumulator_copy_per_worker\": " << (s.accumulatorCopyPerWorker ? "true" : "false")
       << ", \"estimate_bytes\": " << s.memoryEstimateBytes
-      << ", \"resident_before_bytes\": " << before << ", \"peak_resident_bytes\": " << peak
+      << ", \"reachable_sides\": " << s.reachableSides
+      << ", \"overflow_sides\": " << s.overflowSides << ", \"resident_before_bytes\": " << before
+      << ", \"peak_resident_bytes\": " << peak
       << ", \"solve_peak_bytes\": " << (reset ? std::to_string(solvePeak) : std::string("null"))
       << ", \"bytes_per_element_frame\": "
       << (reset ? std::to_string(double(solvePeak) / elementFrames) : std::string("null"))

@@ -7,6 +7,13 @@
 // make shooting 1.5x to 1.8x slower where the sums stay in cache, and the smaller footprint
 // makes it faster where they do not). The solver picks per-worker copies when they fit in
 // half the memory limit (MemoryPlan, planSolveMemory in Solver.h).
+//
+// Only the (record, side) pairs light can reach need slots (Reachability.h): the outsides of
+// a closed room and the insides of closed blocks are about half of all sides, so the
+// accumulators keep slots for the stored sides alone. The probes that decide reachability
+// are a sample, so a path may still hit a side they judged dark: such a side gets its frames
+// in a per-worker overflow entry, created on its first score, which keeps every quantum
+// (sums stay exact and do not depend on which sides overflowed where).
 #pragma once
 
 #include "MemoryBudget.h"
@@ -17,8 +24,11 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <new>
+#include <unordered_map>
+#include <vector>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -49,10 +59,20 @@ inline std::uint64_t fixedPointBufferBytes(std::uint64_t bytes)
   return pages > UINT64_MAX / FixedPointPageBytes ? UINT64_MAX : pages * FixedPointPageBytes;
 }
 
+/// Where add() writes the frames of one (record, side): slots `frameStride` apart, with
+/// atomic adds when the run is in a copy several workers share.
+struct SlotRun
+{
+  std::int64_t* base = nullptr;
+  std::size_t frameStride = 0;
+  bool atomic = false;
+};
+
 /**
  * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), in one copy per
  * worker or one shared copy. The caller picks the quantum: values are rounded to multiples
- * of it, and a slot holds up to 2^63 quanta.
+ * of it, and a slot holds up to 2^63 quanta. `stored` (record * 2 + side flags, or null for
+ * all) names the sides that get slots; the others overflow into per-worker entries.
  */
 template <int Channels>
 class FixedPointAccumulator
@@ -60,47 +80,76 @@ class FixedPointAccumulator
 public:
   /// One quantum for every channel.
   FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records, std::size_t frames,
-    double quantum, FrameLayout layout)
-    : FixedPointAccumulator(workers, copyPerWorker, records, frames, filled(quantum), layout)
+    double quantum, FrameLayout layout, const std::vector<std::uint8_t>* stored = nullptr)
+    : FixedPointAccumulator(
+        workers, copyPerWorker, records, frames, filled(quantum), layout, stored)
   {
   }
 
   /// One quantum per channel: a channel much weaker than the others keeps its precision.
   FixedPointAccumulator(int workers, bool copyPerWorker, std::size_t records, std::size_t frames,
-    const std::array<double, Channels>& quantum, FrameLayout layout)
-    : Stride(records * 2 * frames * Channels)
-    , RecordStride(layout == FrameLayout::FramesInner ? 2 * frames * Channels : 2 * Channels)
+    const std::array<double, Channels>& quantum, FrameLayout layout,
+    const std::vector<std::uint8_t>* stored = nullptr)
+    : Records(records)
+    , Frames(frames)
+    , StoredSides(stored ? storedCount(*stored) : records * 2)
+    , Stride(StoredSides * frames * Channels)
     , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
-    , FrameStride(layout == FrameLayout::FramesInner ? Channels : records * 2 * Channels)
+    , FrameStride(layout == FrameLayout::FramesInner ? Channels : StoredSides * Channels)
     , Quantum(quantum)
     , CopyStride(copyPerWorker ? Stride : 0)
     , Shared(!copyPerWorker && workers > 1)
     , Size(static_cast<std::size_t>(copyPerWorker ? workers : 1) * Stride)
     , Values(allocateZeroed(Size))
+    , Overflow(stored ? static_cast<std::size_t>(workers) : 0)
   {
     for (int c = 0; c < Channels; ++c)
     {
       this->InverseQuantum[c] = 1.0 / this->Quantum[c];
     }
+    if (stored)
+    {
+      this->Slot.assign(records * 2, Unstored);
+      std::uint32_t next = 0;
+      for (std::size_t i = 0; i < records * 2; ++i)
+      {
+        if ((*stored)[i])
+        {
+          this->Slot[i] = next++;
+        }
+      }
+    }
   }
 
-  /// The slots of (record, side) at frame 0 that `worker` adds to; add() steps to other
-  /// frames.
-  std::int64_t* slots(int worker, std::size_t record, int side)
+  /// The slots of (record, side) that `worker` adds to; add() steps to the frames. A side
+  /// without slots gets (once) an overflow entry of the worker's own.
+  SlotRun slots(int worker, std::size_t record, int side)
   {
-    return this->Values.get() + static_cast<std::size_t>(worker) * this->CopyStride +
-      this->offset(record, side, 0);
+    const std::size_t s = this->storedIndex(record, side);
+    if (s != Unstored)
+    {
+      return { this->Values.get() + static_cast<std::size_t>(worker) * this->CopyStride +
+          s * this->SideStride,
+        this->FrameStride, this->Shared };
+    }
+    std::vector<std::int64_t>& entry =
+      this->Overflow[static_cast<std::size_t>(worker)][record * 2 + static_cast<std::size_t>(side)];
+    if (entry.empty())
+    {
+      entry.assign(this->Frames * Channels, 0);
+    }
+    return { entry.data(), Channels, false };
   }
 
   /// Adds non-negative values to one frame's slot (`values` has Channels entries).
-  void add(std::int64_t* recordSlots, std::size_t frame, const double* values) const
+  void add(const SlotRun& run, std::size_t frame, const double* values) const
   {
-    std::int64_t* s = recordSlots + frame * this->FrameStride;
+    std::int64_t* s = run.base + frame * run.frameStride;
     for (int c = 0; c < Channels; ++c)
     {
       // Values are >= 0, so truncating x + 0.5 rounds to nearest.
       const auto quanta = static_cast<std::int64_t>(values[c] * this->InverseQuantum[c] + 0.5);
-      if (!this->Shared)
+      if (!run.atomic)
       {
         s[c] += quanta;
       }
@@ -115,10 +164,10 @@ public:
   /// that the miss overlaps work done before the add. Always inlined: GCC's IPA finds a
   /// function that only prefetches free of side effects and deletes calls to it.
   [[gnu::always_inline]] void prefetch(
-    const std::int64_t* recordSlots, std::size_t first, std::size_t count) const
+    const SlotRun& run, std::size_t first, std::size_t count) const
   {
-    const std::int64_t* begin = recordSlots + first * this->FrameStride;
-    if (this->FrameStride == Channels)
+    const std::int64_t* begin = run.base + first * run.frameStride;
+    if (run.frameStride == Channels)
     {
       const std::int64_t* end = begin + count * Channels;
       for (const std::int64_t* p = begin; p < end; p += 8)
@@ -130,26 +179,109 @@ public:
     }
     for (std::size_t f = 0; f < count; ++f)
     {
-      __builtin_prefetch(begin + f * this->FrameStride);
+      __builtin_prefetch(begin + f * run.frameStride);
     }
   }
 
   /// The sums of (record, side, frame) over workers, written to `out` (Channels entries).
   void total(std::size_t record, int side, std::size_t frame, double* out) const
   {
-    const std::int64_t* v = this->Values.get() + this->offset(record, side, frame);
     std::int64_t sum[Channels] = {};
-    for (std::size_t w = 0; w * this->Stride < this->Size; ++w, v += this->Stride)
+    const std::size_t s = this->storedIndex(record, side);
+    if (s != Unstored)
     {
-      for (int c = 0; c < Channels; ++c)
+      const std::int64_t* v = this->Values.get() + s * this->SideStride + frame * this->FrameStride;
+      for (std::size_t w = 0; w * this->Stride < this->Size; ++w, v += this->Stride)
       {
-        sum[c] += v[c];
+        for (int c = 0; c < Channels; ++c)
+        {
+          sum[c] += v[c];
+        }
+      }
+    }
+    else
+    {
+      const std::size_t key = record * 2 + static_cast<std::size_t>(side);
+      const auto merged = this->Merged.find(key);
+      if (merged != this->Merged.end())
+      {
+        for (int c = 0; c < Channels; ++c)
+        {
+          sum[c] += this->MergedValues[merged->second + frame * Channels + c];
+        }
+      }
+      for (const auto& worker : this->Overflow)
+      {
+        const auto entry = worker.find(key);
+        if (entry != worker.end())
+        {
+          for (int c = 0; c < Channels; ++c)
+          {
+            sum[c] += entry->second[frame * Channels + c];
+          }
+        }
       }
     }
     for (int c = 0; c < Channels; ++c)
     {
       out[c] = static_cast<double>(sum[c]) * this->Quantum[c];
     }
+  }
+
+  /// Marks (adds 1 to) flags[record * 2 + side] of every side with an overflow entry here;
+  /// `flags` has 2 records entries, and may be summed over processes before mergeOverflow().
+  void markOverflow(std::vector<std::int64_t>& flags) const
+  {
+    for (const auto& worker : this->Overflow)
+    {
+      for (const auto& entry : worker)
+      {
+        flags[entry.first] = 1;
+      }
+    }
+  }
+
+  /// Moves the workers' overflow entries into one block with an entry for every side whose
+  /// flag is set (in side order, so that every process has the same block): returns it, of
+  /// `count` values, to be summed over processes as a whole.
+  std::int64_t* mergeOverflow(const std::vector<std::int64_t>& flags, std::size_t& count)
+  {
+    std::size_t entries = 0;
+    for (std::size_t key = 0; key < flags.size(); ++key)
+    {
+      if (flags[key] != 0)
+      {
+        this->Merged[key] = entries * this->Frames * Channels;
+        ++entries;
+      }
+    }
+    this->MergedValues.assign(entries * this->Frames * Channels, 0);
+    for (auto& worker : this->Overflow)
+    {
+      for (const auto& entry : worker)
+      {
+        std::int64_t* into = this->MergedValues.data() + this->Merged.at(entry.first);
+        for (std::size_t i = 0; i < entry.second.size(); ++i)
+        {
+          into[i] += entry.second[i];
+        }
+      }
+      worker.clear();
+    }
+    count = this->MergedValues.size();
+    return this->MergedValues.data();
+  }
+
+  /// Sides without slots that paths scored, over every worker.
+  std::size_t overflowSides() const
+  {
+    std::vector<std::int64_t> flags(this->Records * 2, 0);
+    this->markOverflow(flags);
+    for (const auto& merged : this->Merged)
+    {
+      flags[merged.first] = 1;
+    }
+    return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), 1));
   }
 
   /// Adds every worker's copy into the first and zeroes the others: the sums are unchanged,
@@ -170,11 +302,18 @@ public:
   }
   std::size_t copySize() const { return this->Stride; }
 
-  /// Bytes of `copies` copies (the worker count, or 1 when shared).
+  /// Bytes of `copies` copies (the worker count, or 1 when shared) with slots for both
+  /// sides of `records` records.
   static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
   {
+    return storedBytes(copies, saturatingProduct({ records, 2 }), frames);
+  }
+
+  /// The same with slots for `sides` (record, side) pairs.
+  static std::uint64_t storedBytes(int copies, std::uint64_t sides, std::size_t frames)
+  {
     return saturatingProduct(
-      { static_cast<std::uint64_t>(copies), records, 2, frames, Channels, sizeof(std::int64_t) });
+      { static_cast<std::uint64_t>(copies), sides, frames, Channels, sizeof(std::int64_t) });
   }
 
   /// What those copies allocate: bytes() rounded up to whole pages.
@@ -183,11 +322,28 @@ public:
     return fixedPointBufferBytes(bytes(copies, records, frames));
   }
 
-private:
-  std::size_t offset(std::size_t record, int side, std::size_t frame) const
+  /// storedBytes() rounded up to whole pages, and the index of the stored sides (4 bytes per
+  /// record side).
+  static std::uint64_t allocatedStoredBytes(
+    int copies, std::size_t records, std::uint64_t sides, std::size_t frames)
   {
-    return record * this->RecordStride + static_cast<std::size_t>(side) * this->SideStride +
-      frame * this->FrameStride;
+    return saturatingSum(fixedPointBufferBytes(storedBytes(copies, sides, frames)),
+      saturatingProduct({ records, 2, sizeof(std::uint32_t) }));
+  }
+
+private:
+  static constexpr std::uint32_t Unstored = 0xffffffffu;
+
+  std::size_t storedIndex(std::size_t record, int side) const
+  {
+    const std::size_t key = record * 2 + static_cast<std::size_t>(side);
+    return this->Slot.empty() ? key : (this->Slot[key] == Unstored ? Unstored : this->Slot[key]);
+  }
+
+  static std::size_t storedCount(const std::vector<std::uint8_t>& stored)
+  {
+    return static_cast<std::size_t>(
+      std::count_if(stored.begin(), stored.end(), [](std::uint8_t s) { return s != 0; }));
   }
 
   static std::array<double, Channels> filled(double value)
@@ -221,8 +377,10 @@ private:
     return std::unique_ptr<std::int64_t[], Free>(static_cast<std::int64_t*>(memory));
   }
 
+  std::size_t Records;
+  std::size_t Frames;
+  std::size_t StoredSides;
   std::size_t Stride;
-  std::size_t RecordStride;
   std::size_t SideStride;
   std::size_t FrameStride;
   std::array<double, Channels> Quantum;
@@ -231,6 +389,14 @@ private:
   bool Shared;            ///< one copy for several workers: atomic adds
   std::size_t Size;
   std::unique_ptr<std::int64_t[], Free> Values;
+  /// The stored index of each record * 2 + side, Unstored for none; empty when all are.
+  std::vector<std::uint32_t> Slot;
+  /// Per worker, the frames of the sides without slots that it scored (node-based, so that
+  /// the runs slots() hands out stay valid as entries are added).
+  std::vector<std::unordered_map<std::size_t, std::vector<std::int64_t>>> Overflow;
+  /// After mergeOverflow(): each overflowed side's offset in MergedValues.
+  std::map<std::size_t, std::size_t> Merged;
+  std::vector<std::int64_t> MergedValues;
 };
 
 } // namespace mlr

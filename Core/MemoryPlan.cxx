@@ -14,7 +14,8 @@ namespace mlr
 {
 
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options, std::size_t lights)
+  std::size_t frames, const SolverOptions& options, std::size_t lights,
+  std::uint64_t reachablePatchSides)
 {
   const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
   MemoryPlan plan;
@@ -23,12 +24,26 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t indirect = direct;
   plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
   // The accumulators of `copies` copies: a scalar share per element side and RGB power per
-  // patch side, for every frame, each buffer in whole pages.
+  // patch side, for every frame, each buffer in whole pages; once reachability is known, for
+  // the reachable sides alone, with an index of the sides. The overflow of sides the probes
+  // missed is not counted: a few sides at most.
   const auto accumulators = [&](std::uint64_t copies)
   {
     const int c = static_cast<int>(copies);
-    return saturatingSum(FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
-      FixedPointAccumulator<3>::allocatedBytes(c, patches, frames));
+    if (reachablePatchSides == AllPatchSides)
+    {
+      return saturatingSum(FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
+        FixedPointAccumulator<3>::allocatedBytes(c, patches, frames));
+    }
+    const std::uint64_t patchSides = std::min<std::uint64_t>(reachablePatchSides, 2 * patches);
+    const std::uint64_t elementSides = elements == 0
+      ? 0
+      : saturatingProduct({ patchSides, elements / std::max<std::size_t>(patches, 1) });
+    return saturatingSum(
+      saturatingSum(
+        FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames),
+        FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames)),
+      saturatingProduct({ elements, 2 })); // the element sides' flags
   };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,

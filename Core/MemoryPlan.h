@@ -35,10 +35,16 @@ struct MemoryPlan
   std::uint64_t peak = 0; ///< the estimate: the larger phase, shooting or gathering
 };
 
+/// Every patch side has shooting accumulators: the plan before reachability is known.
+constexpr std::uint64_t AllPatchSides = UINT64_MAX;
+
 /// The plan of a solve of `frames` frames lit by `lights` light sources (area lights, scene
-/// emitters and directional lights; their per-frame data is counted).
+/// emitters and directional lights; their per-frame data is counted). `reachablePatchSides`:
+/// the patch sides light can reach (Reachability.h), which alone, with their elements' sides,
+/// have shooting accumulators; AllPatchSides, the bound before the probes, counts every side.
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
-  std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
+  std::size_t frames, const SolverOptions& options, std::size_t lights = 1,
+  std::uint64_t reachablePatchSides = AllPatchSides);
 
 /// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
 std::uint64_t estimateSolveMemory(

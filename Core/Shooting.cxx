@@ -88,19 +88,23 @@ class ShootingRun
 {
 public:
   ShootingRun(const Scene& scene, const LightSource& source, const SolverOptions& options,
-    const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares)
+    const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares,
+    const std::vector<std::uint8_t>& reachable)
     : SceneRef(scene)
     , SourceRef(source)
     , Options(options)
     , Tracer(tracer)
     , Frames(source.positions())
     , Reuse(options.reuseShooting && source.positions() > 1)
+    , StoredElementSides(reachable.empty() ? std::vector<std::uint8_t>() : expand(reachable))
     , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions(), 0x1.0p-50,
-        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter,
+        reachable.empty() ? nullptr : &StoredElementSides)
     , PatchPower(workers, copyPerWorker, scene.patchCount(), source.positions(),
         { quantumFor(source.power().r), quantumFor(source.power().g),
           quantumFor(source.power().b) },
-        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter)
+        Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter,
+        reachable.empty() ? nullptr : &reachable)
     , Counters(static_cast<std::size_t>(workers))
     , Scratch(static_cast<std::size_t>(workers))
   {
@@ -116,6 +120,17 @@ public:
 
   bool reuses() const { return this->Reuse; }
 
+  /// Element sides (element * 2 + side) of the reachable patch sides.
+  static std::vector<std::uint8_t> expand(const std::vector<std::uint8_t>& patchSides)
+  {
+    std::vector<std::uint8_t> sides(patchSides.size() * Scene::ElementsPerPatch);
+    for (std::size_t i = 0; i < sides.size(); ++i)
+    {
+      sides[i] = patchSides[Scene::patchOfElement(i / 2) * 2 + i % 2];
+    }
+    return sides;
+  }
+
   void shootReused(std::uint64_t path, int worker);
   void shootClassic(std::size_t position, std::uint64_t path, int worker);
   /// Adds this source's light to `solution` (the elements' irradiance, the patches'
@@ -125,14 +140,14 @@ public:
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
 
-  /// Sums the scores over ranks (SolverOptions::sumAcrossRanks): integers, so every rank then
-  /// holds exactly the serial sums, whatever rank and worker traced each path.
-  void sumAcrossRanks(double& secondsReducing)
+  /// Sums the workers' scores, and then those of the ranks (SolverOptions::sumAcrossRanks):
+  /// integers, so every rank then holds exactly the serial sums, whatever rank and worker
+  /// traced each path. The sides that overflowed on any rank get an entry on every rank.
+  /// Returns the sides without slots that paths scored, elements' and patches'.
+  std::uint64_t sumAcrossWorkersAndRanks(double& secondsReducing)
   {
-    mlr::sumAcrossRanks(
-      this->Options, this->ElementShare.collapse(), this->ElementShare.copySize(), secondsReducing);
-    mlr::sumAcrossRanks(
-      this->Options, this->PatchPower.collapse(), this->PatchPower.copySize(), secondsReducing);
+    return sumOne(this->ElementShare, this->SceneRef.elementCount(), secondsReducing) +
+      sumOne(this->PatchPower, this->SceneRef.patchCount(), secondsReducing);
   }
 
   /// Which active position path `path` of a reuse solve starts from: paths are numbered
@@ -148,6 +163,32 @@ public:
   const std::vector<double>& pathsFromPosition() const { return this->PathsFromPosition; }
 
 private:
+  template <int Channels>
+  std::uint64_t sumOne(
+    FixedPointAccumulator<Channels>& sums, std::size_t records, double& secondsReducing)
+  {
+    const bool ranks = this->Options.ranks > 1;
+    std::int64_t* first = sums.collapse();
+    if (ranks)
+    {
+      mlr::sumAcrossRanks(this->Options, first, sums.copySize(), secondsReducing);
+    }
+    std::vector<std::int64_t> flags(records * 2, 0);
+    sums.markOverflow(flags);
+    if (ranks)
+    {
+      mlr::sumAcrossRanks(this->Options, flags.data(), flags.size(), secondsReducing);
+    }
+    std::size_t count = 0;
+    std::int64_t* merged = sums.mergeOverflow(flags, count);
+    if (ranks)
+    {
+      mlr::sumAcrossRanks(this->Options, merged, count, secondsReducing);
+    }
+    return static_cast<std::uint64_t>(
+      std::count_if(flags.begin(), flags.end(), [](std::int64_t f) { return f != 0; }));
+  }
+
   bool emit(RandomStream& random, std::size_t position, int worker, EmittedPath& path, RayHit& hit);
   void scoreAndWalk(RandomStream& random, const RayHit& firstHit, const double* shares,
     std::size_t firstFrame, std::size_t frameCount, int worker);
@@ -161,6 +202,9 @@ private:
   const RayTracer& Tracer;
   std::size_t Frames;
   bool Reuse;
+  /// The element sides with accumulator slots: those of the reachable patch sides (empty:
+  /// every side).
+  std::vector<std::uint8_t> StoredElementSides;
   // Direct light needs one scalar per element side and frame: the share of the source's
   // power whose first hit lands there. Its colour rho_e Phi is the same for every hit, and
   // a scalar is a third of the memory traffic of RGB in the hottest loop.
@@ -210,7 +254,7 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
   const Rgb& firstRho = this->SceneRef.elementReflectance(firstHit.element);
   Rgb colour = firstRho * this->SourceRef.power();
   {
-    std::int64_t* elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
+    const SlotRun elementSlots = this->ElementShare.slots(worker, firstHit.element, firstSide);
     for (std::size_t f = 0; f < frameCount; ++f)
     {
       this->ElementShare.add(elementSlots, firstFrame + f, &shares[f]);
@@ -226,11 +270,11 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
   // A bounce's score is written after the next ray is traced: its slots were prefetched
   // when the hit was found, so the trace hides the cache miss.
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
-  std::int64_t* pendingSlots = nullptr;
+  SlotRun pendingSlots;
   Rgb pendingPower;
   auto scorePending = [&]
   {
-    if (pendingSlots)
+    if (pendingSlots.base)
     {
       for (std::size_t f = 0; f < frameCount; ++f)
       {
@@ -238,7 +282,7 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
           pendingPower.b * shares[f] };
         this->PatchPower.add(pendingSlots, firstFrame + f, power);
       }
-      pendingSlots = nullptr;
+      pendingSlots.base = nullptr;
     }
   };
   RayHit hit = firstHit;
@@ -602,9 +646,10 @@ double shootingCost(const LightSource& source, const SolverOptions& options)
 
 ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
   const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
+  const std::vector<std::uint8_t>& reachable, const std::function<bool(double fraction)>& fraction,
+  double& secondsReducing, Solution& solution)
 {
-  ShootingRun run(scene, source, options, tracer, workers, copyPerWorker, shares);
+  ShootingRun run(scene, source, options, tracer, workers, copyPerWorker, shares, reachable);
   const std::uint64_t paths = options.pathsPerFrame;
   const std::vector<std::size_t>& positions = source.activePositions();
   ShootingResult result;
@@ -654,9 +699,9 @@ ShootingResult shoot(const Scene& scene, const LightSource& source, const Solver
       fraction, secondsReducing);
     result.pathsCast = paths * positions.size();
   }
-  if (options.ranks > 1 && !positions.empty())
+  if (!positions.empty())
   {
-    run.sumAcrossRanks(secondsReducing);
+    result.overflowSides = run.sumAcrossWorkersAndRanks(secondsReducing);
   }
   run.addTo(solution);
   for (const WorkerCounters& c : run.counters())

@@ -29,6 +29,8 @@ struct ShootingResult
   WorkerCounters counters;
   /// The fewest and most paths a position cast, over N/n; 1 and 1 unless reused and balanced.
   double smallestShare = 1, largestShare = 1;
+  /// Element and patch sides without accumulator slots that paths scored (see shoot()).
+  std::uint64_t overflowSides = 0;
 };
 
 /**
@@ -46,12 +48,14 @@ std::vector<double> positionShares(const Scene& scene, const LightSource& source
  * Shoots options.pathsPerFrame effective paths per frame from `source` (reused over its
  * positions, or classic: each position its own), shared by the ranks and summed over them,
  * and adds the source's radiosity to `solution`. `copyPerWorker`: one copy of the sums per
- * worker (MemoryPlan). `shares`: positionShares(), for this or a larger N. `fraction` gets
- * the share done; false cancels.
+ * worker (MemoryPlan). `shares`: positionShares(), for this or a larger N. `reachable`:
+ * reachableSides(), the patch sides (and their elements' sides) that get accumulator slots;
+ * a hit elsewhere overflows into an entry of its own, so no light is lost; empty gives every
+ * side slots. `fraction` gets the share done; false cancels.
  */
 ShootingResult shoot(const Scene& scene, const LightSource& source, const SolverOptions& options,
   const RayTracer& tracer, int workers, bool copyPerWorker, const std::vector<double>& shares,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
-  Solution& solution);
+  const std::vector<std::uint8_t>& reachable, const std::function<bool(double fraction)>& fraction,
+  double& secondsReducing, Solution& solution);
 
 } // namespace mlr

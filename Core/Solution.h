@@ -31,8 +31,11 @@ struct SolverStatistics
   std::uint64_t gatheringSides = 0;   ///< element sides that gathered
   std::uint64_t reachabilityRays = 0; ///< probes that decided which sides light can reach
   std::uint64_t reachableSides = 0;   ///< patch sides light can reach (the others stay dark)
-  std::uint64_t sources = 0;          ///< lights shot: moving, static, directional, emitters
-  std::uint64_t staticPathsCast = 0;  ///< of pathsCast, from sources solved once for all frames
+  /// Element and patch sides judged unreachable that shooting paths hit all the same, summed
+  /// over sources and batches: their light went to overflow entries (nothing is lost).
+  std::uint64_t overflowSides = 0;
+  std::uint64_t sources = 0;         ///< lights shot: moving, static, directional, emitters
+  std::uint64_t staticPathsCast = 0; ///< of pathsCast, from sources solved once for all frames
   /// Rays of the pilots that shared the paths out over a moving light's positions (traced
   /// alike on every rank, counted once; in none of the counts above).
   std::uint64_t pilotRays = 0;

@@ -26,14 +26,13 @@ double secondsSince(Clock::time_point start)
 }
 
 /// The fractions of the progress its phases take, weighted by their expected ray counts:
-/// shooting each source, reachability, then gathering.
+/// shooting each source, then gathering (reachability, before them, is cheap).
 struct ProgressPlan
 {
   std::vector<double> shooting;
-  double reachability = 0;
 
-  ProgressPlan(const Scene& scene, const std::vector<LightSource>& sources, std::size_t frames,
-    const SolverOptions& options)
+  ProgressPlan(
+    const std::vector<LightSource>& sources, std::size_t frames, const SolverOptions& options)
   {
     double total = 0;
     for (const LightSource& source : sources)
@@ -41,15 +40,13 @@ struct ProgressPlan
       this->shooting.push_back(shootingCost(source, options));
       total += this->shooting.back();
     }
-    this->reachability = static_cast<double>(scene.patchCount() * 2 * ReachabilityProbesPerSide);
     const double gathering = options.gatheringRatio * static_cast<double>(options.pathsPerFrame) *
       (options.reuseGathering ? 1.0 : static_cast<double>(frames));
-    total += this->reachability + gathering;
+    total += gathering;
     for (double& share : this->shooting)
     {
       share /= total;
     }
-    this->reachability /= total;
   }
 };
 
@@ -190,7 +187,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       {
         checkBatchPathsPerPosition(source, options);
       }
-      shares.emplace(scene, sources, frames, options);
+      shares.emplace(sources, frames, options);
       if (progress && !progress(0.0))
       {
         throw Cancelled();
@@ -231,11 +228,28 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     },
     &secondsReducing);
 
+  // The patch sides light can reach, from geometry alone (deterministic and cheap: every rank
+  // probes every side): only they get shooting accumulators and gather. With them known, the
+  // plan counts the accumulators they take, and may give each worker a copy after all.
+  std::vector<std::uint8_t> reachable;
+  agreeAcrossRanks(
+    options,
+    [&]
+    {
+      reachable = reachableSides(
+        scene, tracer, sources, options, workers,
+        [&](double) { return !progress || progress(0.0); }, stats.reachabilityRays);
+    },
+    &secondsReducing);
+  stats.reachableSides =
+    static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
+  plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames,
+    options, sources.size(), stats.reachableSides);
+
   // One pass: shooting every source, then gathering, into `into`. A batched solve runs one per
   // batch, sharing the scene, the tracer and the reachable sides (which do not depend on the
   // seed).
   WorkerCounters rays;
-  std::optional<std::vector<std::uint8_t>> reachable;
   auto pass = [&](const SolverOptions& passOptions, Solution& into,
                 const std::function<bool(double)>& fraction)
   {
@@ -252,7 +266,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     {
       const ShootingResult shot =
         shoot(scene, sources[i], passOptions, tracer, workers, plan.accumulatorCopyPerWorker,
-          positionShare[i], phaseTick(shares->shooting[i]), secondsReducing, into);
+          positionShare[i], reachable, phaseTick(shares->shooting[i]), secondsReducing, into);
       stats.pathsCast += shot.pathsCast;
       stats.staticPathsCast += sources[i].isStatic() ? shot.pathsCast : 0;
       if (!sources[i].isStatic())
@@ -261,6 +275,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
         stats.largestPositionShare = std::max(stats.largestPositionShare, shot.largestShare);
       }
       rays += shot.counters;
+      stats.overflowSides += shot.overflowSides;
     }
     stats.secondsShooting += secondsSince(shootingStart);
 
@@ -270,22 +285,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     into.allocateIndirect();
     if (passOptions.gatheringRatio > 0)
     {
-      // Deterministic and cheap: every rank probes every side.
-      const auto reachabilityTick = phaseTick(shares->reachability);
-      if (!reachable)
-      {
-        agreeAcrossRanks(
-          passOptions,
-          [&]
-          {
-            reachable = reachableSides(scene, tracer, sources, passOptions, workers,
-              reachabilityTick, stats.reachabilityRays);
-          },
-          &secondsReducing);
-        stats.reachableSides =
-          static_cast<std::uint64_t>(std::count(reachable->begin(), reachable->end(), 1));
-      }
-      const GatheringResult gathered = gatherIndirect(scene, tracer, passOptions, *reachable,
+      const GatheringResult gathered = gatherIndirect(scene, tracer, passOptions, reachable,
         workers, phaseTick(1.0 - progressBase), secondsReducing, into);
       stats.gatheringSides = gathered.sides;
       rays += gathered.counters;

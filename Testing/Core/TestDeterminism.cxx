@@ -2,6 +2,8 @@
 #include "CoreChecks.h"
 #include "FixedPointAccumulator.h"
 #include "GeneratedScenes.h"
+#include "RayTracer.h"
+#include "Shooting.h"
 #include "Solver.h"
 
 #include <gtest/gtest.h>
@@ -63,28 +65,37 @@ TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
   // copy between the workers (MemoryPlan); integer sums make that change no bit.
   const auto [shooting, gathering] = GetParam();
   const Scene scene = box();
+  Solution one = solveWith(1, 42, shooting, gathering);
+  // The plan counts accumulators for the sides light can reach (the inside of the box).
+  const std::uint64_t reachable = one.statistics.reachableSides;
+  EXPECT_EQ(reachable, scene.patchCount());
   SolverOptions o;
   o.threads = 3;
   o.memoryLimitBytes = std::uint64_t(1) << 40;
-  const MemoryPlan roomy =
-    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const auto plan = [&]
+  {
+    return planSolveMemory(
+      scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o, 1, reachable);
+  };
+  const MemoryPlan roomy = plan();
   ASSERT_TRUE(roomy.accumulatorCopyPerWorker);
   o.memoryLimitBytes = 2 * roomy.peak - 1;
-  const MemoryPlan tight =
-    planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o);
+  const MemoryPlan tight = plan();
   ASSERT_FALSE(tight.accumulatorCopyPerWorker);
-  // One copy instead of three, each buffer in whole pages: on a scene this small both fit
-  // in the same pages, so the shared copy saves nothing here, but it never costs more.
+  // One copy instead of three, each buffer in whole pages and with the index of the stored
+  // sides: on a scene this small both fit in the same pages, so the shared copy saves
+  // nothing here, but it never costs more.
   const auto copies = [&](int n)
   {
-    return FixedPointAccumulator<1>::allocatedBytes(n, scene.elementCount(), Frames) +
-      FixedPointAccumulator<3>::allocatedBytes(n, scene.patchCount(), Frames);
+    return FixedPointAccumulator<1>::allocatedStoredBytes(
+             n, scene.elementCount(), reachable * Scene::ElementsPerPatch, Frames) +
+      FixedPointAccumulator<3>::allocatedStoredBytes(n, scene.patchCount(), reachable, Frames) +
+      scene.elementCount() * 2;
   };
   EXPECT_EQ(tight.accumulators, copies(1));
   EXPECT_EQ(roomy.accumulators, copies(3));
   EXPECT_LE(tight.peak, roomy.peak);
 
-  Solution one = solveWith(1, 42, shooting, gathering);
   Solution shared = solveWith(3, 42, shooting, gathering, o.memoryLimitBytes);
   EXPECT_TRUE(one.statistics.accumulatorCopyPerWorker);
   EXPECT_FALSE(shared.statistics.accumulatorCopyPerWorker);
@@ -111,3 +122,47 @@ INSTANTIATE_TEST_SUITE_P(AllReuseModes, Determinism,
     return std::string(info.param.first ? "ShootingReuse" : "ShootingClassic") +
       (info.param.second ? "GatheringReuse" : "GatheringClassic");
   });
+
+TEST(Determinism, SidesWithoutSlotsLoseNoLight)
+{
+  // Shooting with slots for no side at all sends every score to the overflow entries: the
+  // direct light and the patch solution must be the same bits as with slots for every side,
+  // classic and reused, on one worker and three.
+  const Scene scene = box();
+  LightRig rig;
+  rig.areaLights.emplace_back(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1, 2, 3),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, Frames));
+  const std::vector<MovingLight> emitters;
+  const std::vector<LightSource> sources = lightSources(scene, rig, emitters);
+  ASSERT_EQ(sources.size(), 1u);
+  const RayTracer tracer(scene);
+  const std::vector<std::uint8_t> none(2 * scene.patchCount(), 0);
+  for (bool reuse : { false, true })
+  {
+    auto shot = [&](
+                  int workers, const std::vector<std::uint8_t>& reachable, std::uint64_t& overflow)
+    {
+      SolverOptions o;
+      o.pathsPerFrame = 20000;
+      o.reuseShooting = reuse;
+      Solution solution(Frames, scene.elementCount(), scene.patchCount());
+      double reducing = 0;
+      overflow = shoot(
+        scene, sources[0], o, tracer, workers, true, {}, reachable, [](double) { return true; },
+        reducing, solution)
+                   .overflowSides;
+      return solution;
+    };
+    std::uint64_t overflowAll = 0, overflowNone = 0, overflowThree = 0;
+    Solution all = shot(1, {}, overflowAll);
+    Solution overflowed = shot(1, none, overflowNone);
+    Solution three = shot(3, none, overflowThree);
+    EXPECT_EQ(overflowAll, 0u);
+    EXPECT_GT(overflowNone, scene.patchCount()) << "elements' and patches' sides were hit";
+    EXPECT_EQ(overflowThree, overflowNone);
+    EXPECT_TRUE(checks::sameBits(all.directData(), overflowed.directData())) << reuse;
+    EXPECT_TRUE(checks::sameBits(all.patchData(), overflowed.patchData())) << reuse;
+    EXPECT_TRUE(checks::sameBits(all.directData(), three.directData())) << reuse;
+    EXPECT_TRUE(checks::sameBits(all.patchData(), three.patchData())) << reuse;
+  }
+}

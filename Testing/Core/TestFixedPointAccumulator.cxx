@@ -58,10 +58,10 @@ std::vector<std::int64_t> expectedQuanta(const std::vector<Score>& scores)
 
 /// Scores `scores` with `workers` workers, score i by worker i % workers, in the given
 /// order, and returns every total.
-std::vector<double> totals(
-  const std::vector<Score>& scores, int workers, bool copyPerWorker, FrameLayout layout)
+std::vector<double> totals(const std::vector<Score>& scores, int workers, bool copyPerWorker,
+  FrameLayout layout, const std::vector<std::uint8_t>* stored = nullptr)
 {
-  FixedPointAccumulator<1> sums(workers, copyPerWorker, Records, Frames, Quantum, layout);
+  FixedPointAccumulator<1> sums(workers, copyPerWorker, Records, Frames, Quantum, layout, stored);
   for (std::size_t i = 0; i < scores.size(); ++i)
   {
     const Score& s = scores[i];
@@ -242,7 +242,7 @@ TEST(FixedPointAccumulator, EverySlotIsDistinctInBothLayouts)
     {
       for (int side = 0; side < 2; ++side)
       {
-        std::int64_t* slots = sums.slots(0, r, side);
+        const SlotRun slots = sums.slots(0, r, side);
         for (std::size_t f = 0; f < frames; ++f)
         {
           const double v[3] = { code(r, side, f, 0), code(r, side, f, 1), code(r, side, f, 2) };
@@ -333,4 +333,67 @@ TEST(FixedPointAccumulator, BytesCountEveryCopy)
   EXPECT_EQ(FixedPointAccumulator<3>::bytes(4, 10, 7), 4u * 10 * 2 * 7 * 3 * 8);
   // Large counts do not wrap in 32 bits.
   EXPECT_EQ(FixedPointAccumulator<3>::bytes(8, 1000000, 1000), 8ull * 1000000 * 2 * 1000 * 3 * 8);
+}
+
+TEST(FixedPointAccumulator, SidesWithoutSlotsOverflowAndLoseNothing)
+{
+  // Slots for some sides only (what reachability gives): scores on the others go to the
+  // workers' overflow entries, and every total is the same as with slots for all.
+  const std::vector<Score> scores = someScores(20000);
+  const std::vector<double> reference = totals(scores, 1, true, FrameLayout::FramesInner);
+  std::vector<std::uint8_t> stored(Records * 2, 0);
+  for (std::size_t i = 0; i < stored.size(); i += 3)
+  {
+    stored[i] = 1;
+  }
+  std::vector<std::uint8_t> none(Records * 2, 0);
+  for (const std::vector<std::uint8_t>* mask : { &stored, &none })
+  {
+    for (int workers : { 1, 3 })
+    {
+      for (bool copyPerWorker : { true, false })
+      {
+        for (FrameLayout layout : { FrameLayout::FramesInner, FrameLayout::FramesOuter })
+        {
+          EXPECT_EQ(totals(scores, workers, copyPerWorker, layout, mask), reference)
+            << workers << " workers, copy per worker " << copyPerWorker;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(FixedPointAccumulator<1>::storedBytes(1, 4, Frames), 4u * Frames * 8);
+
+  // Collapsed and merged (as before a sum over processes), the totals stay, and the
+  // overflow is one block in side order with an entry for every flagged side.
+  FixedPointAccumulator<1> sums(
+    3, true, Records, Frames, Quantum, FrameLayout::FramesInner, &stored);
+  for (std::size_t i = 0; i < scores.size(); ++i)
+  {
+    const Score& s = scores[i];
+    sums.add(sums.slots(static_cast<int>(i % 3), s.record, s.side), s.frame, &s.value);
+  }
+  EXPECT_EQ(sums.copySize(), 4 * Frames);
+  std::vector<std::int64_t> flags(Records * 2, 0);
+  sums.markOverflow(flags);
+  EXPECT_EQ(std::count(flags.begin(), flags.end(), 1), 6) << "every side without slots was hit";
+  flags[0] = 1; // a side another process overflowed: it gets an entry of zeros
+  sums.collapse();
+  std::size_t count = 0;
+  sums.mergeOverflow(flags, count);
+  EXPECT_EQ(count, 7 * Frames);
+  EXPECT_EQ(sums.overflowSides(), 7u);
+  std::vector<double> merged;
+  for (std::size_t r = 0; r < Records; ++r)
+  {
+    for (int side = 0; side < 2; ++side)
+    {
+      for (std::size_t f = 0; f < Frames; ++f)
+      {
+        double t = 0;
+        sums.total(r, side, f, &t);
+        merged.push_back(t);
+      }
+    }
+  }
+  EXPECT_EQ(merged, reference);
 }

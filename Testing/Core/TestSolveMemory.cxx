@@ -250,9 +250,13 @@ std::vector<Measured> measureTheModes()
     MovingLight(f.light.polygons(), Rgb(1), std::vector<Vec3>{ Vec3(), Vec3(0.01, 0, 0) }),
     optionsFor(2, 0));
 
+  // The plan counts accumulators for the sides light can reach, which a solve reports.
+  const std::uint64_t reachable =
+    solve(f.scene, f.light, optionsFor(1, 0)).statistics.reachableSides;
+  EXPECT_EQ(reachable, f.scene.patchCount()) << "the inside of the box";
   const int threads = 3;
   const MemoryPlan perWorker = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
-    f.scene.points().size(), frames, optionsFor(threads, 0));
+    f.scene.points().size(), frames, optionsFor(threads, 0), 1, reachable);
   EXPECT_TRUE(perWorker.accumulatorCopyPerWorker);
   // A limit of the per-worker peak leaves no room for the copies (they need it to be within
   // half the limit): the workers share one copy.
@@ -266,8 +270,8 @@ std::vector<Measured> measureTheModes()
   {
     Measured r;
     r.mode = mode.name;
-    r.plan = planSolveMemory(
-      f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(), frames, mode.options);
+    r.plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(),
+      frames, mode.options, 1, reachable);
     const Measurement m;
     const Solution solution = solve(f.scene, f.light, mode.options);
     r.peak = m.peak();
@@ -324,8 +328,9 @@ TEST(SolveMemory, TheEstimateBoundsABatchedSolve)
   SolverOptions options = optionsFor(3, 0);
   options.pathsPerFrame = 4000;
   options.errorBatches = 4;
-  const MemoryPlan plan = planSolveMemory(
-    f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(), frames, options);
+  const std::uint64_t reachable = f.scene.patchCount(); // the inside of the box
+  const MemoryPlan plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
+    f.scene.points().size(), frames, options, 1, reachable);
   EXPECT_GT(plan.errorEstimate, 0u);
   const Measurement m;
   const Solution solution = solve(f.scene, f.light, options);
