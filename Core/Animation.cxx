@@ -123,8 +123,14 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   {
     solveProgress = [&](double f) { return progress(RemeshingShare + solveShare * f); };
   }
-  animation.solution = solveInChunks(
-    scene, lights, options.solver, framesPerChunk, solveProgress, options.chunkFrames);
+  ChunkFramesCallback onFrames;
+  if (streamed)
+  {
+    onFrames = [&](std::size_t first, Solution& frames)
+    { options.chunkFrames(animation, first, frames); };
+  }
+  animation.solution =
+    solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress, onFrames);
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
     animation.solution.warnings.end());

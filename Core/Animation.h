@@ -9,11 +9,19 @@
 #include "Solver.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace mlr
 {
+
+struct Animation;
+
+/// Receives frames [firstFrame, firstFrame + frames.frameCount()) of `animation` (its patches,
+/// scene and warnings so far; its solution not yet) once they are final (ChunkFramesCallback).
+using AnimationFramesCallback =
+  std::function<void(const Animation& animation, std::size_t firstFrame, Solution& frames)>;
 
 struct AnimationOptions
 {
@@ -31,7 +39,7 @@ struct AnimationOptions
   /// When set, the frames are streamed: each chunk's finished frames go here as soon as they
   /// are solved and are freed after (Chunks.h), and Animation::solution keeps the statistics
   /// only. The memory policy then counts one chunk's frames, not all.
-  ChunkFramesCallback chunkFrames;
+  AnimationFramesCallback chunkFrames;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.

@@ -20,7 +20,7 @@ std::size_t chunkOverlap(std::size_t framesPerChunk)
 
 ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk)
 {
-  if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk)
+  if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk && framesPerChunk < frames)
   {
     throw Error("the frames per chunk are " + std::to_string(framesPerChunk) +
       ": give 0 (the memory limit chooses) or at least " + std::to_string(MinimumFramesPerChunk));
@@ -446,12 +446,14 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       copyFrames(estimate, end, c.solveEnd, { &*tail, end });
     }
     const ErrorEstimateSummary chunkErrors = current.errorEstimate;
+    const SolverStatistics chunkStatistics = current.statistics;
     current = Solution();
     if (onFrames)
     {
       finished.litSideData() = litSides;
       finished.patchLitSideData() = patchLitSides;
       summariseErrors(finished, chunkErrors);
+      finished.statistics = chunkStatistics;
       onFrames(begin, finished);
     }
   }

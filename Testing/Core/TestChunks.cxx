@@ -88,6 +88,7 @@ TEST(Chunks, PlanCoversEveryFrameWithWeightsSummingToOne)
   EXPECT_EQ(planChunks(30, 0).chunks.size(), 1u);
   EXPECT_EQ(planChunks(30, 30).chunks.size(), 1u);
   EXPECT_EQ(planChunks(30, 100).chunks.size(), 1u);
+  EXPECT_EQ(planChunks(1, 1).chunks.size(), 1u); // a static scene: one frame, one chunk
   checks::expectError([] { planChunks(30, 1); }, "at least 2");
   SolverOptions o;
   o.framesPerChunk = 1;
@@ -271,8 +272,9 @@ TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
   options.solver.framesPerChunk = 4;
   options.remeshing.targetEdgeLength = 0.25;
   std::size_t streamed = 0;
-  options.chunkFrames = [&](std::size_t first, Solution& frames)
+  options.chunkFrames = [&](const Animation& animation, std::size_t first, Solution& frames)
   {
+    EXPECT_EQ(animation.scene.elementCount(), frames.elementCount());
     EXPECT_EQ(first, streamed);
     streamed += frames.frameCount();
   };
