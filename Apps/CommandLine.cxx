@@ -368,6 +368,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--seed", "S", o.seed, parseInteger);
   option("--threads", "T", o.threads, parseInteger);
   option("--memory-limit", "MIB", o.memoryLimit, parseInteger);
+  option("--frames-per-chunk", "C", o.framesPerChunk, parseInteger);
   option("--error-batches", "B", o.errorBatches, parseInteger);
   option("--target-error", "FRACTION", o.targetError, parseNumber);
   option("--time-limit", "SECONDS", o.timeLimit, parseNumber);
@@ -730,6 +731,17 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkRange<long long>("--memory-limit", *o.memoryLimit, 1, filter->GetMemoryLimitMaxValue());
     filter->SetMemoryLimit(static_cast<int>(*o.memoryLimit));
   }
+  if (o.framesPerChunk)
+  {
+    if (*o.framesPerChunk == 1)
+    {
+      throw UsageError("--frames-per-chunk is 1: give 0 (the memory limit chooses) or at least "
+                       "2, so that the blends at a chunk's two seams do not overlap");
+    }
+    checkRange<long long>(
+      "--frames-per-chunk", *o.framesPerChunk, 0, filter->GetFramesPerChunkMaxValue());
+    filter->SetFramesPerChunk(static_cast<int>(*o.framesPerChunk));
+  }
   if (o.errorBatches)
   {
     checkRange<long long>("--error-batches", *o.errorBatches, 1, 4096);
@@ -908,6 +920,11 @@ Solver:
   --threads T           worker threads, 0 for every core (default 0)
   --memory-limit MIB    refuse, before allocating, a solve (or reading a file) estimated to
                         need more memory than this (default: half the physical memory)
+  --frames-per-chunk C  solve the frames in chunks of C consecutive frames (at least 2), each
+                        a full-reuse solve blended with the next over C/8 frames (at least 1)
+                        around each seam: memory depends on C, not on the frame count
+                        (default 0: every frame at once when that fits --memory-limit, else
+                        the longest chunks that do)
   --error-batches B     solve as B independent batches of N/B paths: their spread gives
                         every element's standard error, RadiosityStdError (default 16;
                         1: no error estimate)

@@ -161,6 +161,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "errorBatches", filter->GetErrorBatches() },
     { "targetError", jsonNumber(filter->GetTargetRelativeError()) },
     { "timeLimit", jsonNumber(filter->GetTimeLimit()) },
+    { "framesPerChunk", filter->GetFramesPerChunk() },
   };
 
   // Every statistic the filter reports, except those that describe one frame.

@@ -32,9 +32,11 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -381,8 +383,59 @@ int run(int argc, char** argv)
     prepareDirectory(output, options.png);
   }
 
+  // A solve in several chunks streams: each chunk's frames are written as soon as they are
+  // final, then freed (the filter keeps the last chunk's). Pictures and sensors need every
+  // frame kept, and so does a solve in one chunk, whose frames are written after it.
+  const bool streaming = !sensors && options.png.empty();
+  std::vector<FrameRecord> records;
+  std::optional<FrameWriter> streamWriter; // destroyed before `output`, as below
+  std::exception_ptr streamFailure;
+  if (streaming)
+  {
+    filter->SetChunkObserver(
+      [&](std::size_t f, vtkPolyData* elements)
+      {
+        if (streamFailure || Interrupted)
+        {
+          return;
+        }
+        try
+        {
+          if (!streamWriter)
+          {
+            streamWriter.emplace(writerThreads());
+          }
+          FrameRecord record;
+          record.time = times[f];
+          record.file = naming.frameName(f, ".vtu");
+          tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+          streamWriter->write(elements, times[f], output.stage(naming.directory / record.file));
+          records.push_back(record);
+        }
+        catch (...)
+        {
+          streamFailure = std::current_exception();
+          filter->SetAbortExecute(1);
+        }
+      });
+  }
   const Clock::time_point solveStarted = Clock::now();
-  vtkPolyData* first = frameAt(filter, times.front()); // the solve
+  vtkPolyData* first = nullptr;
+  try
+  {
+    // The solve; streamed, only the last chunk's frames are kept.
+    first = frameAt(filter, streaming ? times.back() : times.front());
+  }
+  catch (...)
+  {
+    if (streamFailure)
+    {
+      std::rethrow_exception(streamFailure);
+    }
+    throw;
+  }
+  filter->SetChunkObserver({});
+  const bool streamed = !records.empty();
   const double update = secondsSince(solveStarted);
   // Later updates only copy frames out of the filter's cache: their progress is not the solve's.
   filter->RemoveObserver(solving);
@@ -400,8 +453,17 @@ int run(int argc, char** argv)
   stages.solving = update - stages.remeshing;
 
   const Clock::time_point writingStarted = Clock::now();
-  std::vector<FrameRecord> records;
   std::vector<std::pair<double, std::string>> sensorEntries;
+  if (streamed)
+  {
+    streamWriter->finish();
+    if (records.size() != times.size())
+    {
+      throw InputError("the solve streamed " + std::to_string(records.size()) + " of " +
+        std::to_string(times.size()) + " frames: nothing was written");
+    }
+  }
+  else
   {
     // Destroyed before `output`: no frame is still being written when a failure rolls back.
     FrameWriter writer(writerThreads());

@@ -1,6 +1,9 @@
 #include "Animation.h"
 
+#include "Error.h"
 #include "MemoryBudget.h"
+
+#include <algorithm>
 
 namespace mlr
 {
@@ -23,6 +26,25 @@ std::uint64_t outputBytes(const AnimationOptions& options, const LightRig& light
                     options.solver, options.sensorOptions),
       saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
 }
+
+/// Ranks whose memory limits chose different chunks would add up different solves: every
+/// rank's C is compared (the sums of C and C^2 agree with R C and R C^2 only when all are C).
+void agreeOnChunks(const SolverOptions& options, std::size_t framesPerChunk)
+{
+  if (options.ranks <= 1)
+  {
+    return;
+  }
+  const auto c = static_cast<std::int64_t>(framesPerChunk);
+  std::int64_t sums[2] = { c, c * c };
+  options.sumAcrossRanks(sums, 2);
+  if (sums[0] * sums[0] != options.ranks * sums[1])
+  {
+    throw Error("the ranks' memory limits chose different chunk lengths: give the frames per "
+                "chunk (--frames-per-chunk, FramesPerChunk) so that every rank solves the same "
+                "chunks");
+  }
+}
 }
 
 Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
@@ -41,6 +63,25 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const std::size_t frames = frameCount(lights, soupEmits);
   const std::size_t lightCount = lights.areaLights.size() + lights.pointLights.size() +
     lights.directionalLights.size() + lights.skies.size();
+  const bool streamed = static_cast<bool>(options.chunkFrames);
+  if (streamed && !options.sensors.empty())
+  {
+    throw Error("sensors need every frame of the animation at once: solve them without "
+                "streaming the frames chunk by chunk");
+  }
+  // The chunks' length, from the memory limit unless set, and the one memory check of the
+  // solve in those chunks.
+  std::size_t framesPerChunk = frames;
+  auto checkChunkedMemory =
+    [&](std::size_t patches, std::size_t elements, std::size_t points, bool approximate)
+  {
+    const std::uint64_t outputs = outputBytes(options, lights, soupEmits, elements, points, frames);
+    framesPerChunk = chooseFramesPerChunk(
+      patches, elements, points, frames, options.solver, lightCount, outputs, streamed);
+    checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
+                       options.solver, lightCount, outputs, streamed),
+      std::min(frames, framesPerChunk), patches, elements, options.solver, approximate);
+  };
 
   RemeshOptions remeshing = options.remeshing;
   remeshing.memoryLimitBytes = options.solver.memoryLimitBytes;
@@ -51,10 +92,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   remeshing.checkExpectedPatches = [&](std::size_t expected)
   {
     const std::size_t patches = expected / 2;
-    checkSolveMemory(saturatingSum(estimateSolveMemory(patches, 4 * patches, 2 * patches, frames,
-                                     options.solver, lightCount),
-                       outputBytes(options, lights, soupEmits, 4 * patches, 2 * patches, frames)),
-      frames, patches, 4 * patches, options.solver, true);
+    checkChunkedMemory(patches, 4 * patches, 2 * patches, true);
   };
   ProgressCallback remeshProgress;
   if (progress)
@@ -74,12 +112,10 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       animation.scene = Scene::fromPatchMesh(remeshed.mesh);
       animation.patches = std::move(remeshed.mesh);
       const Scene& scene = animation.scene;
-      checkSolveMemory(saturatingSum(estimateSolveMemory(scene, frames, options.solver, lightCount),
-                         outputBytes(options, lights, soupEmits, scene.elementCount(),
-                           scene.points().size(), frames)),
-        frames, scene.patchCount(), scene.elementCount(), options.solver);
+      checkChunkedMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), false);
     });
   const Scene& scene = animation.scene;
+  agreeOnChunks(options.solver, framesPerChunk);
 
   const double sensorShare = options.sensors.empty() ? 0.0 : SensorShare;
   const double solveShare = 1 - RemeshingShare - sensorShare;
@@ -88,7 +124,14 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   {
     solveProgress = [&](double f) { return progress(RemeshingShare + solveShare * f); };
   }
-  animation.solution = solve(scene, lights, options.solver, solveProgress);
+  ChunkFramesCallback onFrames;
+  if (streamed)
+  {
+    onFrames = [&](std::size_t first, Solution& frames)
+    { options.chunkFrames(animation, first, frames); };
+  }
+  animation.solution =
+    solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress, onFrames);
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
     animation.solution.warnings.end());

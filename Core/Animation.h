@@ -2,17 +2,26 @@
 // per-frame radiosity of every element out.
 #pragma once
 
+#include "Chunks.h"
 #include "Remeshing.h"
 #include "Scene.h"
 #include "Sensors.h"
 #include "Solver.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace mlr
 {
+
+struct Animation;
+
+/// Receives frames [firstFrame, firstFrame + frames.frameCount()) of `animation` (its patches,
+/// scene and warnings so far; its solution not yet) once they are final (ChunkFramesCallback).
+using AnimationFramesCallback =
+  std::function<void(const Animation& animation, std::size_t firstFrame, Solution& frames)>;
 
 struct AnimationOptions
 {
@@ -27,6 +36,10 @@ struct AnimationOptions
   SensorSet sensors;
   SensorOptions sensorOptions;
   std::uint64_t outputBytesPerSensorFrame = 0;
+  /// When set, the frames are streamed: each chunk's finished frames go here as soon as they
+  /// are solved and are freed after (Chunks.h), and Animation::solution keeps the statistics
+  /// only. The memory policy then counts one chunk's frames, not all.
+  AnimationFramesCallback chunkFrames;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.
@@ -50,7 +63,9 @@ struct Animation
  * caller's outputs included. Throws mlr::Error naming what to fix and mlr::Cancelled.
  * Progress: remeshing takes the first 5%, solving the rest (with sensors, the sensors take the
  * last 5%). Sensors are checked before remeshing and solved once the scene is: they do not
- * change its radiosity.
+ * change its radiosity. The frames are solved in chunks (solveInChunks) of
+ * options.solver.framesPerChunk frames, or of the most frames the memory limit allows
+ * (chooseFramesPerChunk): every frame at once when it fits.
  */
 Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const AnimationOptions& options, const ProgressCallback& progress = {});

@@ -1,5 +1,6 @@
 #include "MemoryPlan.h"
 
+#include "Chunks.h"
 #include "ErrorEstimate.h"
 #include "FixedPointAccumulator.h"
 
@@ -97,6 +98,67 @@ std::uint64_t estimateSolveMemory(
 {
   return estimateSolveMemory(
     scene.patchCount(), scene.elementCount(), scene.points().size(), frames, options, lights);
+}
+
+std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
+  std::uint64_t fixedBytes, bool streamed)
+{
+  if (framesPerChunk == 0 || framesPerChunk >= frames)
+  {
+    return saturatingSum(
+      estimateSolveMemory(patches, elements, points, frames, options, lights), fixedBytes);
+  }
+  const std::size_t m = chunkOverlap(framesPerChunk);
+  // The frames a Solution holds outside a solve: direct and indirect irradiance and the
+  // patches, and the standard errors of a batched solve.
+  const std::uint64_t perFrame = saturatingProduct(
+    { 2 * elements * (errorEstimateBytes(patches, elements, 1, options) > 0 ? 3 : 2) + 2 * patches,
+      sizeof(PackedRgb) });
+  const std::uint64_t solving = estimateSolveMemory(
+    patches, elements, points, std::min(frames, framesPerChunk + 2 * m), options, lights);
+  const std::uint64_t held =
+    saturatingProduct(perFrame, 2 * m + (streamed ? framesPerChunk : frames));
+  return saturatingSum(saturatingSum(solving, held), fixedBytes);
+}
+
+std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
+  bool streamed)
+{
+  if (options.framesPerChunk > 0)
+  {
+    return static_cast<std::size_t>(std::min<std::uint64_t>(options.framesPerChunk, frames));
+  }
+  const std::uint64_t limit = memoryLimitBytes(options);
+  auto fits = [&](std::size_t c)
+  {
+    return estimateChunkedMemory(
+             patches, elements, points, frames, c, options, lights, fixedBytes, streamed) <= limit;
+  };
+  if (frames <= MinimumFramesPerChunk || fits(frames))
+  {
+    return frames;
+  }
+  // The estimate grows with C: the largest C that fits, by bisection.
+  std::size_t lo = MinimumFramesPerChunk, hi = frames - 1;
+  if (!fits(lo))
+  {
+    return lo;
+  }
+  while (lo < hi)
+  {
+    const std::size_t mid = lo + (hi - lo + 1) / 2;
+    if (fits(mid))
+    {
+      lo = mid;
+    }
+    else
+    {
+      hi = mid - 1;
+    }
+  }
+  return lo;
 }
 
 std::uint64_t memoryLimitBytes(const SolverOptions& options)

@@ -54,6 +54,23 @@ std::uint64_t estimateSolveMemory(
 std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights = 1);
 
+/**
+ * The peak of a solve of `frames` frames in chunks of `framesPerChunk` (Chunks.h; 0 or
+ * `frames` and more: one chunk, the plain solve): one chunk's solve, the estimate of its seam
+ * kept for the next, and the finished frames, those of one chunk when they are `streamed` to
+ * the caller, else all. `fixedBytes` (the caller's outputs) is added.
+ */
+std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
+  std::uint64_t fixedBytes, bool streamed);
+
+/// C: options.framesPerChunk when set, else every frame when that fits the memory limit,
+/// else the most frames per chunk whose estimateChunkedMemory does (at least 2: the memory
+/// check then says what does not fit).
+std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
+  std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
+  bool streamed);
+
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);
 

@@ -224,6 +224,16 @@ bool sameSky(SkyModel model, const SkyFrame& a, const SkyFrame& b)
 }
 }
 
+Sky Sky::slice(std::size_t first, std::size_t count) const
+{
+  if (this->Frames.size() == 1)
+  {
+    return Sky(this->Model, this->Up, std::vector<SkyFrame>(count, this->Frames.front()));
+  }
+  return Sky(this->Model, this->Up,
+    std::vector<SkyFrame>(this->Frames.begin() + first, this->Frames.begin() + first + count));
+}
+
 Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, int threads)
   : Model(model)
   , FrameCount(frames.size())

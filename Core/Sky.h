@@ -91,6 +91,8 @@ public:
   SkyModel model() const { return this->Model; }
   const Vec3& up() const { return this->Up; }
   std::size_t frameCount() const { return this->FrameCount; }
+  /// The sky of frames [first, first + count) (the frames of a chunk, Chunks.h).
+  Sky slice(std::size_t first, std::size_t count) const;
   /// The positions: 1 when every frame is the same sky, else one per frame.
   std::size_t positions() const { return this->Lambda.size(); }
   /// The integral of the radiance over the sky's solid angle (W/m^2) at `position`.

@@ -16,6 +16,9 @@ namespace mlr
 struct SolverStatistics
 {
   std::uint64_t frames = 0;
+  /// The chunks the frames were solved in, of framesPerChunk frames each (Chunks.h).
+  std::uint64_t chunks = 1;
+  std::uint64_t framesPerChunk = 0;
   std::uint64_t patches = 0;
   std::uint64_t elements = 0;
   std::uint64_t effectivePathsPerFrame = 0;

@@ -129,6 +129,11 @@ void validateOptions(const SolverOptions& options)
     throw Error("the gathering ratio k times the paths per frame is over the maximum of " +
       std::to_string(MaximumPathsPerFrame) + " rays per frame");
   }
+  if (options.framesPerChunk == 1)
+  {
+    throw Error("the frames per chunk are 1: give 0 (the memory limit chooses) or at least 2, "
+                "so that the blends at a chunk's two seams do not overlap");
+  }
   if (options.threads < 0 || options.threads > 1024)
   {
     throw Error("the thread count is " + std::to_string(options.threads) +

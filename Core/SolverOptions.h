@@ -37,6 +37,10 @@ struct SolverOptions
   /// Refuse solves whose memory estimate exceeds this many bytes; 0 means half of the
   /// physical memory.
   std::uint64_t memoryLimitBytes = 0;
+  /// C: solve the animation in chunks of this many consecutive frames, each a full-reuse
+  /// solve of its own, so that memory depends on C, not on the frame count (Chunks.h);
+  /// 0 lets the memory limit choose (the whole animation when it fits). At least 2.
+  std::uint64_t framesPerChunk = 0;
 
   /// B: the solve runs as B independent batches of N/B paths per frame (and k N/B gathering
   /// rays) whose mean is the result and whose spread gives every element's standard error
@@ -97,8 +101,9 @@ template <typename Visitor>
 void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
-    reuseGathering, twoSided, seed, threads, memoryLimitBytes, errorBatches, targetRelativeError,
-    timeLimitSeconds, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks, log] = options;
+    reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, errorBatches,
+    targetRelativeError, timeLimitSeconds, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks,
+    log] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -111,6 +116,8 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   // The limit decides whether a solve runs and how it holds its sums, never its result;
   // every rank checks its own.
   visit("memoryLimitBytes", memoryLimitBytes, OptionRole::PerRank);
+  // The chunks decide the seeds and the blends: the ranks solve the same chunks.
+  visit("framesPerChunk", framesPerChunk, OptionRole::Result);
   visit("errorBatches", errorBatches, OptionRole::Result);
   visit("targetRelativeError", targetRelativeError, OptionRole::Result);
   // The ranks stop together (the first to run out of time stops all), so they must agree on

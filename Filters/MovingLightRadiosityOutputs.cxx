@@ -219,6 +219,8 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   auto real = [&](const char* name, double value)
   { addValue<vtkDoubleArray>(fieldData, name, value); };
   count("Frames", statistics.frames);
+  count("Chunks", statistics.chunks);
+  count("FramesPerChunk", statistics.framesPerChunk);
   count("Patches", statistics.patches);
   count("Elements", statistics.elements);
   count("PathsPerFrame", statistics.effectivePathsPerFrame);

@@ -81,6 +81,9 @@ struct vtkMovingLightRadiosity::vtkInternals
   vtkSmartPointer<vtkPolyData> Patches;
   vtkSmartPointer<vtkFieldData> Statistics;
   mlr::Solution Solution;
+  /// The frame Solution starts at: 0 but when chunks were streamed to the ChunkObserver,
+  /// which leaves the last chunk's frames.
+  std::size_t FirstFrame = 0;
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
@@ -130,6 +133,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->PathEnd[1] = this->PathEnd[2] = 0.0;
   this->NumberOfPositions = 10;
   this->MemoryLimit = 0;
+  this->FramesPerChunk = 0;
   this->SolveCount = 0;
   this->Exposure = 0.0;
   this->LuminousEfficacy = 179.0;
@@ -550,13 +554,6 @@ int vtkMovingLightRadiosity::RequestData(
     return 0;
   }
   vtkInternals& cache = *this->Internals;
-  // A sky's frames have the Perez efficacy of their daylight; other light LuminousEfficacy.
-  auto efficacyOf = [this](const vtkInternals& c, std::size_t f)
-  {
-    return c.DaylightEfficacy.empty()
-      ? this->LuminousEfficacy
-      : c.DaylightEfficacy[std::min(f, c.DaylightEfficacy.size() - 1)];
-  };
   // Whether anything that decides the result changed since the last solve or attempt.
   bool unchanged = this->GetMTime() <= cache.PropertiesTime.GetMTime();
   for (int port = 0; unchanged && port < this->GetNumberOfInputPorts(); ++port)
@@ -597,134 +594,167 @@ int vtkMovingLightRadiosity::RequestData(
     ? trigger->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
     : cache.Times.front();
   const std::size_t frame = mlr::vtkinputs::frameAtOrBelow(cache.Times, requested);
-  // A scene lit only by things that do not move (its emitters, static lights) is solved once,
-  // whatever time steps the Trajectory or NumberOfPositions declare: every step shows it.
-  const std::size_t solved = cache.Solution.frameCount() > 1 ? frame : 0;
-
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
     vtkPolyData* output = vtkPolyData::GetData(outputVector, port);
-    if (cache.Elements)
+    if (!this->FillOutput(port, frame, output))
     {
-      if (port == ELEMENTS_PORT)
-      {
-        output->ShallowCopy(cache.Elements);
-        mlr::vtkoutputs::addElementRadiosity(
-          cache.Solution, solved, cache.TwoSided, output->GetCellData());
-        mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
-          std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
-          output->GetCellData());
-        mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
-          efficacyOf(cache, frame), output->GetPointData(), output->GetCellData());
-        mlr::vtkoutputs::addStdErrorArrays(
-          cache.Solution, cache.Shading, solved, output->GetPointData(), output->GetCellData());
-        if (cache.Distributed)
-        {
-          // Cut from the whole frame, so that the point arrays at the cut average over the
-          // cells of both sides, as in serial.
-          output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedElements));
-        }
-      }
-      else if (port == PATCHES_PORT)
-      {
-        output->ShallowCopy(cache.Patches);
-        mlr::vtkoutputs::addPatchRadiosity(
-          cache.Solution, cache.PatchLitSides, solved, output->GetCellData());
-        if (cache.Distributed)
-        {
-          output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedPatches));
-        }
-      }
-      else if (port == SENSORS_OUTPUT_PORT)
-      {
-        if (cache.SensorMesh && cache.OutputsLight)
-        {
-          if (cache.SensorThreshold != this->DaylightAutonomyThreshold)
-          {
-            cache.SensorSteps.autonomyThreshold = this->DaylightAutonomyThreshold;
-            cache.SensorMesh =
-              mlr::vtksensors::sensorMesh(cache.SensorPoints, cache.Sensors, cache.SensorSteps);
-            cache.SensorThreshold = this->DaylightAutonomyThreshold;
-          }
-          output->ShallowCopy(cache.SensorMesh);
-          mlr::vtksensors::addSensorArrays(
-            cache.Sensors, solved, efficacyOf(cache, frame), output->GetPointData());
-        }
-      }
-      else if (cache.OutputsLight)
-      {
-        // Every area light, posed as in this frame, at this frame's power.
-        vtkNew<vtkAppendPolyData> lights;
-        for (const mlr::MovingLight& light : cache.Rig.areaLights)
-        {
-          const std::size_t k = light.frameCount() > 1 ? frame : 0;
-          mlr::vtkoutputs::LightTransform transform;
-          transform.rotation = light.pose(k).rotation.rows();
-          transform.translation = light.rigidTranslation(k);
-          lights->AddInputData(mlr::vtkoutputs::posedLight(
-            light.polygons(), transform, light.power() * light.pose(k).power));
-        }
-        if (lights->GetNumberOfInputConnections(0) > 0)
-        {
-          lights->Update();
-          output->ShallowCopy(lights->GetOutput());
-        }
-      }
-      vtkNew<vtkFieldData> fieldData;
-      fieldData->ShallowCopy(cache.Statistics);
-      // The first area light's place; a directional light's direction.
-      mlr::Vec3 position, translation;
-      if (!cache.Rig.areaLights.empty())
-      {
-        const mlr::MovingLight& light = cache.Rig.areaLights.front();
-        const std::size_t k = light.frameCount() > 1 ? frame : 0;
-        position = light.pose(k).position;
-        translation = light.translation(k);
-      }
-      else if (!cache.Rig.pointLights.empty())
-      {
-        const mlr::PointLight& light = cache.Rig.pointLights.front();
-        position = light.position(light.frameCount() > 1 ? frame : 0);
-        translation = position - light.position(0);
-      }
-      mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
-      if (!cache.Rig.directionalLights.empty())
-      {
-        const mlr::DirectionalLight& sun = cache.Rig.directionalLights.front();
-        const mlr::Vec3& s = sun.direction(sun.frameCount() > 1 ? frame : 0);
-        vtkNew<vtkDoubleArray> direction;
-        direction->SetName("SunDirection");
-        direction->SetNumberOfComponents(3);
-        direction->InsertNextTuple3(s.x, s.y, s.z);
-        fieldData->AddArray(direction);
-        for (const auto& [name, values] : { std::make_pair("SunAzimuth", &cache.SunAzimuth),
-               std::make_pair("SunElevation", &cache.SunElevation) })
-        {
-          if (frame < values->size())
-          {
-            vtkNew<vtkDoubleArray> angle;
-            angle->SetName(name);
-            angle->InsertNextValue((*values)[frame]);
-            fieldData->AddArray(angle);
-          }
-        }
-      }
-      mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
-      mlr::vtkoutputs::addValue<vtkDoubleArray>(
-        fieldData, "LuminousEfficacy", efficacyOf(cache, frame));
-      if (!cache.DaylightEfficacy.empty())
-      {
-        vtkNew<vtkStringArray> model;
-        model->SetName("LuminousEfficacyModel");
-        model->InsertNextValue("Perez (1990) direct and diffuse efficacies, weighted by the "
-                               "frame's direct and diffuse horizontal irradiance");
-        fieldData->AddArray(model);
-      }
-      output->SetFieldData(fieldData);
+      return 0;
     }
-    output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
   }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyData* output)
+{
+  vtkInternals& cache = *this->Internals;
+  auto efficacyOf = [this](const vtkInternals& c, std::size_t f)
+  {
+    return c.DaylightEfficacy.empty()
+      ? this->LuminousEfficacy
+      : c.DaylightEfficacy[std::min(f, c.DaylightEfficacy.size() - 1)];
+  };
+  // A scene lit only by things that do not move (its emitters, static lights) is solved once,
+  // whatever time steps the Trajectory or NumberOfPositions declare: every step shows it.
+  // Streamed chunks leave only the last chunk's frames, from FirstFrame on.
+  if (cache.Solution.frameCount() > 1 &&
+    (frame < cache.FirstFrame || frame >= cache.FirstFrame + cache.Solution.frameCount()))
+  {
+    vtkErrorMacro(<< "time step " << frame << " was streamed to the chunk observer and is no "
+                  << "longer kept (frames " << cache.FirstFrame << " to "
+                  << cache.FirstFrame + cache.Solution.frameCount() - 1
+                  << " are): solve again without the observer to keep every frame");
+    return false;
+  }
+  const std::size_t solved = cache.Solution.frameCount() > 1 ? frame - cache.FirstFrame : 0;
+  if (cache.Elements)
+  {
+    if (port == ELEMENTS_PORT)
+    {
+      output->ShallowCopy(cache.Elements);
+      mlr::vtkoutputs::addElementRadiosity(
+        cache.Solution, solved, cache.TwoSided, output->GetCellData());
+      mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
+        std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
+        output->GetCellData());
+      mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
+        efficacyOf(cache, frame), output->GetPointData(), output->GetCellData());
+      mlr::vtkoutputs::addStdErrorArrays(
+        cache.Solution, cache.Shading, solved, output->GetPointData(), output->GetCellData());
+      if (cache.Distributed)
+      {
+        // Cut from the whole frame, so that the point arrays at the cut average over the
+        // cells of both sides, as in serial.
+        output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedElements));
+      }
+    }
+    else if (port == PATCHES_PORT)
+    {
+      output->ShallowCopy(cache.Patches);
+      mlr::vtkoutputs::addPatchRadiosity(
+        cache.Solution, cache.PatchLitSides, solved, output->GetCellData());
+      if (cache.Distributed)
+      {
+        output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedPatches));
+      }
+    }
+    else if (port == SENSORS_OUTPUT_PORT)
+    {
+      if (cache.SensorMesh && cache.OutputsLight)
+      {
+        if (cache.SensorThreshold != this->DaylightAutonomyThreshold)
+        {
+          cache.SensorSteps.autonomyThreshold = this->DaylightAutonomyThreshold;
+          cache.SensorMesh =
+            mlr::vtksensors::sensorMesh(cache.SensorPoints, cache.Sensors, cache.SensorSteps);
+          cache.SensorThreshold = this->DaylightAutonomyThreshold;
+        }
+        output->ShallowCopy(cache.SensorMesh);
+        mlr::vtksensors::addSensorArrays(
+          cache.Sensors, solved, efficacyOf(cache, frame), output->GetPointData());
+      }
+    }
+    else if (cache.OutputsLight)
+    {
+      // Every area light, posed as in this frame, at this frame's power.
+      vtkNew<vtkAppendPolyData> lights;
+      for (const mlr::MovingLight& light : cache.Rig.areaLights)
+      {
+        const std::size_t k = light.frameCount() > 1 ? frame : 0;
+        mlr::vtkoutputs::LightTransform transform;
+        transform.rotation = light.pose(k).rotation.rows();
+        transform.translation = light.rigidTranslation(k);
+        lights->AddInputData(mlr::vtkoutputs::posedLight(
+          light.polygons(), transform, light.power() * light.pose(k).power));
+      }
+      if (lights->GetNumberOfInputConnections(0) > 0)
+      {
+        lights->Update();
+        output->ShallowCopy(lights->GetOutput());
+      }
+    }
+    vtkNew<vtkFieldData> fieldData;
+    fieldData->ShallowCopy(cache.Statistics);
+    // The first area light's place; a directional light's direction.
+    mlr::Vec3 position, translation;
+    if (!cache.Rig.areaLights.empty())
+    {
+      const mlr::MovingLight& light = cache.Rig.areaLights.front();
+      const std::size_t k = light.frameCount() > 1 ? frame : 0;
+      position = light.pose(k).position;
+      translation = light.translation(k);
+    }
+    else if (!cache.Rig.pointLights.empty())
+    {
+      const mlr::PointLight& light = cache.Rig.pointLights.front();
+      position = light.position(light.frameCount() > 1 ? frame : 0);
+      translation = position - light.position(0);
+    }
+    mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
+    if (!cache.Rig.directionalLights.empty())
+    {
+      const mlr::DirectionalLight& sun = cache.Rig.directionalLights.front();
+      const mlr::Vec3& s = sun.direction(sun.frameCount() > 1 ? frame : 0);
+      vtkNew<vtkDoubleArray> direction;
+      direction->SetName("SunDirection");
+      direction->SetNumberOfComponents(3);
+      direction->InsertNextTuple3(s.x, s.y, s.z);
+      fieldData->AddArray(direction);
+      for (const auto& [name, values] : { std::make_pair("SunAzimuth", &cache.SunAzimuth),
+             std::make_pair("SunElevation", &cache.SunElevation) })
+      {
+        if (frame < values->size())
+        {
+          vtkNew<vtkDoubleArray> angle;
+          angle->SetName(name);
+          angle->InsertNextValue((*values)[frame]);
+          fieldData->AddArray(angle);
+        }
+      }
+    }
+    mlr::vtkoutputs::addExposureFieldData(fieldData, cache.AutoExposure, this->Exposure);
+    mlr::vtkoutputs::addValue<vtkDoubleArray>(
+      fieldData, "LuminousEfficacy", efficacyOf(cache, frame));
+    if (!cache.DaylightEfficacy.empty())
+    {
+      vtkNew<vtkStringArray> model;
+      model->SetName("LuminousEfficacyModel");
+      model->InsertNextValue("Perez (1990) direct and diffuse efficacies, weighted by the "
+                             "frame's direct and diffuse horizontal irradiance");
+      fieldData->AddArray(model);
+    }
+    output->SetFieldData(fieldData);
+  }
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetChunkObserver(ChunkObserver observer)
+{
+  // Like SetAbortExecute, no MTime: the observer decides where frames go, not what they are.
+  this->ChunkFramesObserver = std::move(observer);
 }
 
 //------------------------------------------------------------------------------
@@ -982,6 +1012,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
     solverOptions.threads = this->NumberOfThreads;
     solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
+    if (this->FramesPerChunk == 1)
+    {
+      throw mlr::Error("FramesPerChunk is 1: give 0 (MemoryLimit chooses) or at least 2, so "
+                       "that the blends at a chunk's two seams do not overlap");
+    }
+    solverOptions.framesPerChunk = static_cast<std::uint64_t>(this->FramesPerChunk);
     // Core refuses the other bad values (NaN targets included) naming the property to fix.
     if (this->ErrorBatches < 0)
     {
@@ -1040,6 +1076,50 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         vtkDebugMacro(<< message);
       };
     }
+    // Streaming: each chunk's frames go to the observer once final, and are freed after. A
+    // solve in one chunk comes whole, and is kept as without the observer.
+    std::optional<mlr::Solution> whole;
+    bool streamed = false;
+    if (this->ChunkFramesObserver && !controller && options.sensors.empty())
+    {
+      options.chunkFrames =
+        [&](const mlr::Animation& solving, std::size_t first, mlr::Solution& frames)
+      {
+        if (first == 0 && (frames.frameCount() == cache.Times.size() || frames.frameCount() == 1))
+        {
+          whole = std::move(frames);
+          return;
+        }
+        if (!streamed)
+        {
+          // The display of every frame, from the first chunk: its lit sides are every chunk's.
+          cache.Rig = rig;
+          cache.Shading = mlr::vtkoutputs::smoothShading(solving.scene, frames);
+          cache.Elements = mlr::vtkoutputs::smoothElementMesh(solving.scene, cache.Shading);
+          cache.AutoExposure = mlr::vtkoutputs::autoExposure(frames);
+          cache.Patches = mlr::vtkoutputs::patchMesh(solving.scene, solving.patches.points.size());
+          cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(frames);
+          cache.TwoSided = solverOptions.twoSided;
+          streamed = true;
+        }
+        // The frames carry the statistics of their chunk; the last update, the animation's.
+        cache.Statistics = mlr::vtkoutputs::statisticsFieldData(frames.statistics, solverOptions);
+        cache.Solution = std::move(frames);
+        cache.FirstFrame = first;
+        for (std::size_t f = first; f < first + cache.Solution.frameCount(); ++f)
+        {
+          if (this->CheckAbort())
+          {
+            return;
+          }
+          vtkNew<vtkPolyData> elements;
+          if (this->FillOutput(ELEMENTS_PORT, f, elements))
+          {
+            this->ChunkFramesObserver(f, elements);
+          }
+        }
+      };
+    }
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
       [this, reportsProgress](double fraction)
       {
@@ -1056,16 +1136,34 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       vtkWarningMacro(<< warning);
     }
     const mlr::Scene& scene = animation.scene;
+    if (whole)
+    {
+      whole->statistics = animation.solution.statistics;
+      animation.solution = std::move(*whole);
+    }
     mlr::Solution& solution = animation.solution;
-    cache.Rig = std::move(rig);
-
-    cache.Shading = mlr::vtkoutputs::smoothShading(scene, solution);
-    cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
-    cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
-    cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
-    cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
-    mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
-    cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
+    if (streamed)
+    {
+      this->CheckAbort();
+      if (this->GetAbortExecute())
+      {
+        throw mlr::Cancelled();
+      }
+      // The frames went to the observer; the last chunk's stay, with the whole solve's
+      // statistics.
+      cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
+    }
+    else
+    {
+      cache.Rig = std::move(rig);
+      cache.Shading = mlr::vtkoutputs::smoothShading(scene, solution);
+      cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
+      cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
+      cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
+      cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
+      mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
+      cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);
+    }
     if (!options.sensors.empty())
     {
       // The metrics count every time step, each showing its solved frame (one for a scene
@@ -1090,8 +1188,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.SensorPoints = std::move(options.sensors);
       cache.SensorSteps = std::move(steps);
     }
-    cache.Solution = std::move(solution);
-    cache.TwoSided = solverOptions.twoSided;
+    if (!streamed)
+    {
+      cache.Solution = std::move(solution);
+      cache.TwoSided = solverOptions.twoSided;
+    }
     if (controller)
     {
       const int rank = controller->GetLocalProcessId();
@@ -1228,6 +1329,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
      << this->PathEnd[2] << ")\n";
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
+  os << indent << "FramesPerChunk: " << this->FramesPerChunk << "\n";
   os << indent << "ErrorBatches: " << this->ErrorBatches << "\n";
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
   os << indent << "TimeLimit: " << this->TimeLimit << " s\n";

@@ -132,8 +132,10 @@
 #include "MovingLightRadiosityFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
-#include <memory> // For std::unique_ptr
-#include <string> // For std::string
+#include <cstddef>    // For std::size_t
+#include <functional> // For std::function
+#include <memory>     // For std::unique_ptr
+#include <string>     // For std::string
 
 class MOVINGLIGHTRADIOSITYFILTERS_EXPORT vtkMovingLightRadiosity : public vtkPolyDataAlgorithm
 {
@@ -495,6 +497,19 @@ public:
   vtkGetMacro(MemoryLimit, int);
   ///@}
 
+  ///@{
+  /**
+   * Solve the light positions in chunks of this many consecutive frames, each a full-reuse
+   * solve of its own blended with the next over C/8 positions (at least 1) on each side of a
+   * seam, so that the solve's memory depends on the chunk, not on the animation's length;
+   * 0 lets MemoryLimit choose: every frame at once when that fits, else the longest chunks
+   * that do. 1 is refused (the blends of a chunk's two seams would overlap). The frames are
+   * kept for the time steps; the chunks' seeds derive from Seed. Default 0.
+   */
+  vtkSetClampMacro(FramesPerChunk, int, 0, VTK_INT_MAX);
+  vtkGetMacro(FramesPerChunk, int);
+  ///@}
+
   // ---------------------------------------------------------------- Error estimate
   ///@{
   /**
@@ -597,6 +612,20 @@ public:
    */
   void SetAbortExecute(vtkTypeBool abort) override;
 
+#ifndef __VTK_WRAP__
+  /**
+   * C++ only: streams a solve in several chunks (FramesPerChunk, or chunks the MemoryLimit
+   * chooses, with one chunk's frames counted instead of all). Once a chunk's frames are final,
+   * `observer` gets each of them in order, as the Elements output of that time step would be,
+   * and they are freed after: only the last chunk's frames stay for the time steps. The
+   * display's exposure and the lit sides are then those of the first chunk. A solve in one
+   * chunk, with sensors or over several ranks keeps every frame as without an observer.
+   * An empty observer turns streaming off.
+   */
+  using ChunkObserver = std::function<void(std::size_t frame, vtkPolyData* elements)>;
+  void SetChunkObserver(ChunkObserver observer);
+#endif
+
 protected:
   vtkMovingLightRadiosity();
   ~vtkMovingLightRadiosity() override;
@@ -624,6 +653,7 @@ protected:
   double PathEnd[3];
   int NumberOfPositions;
   int MemoryLimit;
+  int FramesPerChunk;
   int LightType;
   double SunIrradiance;
   int SkyModel;
@@ -655,9 +685,13 @@ private:
 
   /// Solves every frame and caches the result; returns false (after an error) on failure.
   bool Solve(vtkInformationVector** inputVector);
+  /// Fills output port `port` with frame `frame` of the cache; false (after an error) when
+  /// that frame is not kept.
+  bool FillOutput(int port, std::size_t frame, vtkPolyData* output);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
+  std::function<void(std::size_t, vtkPolyData*)> ChunkFramesObserver;
 };
 
 #endif

@@ -38,6 +38,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.errorBatches = 16;
   else if (name == "targetRelativeError")
     options.targetRelativeError = 0.02;
+  else if (name == "framesPerChunk")
+    options.framesPerChunk = 8;
   else if (name == "timeLimitSeconds")
     options.timeLimitSeconds = 60;
   else if (name == "log")
@@ -71,7 +73,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 18u);
+  EXPECT_EQ(names.size(), 19u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

@@ -1,0 +1,214 @@
+#include "ChunkBenchmarks.h"
+
+#include "Chunks.h"
+#include "GeneratedScenes.h"
+#include "Solver.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace mlr::bench
+{
+namespace
+{
+constexpr double MiB = 1024.0 * 1024.0;
+constexpr std::uint64_t Paths = 600000;
+
+std::uint64_t statusBytes(const std::string& field)
+{
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+  {
+    if (line.compare(0, field.size() + 1, field + ":") == 0)
+    {
+      std::istringstream value(line.substr(field.size() + 1));
+      std::uint64_t kib = 0;
+      value >> kib;
+      return kib * 1024;
+    }
+  }
+  return 0;
+}
+
+void resetPeak()
+{
+  std::ofstream clear("/proc/self/clear_refs");
+  clear << "5" << std::flush;
+}
+
+SolverOptions optionsFor(const ScaleCaseOptions& scale, bool reuse, std::uint64_t seed = 0)
+{
+  SolverOptions o;
+  o.pathsPerFrame = Paths;
+  o.threads = scale.threads;
+  o.memoryLimitBytes = scale.memoryLimitBytes;
+  o.reuseShooting = reuse;
+  o.reuseGathering = reuse;
+  o.seed = seed;
+  return o;
+}
+
+struct Room
+{
+  Scene scene;
+  LightRig rig;
+};
+
+Room room(std::size_t frames)
+{
+  const scenes::PaperRoom r = scenes::paperScaleRoom(frames);
+  Room out{ Scene::fromPatchMesh(r.mesh), {} };
+  out.rig.areaLights.emplace_back(r.light, Rgb(100, 100, 100), r.translations);
+  return out;
+}
+
+/// Every frame's total radiosity (lit side, sum over channels) of every element, streamed.
+std::vector<std::vector<float>> framesOf(
+  const Room& r, const SolverOptions& o, std::size_t framesPerChunk)
+{
+  std::vector<std::vector<float>> frames;
+  solveInChunks(r.scene, r.rig, o, framesPerChunk, {},
+    [&](std::size_t, Solution& s)
+    {
+      for (std::size_t f = 0; f < s.frameCount(); ++f)
+      {
+        std::vector<float> b(s.elementCount());
+        for (std::size_t e = 0; e < s.elementCount(); ++e)
+        {
+          b[e] = static_cast<float>(s.total(f, e, s.litSide(e)).sum());
+        }
+        frames.push_back(std::move(b));
+      }
+    });
+  return frames;
+}
+
+/// The RMS error of the change from frame f to f + 1, from two independent estimates a, b.
+double flicker(
+  const std::vector<std::vector<float>>& a, const std::vector<std::vector<float>>& b, std::size_t f)
+{
+  double sum = 0;
+  for (std::size_t e = 0; e < a[f].size(); ++e)
+  {
+    const double d = (double(a[f + 1][e]) - a[f][e]) - (double(b[f + 1][e]) - b[f][e]);
+    sum += d * d;
+  }
+  return std::sqrt(sum / (2.0 * double(a[f].size())));
+}
+}
+
+std::string runChunkedAnimation(const ScaleCaseOptions& scale)
+{
+  constexpr std::size_t framesPerChunk = 100;
+  std::printf("\nLong animations in chunks of %zu frames (overlap %zu), streamed, N = %llu, "
+              "full reuse\n%8s %7s %9s %9s %12s %14s\n",
+    framesPerChunk, chunkOverlap(framesPerChunk), static_cast<unsigned long long>(Paths), "frames",
+    "chunks", "total s", "ms/frame", "peak MiB", "estimate MiB");
+  std::fflush(stdout);
+  std::ostringstream json;
+  json << "{\"frames_per_chunk\": " << framesPerChunk << ", \"runs\": [";
+  double seconds3000 = 0;
+  int threads = 0;
+  for (const std::size_t frames : { 300, 1000, 3000 })
+  {
+    const Room r = room(frames);
+    const SolverOptions o = optionsFor(scale, true);
+    const std::uint64_t before = statusBytes("VmRSS");
+    resetPeak();
+    const SolverStatistics s = solveInChunks(r.scene, r.rig, o, framesPerChunk, {},
+      [](std::size_t, Solution&) {
+      }).statistics;
+    const std::uint64_t peak = statusBytes("VmHWM");
+    const std::uint64_t solvePeak = peak > before ? peak - before : 0;
+    const std::uint64_t estimate = estimateChunkedMemory(r.scene.patchCount(),
+      r.scene.elementCount(), r.scene.points().size(), frames, framesPerChunk, o, 1, 0, true);
+    std::printf("%8zu %7llu %9.2f %9.2f %12.1f %14.1f\n", frames,
+      static_cast<unsigned long long>(s.chunks), s.secondsTotal, 1000 * s.secondsTotal / frames,
+      double(solvePeak) / MiB, double(estimate) / MiB);
+    std::fflush(stdout);
+    json << (frames == 300 ? "" : ", ") << "{\"frames\": " << frames << ", \"chunks\": " << s.chunks
+         << ", \"seconds\": " << s.secondsTotal << ", \"peak_bytes\": " << solvePeak
+         << ", \"estimate_bytes\": " << estimate << "}";
+    if (frames == 3000)
+    {
+      seconds3000 = s.secondsTotal;
+    }
+    threads = s.threads;
+  }
+
+  // Classic solves every frame alone: timed over 100 frames, per frame.
+  constexpr std::size_t classicFrames = 100;
+  const Room c = room(classicFrames);
+  const double classicSeconds =
+    solve(c.scene, c.rig, optionsFor(scale, false)).statistics.secondsTotal;
+  const double classicPerFrame = classicSeconds / classicFrames;
+  const double ratio = classicPerFrame * 3000 / seconds3000;
+  std::printf("Classic: %.1f ms per frame (%zu frames in %.2f s), %.0f s for 3,000 frames. "
+              "Chunked full reuse over 3,000 frames: %.2f s, %.1fx faster. Target: at least "
+              "15x: %s. Threads: %d\n",
+    1000 * classicPerFrame, classicFrames, classicSeconds, classicPerFrame * 3000, seconds3000,
+    ratio, ratio >= 15 ? "met" : "MISSED", threads);
+  std::fflush(stdout);
+
+  // Flicker: 300 frames in chunks of 30 (overlap 3), two seeds, and one chunk beside it.
+  constexpr std::size_t seamFrames = 300, seamChunk = 30;
+  const Room f = room(seamFrames);
+  const ChunkPlan plan = planChunks(seamFrames, seamChunk);
+  const auto a = framesOf(f, optionsFor(scale, true, 1), seamChunk);
+  const auto b = framesOf(f, optionsFor(scale, true, 2), seamChunk);
+  const auto wa = framesOf(f, optionsFor(scale, true, 1), 0);
+  const auto wb = framesOf(f, optionsFor(scale, true, 2), 0);
+  // A change is at a seam when either of its frames is a blend of two chunks.
+  auto blended = [&](std::size_t frame)
+  {
+    for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+    {
+      const double w = plan.weight(k, frame);
+      if (w > 0 && w < 1)
+      {
+        return true;
+      }
+    }
+    return false;
+  };
+  double seam = 0, inside = 0, whole = 0;
+  std::size_t seams = 0, insides = 0;
+  for (std::size_t t = 0; t + 1 < seamFrames; ++t)
+  {
+    const double e = flicker(a, b, t);
+    // Inside: away from the seams and from the animation's ends, as the seams are.
+    if (blended(t) || blended(t + 1))
+    {
+      seam += e * e;
+      ++seams;
+    }
+    else if (t >= seamChunk && t + 1 + seamChunk < seamFrames)
+    {
+      inside += e * e;
+      ++insides;
+    }
+    const double ew = flicker(wa, wb, t);
+    whole += ew * ew;
+  }
+  seam = std::sqrt(seam / double(seams));
+  inside = std::sqrt(inside / double(insides));
+  whole = std::sqrt(whole / double(seamFrames - 1));
+  std::printf("Flicker (RMS error of the frame-to-frame change, W/m^2, two seeds), %zu frames in "
+              "chunks of %zu: at the seams %.3f (%zu changes), inside the chunks %.3f (%zu), "
+              "ratio %.2f (target at most 1.1: %s); one chunk of %zu frames: %.3f\n",
+    seamFrames, seamChunk, seam, seams, inside, insides, seam / inside,
+    seam / inside <= 1.1 ? "met" : "MISSED", seamFrames, whole);
+
+  json << "], \"classic_seconds_per_frame\": " << classicPerFrame << ", \"speedup_3000\": " << ratio
+       << ", \"flicker_seam\": " << seam << ", \"flicker_inside\": " << inside
+       << ", \"flicker_one_chunk\": " << whole << "}";
+  return json.str();
+}
+
+} // namespace mlr::bench

@@ -1,0 +1,492 @@
+#include "Chunks.h"
+
+#include "Error.h"
+#include "ErrorEstimate.h"
+#include "Random.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <string>
+
+namespace mlr
+{
+
+std::size_t chunkOverlap(std::size_t framesPerChunk)
+{
+  return std::max<std::size_t>(1, framesPerChunk / 8);
+}
+
+ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk)
+{
+  if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk && framesPerChunk < frames)
+  {
+    throw Error("the frames per chunk are " + std::to_string(framesPerChunk) +
+      ": give 0 (the memory limit chooses) or at least " + std::to_string(MinimumFramesPerChunk));
+  }
+  ChunkPlan plan;
+  plan.frames = frames;
+  plan.framesPerChunk = framesPerChunk == 0 || framesPerChunk >= frames ? frames : framesPerChunk;
+  plan.overlap = plan.framesPerChunk >= frames ? 0 : chunkOverlap(plan.framesPerChunk);
+  for (std::size_t begin = 0; begin < frames || plan.chunks.empty(); begin += plan.framesPerChunk)
+  {
+    ChunkPlan::Chunk chunk;
+    chunk.begin = begin;
+    chunk.end = std::min(frames, begin + plan.framesPerChunk);
+    chunk.solveBegin = begin - std::min(begin, plan.overlap);
+    chunk.solveEnd = std::min(frames, chunk.end + plan.overlap);
+    plan.chunks.push_back(chunk);
+    if (plan.framesPerChunk == 0)
+    {
+      break;
+    }
+  }
+  // A last chunk shorter than the overlap would leave frames of its seam's blend to a chunk
+  // that does not solve them: it joins the chunk before.
+  if (plan.chunks.size() > 1 && plan.chunks.back().end - plan.chunks.back().begin < plan.overlap)
+  {
+    plan.chunks.pop_back();
+    plan.chunks.back().end = frames;
+    plan.chunks.back().solveEnd = frames;
+  }
+  return plan;
+}
+
+double ChunkPlan::weight(std::size_t chunk, std::size_t frame) const
+{
+  const Chunk& c = this->chunks[chunk];
+  if (frame < c.solveBegin || frame >= c.solveEnd)
+  {
+    return 0;
+  }
+  const double m = static_cast<double>(this->overlap);
+  // The ramp across a seam s: the later chunk's weight rises from 1/(4m) to 1 - 1/(4m) over
+  // [s - m, s + m), frame centres at f + 1/2.
+  auto rising = [m](std::size_t seam, std::size_t f)
+  { return (static_cast<double>(f) + 0.5 - (static_cast<double>(seam) - m)) / (2 * m); };
+  if (chunk > 0 && frame < c.begin + this->overlap)
+  {
+    return rising(c.begin, frame);
+  }
+  if (chunk + 1 < this->chunks.size() && frame + this->overlap >= c.end)
+  {
+    return 1 - rising(c.end, frame);
+  }
+  return 1;
+}
+
+std::size_t ChunkPlan::finishedBegin(std::size_t chunk) const
+{
+  return chunk == 0 ? 0 : this->chunks[chunk].begin - this->overlap;
+}
+
+std::size_t ChunkPlan::finishedEnd(std::size_t chunk) const
+{
+  return chunk + 1 == this->chunks.size() ? this->frames : this->chunks[chunk].end - this->overlap;
+}
+
+std::uint64_t chunkSeed(std::uint64_t seed, std::size_t chunk)
+{
+  return RandomStream(seed, StreamPurpose::Chunks, chunk).nextBits();
+}
+
+LightRig sliceRig(const LightRig& rig, std::size_t first, std::size_t count)
+{
+  auto poses = [&](const std::vector<LightPose>& all)
+  { return std::vector<LightPose>(all.begin() + first, all.begin() + first + count); };
+  LightRig slice = rig;
+  for (MovingLight& light : slice.areaLights)
+  {
+    if (light.frameCount() > 1)
+    {
+      light.setPoses(poses(light.poses()));
+    }
+  }
+  for (PointLight& light : slice.pointLights)
+  {
+    if (light.frameCount() > 1)
+    {
+      light.setPoses(poses(light.poses()));
+    }
+  }
+  for (DirectionalLight& light : slice.directionalLights)
+  {
+    if (light.frameCount() > 1)
+    {
+      std::vector<Vec3> directions;
+      std::vector<Rgb> factors;
+      for (std::size_t f = first; f < first + count; ++f)
+      {
+        directions.push_back(light.direction(f));
+        factors.push_back(light.powerFactor(f));
+      }
+      light = DirectionalLight(directions, light.irradiance(), factors);
+    }
+  }
+  for (Sky& sky : slice.skies)
+  {
+    if (sky.frameCount() > 1)
+    {
+      sky = sky.slice(first, count);
+    }
+  }
+  return slice;
+}
+
+namespace
+{
+/// A chunk's estimate: `solution` holds the frames from `first` on.
+struct Estimate
+{
+  Solution* solution = nullptr;
+  std::size_t first = 0;
+};
+
+/// Copies frames [begin, end) of `src` into `dest` (frame f at f - dest.first), bit for bit.
+void copyFrames(const Estimate& src, std::size_t begin, std::size_t end, const Estimate& dest)
+{
+  Solution& s = *src.solution;
+  Solution& d = *dest.solution;
+  const std::size_t n = end - begin;
+  auto copy =
+    [n](std::vector<PackedRgb>& from, std::size_t i, std::vector<PackedRgb>& to, std::size_t j)
+  {
+    if (!from.empty())
+    {
+      std::copy(from.begin() + i, from.begin() + i + n, to.begin() + j);
+    }
+  };
+  for (std::size_t e = 0; e < s.elementCount(); ++e)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      const std::size_t i = s.elementIndex(begin - src.first, e, side);
+      const std::size_t j = d.elementIndex(begin - dest.first, e, side);
+      copy(s.directData(), i, d.directData(), j);
+      copy(s.indirectData(), i, d.indirectData(), j);
+      copy(s.stdErrorData(), i, d.stdErrorData(), j);
+    }
+  }
+  for (std::size_t p = 0; p < s.patchCount(); ++p)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      copy(s.patchData(), s.patchIndex(begin - src.first, p, side), d.patchData(),
+        d.patchIndex(begin - dest.first, p, side));
+    }
+  }
+}
+
+/// The blend of two independent estimates, wa a + wb b, rounded once.
+PackedRgb blend(const PackedRgb& a, double wa, const PackedRgb& b, double wb)
+{
+  return PackedRgb(Rgb(a) * wa + Rgb(b) * wb);
+}
+
+/// The standard error of that blend: the variances add, s^2 = wa^2 sa^2 + wb^2 sb^2.
+PackedRgb blendError(const PackedRgb& a, double wa, const PackedRgb& b, double wb)
+{
+  const Rgb sa(a), sb(b);
+  auto q = [&](double x, double y) { return std::sqrt(wa * wa * x * x + wb * wb * y * y); };
+  return PackedRgb(Rgb(q(sa.r, sb.r), q(sa.g, sb.g), q(sa.b, sb.b)));
+}
+
+/**
+ * Writes frames [begin, end) into `dest` from chunk `chunk`'s estimate `current` and, across
+ * its first seam, the estimate `before` of the chunk before, blended with plan.weight. The
+ * frames of weight 1 are copied, bit for bit.
+ */
+void finishFrames(const ChunkPlan& plan, std::size_t chunk, const Estimate& before,
+  const Estimate& current, std::size_t begin, std::size_t end, const Estimate& dest)
+{
+  std::size_t blendEnd = begin;
+  while (blendEnd < end && plan.weight(chunk, blendEnd) < 1)
+  {
+    ++blendEnd;
+  }
+  copyFrames(current, blendEnd, end, dest);
+  if (blendEnd == begin)
+  {
+    return;
+  }
+  if (!before.solution)
+  {
+    throw Error("internal error: a chunk's seam has no chunk before it");
+  }
+  Solution& c = *current.solution;
+  Solution& b = *before.solution;
+  Solution& d = *dest.solution;
+  const bool errors = c.hasErrorEstimate();
+  const bool indirect = !c.indirectData().empty();
+  for (std::size_t f = begin; f < blendEnd; ++f)
+  {
+    const double wc = plan.weight(chunk, f), wb = 1 - wc;
+    const std::size_t fc = f - current.first, fb = f - before.first, fd = f - dest.first;
+    for (std::size_t e = 0; e < c.elementCount(); ++e)
+    {
+      for (const Side side : { Side::Front, Side::Back })
+      {
+        const std::size_t ic = c.elementIndex(fc, e, side), ib = b.elementIndex(fb, e, side);
+        const std::size_t id = d.elementIndex(fd, e, side);
+        d.directData()[id] = blend(c.directData()[ic], wc, b.directData()[ib], wb);
+        if (indirect)
+        {
+          d.indirectData()[id] = blend(c.indirectData()[ic], wc, b.indirectData()[ib], wb);
+        }
+        if (errors)
+        {
+          d.stdErrorData()[id] = blendError(c.stdErrorData()[ic], wc, b.stdErrorData()[ib], wb);
+        }
+      }
+    }
+    for (std::size_t p = 0; p < c.patchCount(); ++p)
+    {
+      for (const Side side : { Side::Front, Side::Back })
+      {
+        d.patchData()[d.patchIndex(fd, p, side)] = blend(c.patchData()[c.patchIndex(fc, p, side)],
+          wc, b.patchData()[b.patchIndex(fb, p, side)], wb);
+      }
+    }
+  }
+}
+
+/// An empty Solution of `frames` frames shaped as `like`: its reflectance, emission and
+/// arrays (the indirect light and standard errors when `like` has them).
+Solution shapedLike(Solution& like, std::size_t frames)
+{
+  Solution s(frames, like.elementCount(), like.patchCount());
+  s.reflectanceData() = like.reflectanceData();
+  s.emissionData() = like.emissionData();
+  s.allocateIndirect();
+  if (like.hasErrorEstimate())
+  {
+    s.stdErrorData().assign(s.directData().size(), PackedRgb());
+  }
+  return s;
+}
+
+/// The per-frame relative error statistics of `s` (its lit sides chosen), recomputed.
+void summariseErrors(Solution& s, const ErrorEstimateSummary& like)
+{
+  if (!s.hasErrorEstimate())
+  {
+    return;
+  }
+  ErrorEstimateSummary& summary = s.errorEstimate;
+  summary.batches = like.batches;
+  summary.rounds = like.rounds;
+  summary.pathsPerFrame = like.pathsPerFrame;
+  summary.target = like.target;
+  summary.stoppedBy = like.stoppedBy;
+  summary.relativeErrorMedian.clear();
+  summary.relativeErrorP95.clear();
+  summary.litElements.clear();
+  for (std::size_t f = 0; f < s.frameCount(); ++f)
+  {
+    const FrameError e = frameError(
+      s, f, [&](std::size_t element, Side side) { return s.radiosityStdError(f, element, side); });
+    summary.relativeErrorMedian.push_back(e.median);
+    summary.relativeErrorP95.push_back(e.p95);
+    summary.litElements.push_back(e.litElements);
+  }
+}
+
+/// Adds a chunk's statistics to the animation's.
+void accumulate(const SolverStatistics& c, bool first, SolverStatistics& s)
+{
+  if (first)
+  {
+    const std::uint64_t frames = s.frames;
+    s = c;
+    s.frames = frames;
+    return;
+  }
+  s.effectivePathsPerFrame = std::min(s.effectivePathsPerFrame, c.effectivePathsPerFrame);
+  s.pathsCast += c.pathsCast;
+  s.shootingRays += c.shootingRays;
+  s.shadowRays += c.shadowRays;
+  s.shadowRaysBlocked += c.shadowRaysBlocked;
+  s.firstHits += c.firstHits;
+  s.gatheringRays += c.gatheringRays;
+  s.missedRays += c.missedRays;
+  s.gatheringSides = std::max(s.gatheringSides, c.gatheringSides);
+  s.reachabilityRays += c.reachabilityRays;
+  s.reachableSides = std::max(s.reachableSides, c.reachableSides);
+  s.staticPathsCast += c.staticPathsCast;
+  s.pilotRays += c.pilotRays;
+  s.smallestPositionShare = std::min(s.smallestPositionShare, c.smallestPositionShare);
+  s.largestPositionShare = std::max(s.largestPositionShare, c.largestPositionShare);
+  s.secondsSetup += c.secondsSetup;
+  s.secondsShooting += c.secondsShooting;
+  s.secondsGathering += c.secondsGathering;
+  s.secondsReducing += c.secondsReducing;
+  s.memoryEstimateBytes = std::max(s.memoryEstimateBytes, c.memoryEstimateBytes);
+  s.accumulatorCopyPerWorker = s.accumulatorCopyPerWorker && c.accumulatorCopyPerWorker;
+}
+
+void accumulate(const ErrorEstimateSummary& c, bool first, ErrorEstimateSummary& s)
+{
+  if (first)
+  {
+    s = c;
+    return;
+  }
+  s.batches += c.batches;
+  s.rounds = std::max(s.rounds, c.rounds);
+  // The animation's N is that of its least solved chunk; a limit that stopped one says so.
+  s.pathsPerFrame = std::min(s.pathsPerFrame, c.pathsPerFrame);
+  if (c.stoppedBy == "time limit" || c.stoppedBy == "path limit")
+  {
+    s.stoppedBy = c.stoppedBy;
+  }
+}
+}
+
+Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames)
+{
+  const std::size_t frames = frameCount(rig, scene.hasEmission());
+  const ChunkPlan plan = planChunks(frames, framesPerChunk);
+  if (plan.chunks.size() == 1)
+  {
+    Solution solution = solve(scene, rig, options, progress);
+    solution.statistics.framesPerChunk = frames;
+    if (onFrames)
+    {
+      Solution statistics;
+      statistics.statistics = solution.statistics;
+      statistics.errorEstimate = solution.errorEstimate;
+      statistics.warnings = solution.warnings;
+      onFrames(0, solution);
+      return statistics;
+    }
+    return solution;
+  }
+
+  // Progress: each chunk's share is its positions' share of all the positions solved.
+  double positionsSolved = 0;
+  for (const ChunkPlan::Chunk& c : plan.chunks)
+  {
+    positionsSolved += static_cast<double>(c.solveEnd - c.solveBegin);
+  }
+  Solution whole; // every frame, without onFrames
+  Solution result;
+  SolverStatistics& stats = result.statistics;
+  stats.frames = frames;
+  ErrorEstimateSummary errors;
+  std::vector<Side> litSides, patchLitSides;
+  std::vector<std::string> warnings;
+  // The estimate of the frames around the last seam, which the next chunk blends with.
+  std::optional<Solution> tail;
+  std::size_t tailFirst = 0;
+  double progressBase = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+  {
+    const ChunkPlan::Chunk& c = plan.chunks[k];
+    const std::size_t positions = c.solveEnd - c.solveBegin;
+    SolverOptions chunkOptions = options;
+    chunkOptions.seed = chunkSeed(options.seed, k);
+    const double share = static_cast<double>(positions) / positionsSolved;
+    ProgressCallback chunkProgress;
+    if (progress)
+    {
+      chunkProgress = [&, base = progressBase, share](double f)
+      { return progress(base + share * f); };
+    }
+    progressBase += share;
+    if (options.log)
+    {
+      options.log("chunk " + std::to_string(k + 1) + " of " + std::to_string(plan.chunks.size()) +
+        ": frames " + std::to_string(c.begin) + " to " + std::to_string(c.end - 1) +
+        ", solving positions " + std::to_string(c.solveBegin) + " to " +
+        std::to_string(c.solveEnd - 1));
+    }
+    Solution current =
+      solve(scene, sliceRig(rig, c.solveBegin, positions), chunkOptions, chunkProgress);
+    accumulate(current.statistics, k == 0, stats);
+    if (current.hasErrorEstimate())
+    {
+      accumulate(current.errorEstimate, k == 0, errors);
+    }
+    for (const std::string& w : current.warnings)
+    {
+      if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
+      {
+        warnings.push_back(w);
+      }
+    }
+    if (k == 0)
+    {
+      litSides = current.litSideData();
+      patchLitSides = current.patchLitSideData();
+      if (!onFrames)
+      {
+        whole = shapedLike(current, frames);
+      }
+    }
+
+    const std::size_t begin = plan.finishedBegin(k), end = plan.finishedEnd(k);
+    Solution finished;
+    Solution& dest = onFrames ? finished : whole;
+    if (onFrames)
+    {
+      finished = shapedLike(current, end - begin);
+    }
+    const Estimate estimate{ &current, c.solveBegin };
+    finishFrames(plan, k, { tail ? &*tail : nullptr, tailFirst }, estimate, begin, end,
+      { &dest, onFrames ? begin : 0 });
+    // The next chunk's blend needs this chunk's estimate of the seam between them only.
+    tail.reset();
+    if (k + 1 < plan.chunks.size())
+    {
+      tailFirst = end;
+      tail.emplace(shapedLike(current, c.solveEnd - end));
+      copyFrames(estimate, end, c.solveEnd, { &*tail, end });
+    }
+    const ErrorEstimateSummary chunkErrors = current.errorEstimate;
+    const SolverStatistics chunkStatistics = current.statistics;
+    current = Solution();
+    if (onFrames)
+    {
+      finished.litSideData() = litSides;
+      finished.patchLitSideData() = patchLitSides;
+      summariseErrors(finished, chunkErrors);
+      finished.statistics = chunkStatistics;
+      onFrames(begin, finished);
+    }
+  }
+  // A chunk where every light is off (a night) warns that no light arrived; the animation
+  // only when none arrived anywhere.
+  if (stats.firstHits > 0)
+  {
+    warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
+                     [](const std::string& w) { return w.rfind("no light reached", 0) == 0; }),
+      warnings.end());
+  }
+  Solution& out = onFrames ? result : whole;
+  if (!onFrames)
+  {
+    whole.chooseLitSides();
+    summariseErrors(whole, errors);
+  }
+  else
+  {
+    out.errorEstimate = errors;
+  }
+  out.statistics = stats;
+  out.statistics.frames = frames;
+  out.statistics.chunks = plan.chunks.size();
+  out.statistics.framesPerChunk = plan.framesPerChunk;
+  out.statistics.meanPathLength = stats.pathsCast > 0 ? 1.0 +
+      (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) /
+        options.firstBounceSurvival
+                                                      : 0.0;
+  out.statistics.secondsTotal =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.warnings = std::move(warnings);
+  return std::move(out);
+}
+
+} // namespace mlr

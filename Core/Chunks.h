@@ -1,0 +1,85 @@
+// Animations of any length: the frames solved in chunks of consecutive frames, each a
+// full-reuse solve of its own, blended where chunks overlap and handed on chunk by chunk, so
+// that memory depends on the chunk's length, not the animation's (Documentation/Method.md,
+// "Long animations: chunks").
+#pragma once
+
+#include "LightSource.h"
+#include "Solution.h"
+#include "Solver.h"
+#include "SolverOptions.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace mlr
+{
+
+/// The fewest frames a chunk may have: with fewer, the blends of a chunk's two seams would
+/// overlap.
+constexpr std::size_t MinimumFramesPerChunk = 2;
+
+/// The positions a chunk solves beyond its own frames on each side: C / 8, at least 1.
+std::size_t chunkOverlap(std::size_t framesPerChunk);
+
+/**
+ * How the frames of an animation are split. Chunk k owns frames [begin, end) (C of them, the
+ * last may have fewer) and solves the positions [solveBegin, solveEnd): its own and m more on
+ * each side, clipped at the animation's ends. Around the seam s between chunks k and k+1 both
+ * solve the 2m frames [s - m, s + m), whose result is the blend of the two estimates.
+ */
+struct ChunkPlan
+{
+  struct Chunk
+  {
+    std::size_t begin = 0, end = 0;
+    std::size_t solveBegin = 0, solveEnd = 0;
+  };
+  std::size_t frames = 0;
+  std::size_t framesPerChunk = 0;
+  std::size_t overlap = 0; ///< m
+  std::vector<Chunk> chunks;
+
+  /// The weight of chunk `chunk`'s estimate of `frame` in the result: 1 away from the seams, a
+  /// linear ramp across the 2m frames of a seam, where the two chunks' weights sum to one; 0
+  /// for the frames the chunk does not solve.
+  double weight(std::size_t chunk, std::size_t frame) const;
+
+  /// The frames whose result is final once chunk `chunk` is solved (and the one before it):
+  /// from the start of its first seam's blend to the start of its second's.
+  std::size_t finishedBegin(std::size_t chunk) const;
+  std::size_t finishedEnd(std::size_t chunk) const;
+};
+
+/// The chunks of `frames` frames in chunks of `framesPerChunk` (0 or at least `frames`: one
+/// chunk). Throws mlr::Error for 1 frame per chunk.
+ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk);
+
+/// The seed chunk `chunk` solves with: a SplitMix64 mix of the solve's seed and the chunk, so
+/// that no two chunks share a random stream.
+std::uint64_t chunkSeed(std::uint64_t seed, std::size_t chunk);
+
+/// The rig restricted to frames [first, first + count): every moving light keeps those poses,
+/// static lights stay as they are.
+LightRig sliceRig(const LightRig& rig, std::size_t first, std::size_t count);
+
+/// Receives frames [firstFrame, firstFrame + frames.frameCount()) once they are final; the
+/// Solution may be moved from. Chunk by chunk, in frame order.
+using ChunkFramesCallback = std::function<void(std::size_t firstFrame, Solution& frames)>;
+
+/**
+ * Solves the animation in the chunks of planChunks(frames, framesPerChunk). With one chunk
+ * this is solve(scene, rig, options, progress), bit for bit. With several, each is a solve of
+ * sliceRig over its positions with chunkSeed; the result is bit-identical for any thread count.
+ * With `onFrames` the finished frames of each chunk go to it and are then freed (the returned
+ * Solution holds the statistics only); without, the returned Solution holds every frame. Lit
+ * sides: with onFrames, those of the first chunk for every chunk (a frame streamed cannot wait
+ * for the last); without, chosen over the whole animation. Throws as solve() does.
+ */
+Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  std::size_t framesPerChunk, const ProgressCallback& progress = {},
+  const ChunkFramesCallback& onFrames = {});
+
+} // namespace mlr

@@ -1,0 +1,288 @@
+// Animations solved in chunks: the plan and its blend weights, bits independent of the thread
+// count, one chunk as the plain solve, streaming as assembling, an unbiased seam, and a memory
+// limit that leaves room for 2 frames per chunk.
+#include "Animation.h"
+#include "Chunks.h"
+#include "CoreChecks.h"
+#include "GeneratedScenes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace mlr;
+
+namespace
+{
+constexpr std::size_t Frames = 12;
+
+Scene box()
+{
+  return Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.6, 0.5, 0.4) }));
+}
+
+LightRig rig(std::size_t frames = Frames)
+{
+  LightRig r;
+  r.areaLights.emplace_back(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1, 2, 3),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.2, 0.9 }, { 0.8, 0.8, 0.9 }, frames));
+  return r;
+}
+
+SolverOptions options(std::uint64_t paths, std::uint64_t seed, int threads = 2)
+{
+  SolverOptions o;
+  o.pathsPerFrame = paths;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
+
+/// The mean of the total radiosity (lit side, sum over channels) over the elements, by area.
+double frameMean(const Scene& scene, const Solution& s, std::size_t frame)
+{
+  double sum = 0, area = 0;
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    sum += scene.elementArea(e) * s.total(frame, e, s.litSide(e)).sum();
+    area += scene.elementArea(e);
+  }
+  return sum / area;
+}
+}
+
+TEST(Chunks, PlanCoversEveryFrameWithWeightsSummingToOne)
+{
+  for (const std::size_t c : { 2, 3, 4, 8, 16, 17 })
+  {
+    const ChunkPlan plan = planChunks(100, c);
+    EXPECT_EQ(plan.overlap, std::max<std::size_t>(1, c / 8));
+    EXPECT_EQ(plan.chunks.front().begin, 0u);
+    EXPECT_EQ(plan.chunks.back().end, 100u);
+    for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+    {
+      const ChunkPlan::Chunk& chunk = plan.chunks[k];
+      if (k > 0)
+      {
+        EXPECT_EQ(chunk.begin, plan.chunks[k - 1].end);
+        EXPECT_EQ(plan.finishedBegin(k), plan.finishedEnd(k - 1));
+      }
+      EXPECT_EQ(chunk.solveBegin, k == 0 ? 0 : chunk.begin - plan.overlap);
+      EXPECT_LE(chunk.solveEnd, std::min<std::size_t>(100, chunk.end + plan.overlap));
+    }
+    for (std::size_t f = 0; f < 100; ++f)
+    {
+      double sum = 0;
+      int solvedBy = 0;
+      for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+      {
+        const double w = plan.weight(k, f);
+        EXPECT_GE(w, 0.0);
+        sum += w;
+        solvedBy += w > 0;
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12) << "frame " << f << ", " << c << " frames per chunk";
+      EXPECT_LE(solvedBy, 2);
+    }
+  }
+  EXPECT_EQ(planChunks(30, 0).chunks.size(), 1u);
+  EXPECT_EQ(planChunks(30, 30).chunks.size(), 1u);
+  EXPECT_EQ(planChunks(30, 100).chunks.size(), 1u);
+  EXPECT_EQ(planChunks(1, 1).chunks.size(), 1u); // a static scene: one frame, one chunk
+  checks::expectError([] { planChunks(30, 1); }, "at least 2");
+  SolverOptions o;
+  o.framesPerChunk = 1;
+  checks::expectError([&] { validateOptions(o); }, "frames per chunk");
+}
+
+TEST(Chunks, SlicedRigKeepsThePosesOfItsFrames)
+{
+  LightRig r = rig();
+  r.directionalLights.emplace_back(std::vector<Vec3>(Frames, Vec3(0, 0, 1)), Rgb(1));
+  r.areaLights.emplace_back(
+    scenes::squareLightFacingDown({ 0.5, 0.5, 0.95 }, 0.1), Rgb(1), std::vector<Vec3>{ Vec3() });
+  const LightRig s = sliceRig(r, 3, 5);
+  EXPECT_EQ(frameCount(s, false), 5u);
+  EXPECT_EQ(s.areaLights[0].pose(0).position.x, r.areaLights[0].pose(3).position.x);
+  EXPECT_EQ(s.areaLights[0].pose(4).position.x, r.areaLights[0].pose(7).position.x);
+  EXPECT_EQ(s.areaLights[1].frameCount(), 1u); // static lights stay static
+  EXPECT_EQ(s.directionalLights[0].frameCount(), 5u);
+}
+
+TEST(Chunks, OneChunkIsThePlainSolveBitForBit)
+{
+  const Scene scene = box();
+  SolverOptions o = options(20000, 7);
+  o.errorBatches = 4;
+  Solution plain = solve(scene, rig(), o);
+  for (const std::size_t c : { 0, 12, 50 })
+  {
+    Solution chunked = solveInChunks(scene, rig(), o, c);
+    EXPECT_EQ(chunked.statistics.chunks, 1u);
+    EXPECT_TRUE(checks::sameBits(plain.directData(), chunked.directData()));
+    EXPECT_TRUE(checks::sameBits(plain.indirectData(), chunked.indirectData()));
+    EXPECT_TRUE(checks::sameBits(plain.patchData(), chunked.patchData()));
+    EXPECT_TRUE(checks::sameBits(plain.stdErrorData(), chunked.stdErrorData()));
+  }
+}
+
+TEST(Chunks, ThreadCountDoesNotChangeABit)
+{
+  const Scene scene = box();
+  SolverOptions o = options(20000, 42, 1);
+  o.errorBatches = 3;
+  Solution one = solveInChunks(scene, rig(), o, 4);
+  o.threads = 2;
+  Solution two = solveInChunks(scene, rig(), o, 4);
+  o.threads = 3;
+  Solution three = solveInChunks(scene, rig(), o, 4);
+  EXPECT_EQ(one.statistics.chunks, 3u);
+  EXPECT_EQ(one.frameCount(), Frames);
+  for (Solution* s : { &two, &three })
+  {
+    EXPECT_TRUE(checks::sameBits(one.directData(), s->directData()));
+    EXPECT_TRUE(checks::sameBits(one.indirectData(), s->indirectData()));
+    EXPECT_TRUE(checks::sameBits(one.patchData(), s->patchData()));
+    EXPECT_TRUE(checks::sameBits(one.stdErrorData(), s->stdErrorData()));
+    EXPECT_EQ(one.statistics.shadowRays, s->statistics.shadowRays);
+  }
+  // Chunks differ from the plain solve: their seeds and positions are their own.
+  Solution plain = solve(scene, rig(), o);
+  EXPECT_FALSE(checks::sameBits(one.directData(), plain.directData()));
+}
+
+TEST(Chunks, StreamedFramesAreTheAssembledOnes)
+{
+  const Scene scene = box();
+  SolverOptions o = options(20000, 3);
+  o.errorBatches = 2;
+  Solution whole = solveInChunks(scene, rig(), o, 5);
+  std::size_t next = 0;
+  const Solution stats = solveInChunks(scene, rig(), o, 5, {},
+    [&](std::size_t first, Solution& frames)
+    {
+      EXPECT_EQ(first, next);
+      next += frames.frameCount();
+      for (std::size_t f = 0; f < frames.frameCount(); ++f)
+      {
+        for (std::size_t e = 0; e < scene.elementCount(); ++e)
+        {
+          for (const Side side : { Side::Front, Side::Back })
+          {
+            ASSERT_EQ(
+              frames.irradiance(f, e, side).sum(), whole.irradiance(first + f, e, side).sum());
+            ASSERT_EQ(frames.irradianceStdError(f, e, side).sum(),
+              whole.irradianceStdError(first + f, e, side).sum());
+          }
+        }
+        EXPECT_EQ(frames.errorEstimate.relativeErrorP95.size(), frames.frameCount());
+      }
+    });
+  EXPECT_EQ(next, Frames);
+  EXPECT_EQ(stats.frameCount(), 0u);
+  EXPECT_EQ(stats.statistics.frames, Frames);
+  EXPECT_EQ(stats.statistics.chunks, 3u);
+  EXPECT_EQ(stats.statistics.shadowRays, whole.statistics.shadowRays);
+}
+
+TEST(Chunks, MeanOverSeedsAtASeamIsClassics)
+{
+  // 4 frames per chunk, m = 1: frames 3 and 4 blend chunks 0 and 1. Over S seeds the mean of
+  // each mode's frame mean differs from the other's by noise only: 4 standard errors of the
+  // difference, from the seeds' own spread.
+  const Scene scene = box();
+  constexpr int Seeds = 12;
+  constexpr std::uint64_t Paths = 8000;
+  const std::vector<std::size_t> frames{ 1, 3, 4, 8 };
+  std::vector<double> sumC(frames.size()), sqC(frames.size()), sumR(frames.size()),
+    sqR(frames.size());
+  for (int seed = 0; seed < Seeds; ++seed)
+  {
+    const Solution chunked = solveInChunks(scene, rig(), options(Paths, 100 + seed), 4);
+    const Solution classic =
+      solve(scene, rig(), checks::modeOptions(false, Paths, 500 + static_cast<unsigned>(seed)));
+    for (std::size_t i = 0; i < frames.size(); ++i)
+    {
+      const double c = frameMean(scene, chunked, frames[i]);
+      const double r = frameMean(scene, classic, frames[i]);
+      sumC[i] += c;
+      sqC[i] += c * c;
+      sumR[i] += r;
+      sqR[i] += r * r;
+    }
+  }
+  for (std::size_t i = 0; i < frames.size(); ++i)
+  {
+    const double mc = sumC[i] / Seeds, mr = sumR[i] / Seeds;
+    const double vc = (sqC[i] - Seeds * mc * mc) / (Seeds - 1);
+    const double vr = (sqR[i] - Seeds * mr * mr) / (Seeds - 1);
+    const double tolerance = 4 * std::sqrt((vc + vr) / Seeds);
+    EXPECT_NEAR(mc, mr, tolerance) << "frame " << frames[i];
+    EXPECT_GT(mc, 0);
+  }
+}
+
+TEST(Chunks, MemoryLimitForTwoFramesPerChunkGivesTheRightResult)
+{
+  // Enough frames that the frames, not the scene's fixed buffers, decide the memory.
+  constexpr std::size_t Long = 40;
+  const Scene scene = box();
+  SolverOptions o = options(20000, 11);
+  const auto estimate = [&](std::size_t c)
+  {
+    return estimateChunkedMemory(
+      scene.patchCount(), scene.elementCount(), scene.points().size(), Long, c, o, 1, 0, true);
+  };
+  ASSERT_LT(estimate(2), estimate(3));
+  o.memoryLimitBytes = (estimate(2) + estimate(3)) / 2;
+  const std::size_t c = chooseFramesPerChunk(
+    scene.patchCount(), scene.elementCount(), scene.points().size(), Long, o, 1, 0, true);
+  EXPECT_EQ(c, 2u);
+  // The whole solve would not fit: the memory check refuses it.
+  checks::expectError([&] { solve(scene, rig(Long), o); }, "memory");
+
+  // Streamed in chunks of 2, every frame agrees with a plain solve of 8 times the paths: each
+  // frame's mean radiosity within 5 standard errors, the relative standard error of a frame
+  // mean being about 1/sqrt(N) (the box's walls all see the light).
+  std::vector<double> means(Long);
+  solveInChunks(scene, rig(Long), o, c, {},
+    [&](std::size_t first, Solution& frames)
+    {
+      for (std::size_t f = 0; f < frames.frameCount(); ++f)
+      {
+        means[first + f] = frameMean(scene, frames, f);
+      }
+    });
+  SolverOptions reference = options(160000, 12);
+  const Solution ref = solve(scene, rig(Long), reference);
+  for (std::size_t f = 0; f < Long; ++f)
+  {
+    const double r = frameMean(scene, ref, f);
+    EXPECT_NEAR(means[f], r, 5 * r / std::sqrt(20000.0)) << "frame " << f;
+  }
+}
+
+TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
+{
+  // Through the one entry point: a set C is used, the frames stream, the statistics say so.
+  PolygonSoup soup = scenes::boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }, true);
+  AnimationOptions options;
+  options.solver.pathsPerFrame = 10000;
+  options.solver.threads = 2;
+  options.solver.framesPerChunk = 4;
+  options.remeshing.targetEdgeLength = 0.25;
+  std::size_t streamed = 0;
+  options.chunkFrames = [&](const Animation& animation, std::size_t first, Solution& frames)
+  {
+    EXPECT_EQ(animation.scene.elementCount(), frames.elementCount());
+    EXPECT_EQ(first, streamed);
+    streamed += frames.frameCount();
+  };
+  const Animation a = solveAnimation(soup, rig(), options);
+  EXPECT_EQ(streamed, Frames);
+  EXPECT_EQ(a.solution.statistics.chunks, 3u);
+  EXPECT_EQ(a.solution.statistics.framesPerChunk, 4u);
+  options.sensors.points.push_back(Vec3(0.5, 0.5, 0.01));
+  options.sensors.normals.push_back(Vec3(0, 0, 1));
+  checks::expectError([&] { solveAnimation(soup, rig(), options); }, "sensors");
+}
