@@ -80,7 +80,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       patches, elements, points, frames, options.solver, lightCount, outputs, streamed);
     checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
                        options.solver, lightCount, outputs, streamed),
-      std::min(frames, framesPerChunk), patches, elements, options.solver, approximate);
+      streamed ? std::min(frames, framesPerChunk) : frames, patches, elements, options.solver,
+      approximate);
   };
 
   RemeshOptions remeshing = options.remeshing;

@@ -358,6 +358,12 @@ void addRepairWarnings(CgalRemeshOutput& out)
     out.warnings.push_back("removed " + countOf(out.duplicateTriangles, "duplicate triangle") +
       " (on the same 3 points as an earlier one, whose material was kept)");
   }
+  if (out.foldedTriangles > 0)
+  {
+    out.warnings.push_back("removed " + countOf(out.foldedTriangles, "triangle") +
+      " lying on an earlier one (sharing an edge, in its plane and on its side: two "
+      "triangulations of one face, whose first was kept)");
+  }
   if (out.splitPoints > 0)
   {
     out.warnings.push_back("split " + countOf(out.splitPoints, "point") +

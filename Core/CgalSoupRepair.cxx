@@ -9,6 +9,7 @@
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 
 #include <algorithm>
+#include <array>
 
 namespace mlr::detail
 {
@@ -79,6 +80,62 @@ std::size_t removeDuplicateTriangles(RepairedSoup& soup, CancellationPoll& poll)
       keep[sorted[i].second] = false;
       ++removed;
     }
+  }
+  keepTriangles(soup, keep);
+  return removed;
+}
+
+/// Keeps the first of two triangles that share an edge, lie in one plane and are on the same
+/// side of that edge, so that they overlap: two triangulations of one face, or a face folded
+/// onto itself. CGAL 5.5's autorefinement does not handle three such coplanar faces meeting
+/// at a point (it binds a reference to a null point), and no surface can hold both.
+std::size_t removeFoldedTriangles(RepairedSoup& soup, CancellationPoll& poll)
+{
+  std::vector<std::array<std::size_t, 4>> edges; // a, b (a < b), opposite corner, triangle
+  edges.reserve(3 * soup.triangles.size());
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    const CgalTriangle& t = soup.triangles[i];
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::size_t a = t[k], b = t[(k + 1) % 3];
+      edges.push_back({ std::min(a, b), std::max(a, b), t[(k + 2) % 3], i });
+    }
+  }
+  std::sort(edges.begin(), edges.end(),
+    [&poll](const auto& x, const auto& y)
+    {
+      poll.tick();
+      return x < y;
+    });
+  std::vector<bool> keep(soup.triangles.size(), true);
+  std::size_t removed = 0;
+  for (std::size_t e = 0; e < edges.size();)
+  {
+    std::size_t end = e + 1;
+    while (end < edges.size() && edges[end][0] == edges[e][0] && edges[end][1] == edges[e][1])
+    {
+      ++end;
+    }
+    const Point& a = soup.points[edges[e][0]];
+    const Point& b = soup.points[edges[e][1]];
+    for (std::size_t j = e + 1; j < end; ++j)
+    {
+      for (std::size_t i = e; i < j && keep[edges[j][3]]; ++i)
+      {
+        poll.tick();
+        const Point& c = soup.points[edges[i][2]];
+        const Point& d = soup.points[edges[j][2]];
+        if (keep[edges[i][3]] && edges[i][3] != edges[j][3] && CGAL::coplanar(a, b, c, d) &&
+          CGAL::coplanar_orientation(a, b, c, d) == CGAL::POSITIVE)
+        {
+          const std::size_t later = std::max(edges[i][3], edges[j][3]);
+          keep[later] = false;
+          ++removed;
+        }
+      }
+    }
+    e = end;
   }
   keepTriangles(soup, keep);
   return removed;
@@ -159,6 +216,7 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
   poll.check();
   out.degenerateTriangles = removeDegenerateTriangles(soup);
   out.duplicateTriangles = removeDuplicateTriangles(soup, poll);
+  out.foldedTriangles = removeFoldedTriangles(soup, poll);
   PMP::remove_isolated_points_in_polygon_soup(soup.points, soup.triangles);
   poll.check();
   // A soup that already is an oriented manifold mesh (most are) would come out of

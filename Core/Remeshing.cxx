@@ -487,7 +487,8 @@ void buildPatches(const PolygonSoup& soup, const detail::TriangleSoup& triangles
     }
     result.statistics.regions = cgal.regions;
     result.statistics.fallbackRegions = cgal.fallbackRegions;
-    result.statistics.removedTriangles = cgal.degenerateTriangles + cgal.duplicateTriangles;
+    result.statistics.removedTriangles =
+      cgal.degenerateTriangles + cgal.duplicateTriangles + cgal.foldedTriangles;
     result.statistics.contactSplitTriangles = cgal.contactSplitTriangles;
     result.statistics.coveredTriangles = cgal.coveredTriangles;
     result.statistics.coveredArea = cgal.coveredArea;

@@ -409,6 +409,26 @@ TEST(RemeshingMessyInput, DuplicatePolygonsAreIgnoredKeepingTheFirstMaterial)
   }
 }
 
+TEST(RemeshingMessyInput, TwoTriangulationsOfOneFaceKeepTheFirst)
+{
+  // A quad and, in its plane on the same corners, triangles over it cut along the other
+  // diagonal, with a wall standing on one edge: CGAL's autorefinement cannot split three such
+  // coplanar faces, so the later ones must not reach it.
+  PolygonSoup soup;
+  soup.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 2, 0 }, { 0, 1, 1 } };
+  soup.polygons = { { 0, 1, 2, 3 }, { 3, 2, 4 }, { 0, 1, 2 }, { 0, 2, 3 }, { 1, 2, 3 } };
+  soup.materials = { Material{ Rgb(0.5) }, Material{ Rgb(0.5) }, Material{ Rgb(0.3) },
+    Material{ Rgb(0.3) }, Material{ Rgb(0.3) } };
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "lying on an earlier one")) << joined(result.warnings);
+  const double quadArea = 1.5, wallArea = 0.5 * std::sqrt(3.0);
+  EXPECT_NEAR(totalArea(result.mesh), quadArea + wallArea, 0.005 * (quadArea + wallArea));
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    EXPECT_EQ(result.mesh.reflectance[p], Rgb(0.5)) << "patch " << p << " of a dropped triangle";
+  }
+}
+
 TEST(RemeshingMessyInput, SelfCrossingPolygonIsIgnoredWithAWarning)
 {
   PolygonSoup soup;
