@@ -272,6 +272,35 @@ public:
     return this->MergedValues.data();
   }
 
+  /// After collapse() and mergeOverflow(): the sums of (record, side), frame f's channels at
+  /// run.base + f * run.frameStride, or a null base for a side nothing scored.
+  SlotRun summed(std::size_t record, int side) const
+  {
+    const std::size_t s = this->storedIndex(record, side);
+    if (s != Unstored)
+    {
+      return { this->Values.get() + s * this->SideStride, this->FrameStride, false };
+    }
+    const auto merged = this->Merged.find(record * 2 + static_cast<std::size_t>(side));
+    if (merged == this->Merged.end())
+    {
+      return {};
+    }
+    return { const_cast<std::int64_t*>(this->MergedValues.data()) + merged->second, Channels,
+      false };
+  }
+
+  /// One frame's channels of a summed() run, in the values' units.
+  void read(const SlotRun& run, std::size_t frame, double* out) const
+  {
+    for (int c = 0; c < Channels; ++c)
+    {
+      out[c] = run.base
+        ? static_cast<double>(run.base[frame * run.frameStride + c]) * this->Quantum[c]
+        : 0.0;
+    }
+  }
+
   /// Sides without slots that paths scored, over every worker.
   std::size_t overflowSides() const
   {

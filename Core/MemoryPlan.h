@@ -17,7 +17,8 @@ namespace mlr
  * allocations. Results are single precision (PackedRgb): direct irradiance per element side,
  * patch radiosity per patch side, and indirect irradiance per element side, allocated when
  * gathering starts, after the shooting accumulators are freed. The peak is the larger of the
- * two phases. Shooting accumulators (64-bit fixed point) take one copy per worker (plain
+ * two phases. Shooting accumulators (64-bit fixed point, for the reachable sides once they are
+ * known; see planSolveMemory) take one copy per worker (plain
  * adds, the fastest) when that peak fits in half the memory limit, and otherwise one copy
  * shared by the workers (atomic adds: memory independent of the core count; shooting 1.5x to
  * 1.8x slower where the sums stay in cache, faster on large scenes that wait on memory).

@@ -568,6 +568,8 @@ void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int wor
 
 void ShootingRun::addTo(Solution& solution) const
 {
+  // The sums are collapsed and merged (sumAcrossWorkersAndRanks): each side's run is looked
+  // up once, and sides nothing scored (the unreachable ones) are skipped.
   const std::size_t elements = this->SceneRef.elementCount();
   const std::size_t patches = this->SceneRef.patchCount();
   const std::size_t frames = solution.frameCount();
@@ -580,10 +582,15 @@ void ShootingRun::addTo(Solution& solution) const
     const Rgb irradiance = this->SourceRef.power() / this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
+      const SlotRun run = this->ElementShare.summed(e, s);
+      if (!run.base)
+      {
+        continue;
+      }
       for (std::size_t f = 0; f < frames; ++f)
       {
         double share = 0;
-        this->ElementShare.total(e, s, positionOf(f), &share);
+        this->ElementShare.read(run, positionOf(f), &share);
         if (share != 0)
         {
           direct[solution.elementIndex(f, e, static_cast<Side>(s))] +=
@@ -598,21 +605,32 @@ void ShootingRun::addTo(Solution& solution) const
     const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->SourceRef.power();
     for (int s = 0; s < 2; ++s)
     {
+      const SlotRun power = this->PatchPower.summed(p, s);
+      SlotRun element[Scene::ElementsPerPatch];
+      bool any = power.base != nullptr;
+      for (std::size_t i = 0; i < Scene::ElementsPerPatch; ++i)
+      {
+        element[i] = this->ElementShare.summed(p * Scene::ElementsPerPatch + i, s);
+        any = any || element[i].base;
+      }
+      if (!any)
+      {
+        continue; // zeros: adding them changes no bit
+      }
       for (std::size_t f = 0; f < frames; ++f)
       {
         const std::size_t k = positionOf(f);
-        double power[3];
-        this->PatchPower.total(p, s, k, power);
+        double sums[3];
+        this->PatchPower.read(power, k, sums);
         double share = 0;
-        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
-             ++e)
+        for (const SlotRun& run : element)
         {
           double elementShare = 0;
-          this->ElementShare.total(e, s, k, &elementShare);
+          this->ElementShare.read(run, k, &elementShare);
           share += elementShare;
         }
         patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
-          (Rgb(power[0], power[1], power[2]) + firstHitColour * share) * this->SourceRef.factor(k) *
+          (Rgb(sums[0], sums[1], sums[2]) + firstHitColour * share) * this->SourceRef.factor(k) *
           inverseArea;
       }
     }
