@@ -148,8 +148,7 @@ bool parse(int argc, char** argv, Arguments& a)
       {
         std::fprintf(stderr,
           "mlr-benchmark: --case must be all, paper, rotating, spotlight, sun, "
-          "remesh, long, chunks, large, ends, error-bars or target-error
-");
+          "remesh, long, chunks, large, ends, error-bars or target-error\n");
         return false;
       }
     }
