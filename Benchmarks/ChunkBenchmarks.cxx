@@ -110,7 +110,7 @@ std::string runChunkedAnimation(const ScaleCaseOptions& scale)
   std::printf("\nLong animations in chunks of %zu frames (overlap %zu), streamed, N = %llu, "
               "full reuse\n%8s %7s %9s %9s %12s %12s %14s\n",
     framesPerChunk, chunkOverlap(framesPerChunk), static_cast<unsigned long long>(Paths), "frames",
-    "chunks", "total s", "ms/frame", "peak MiB", "estimate MiB");
+    "chunks", "total s", "ms/frame", "solve MiB", "process MiB", "estimate MiB");
   std::fflush(stdout);
   std::ostringstream json;
   json << "{\"frames_per_chunk\": " << framesPerChunk << ", \"runs\": [";
