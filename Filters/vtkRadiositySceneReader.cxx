@@ -37,6 +37,16 @@ std::string lowerExtension(const char* fileName)
   return extension;
 }
 
+/// A name from the file as a value of a string array: VTK's XML format ends each value with a
+/// NUL byte, so a name holding one would come back as two values, and its reader then writes
+/// past the array's end. Control characters become '?', which also keeps them off the screen.
+std::string printableName(std::string name)
+{
+  std::replace_if(
+    name.begin(), name.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; }, '?');
+  return name;
+}
+
 vtkSmartPointer<vtkStringArray> stringField(const char* name, const std::string& value)
 {
   auto array = vtkSmartPointer<vtkStringArray>::New();
@@ -182,7 +192,7 @@ int vtkRadiositySceneReader::RequestData(
   names->SetName("MaterialNames");
   for (const auto& material : scene.materials)
   {
-    names->InsertNextValue(material.name);
+    names->InsertNextValue(printableName(material.name));
   }
 
   output->SetPoints(scene.points);

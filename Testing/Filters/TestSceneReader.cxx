@@ -8,6 +8,7 @@
 #include "vtkFieldData.h"
 #include "vtkImageData.h"
 #include "vtkJPEGWriter.h"
+#include "vtkNew.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
@@ -15,6 +16,8 @@
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkXMLPolyDataReader.h"
+#include "vtkXMLPolyDataWriter.h"
 
 #include <gtest/gtest.h>
 
@@ -362,6 +365,30 @@ TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
   EXPECT_NE(result.warnings().find("'red'"), std::string::npos) << result.warnings();
   expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
   expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 0);
+}
+
+TEST(SceneReader, MaterialNamesWithControlCharactersSurviveAnXmlRoundTrip)
+{
+  // VTK's XML files end each string value with a NUL byte: a name holding one came back as
+  // two values, and the XML reader then wrote past the array's end.
+  const TestFolder scratch("control-characters");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "scene.obj",
+    std::string("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl a\0b\tc\nf 1 2 3\n"
+                "usemtl d\nf 1 3 4\n",
+      70));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "a?b?c", "d" }));
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetInputData(result.output);
+  writer->WriteToOutputStringOn();
+  ASSERT_EQ(writer->Write(), 1);
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->ReadFromInputStringOn();
+  reader->SetInputString(writer->GetOutputString());
+  reader->Update();
+  EXPECT_EQ(materialNames(reader->GetOutput()), materialNames(result.output));
 }
 
 // --- The same scene in every format -----------------------------------------------------------
