@@ -2,6 +2,7 @@
 // with the measured speed-up beside the paper's eq. (4) and our ray rate beside bare
 // Embree's for the same ray kinds; then a turning light and the sun over a town block
 // (RigBenchmarks.h). Everything printed is measured in this one run.
+#include "AnnualBenchmark.h"
 #include "BareEmbree.h"
 #include "Error.h"
 #include "GeneratedScenes.h"
@@ -36,6 +37,7 @@ struct Arguments
   int referenceFactor = 16;
   std::string cache = "output/benchmark-cache";
   std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
+  bench::AnnualCaseOptions annual;  ///< --weather, --dates, --classic-frames
 };
 
 void usage()
@@ -66,7 +68,11 @@ void usage()
     "            and peak memory against the estimate (about 3 minutes, not in all)\n"
     "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half "
     "the\n"
-    "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n");
+    "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n"
+    "  annual:   the town block with about 1,000 work-plane sensors under every daylit hour of a\n"
+    "            weather file: full reuse end to end, classic on K frames extrapolated, MSE,\n"
+    "            memory (not in all); --weather FILE.epw (default Data/paris_synthetic.epw),\n"
+    "            --dates MM-DD,MM-DD (default the whole year), --classic-frames K (default 48)\n");
 }
 
 bool parse(int argc, char** argv, Arguments& a)
@@ -101,11 +107,11 @@ bool parse(int argc, char** argv, Arguments& a)
       a.which = argv[++i];
       if (a.which != "all" && a.which != "paper" && a.which != "rotating" &&
         a.which != "spotlight" && a.which != "sun" && a.which != "remesh" && a.which != "long" &&
-        a.which != "large")
+        a.which != "large" && a.which != "annual")
       {
         std::fprintf(stderr,
           "mlr-benchmark: --case must be all, paper, rotating, spotlight, sun, "
-          "remesh, long or large\n");
+          "remesh, long, large or annual\n");
         return false;
       }
     }
@@ -116,6 +122,18 @@ bool parse(int argc, char** argv, Arguments& a)
     else if (flag == "--memory-limit-mib" && hasValue)
     {
       a.memoryLimitMiB = std::strtoull(argv[++i], nullptr, 10);
+    }
+    else if (flag == "--weather" && hasValue)
+    {
+      a.annual.weather = argv[++i];
+    }
+    else if (flag == "--dates" && hasValue)
+    {
+      a.annual.dates = argv[++i];
+    }
+    else if (flag == "--classic-frames" && hasValue)
+    {
+      a.annual.classicFrames = std::strtoull(argv[++i], nullptr, 10);
     }
     else if (flag == "--cache" && hasValue)
     {
@@ -358,6 +376,15 @@ int main(int argc, char** argv)
     if (args.which == "large")
     {
       json.push_back("  \"large_scene\": " + bench::runLargeScene(scaleOptions));
+    }
+    if (args.which == "annual")
+    {
+      bench::AnnualCaseOptions annual = args.annual;
+      annual.paths = args.paths;
+      annual.threads = args.threads;
+      annual.referenceFactor = args.referenceFactor;
+      annual.cacheDirectory = args.cache;
+      json.push_back("  \"annual\": " + bench::runAnnual(annual));
     }
     if (!args.json.empty())
     {
