@@ -71,7 +71,8 @@ void usage()
     "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n"
     "  annual:   the town block with about 1,000 work-plane sensors under every daylit hour of a\n"
     "            weather file: full reuse end to end, classic on K frames extrapolated, MSE,\n"
-    "            memory (not in all); --weather FILE.epw (default Data/paris_synthetic.epw),\n"
+    "            memory (2 minutes, 10 more the first time; not in all); --weather FILE.epw "
+    "(default Data/paris_synthetic.epw),\n"
     "            --dates MM-DD,MM-DD (default the whole year), --classic-frames K (default 48)\n");
 }
 
