@@ -2,16 +2,19 @@
 // block, each full reuse against classic with errors against a high-N classic reference.
 #pragma once
 
+#include "LightSource.h"
+#include "Scene.h"
+#include "Solution.h"
+#include "SolverOptions.h"
+
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mlr
 {
 struct PatchMesh;
-class Scene;
-struct LightRig;
-struct SolverOptions;
 }
 
 namespace mlr::bench
@@ -66,5 +69,24 @@ struct ReferenceRadiosity
 ReferenceRadiosity classicReference(const std::string& name, const PatchMesh& mesh,
   const Scene& scene, const LightRig& rig, const SolverOptions& base,
   const RigCaseOptions& options);
+/// Errors against a classic reference of a rig, for the cases of other files.
+struct ReferenceErrors
+{
+  std::uint64_t referencePaths = 0;
+  double referenceSeconds = 0; ///< what the reference's solve took when it was computed
+  bool cached = false;
+  /// Per solution given, per frame of the rig: the MSE as the cases above measure it.
+  std::vector<std::vector<double>> mse;
+  std::vector<double> referenceMeanRadiosity; ///< per frame of the rig
+};
+
+/**
+ * The MSE of each of `solutions` against classic at referenceFactor x N (another seed) of
+ * `rig` on `mesh`, cached in c.cacheDirectory under `name` as the other cases' references:
+ * solution i's frame frames[i][f] against the reference's frame f, for every frame f of `rig`.
+ */
+ReferenceErrors referenceErrors(const std::string& name, const PatchMesh& mesh, const Scene& scene,
+  const LightRig& rig, const SolverOptions& options, const RigCaseOptions& c,
+  const std::vector<std::pair<const Solution*, std::vector<std::size_t>>>& solutions);
 
 } // namespace mlr::bench

@@ -152,7 +152,24 @@ SkyDistribution::SkyDistribution(
   }
 }
 
-double SkyDistribution::operator()(const Vec3& v) const
+double SkyDistribution::gradation(double z) const
+{
+  const double cosZ = std::max(z, 0.0);
+  switch (this->Model)
+  {
+    case SkyModel::Uniform:
+    case SkyModel::CieOvercast:
+      return 1.0;
+    case SkyModel::CieClear:
+      return cosZ > 0 ? 1.0 - std::exp(-0.32 / cosZ) : 1.0;
+    case SkyModel::Perez:
+      break;
+  }
+  const double* k = this->Coefficients;
+  return cosZ > 0 ? 1.0 + k[0] * std::exp(k[1] / cosZ) : 1.0 + 0.0 * k[0];
+}
+
+double SkyDistribution::operator()(const Vec3& v, double gradation) const
 {
   const double cosZ = std::max(v.z, 0.0);
   switch (this->Model)
@@ -164,7 +181,6 @@ double SkyDistribution::operator()(const Vec3& v) const
     case SkyModel::CieClear:
     {
       const double chi = std::acos(std::clamp(dot(v, this->Sun), -1.0, 1.0));
-      const double gradation = cosZ > 0 ? 1.0 - std::exp(-0.32 / cosZ) : 1.0;
       const double c = std::cos(chi);
       const double indicatrix =
         1.0 + 10.0 * (std::exp(-3.0 * chi) - std::exp(-3.0 * M_PI / 2)) + 0.45 * c * c;
@@ -175,7 +191,6 @@ double SkyDistribution::operator()(const Vec3& v) const
   }
   const double* k = this->Coefficients;
   const double gamma = std::acos(std::clamp(dot(v, this->Sun), -1.0, 1.0));
-  const double gradation = cosZ > 0 ? 1.0 + k[0] * std::exp(k[1] / cosZ) : 1.0 + 0.0 * k[0];
   const double c = std::cos(gamma);
   // Negative only where the fit extrapolates badly: no light there.
   return std::max(0.0, gradation * (1.0 + k[2] * std::exp(k[3] * gamma) + k[4] * c * c));
@@ -293,6 +308,30 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, in
   std::vector<std::uint8_t> dark(positions, 0);
   const int workers = resolveThreadCount(threads);
   std::vector<std::vector<double>> means(static_cast<std::size_t>(workers));
+  // The subsamples' directions, the same for every position: cos and sin of each azimuth,
+  // and the cosine and sine of each zenith angle.
+  std::vector<double> cosPhi(std::size_t(Sectors) * SubSamples),
+    sinPhi(std::size_t(Sectors) * SubSamples), ringCos(std::size_t(Rings) * SubSamples),
+    ringSin(std::size_t(Rings) * SubSamples);
+  for (int s = 0; s < Sectors; ++s)
+  {
+    for (int j = 0; j < SubSamples; ++j)
+    {
+      const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
+      cosPhi[std::size_t(s) * SubSamples + j] = std::cos(phi);
+      sinPhi[std::size_t(s) * SubSamples + j] = std::sin(phi);
+    }
+  }
+  for (int r = 0; r < Rings; ++r)
+  {
+    const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
+    for (int i = 0; i < SubSamples; ++i)
+    {
+      const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
+      ringCos[std::size_t(r) * SubSamples + i] = cz;
+      ringSin[std::size_t(r) * SubSamples + i] = std::sqrt(std::max(0.0, 1 - cz * cz));
+    }
+  }
   parallelFor(
     positions, workers,
     [&](std::size_t k, int worker)
@@ -303,24 +342,30 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, in
       const SkyDistribution f(model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
         frame.directNormal, frame.dayOfYear);
       double horizontal = 0, total = 0;
+      double gradation[SubSamples];
       for (int r = 0; r < Rings; ++r)
       {
         const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
         const double solidAngle = SectorStep * (c0 - c1);
         const double cosine = SectorStep * (c0 * c0 - c1 * c1) / 2;
+        const double* cz = ringCos.data() + std::size_t(r) * SubSamples;
+        const double* sz = ringSin.data() + std::size_t(r) * SubSamples;
+        for (int i = 0; i < SubSamples; ++i)
+        {
+          gradation[i] = f.gradation(cz[i]);
+        }
         for (int s = 0; s < Sectors; ++s)
         {
           // The cell's mean by the midpoint rule in cos(theta) and phi, which is uniform in
           // solid angle: the paths draw directions uniformly within the cell.
           double sum = 0;
+          const double* cp = cosPhi.data() + std::size_t(s) * SubSamples;
+          const double* sp = sinPhi.data() + std::size_t(s) * SubSamples;
           for (int i = 0; i < SubSamples; ++i)
           {
-            const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
-            const double sz = std::sqrt(std::max(0.0, 1 - cz * cz));
             for (int j = 0; j < SubSamples; ++j)
             {
-              const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
-              sum += f({ sz * std::cos(phi), sz * std::sin(phi), cz });
+              sum += f({ sz[i] * cp[j], sz[i] * sp[j], cz[i] }, gradation[i]);
             }
           }
           const double m = sum / (SubSamples * SubSamples);

@@ -48,7 +48,15 @@ public:
   SkyDistribution(SkyModel model, const Vec3& sun, double diffuseHorizontal, double directNormal,
     int dayOfYear = 0);
   /// At the unit direction `towardsSky` (z >= 0).
-  double operator()(const Vec3& towardsSky) const;
+  double operator()(const Vec3& towardsSky) const
+  {
+    return (*this)(towardsSky, this->gradation(towardsSky.z));
+  }
+  /// The same, with gradation(towardsSky.z) given: it depends on the zenith angle alone, so
+  /// that a table of a ring's directions computes it once.
+  double operator()(const Vec3& towardsSky, double gradation) const;
+  /// The factor of the clear and Perez models that depends on the zenith angle alone.
+  double gradation(double cosZenith) const;
   /// The Perez sky clearness epsilon and brightness Delta (1 and 0 for the other models).
   double clearness() const { return this->Clearness; }
   double brightness() const { return this->Brightness; }

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <functional>
 
 using namespace mlr;
@@ -368,4 +370,39 @@ TEST(Sky, AConstantSkyIsOnePositionSolvedOnce)
   EXPECT_EQ(Sky(SkyModel::CieClear, { 0, 0, 1 }, moving).positions(), 3u);
   // The uniform and overcast skies ignore the sun.
   EXPECT_EQ(Sky(SkyModel::CieOvercast, { 0, 0, 1 }, moving).positions(), 1u);
+}
+
+TEST(Sky, TheTablesAreTheSameBitsForAnyThreadCount)
+{
+  // Every model over frames whose sun and irradiances change, tabulated on 1 and 3 workers:
+  // each position's cells, integral and draws agree bit for bit.
+  std::vector<SkyFrame> frames;
+  for (int k = 0; k < 7; ++k)
+  {
+    frames.push_back(
+      SkyFrame{ sunDirection(10 + 9 * k, 25 * k), 80 + 5 * k, 100 + 60 * k, 30 * k });
+  }
+  for (SkyModel model :
+    { SkyModel::Uniform, SkyModel::CieOvercast, SkyModel::CieClear, SkyModel::Perez })
+  {
+    const Sky one(model, { 0.1, 0, 1 }, frames, 1), three(model, { 0.1, 0, 1 }, frames, 3);
+    ASSERT_EQ(one.positions(), three.positions());
+    std::uint64_t hash = 1469598103934665603ULL;
+    for (std::size_t j = 0; j < one.positions(); ++j)
+    {
+      EXPECT_EQ(one.integral(j), three.integral(j)) << skyModelName(model) << " " << j;
+      for (std::size_t cell = 0; cell < Sky::Cells; ++cell)
+      {
+        ASSERT_EQ(one.density(j, cell), three.density(j, cell)) << skyModelName(model);
+        double d = one.density(j, cell);
+        std::uint64_t bits;
+        std::memcpy(&bits, &d, sizeof bits);
+        hash = (hash ^ bits) * 1099511628211ULL;
+      }
+      const Vec3 a = one.sample(j, 0.3, 0.6, 0.2), b = three.sample(j, 0.3, 0.6, 0.2);
+      EXPECT_TRUE(a.x == b.x && a.y == b.y && a.z == b.z);
+    }
+    std::printf(
+      "%s: tables %016llx\n", skyModelName(model).c_str(), static_cast<unsigned long long>(hash));
+  }
 }
