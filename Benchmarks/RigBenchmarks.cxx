@@ -743,43 +743,45 @@ ReferenceRadiosity classicReference(const std::string& name, const PatchMesh& me
   checkOptions(options);
   Reference ref = referenceSolution(name, mesh, scene, rig, base, options);
   return { ref.paths, std::move(ref.litSide), std::move(ref.radiosity) };
-  ReferenceErrors referenceErrors(const std::string& name, const PatchMesh& mesh,
-    const Scene& scene, const LightRig& rig, const SolverOptions& options, const RigCaseOptions& c,
-    const std::vector<std::pair<const Solution*, std::vector<std::size_t>>>& solutions)
+}
+
+ReferenceErrors referenceErrors(const std::string& name, const PatchMesh& mesh, const Scene& scene,
+  const LightRig& rig, const SolverOptions& options, const RigCaseOptions& c,
+  const std::vector<std::pair<const Solution*, std::vector<std::size_t>>>& solutions)
+{
+  checkOptions(c);
+  const Reference ref = referenceSolution(name, mesh, scene, rig, options, c);
+  ReferenceErrors out;
+  out.referencePaths = ref.paths;
+  out.referenceSeconds = ref.seconds;
+  out.cached = ref.cached;
+  for (std::size_t f = 0; f < ref.frames; ++f)
   {
-    checkOptions(c);
-    const Reference ref = referenceSolution(name, mesh, scene, rig, options, c);
-    ReferenceErrors out;
-    out.referencePaths = ref.paths;
-    out.referenceSeconds = ref.seconds;
-    out.cached = ref.cached;
+    out.referenceMeanRadiosity.push_back(meanRadiosity(scene, ref, f));
+  }
+  for (const auto& [solution, frames] : solutions)
+  {
+    std::vector<double> mse;
     for (std::size_t f = 0; f < ref.frames; ++f)
     {
-      out.referenceMeanRadiosity.push_back(meanRadiosity(scene, ref, f));
-    }
-    for (const auto& [solution, frames] : solutions)
-    {
-      std::vector<double> mse;
-      for (std::size_t f = 0; f < ref.frames; ++f)
+      double sum = 0, area = 0;
+      for (std::size_t e = 0; e < scene.elementCount(); ++e)
       {
-        double sum = 0, area = 0;
-        for (std::size_t e = 0; e < scene.elementCount(); ++e)
+        const Rgb b = solution->total(frames[f], e, static_cast<Side>(ref.litSide[e]));
+        double squared = 0;
+        for (int channel = 0; channel < 3; ++channel)
         {
-          const Rgb b = solution->total(frames[f], e, static_cast<Side>(ref.litSide[e]));
-          double squared = 0;
-          for (int channel = 0; channel < 3; ++channel)
-          {
-            const double d = b[channel] - ref.at(f, e, channel);
-            squared += d * d;
-          }
-          sum += scene.elementArea(e) * squared / 3;
-          area += scene.elementArea(e);
+          const double d = b[channel] - ref.at(f, e, channel);
+          squared += d * d;
         }
-        mse.push_back(sum / area);
+        sum += scene.elementArea(e) * squared / 3;
+        area += scene.elementArea(e);
       }
-      out.mse.push_back(std::move(mse));
+      mse.push_back(sum / area);
     }
-    return out;
+    out.mse.push_back(std::move(mse));
   }
+  return out;
+}
 
 } // namespace mlr::bench
