@@ -380,7 +380,7 @@ TEST(Sky, TheTablesAreTheSameBitsForAnyThreadCount)
   for (int k = 0; k < 7; ++k)
   {
     frames.push_back(
-      SkyFrame{ sunDirection(10 + 9 * k, 25 * k), 80 + 5 * k, 100 + 60 * k, 30 * k });
+      SkyFrame{ sunDirection(10 + 9 * k, 25 * k), 80.0 + 5 * k, 100.0 + 60 * k, 30 * k });
   }
   for (SkyModel model :
     { SkyModel::Uniform, SkyModel::CieOvercast, SkyModel::CieClear, SkyModel::Perez })
