@@ -16,9 +16,10 @@ constexpr std::size_t GatheringSidesPerTask = 32;
 
 /**
  * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
- * on it; each ray that reaches a patch side adds that side's shooting radiosity. Their mean
- * is the side's indirect irradiance (the Solution applies rho_e). With reuse one set of rays
- * serves every frame; otherwise each frame casts its own.
+ * on it; each ray that reaches an element side adds Solution::gatheredRadiosity() there, its
+ * patch's bounced row and its own direct row times its reflectance. Their mean is the side's
+ * indirect irradiance (the Solution applies rho_e). With reuse one set of rays serves every
+ * frame; otherwise each frame casts its own.
  */
 void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
   std::uint32_t elementSide, std::uint64_t rays, Solution& solution, std::vector<Rgb>& sum,
@@ -33,23 +34,35 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   const Vec3 normal = scene.elementSideNormal(element, side);
   sum.assign(frames, Rgb());
 
-  // A hit's row of patch radiosity is added after the next ray is traced: the row was
-  // prefetched when the hit was found, so the trace hides its cache miss.
+  // A hit's rows (its patch's bounced light, its element's direct irradiance) are added after
+  // the next ray is traced: they were prefetched when the hit was found, so the trace hides
+  // their cache misses.
   const std::size_t passes = reuse ? 1 : frames;
   const std::size_t rowLength = reuse ? frames : 1;
+  const std::vector<Rgb>& reflectance = solution.reflectanceData();
   for (std::size_t pass = 0; pass < passes; ++pass)
   {
     Rgb* into = reuse ? sum.data() : &sum[pass];
     const PackedRgb* pending = nullptr;
+    const PackedRgb* pendingDirect = nullptr;
+    Rgb pendingReflectance;
     auto addPending = [&]
     {
       if (pending)
       {
         for (std::size_t f = 0; f < rowLength; ++f)
         {
-          into[f] += pending[f];
+          into[f] += Rgb(pending[f]) + pendingReflectance * Rgb(pendingDirect[f]);
         }
         pending = nullptr;
+      }
+    };
+    auto prefetch = [rowLength](const PackedRgb* row)
+    {
+      const char* bytes = reinterpret_cast<const char*>(row);
+      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
+      {
+        __builtin_prefetch(bytes + byte);
       }
     };
     RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
@@ -75,11 +88,11 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       }
       pending = solution.patchData().data() +
         solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hitElement), hitSide);
-      const char* row = reinterpret_cast<const char*>(pending);
-      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
-      {
-        __builtin_prefetch(row + byte);
-      }
+      pendingDirect = solution.directData().data() +
+        solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
+      pendingReflectance = reflectance[hitElement];
+      prefetch(pending);
+      prefetch(pendingDirect);
     }
     addPending();
   }
@@ -197,23 +210,16 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
 {
   for (std::size_t p = 0; p < scene.patchCount(); ++p)
   {
+    const Rgb& rho = scene.patchReflectance(p);
+    // As irradiance: a channel the patch does not reflect shows none of its indirect light.
+    const auto irradiance = [](double bounced, double reflectance)
+    { return reflectance > 0 ? bounced / reflectance : 0.0; };
     for (int s = 0; s < 2; ++s)
     {
       for (std::size_t f = 0; f < solution.frameCount(); ++f)
       {
-        Rgb directPower;
-        for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
-        {
-          directPower += solution.direct(f, e, static_cast<Side>(s)) * scene.elementArea(e);
-        }
-        const Rgb patchDirect = directPower / scene.patchArea(p);
-        const Rgb b = solution.patchRadiosity(f, p, static_cast<Side>(s));
-        // As irradiance: a channel the patch does not reflect shows none of its indirect light.
-        const Rgb& rho = scene.patchReflectance(p);
-        const auto irradiance = [](double radiosity, double directPart, double reflectance)
-        { return reflectance > 0 ? std::max(0.0, radiosity - directPart) / reflectance : 0.0; };
-        const Rgb rest(irradiance(b.r, patchDirect.r, rho.r), irradiance(b.g, patchDirect.g, rho.g),
-          irradiance(b.b, patchDirect.b, rho.b));
+        const Rgb b = solution.patchBounced(f, p, static_cast<Side>(s));
+        const Rgb rest(irradiance(b.r, rho.r), irradiance(b.g, rho.g), irradiance(b.b, rho.b));
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {
           solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] =

@@ -50,10 +50,10 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing,
   Solution& solution);
 
-/// Without gathering (k = 0) an element's indirect radiosity is its patch's shooting solution
-/// minus the patch's direct part (the area-weighted direct of its four elements), and its
-/// indirect irradiance that divided by the patch's reflectance: zero in a channel the patch
-/// does not reflect, so that a black patch shows only its direct irradiance.
+/// Without gathering (k = 0) an element's indirect radiosity is its patch's bounced light
+/// (Solution::patchBounced), and its indirect irradiance that divided by the patch's
+/// reflectance: zero in a channel the patch does not reflect, so that a black patch shows only
+/// its direct irradiance.
 void indirectFromPatches(const Scene& scene, Solution& solution);
 
 } // namespace mlr

@@ -165,7 +165,7 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
   const std::uint32_t rays = sensorOptions.hemisphereRays;
   scratch.gatheringRays += rays;
-  // What each ray found, as keys: a patch side (2 patch + side), or an escaped ray's sky cell
+  // What each ray found, as keys: an element side (2 element + side), or an escaped ray's sky cell
   // per sky. Sorted and counted, each distinct key costs one pass over the frames, however
   // many rays found it, and the sums run in key order.
   scratch.hits.clear();
@@ -188,7 +188,7 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
     }
     else if (options.twoSided || side == Side::Front)
     {
-      scratch.hits.push_back(2 * Scene::patchOfElement(element) + static_cast<std::size_t>(side));
+      scratch.hits.push_back(2 * static_cast<std::size_t>(element) + static_cast<std::size_t>(side));
     }
   }
   std::sort(scratch.hits.begin(), scratch.hits.end());
@@ -201,11 +201,11 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
       ++end;
     }
     const double count = static_cast<double>(end - i);
-    const std::size_t patch = scratch.hits[i] / 2;
+    const std::size_t element = scratch.hits[i] / 2;
     const Side side = static_cast<Side>(scratch.hits[i] % 2);
     for (std::size_t f = 0; f < frames; ++f)
     {
-      scratch.gathered[f] += Rgb(solution.patchRadiosity(f, patch, side)) * count;
+      scratch.gathered[f] += solution.gatheredRadiosity(f, element, side) * count;
     }
     i = end;
   }

@@ -599,21 +599,15 @@ void ShootingRun::addTo(Solution& solution) const
       }
     }
   }
+  // The patches keep the light that has bounced (Solution::patchBounced): their direct part is
+  // their elements', which the Solution adds where the whole patch radiosity is asked for.
   for (std::size_t p = 0; p < patches; ++p)
   {
     const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
-    const Rgb firstHitColour = this->SceneRef.patchReflectance(p) * this->SourceRef.power();
     for (int s = 0; s < 2; ++s)
     {
       const SlotRun power = this->PatchPower.summed(p, s);
-      SlotRun element[Scene::ElementsPerPatch];
-      bool any = power.base != nullptr;
-      for (std::size_t i = 0; i < Scene::ElementsPerPatch; ++i)
-      {
-        element[i] = this->ElementShare.summed(p * Scene::ElementsPerPatch + i, s);
-        any = any || element[i].base;
-      }
-      if (!any)
+      if (!power.base)
       {
         continue; // zeros: adding them changes no bit
       }
@@ -622,16 +616,8 @@ void ShootingRun::addTo(Solution& solution) const
         const std::size_t k = positionOf(f);
         double sums[3];
         this->PatchPower.read(power, k, sums);
-        double share = 0;
-        for (const SlotRun& run : element)
-        {
-          double elementShare = 0;
-          this->ElementShare.read(run, k, &elementShare);
-          share += elementShare;
-        }
         patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
-          (Rgb(sums[0], sums[1], sums[2]) + firstHitColour * share) * this->SourceRef.factor(k) *
-          inverseArea;
+          Rgb(sums[0], sums[1], sums[2]) * this->SourceRef.factor(k) * inverseArea;
       }
     }
   }

@@ -50,6 +50,8 @@ struct SolverStatistics
   /// shootingRays / pathsCast = 1 + lambda (l - 1).
   double meanPathLength = 0;
   double secondsRemeshing = 0; ///< set by callers that remesh before solving
+  /// The patch edge length the scene was remeshed to (scene units), by callers that remesh.
+  double patchEdgeLength = 0;
   double secondsSetup = 0;     ///< validation, allocation and building the BVH
   double secondsShooting = 0;
   double secondsGathering = 0;
@@ -142,10 +144,35 @@ public:
     return this->emitted(element, side) + this->direct(frame, element, side) +
       this->indirect(frame, element, side);
   }
-  /// The patch-level shooting solution (all bounces), which gathering reads.
+  /// The patch-level shooting solution (all bounces): its bounced light and the mean direct
+  /// radiosity of its four elements (of equal areas: the midpoints split it).
   Rgb patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
   {
+    Rgb direct;
+    for (std::size_t e = patch * Scene::ElementsPerPatch;
+         e < (patch + 1) * Scene::ElementsPerPatch; ++e)
+    {
+      direct += this->direct(frame, e, side);
+    }
+    return this->patchBounced(frame, patch, side) +
+      direct * (1.0 / static_cast<double>(Scene::ElementsPerPatch));
+  }
+  /// Of patchRadiosity(), the light that reached the patch after at least one bounce (W/m^2),
+  /// reflected: the part gathering reads as a patch mean.
+  Rgb patchBounced(std::size_t frame, std::size_t patch, Side side) const
+  {
     return this->Patch[this->patchIndex(frame, patch, side)];
+  }
+  /**
+   * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`)
+   * reads: its patch's bounced light and its own direct radiosity. The direct light, with its
+   * shadow edges, is known per element; only the light of later bounces, which varies slowly,
+   * is read as a patch mean (Documentation/Method.md, section 3).
+   */
+  Rgb gatheredRadiosity(std::size_t frame, std::size_t element, Side side) const
+  {
+    return this->patchBounced(frame, Scene::patchOfElement(element), side) +
+      this->direct(frame, element, side);
   }
   /// The side of an element that received more power over the whole animation.
   Side litSide(std::size_t element) const { return this->LitSide[element]; }
@@ -196,6 +223,7 @@ public:
   void clearRadiosity();
   /// The standard error of the irradiance of every element side and frame, or empty.
   std::vector<PackedRgb>& stdErrorData() { return this->StdError; }
+  /// The patches' bounced light (patchBounced()) of every patch side and frame.
   std::vector<PackedRgb>& patchData() { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }

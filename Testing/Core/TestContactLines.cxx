@@ -611,12 +611,13 @@ TEST(ContactLines, FloorElementsNextToTheBlockShowTheLightTheyReceive)
 TEST(ContactLines, IndirectLightOnTheBlockSidesDoesNotDependOnThePatchSize)
 {
   // Gathering on the block's sides reads the floor next to them. Coarse floor patches across
-  // the footprint's edge average it with the dark under the block, so the sides come out
-  // dark unless the floor is split there. Means and standard errors over seeds.
+  // the footprint's edge average their bounced light (and their elements' direct light) with
+  // the dark under the block, so the sides come out dark unless the floor is split there.
+  // Means and standard errors over seeds.
   auto sides = [](double h, bool split)
   {
     std::vector<double> values;
-    for (std::uint64_t seed = 1; seed <= 4; ++seed)
+    for (std::uint64_t seed = 1; seed <= 8; ++seed)
     {
       values.push_back(sidesIndirectPower(solveBlockOnFloor(h, split, 300000, seed)));
     }
@@ -641,7 +642,9 @@ TEST(ContactLines, IndirectLightOnTheBlockSidesDoesNotDependOnThePatchSize)
   const double noise = std::sqrt(fine.second * fine.second + coarse.second * coarse.second);
   // 4 standard errors, and 1.5% for what coarse patches change elsewhere (measured 0.4%).
   EXPECT_NEAR(coarse.first, fine.first, 4 * noise + 0.015 * fine.first);
-  EXPECT_LT(leaky.first, fine.first - 4 * noise - 0.015 * fine.first);
+  // Unsplit at the same patch size, the sides are darker beyond the noise (measured 4.6%).
+  EXPECT_LT(leaky.first,
+    coarse.first - 4 * std::sqrt(coarse.second * coarse.second + leaky.second * leaky.second));
 }
 
 // --- Cost and cancellation --------------------------------------------------------------------

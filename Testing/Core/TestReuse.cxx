@@ -169,7 +169,7 @@ TEST(Reuse, BalancedSharesBringTheEndsErrorDown)
   double smallest = 1, largest = 1;
   for (int balanced = 0; balanced < 2; ++balanced)
   {
-    for (int r = 0; r < 6; ++r)
+    for (int r = 0; r < 12; ++r)
     {
       SolverOptions o = modeOptions(true, 18000, 500 + r);
       o.balanceFrames = balanced == 1;

@@ -1,0 +1,155 @@
+// Final gathering: what a gathering ray reads where it lands, against form factors. A patch
+// whose four elements have very different direct light must not be read as its mean, or a
+// surface that sees one lit corner of it (a face beside a shadow edge) is biased by the
+// patch size.
+#include "CoreChecks.h"
+#include "Gathering.h"
+#include "Solution.h"
+#include "GeneratedScenes.h"
+#include "RayTracer.h"
+#include "Sensors.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace mlr;
+using mlr::checks::elementFormFactor;
+
+namespace
+{
+constexpr double Rho = 0.5;
+constexpr double LitIrradiance = 4.0; ///< the direct irradiance of the lit floor element
+constexpr double Bounced = 0.3;       ///< the floor patch's radiosity from later bounces
+constexpr double Height = 0.01;       ///< of the receiver over the lit element's centroid
+constexpr double Half = 0.005;        ///< half the receiver's side
+
+/// A floor that is one patch (a triangle of legs 2), and a small square receiver facing down
+/// just above the centroid of the floor's element `lit`.
+struct FloorScene
+{
+  Scene scene;
+  std::size_t lit = 0;
+  Vec3 above;
+};
+
+FloorScene floorScene()
+{
+  PatchMesh mesh;
+  mesh.points = { { 0, 0, 0 }, { 2, 0, 0 }, { 0, 2, 0 } };
+  mesh.triangles = { { 0, 1, 2 } };
+  mesh.reflectance = { Rgb(Rho) };
+  const Scene floor = Scene::fromPatchMesh(mesh);
+  // A corner element: the receiver sees the two edges that part it from its patch's others.
+  FloorScene result;
+  result.lit = 0;
+  const Triangle& t = floor.elementTriangles()[result.lit];
+  const auto& p = floor.points();
+  result.above = (p[t[0]] + p[t[1]] + p[t[2]]) / 3.0 + Vec3(0, 0, Height);
+  scenes::addGriddedQuad(mesh, result.above + Vec3(-Half, Half, 0), { 2 * Half, 0, 0 },
+    { 0, -2 * Half, 0 }, 1, 1, Rgb(Rho));
+  result.scene = Scene::fromPatchMesh(mesh);
+  return result;
+}
+
+/// The floor's element `lit` has direct irradiance LitIrradiance, its other three none, and the
+/// floor patch's bounced light is Bounced.
+Solution floorSolution(const FloorScene& f)
+{
+  const Scene& scene = f.scene;
+  Solution solution(1, scene.elementCount(), scene.patchCount());
+  for (std::size_t e = 0; e < scene.elementCount(); ++e)
+  {
+    solution.reflectanceData()[e] = scene.elementReflectance(e);
+  }
+  solution.directData()[solution.elementIndex(0, f.lit, Side::Front)] =
+    PackedRgb(Rgb(LitIrradiance));
+  solution.patchData()[solution.patchIndex(0, 0, Side::Front)] = PackedRgb(Rgb(Bounced));
+  return solution;
+}
+
+/// What a cosine-weighted ray from `triangle` (normal `normal`) reads, as mean and standard
+/// deviation: rho E + Bounced on the lit element, Bounced on the rest of the floor.
+struct Expected
+{
+  double mean = 0, sigma = 0;
+};
+
+Expected expectedReading(const FloorScene& f, const Vec3& a, const Vec3& b, const Vec3& c,
+  const Vec3& normal)
+{
+  const auto& p = f.scene.points();
+  const Triangle& t = f.scene.elementTriangles()[f.lit];
+  const double toLit = elementFormFactor(a, b, c, normal, { p[t[0]], p[t[1]], p[t[2]] });
+  const double toFloor = elementFormFactor(a, b, c, normal, { p[0], p[1], p[2] });
+  const double lit = Rho * LitIrradiance + Bounced;
+  Expected e;
+  e.mean = toLit * lit + (toFloor - toLit) * Bounced;
+  const double square = toLit * lit * lit + (toFloor - toLit) * Bounced * Bounced;
+  e.sigma = std::sqrt(std::max(0.0, square - e.mean * e.mean));
+  return e;
+}
+}
+
+TEST(Gathering, ReadsTheDirectLightOfTheElementItReaches)
+{
+  // Over the lit corner element, almost every ray lands on it: it reads rho E + Bounced
+  // (about 2.3), where the patch's mean would read rho E / 4 + Bounced (0.8).
+  const FloorScene f = floorScene();
+  const RayTracer tracer(f.scene);
+  Solution solution = floorSolution(f);
+  solution.allocateIndirect();
+  SolverOptions options;
+  options.threads = 1;
+  options.seed = 11;
+  const std::uint64_t raysPerSide = 20000;
+  options.pathsPerFrame = raysPerSide * 2 * f.scene.elementCount();
+  options.gatheringRatio = 1;
+  const std::vector<std::uint8_t> reachable(2 * f.scene.patchCount(), 1);
+  double secondsReducing = 0;
+  gatherIndirect(
+    f.scene, tracer, options, reachable, 1, [](double) { return true; }, secondsReducing, solution);
+
+  const auto& p = f.scene.points();
+  for (std::size_t e = Scene::ElementsPerPatch; e < f.scene.elementCount(); ++e)
+  {
+    const Triangle& t = f.scene.elementTriangles()[e];
+    const Expected x =
+      expectedReading(f, p[t[0]], p[t[1]], p[t[2]], f.scene.elementNormal(e));
+    const double read = solution.indirectIrradiance(0, e, Side::Front).r;
+    EXPECT_NEAR(read, x.mean, 5 * x.sigma / std::sqrt(double(raysPerSide)) + 1e-4 * x.mean)
+      << "receiver element " << e;
+    EXPECT_GT(read, 2.0) << "read as the lit element, not as the patch's mean";
+  }
+  // What the sensors read with, and the patch's radiosity: its direct part the mean of its
+  // elements' (equal areas), rho E / 4.
+  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit, Side::Front).r, Rho * LitIrradiance + Bounced,
+    1e-6);
+  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit + 1, Side::Front).r, Bounced, 1e-6);
+  EXPECT_NEAR(solution.patchRadiosity(0, 0, Side::Front).r, Rho * LitIrradiance / 4 + Bounced,
+    1e-6);
+  EXPECT_NEAR(f.scene.elementArea(f.lit), f.scene.patchArea(0) / 4, 1e-12);
+}
+
+TEST(Gathering, SensorsReadTheDirectLightOfTheElementTheyReach)
+{
+  // A sensor where the receiver was, facing down, with no light of its own to see: what it
+  // reads is what a gathering ray reads.
+  FloorScene f = floorScene();
+  const Solution solution = floorSolution(f);
+  SensorSet sensors;
+  sensors.points = { f.above };
+  sensors.normals = { { 0, 0, -1 } };
+  SensorOptions counts;
+  counts.hemisphereRays = 20000;
+  SolverOptions options;
+  options.threads = 1;
+  options.seed = 5;
+  const SensorSolution result = solveSensors(f.scene, LightRig(), solution, sensors, options, counts);
+  // A point over the lit element: the form factor of a vanishing receiver there.
+  const Vec3 d(1e-6, 0, 0), e(0, 1e-6, 0);
+  const Expected x = expectedReading(f, f.above - d - e, f.above + d - e, f.above + e, { 0, 0, -1 });
+  EXPECT_NEAR(result.irradiance(0, 0).r, x.mean,
+    5 * x.sigma / std::sqrt(double(counts.hemisphereRays)) + 1e-4 * x.mean);
+  EXPECT_GT(result.irradiance(0, 0).r, 2.0);
+}
