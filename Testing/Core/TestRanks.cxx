@@ -48,7 +48,10 @@ public:
     ++round.arrived;
     this->Changed.notify_all();
     this->Changed.wait(lock, [&] { return round.arrived == this->Ranks; });
-    std::memcpy(values, total, count * sizeof(T));
+    if (count > 0) // an empty sum (no overflow entries) may come with no array at all
+    {
+      std::memcpy(values, total, count * sizeof(T));
+    }
     if (++round.left == this->Ranks)
     {
       this->Rounds.erase(this->callIndex());
