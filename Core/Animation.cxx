@@ -129,11 +129,15 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   if (streamed)
   {
     onFrames = [&](std::size_t first, Solution& frames)
-    { options.chunkFrames(animation, first, frames); };
+    {
+      frames.statistics.patchEdgeLength = animation.remeshing.targetEdgeLength;
+      options.chunkFrames(animation, first, frames);
+    };
   }
   animation.solution =
     solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress, onFrames);
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
+  animation.solution.statistics.patchEdgeLength = animation.remeshing.targetEdgeLength;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
     animation.solution.warnings.end());
   if (!options.sensors.empty())

@@ -223,6 +223,7 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("FramesPerChunk", statistics.framesPerChunk);
   count("Patches", statistics.patches);
   count("Elements", statistics.elements);
+  real("PatchEdgeLength", statistics.patchEdgeLength);
   count("PathsPerFrame", statistics.effectivePathsPerFrame);
   count("PathsCast", statistics.pathsCast);
   count("ShootingRays", statistics.shootingRays);
