@@ -649,6 +649,17 @@ bool splitAtContacts(RepairedSoup& soup, const CgalRemeshSettings& settings, Cga
       }
     }
   }
+  // Points that orientation split where more than two faces met on an edge sit on one place
+  // as distinct vertices: CGAL 5.5's autorefinement then meets coincident edges of faces that
+  // share no vertex, and binds a reference to a null pointer.
+  {
+    std::vector<Point> sorted = localPoints;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+    {
+      throw Error("the surfaces touch next to an edge shared by more than two faces");
+    }
+  }
   Mesh mesh;
   PMP::polygon_soup_to_polygon_mesh(localPoints, PolledTriangles(localTriangles, poll), mesh);
   if (mesh.number_of_faces() != set.size() || mesh.number_of_vertices() != localPoints.size())

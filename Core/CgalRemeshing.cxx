@@ -361,8 +361,8 @@ void addRepairWarnings(CgalRemeshOutput& out)
   if (out.foldedTriangles > 0)
   {
     out.warnings.push_back("removed " + countOf(out.foldedTriangles, "triangle") +
-      " lying on an earlier one (sharing an edge, in its plane and on its side: two "
-      "triangulations of one face, whose first was kept)");
+      " overlapping an earlier one in its plane (two triangulations of one face, or a polygon "
+      "drawn over another; the first was kept)");
   }
   if (out.splitPoints > 0)
   {

@@ -5,6 +5,7 @@
 #include "Error.h"
 
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 
@@ -85,57 +86,95 @@ std::size_t removeDuplicateTriangles(RepairedSoup& soup, CancellationPoll& poll)
   return removed;
 }
 
-/// Keeps the first of two triangles that share an edge, lie in one plane and are on the same
-/// side of that edge, so that they overlap: two triangulations of one face, or a face folded
-/// onto itself. CGAL 5.5's autorefinement does not handle three such coplanar faces meeting
-/// at a point (it binds a reference to a null point), and no surface can hold both.
-std::size_t removeFoldedTriangles(RepairedSoup& soup, CancellationPoll& poll)
+/// Whether coplanar, non-degenerate triangles s and t face the same way and overlap with some
+/// area: no supporting
+/// line of an edge of either has the other triangle wholly on its outer side (two convex
+/// polygons' interiors are disjoint exactly when such a line separates them). Exact: the
+/// orientation tests run on the coordinate plane the triangles' plane projects onto one to
+/// one.
+bool interiorsOverlap(const std::array<Point, 3>& s, const std::array<Point, 3>& t)
 {
-  std::vector<std::array<std::size_t, 4>> edges; // a, b (a < b), opposite corner, triangle
-  edges.reserve(3 * soup.triangles.size());
-  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  using Point2 = Kernel::Point_2;
+  std::array<Point2, 3> a, b;
+  for (int axis = 0; axis < 3; ++axis)
   {
-    const CgalTriangle& t = soup.triangles[i];
+    const auto project = [axis](const Point& p)
+    { return axis == 0 ? Point2(p.y(), p.z()) : axis == 1 ? Point2(p.z(), p.x()) : Point2(p.x(), p.y()); };
     for (int k = 0; k < 3; ++k)
     {
-      const std::size_t a = t[k], b = t[(k + 1) % 3];
-      edges.push_back({ std::min(a, b), std::max(a, b), t[(k + 2) % 3], i });
+      a[k] = project(s[k]);
+      b[k] = project(t[k]);
+    }
+    if (!CGAL::collinear(a[0], a[1], a[2]))
+    {
+      break;
     }
   }
-  std::sort(edges.begin(), edges.end(),
-    [&poll](const auto& x, const auto& y)
-    {
-      poll.tick();
-      return x < y;
-    });
-  std::vector<bool> keep(soup.triangles.size(), true);
-  std::size_t removed = 0;
-  for (std::size_t e = 0; e < edges.size();)
+  const auto separates = [](const std::array<Point2, 3>& x, const std::array<Point2, 3>& y)
   {
-    std::size_t end = e + 1;
-    while (end < edges.size() && edges[end][0] == edges[e][0] && edges[end][1] == edges[e][1])
+    for (int k = 0; k < 3; ++k)
     {
-      ++end;
-    }
-    const Point& a = soup.points[edges[e][0]];
-    const Point& b = soup.points[edges[e][1]];
-    for (std::size_t j = e + 1; j < end; ++j)
-    {
-      for (std::size_t i = e; i < j && keep[edges[j][3]]; ++i)
+      const Point2 &p = x[k], &q = x[(k + 1) % 3];
+      const CGAL::Orientation inside = CGAL::orientation(p, q, x[(k + 2) % 3]);
+      if (CGAL::orientation(p, q, y[0]) != inside && CGAL::orientation(p, q, y[1]) != inside &&
+        CGAL::orientation(p, q, y[2]) != inside)
       {
-        poll.tick();
-        const Point& c = soup.points[edges[i][2]];
-        const Point& d = soup.points[edges[j][2]];
-        if (keep[edges[i][3]] && edges[i][3] != edges[j][3] && CGAL::coplanar(a, b, c, d) &&
-          CGAL::coplanar_orientation(a, b, c, d) == CGAL::POSITIVE)
-        {
-          const std::size_t later = std::max(edges[i][3], edges[j][3]);
-          keep[later] = false;
-          ++removed;
-        }
+        return true;
       }
     }
-    e = end;
+    return false;
+  };
+  // Facing the same way only: a face lying face to face on another (a block's bottom on the
+  // floor) is a contact, which splitAtContacts() handles.
+  return CGAL::orientation(a[0], a[1], a[2]) == CGAL::orientation(b[0], b[1], b[2]) &&
+    !separates(a, b) && !separates(b, a);
+}
+
+/// Keeps the first of triangles that lie in one plane, face the same way and overlap with some
+/// area: two
+/// triangulations of one face, a face folded onto itself, or a polygon drawn over another.
+/// CGAL 5.5's autorefinement does not handle such coplanar overlaps (it binds references to
+/// null points, or never ends), and no surface can hold both.
+std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& poll)
+{
+  using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
+  std::vector<TriangleBox> boxes;
+  boxes.reserve(soup.triangles.size());
+  const auto corners = [&soup](std::size_t i)
+  {
+    const CgalTriangle& t = soup.triangles[i];
+    return std::array<Point, 3>{ soup.points[t[0]], soup.points[t[1]], soup.points[t[2]] };
+  };
+  for (std::size_t i = 0; i < soup.triangles.size(); ++i)
+  {
+    const std::array<Point, 3> c = corners(i);
+    boxes.emplace_back(c[0].bbox() + c[1].bbox() + c[2].bbox(), i);
+  }
+  // The pairs (later, earlier), gathered in whatever order the boxes meet, then decided in
+  // triangle order: a triangle goes when it overlaps an earlier one that stays.
+  std::vector<std::pair<std::size_t, std::size_t>> overlapping;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(),
+    [&](const TriangleBox& x, const TriangleBox& y)
+    {
+      poll.tick();
+      const std::array<Point, 3> s = corners(x.info()), t = corners(y.info());
+      if (CGAL::coplanar(s[0], s[1], s[2], t[0]) && CGAL::coplanar(s[0], s[1], s[2], t[1]) &&
+        CGAL::coplanar(s[0], s[1], s[2], t[2]) && interiorsOverlap(s, t))
+      {
+        overlapping.emplace_back(
+          std::max(x.info(), y.info()), std::min(x.info(), y.info()));
+      }
+    });
+  std::sort(overlapping.begin(), overlapping.end());
+  std::vector<bool> keep(soup.triangles.size(), true);
+  std::size_t removed = 0;
+  for (const auto& [later, earlier] : overlapping)
+  {
+    if (keep[later] && keep[earlier])
+    {
+      keep[later] = false;
+      ++removed;
+    }
   }
   keepTriangles(soup, keep);
   return removed;
@@ -216,7 +255,7 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
   poll.check();
   out.degenerateTriangles = removeDegenerateTriangles(soup);
   out.duplicateTriangles = removeDuplicateTriangles(soup, poll);
-  out.foldedTriangles = removeFoldedTriangles(soup, poll);
+  out.foldedTriangles = removeOverlappingTriangles(soup, poll);
   PMP::remove_isolated_points_in_polygon_soup(soup.points, soup.triangles);
   poll.check();
   // A soup that already is an oriented manifold mesh (most are) would come out of

@@ -409,6 +409,25 @@ TEST(RemeshingMessyInput, DuplicatePolygonsAreIgnoredKeepingTheFirstMaterial)
   }
 }
 
+TEST(RemeshingMessyInput, APolygonDrawnOverAnotherInItsPlaneIsDropped)
+{
+  // A triangle inside a floor, sharing none of its corners or edges (a decal drawn over it),
+  // and a floor beside it that shares an edge and a corner: only the decal overlaps.
+  PolygonSoup soup;
+  soup.points = { { 0, 0, 0 }, { 2, 0, 0 }, { 2, 2, 0 }, { 0, 2, 0 }, { 0.5, 0.5, 0 },
+    { 1.5, 0.5, 0 }, { 1, 1.5, 0 }, { 3, 0, 0 }, { 3, 2, 0 } };
+  soup.polygons = { { 0, 1, 2, 3 }, { 4, 5, 6 }, { 1, 7, 8, 2 } };
+  soup.materials = { Material{ Rgb(0.5) }, Material{ Rgb(0.3) }, Material{ Rgb(0.5) } };
+  const RemeshResult result = remesh(soup, withEdgeLength(0.1));
+  EXPECT_TRUE(contains(result.warnings, "removed 1 triangle overlapping an earlier one"))
+    << joined(result.warnings);
+  EXPECT_NEAR(totalArea(result.mesh), 6.0, 0.005 * 6.0);
+  for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
+  {
+    EXPECT_EQ(result.mesh.reflectance[p], Rgb(0.5)) << "patch " << p << " of the decal";
+  }
+}
+
 TEST(RemeshingMessyInput, TwoTriangulationsOfOneFaceKeepTheFirst)
 {
   // A quad and, in its plane on the same corners, triangles over it cut along the other
@@ -420,7 +439,8 @@ TEST(RemeshingMessyInput, TwoTriangulationsOfOneFaceKeepTheFirst)
   soup.materials = { Material{ Rgb(0.5) }, Material{ Rgb(0.5) }, Material{ Rgb(0.3) },
     Material{ Rgb(0.3) }, Material{ Rgb(0.3) } };
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "lying on an earlier one")) << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "overlapping an earlier one in its plane"))
+    << joined(result.warnings);
   const double quadArea = 1.5, wallArea = 0.5 * std::sqrt(3.0);
   EXPECT_NEAR(totalArea(result.mesh), quadArea + wallArea, 0.005 * (quadArea + wallArea));
   for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
