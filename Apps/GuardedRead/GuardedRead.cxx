@@ -3,6 +3,7 @@
 #include "FileChecks.h"
 #include "MemoryBudget.h"
 
+#include "vtkCellArray.h"
 #include "vtkDataSet.h"
 #include "vtkGenericDataObjectReader.h"
 #include "vtkGeometryFilter.h"
@@ -12,8 +13,10 @@
 #include "vtkObjectFactory.h"
 #include "vtkOutputWindow.h"
 #include "vtkPLYReader.h"
+#include "vtkPointSet.h"
 #include "vtkPolyData.h"
 #include "vtkSTLReader.h"
+#include "vtkUnstructuredGrid.h"
 #include "vtkXMLPolyDataReader.h"
 #include "vtkXMLPolyDataWriter.h"
 #include "vtkXMLUnstructuredGridReader.h"
@@ -29,6 +32,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
 #include <sys/mman.h>
 #include <sys/prctl.h>
@@ -456,6 +460,51 @@ ChildOutcome runGuarded(const std::function<int()>& work, std::uint64_t memoryBy
   return outcome;
 }
 
+/// Whether every cell array of `output` is whole: offsets from 0 that never decrease and end
+/// at the connectivity's length, and only ids of points the data set has. Readers of binary
+/// formats (legacy .vtk 5.1) take offsets as the file gives them, and everything downstream
+/// (the XML hand-back allocates the connectivity from the last offset) would trust them.
+bool cellsAreWhole(vtkDataObject* output)
+{
+  auto* points = vtkPointSet::SafeDownCast(output);
+  if (!points)
+  {
+    return true; // image and rectilinear data have implicit cells
+  }
+  std::vector<vtkCellArray*> arrays;
+  if (auto* polygons = vtkPolyData::SafeDownCast(output))
+  {
+    arrays = { polygons->GetVerts(), polygons->GetLines(), polygons->GetPolys(),
+      polygons->GetStrips() };
+  }
+  else if (auto* grid = vtkUnstructuredGrid::SafeDownCast(output))
+  {
+    arrays = { grid->GetCells() };
+  }
+  for (vtkCellArray* cells : arrays)
+  {
+    if (!cells)
+    {
+      continue;
+    }
+    if (!cells->IsValid())
+    {
+      return false;
+    }
+    vtkDataArray* connectivity = cells->GetConnectivityArray();
+    if (connectivity && connectivity->GetNumberOfTuples() > 0)
+    {
+      double range[2];
+      connectivity->GetRange(range, 0);
+      if (range[0] < 0 || range[1] >= static_cast<double>(points->GetNumberOfPoints()))
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 vtkSmartPointer<vtkPolyData> polygonsOf(vtkAlgorithm* reader)
 {
   ErrorCounter counter;
@@ -463,6 +512,12 @@ vtkSmartPointer<vtkPolyData> polygonsOf(vtkAlgorithm* reader)
   vtkDataObject* output = reader->GetOutputDataObject(0);
   if (counter.errors() != 0 || reader->GetErrorCode() != 0 || !output)
   {
+    return nullptr;
+  }
+  if (!cellsAreWhole(output))
+  {
+    std::cerr << "its cells do not fit together: their offsets do not match their lists of "
+                 "points, or they name points the file does not have\n";
     return nullptr;
   }
   if (auto* polygons = vtkPolyData::SafeDownCast(output))
