@@ -5,9 +5,9 @@
 #include "Error.h"
 
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/box_intersection_d.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/box_intersection_d.h>
 
 #include <algorithm>
 #include <array>
@@ -99,7 +99,11 @@ bool interiorsOverlap(const std::array<Point, 3>& s, const std::array<Point, 3>&
   for (int axis = 0; axis < 3; ++axis)
   {
     const auto project = [axis](const Point& p)
-    { return axis == 0 ? Point2(p.y(), p.z()) : axis == 1 ? Point2(p.z(), p.x()) : Point2(p.x(), p.y()); };
+    {
+      return axis == 0 ? Point2(p.y(), p.z())
+        : axis == 1    ? Point2(p.z(), p.x())
+                       : Point2(p.x(), p.y());
+    };
     for (int k = 0; k < 3; ++k)
     {
       a[k] = project(s[k]);
@@ -161,8 +165,7 @@ std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& pol
       if (CGAL::coplanar(s[0], s[1], s[2], t[0]) && CGAL::coplanar(s[0], s[1], s[2], t[1]) &&
         CGAL::coplanar(s[0], s[1], s[2], t[2]) && interiorsOverlap(s, t))
       {
-        overlapping.emplace_back(
-          std::max(x.info(), y.info()), std::min(x.info(), y.info()));
+        overlapping.emplace_back(std::max(x.info(), y.info()), std::min(x.info(), y.info()));
       }
     });
   std::sort(overlapping.begin(), overlapping.end());

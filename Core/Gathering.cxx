@@ -88,8 +88,8 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       }
       pending = solution.patchData().data() +
         solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hitElement), hitSide);
-      pendingDirect = solution.directData().data() +
-        solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
+      pendingDirect =
+        solution.directData().data() + solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
       pendingReflectance = reflectance[hitElement];
       prefetch(pending);
       prefetch(pendingDirect);

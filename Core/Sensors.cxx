@@ -165,9 +165,9 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
   const std::uint32_t rays = sensorOptions.hemisphereRays;
   scratch.gatheringRays += rays;
-  // What each ray found, as keys: an element side (2 element + side), or an escaped ray's sky cell
-  // per sky. Sorted and counted, each distinct key costs one pass over the frames, however
-  // many rays found it, and the sums run in key order.
+  // What each ray found, as keys: an element side (2 element + side), or an escaped ray's sky
+  // cell per sky. Sorted and counted, each distinct key costs one pass over the frames,
+  // however many rays found it, and the sums run in key order.
   scratch.hits.clear();
   scratch.cells.clear();
   for (std::uint32_t r = 0; r < rays; ++r)
@@ -188,7 +188,8 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
     }
     else if (options.twoSided || side == Side::Front)
     {
-      scratch.hits.push_back(2 * static_cast<std::size_t>(element) + static_cast<std::size_t>(side));
+      scratch.hits.push_back(
+        2 * static_cast<std::size_t>(element) + static_cast<std::size_t>(side));
     }
   }
   std::sort(scratch.hits.begin(), scratch.hits.end());

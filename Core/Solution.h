@@ -52,7 +52,7 @@ struct SolverStatistics
   double secondsRemeshing = 0; ///< set by callers that remesh before solving
   /// The patch edge length the scene was remeshed to (scene units), by callers that remesh.
   double patchEdgeLength = 0;
-  double secondsSetup = 0;     ///< validation, allocation and building the BVH
+  double secondsSetup = 0; ///< validation, allocation and building the BVH
   double secondsShooting = 0;
   double secondsGathering = 0;
   /// Of shooting and gathering, the time spent in sums over ranks and the agreements
@@ -149,8 +149,8 @@ public:
   Rgb patchRadiosity(std::size_t frame, std::size_t patch, Side side) const
   {
     Rgb direct;
-    for (std::size_t e = patch * Scene::ElementsPerPatch;
-         e < (patch + 1) * Scene::ElementsPerPatch; ++e)
+    for (std::size_t e = patch * Scene::ElementsPerPatch; e < (patch + 1) * Scene::ElementsPerPatch;
+         ++e)
     {
       direct += this->direct(frame, e, side);
     }

@@ -4,10 +4,10 @@
 // patch size.
 #include "CoreChecks.h"
 #include "Gathering.h"
-#include "Solution.h"
 #include "GeneratedScenes.h"
 #include "RayTracer.h"
 #include "Sensors.h"
+#include "Solution.h"
 
 #include <gtest/gtest.h>
 
@@ -75,8 +75,8 @@ struct Expected
   double mean = 0, sigma = 0;
 };
 
-Expected expectedReading(const FloorScene& f, const Vec3& a, const Vec3& b, const Vec3& c,
-  const Vec3& normal)
+Expected expectedReading(
+  const FloorScene& f, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& normal)
 {
   const auto& p = f.scene.points();
   const Triangle& t = f.scene.elementTriangles()[f.lit];
@@ -114,8 +114,7 @@ TEST(Gathering, ReadsTheDirectLightOfTheElementItReaches)
   for (std::size_t e = Scene::ElementsPerPatch; e < f.scene.elementCount(); ++e)
   {
     const Triangle& t = f.scene.elementTriangles()[e];
-    const Expected x =
-      expectedReading(f, p[t[0]], p[t[1]], p[t[2]], f.scene.elementNormal(e));
+    const Expected x = expectedReading(f, p[t[0]], p[t[1]], p[t[2]], f.scene.elementNormal(e));
     const double read = solution.indirectIrradiance(0, e, Side::Front).r;
     EXPECT_NEAR(read, x.mean, 5 * x.sigma / std::sqrt(double(raysPerSide)) + 1e-4 * x.mean)
       << "receiver element " << e;
@@ -123,11 +122,11 @@ TEST(Gathering, ReadsTheDirectLightOfTheElementItReaches)
   }
   // What the sensors read with, and the patch's radiosity: its direct part the mean of its
   // elements' (equal areas), rho E / 4.
-  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit, Side::Front).r, Rho * LitIrradiance + Bounced,
-    1e-6);
+  EXPECT_NEAR(
+    solution.gatheredRadiosity(0, f.lit, Side::Front).r, Rho * LitIrradiance + Bounced, 1e-6);
   EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit + 1, Side::Front).r, Bounced, 1e-6);
-  EXPECT_NEAR(solution.patchRadiosity(0, 0, Side::Front).r, Rho * LitIrradiance / 4 + Bounced,
-    1e-6);
+  EXPECT_NEAR(
+    solution.patchRadiosity(0, 0, Side::Front).r, Rho * LitIrradiance / 4 + Bounced, 1e-6);
   EXPECT_NEAR(f.scene.elementArea(f.lit), f.scene.patchArea(0) / 4, 1e-12);
 }
 
@@ -145,10 +144,12 @@ TEST(Gathering, SensorsReadTheDirectLightOfTheElementTheyReach)
   SolverOptions options;
   options.threads = 1;
   options.seed = 5;
-  const SensorSolution result = solveSensors(f.scene, LightRig(), solution, sensors, options, counts);
+  const SensorSolution result =
+    solveSensors(f.scene, LightRig(), solution, sensors, options, counts);
   // A point over the lit element: the form factor of a vanishing receiver there.
   const Vec3 d(1e-6, 0, 0), e(0, 1e-6, 0);
-  const Expected x = expectedReading(f, f.above - d - e, f.above + d - e, f.above + e, { 0, 0, -1 });
+  const Expected x =
+    expectedReading(f, f.above - d - e, f.above + d - e, f.above + e, { 0, 0, -1 });
   EXPECT_NEAR(result.irradiance(0, 0).r, x.mean,
     5 * x.sigma / std::sqrt(double(counts.hemisphereRays)) + 1e-4 * x.mean);
   EXPECT_GT(result.irradiance(0, 0).r, 2.0);

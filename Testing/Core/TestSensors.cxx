@@ -142,8 +142,8 @@ TEST(Sensors, LookingDownAtLitGroundGathersItsRadiosity)
   // Over the element's centroid, 1 cm up: 1.4 m from its edges, all but 1e-4 of the cosine
   // rays land on it.
   const Triangle& t = scene.elementTriangles()[below];
-  const Vec3 over = (scene.points()[t[0]] + scene.points()[t[1]] + scene.points()[t[2]]) / 3.0 +
-    Vec3(0, 0, 0.01);
+  const Vec3 over =
+    (scene.points()[t[0]] + scene.points()[t[1]] + scene.points()[t[2]]) / 3.0 + Vec3(0, 0, 0.01);
   const SensorSolution result =
     solveSensors(scene, rig, solution, oneSensor(over, { 0, 0, -1 }), quick(), counts);
   const double read = solution.gatheredRadiosity(0, below, Side::Front).r;
