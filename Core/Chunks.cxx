@@ -2,13 +2,15 @@
 
 #include "Error.h"
 #include "ErrorEstimate.h"
-#include "Random.h"
+#include "Ranks.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 namespace mlr
 {
@@ -86,16 +88,12 @@ std::size_t ChunkPlan::finishedEnd(std::size_t chunk) const
   return chunk + 1 == this->chunks.size() ? this->frames : this->chunks[chunk].end - this->overlap;
 }
 
-std::uint64_t chunkSeed(std::uint64_t seed, std::size_t chunk)
-{
-  return RandomStream(seed, StreamPurpose::Chunks, chunk).nextBits();
-}
-
 LightRig sliceRig(const LightRig& rig, std::size_t first, std::size_t count)
 {
   auto poses = [&](const std::vector<LightPose>& all)
   { return std::vector<LightPose>(all.begin() + first, all.begin() + first + count); };
   LightRig slice = rig;
+  slice.firstFrame = rig.firstFrame + first;
   for (MovingLight& light : slice.areaLights)
   {
     if (light.frameCount() > 1)
@@ -178,18 +176,44 @@ void copyFrames(const Estimate& src, std::size_t begin, std::size_t end, const E
   }
 }
 
-/// The blend of two independent estimates, wa a + wb b, rounded once.
+/// The blend of two estimates, wa a + wb b, rounded once.
 PackedRgb blend(const PackedRgb& a, double wa, const PackedRgb& b, double wb)
 {
   return PackedRgb(Rgb(a) * wa + Rgb(b) * wb);
 }
 
-/// The standard error of that blend: the variances add, s^2 = wa^2 sa^2 + wb^2 sb^2.
-PackedRgb blendError(const PackedRgb& a, double wa, const PackedRgb& b, double wb)
+/// The standard error of that blend for estimates of correlation rho:
+/// s^2 = wa^2 sa^2 + wb^2 sb^2 + 2 wa wb rho sa sb.
+PackedRgb blendError(const PackedRgb& a, double wa, const PackedRgb& b, double wb, double rho)
 {
   const Rgb sa(a), sb(b);
-  auto q = [&](double x, double y) { return std::sqrt(wa * wa * x * x + wb * wb * y * y); };
+  auto q = [&](double x, double y)
+  { return std::sqrt(wa * wa * x * x + wb * wb * y * y + 2 * wa * wb * rho * x * y); };
   return PackedRgb(Rgb(q(sa.r, sb.r), q(sa.g, sb.g), q(sa.b, sb.b)));
+}
+
+/**
+ * The correlation of two chunks' estimates of a frame, pooled over its elements: they share
+ * the paths of the positions both solve, and the gathering rays, so the variance of their
+ * difference d = a - b, sa^2 + sb^2 - 2 rho sa sb, is smaller than the sum. From the
+ * differences themselves: rho = (sum (sa^2 + sb^2) - sum d^2) / (2 sum sa sb), in [0, 1].
+ */
+double correlationOf(const Solution& a, std::size_t fa, const Solution& b, std::size_t fb)
+{
+  double variances = 0, squares = 0, products = 0;
+  for (std::size_t e = 0; e < a.elementCount(); ++e)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      const Rgb d = a.irradiance(fa, e, side) - b.irradiance(fb, e, side);
+      const Rgb sa = a.irradianceStdError(fa, e, side), sb = b.irradianceStdError(fb, e, side);
+      variances +=
+        sa.r * sa.r + sa.g * sa.g + sa.b * sa.b + sb.r * sb.r + sb.g * sb.g + sb.b * sb.b;
+      squares += d.r * d.r + d.g * d.g + d.b * d.b;
+      products += sa.r * sb.r + sa.g * sb.g + sa.b * sb.b;
+    }
+  }
+  return products > 0 ? std::clamp((variances - squares) / (2 * products), 0.0, 1.0) : 0.0;
 }
 
 /**
@@ -223,6 +247,7 @@ void finishFrames(const ChunkPlan& plan, std::size_t chunk, const Estimate& befo
   {
     const double wc = plan.weight(chunk, f), wb = 1 - wc;
     const std::size_t fc = f - current.first, fb = f - before.first, fd = f - dest.first;
+    const double rho = errors ? correlationOf(c, fc, b, fb) : 0.0;
     for (std::size_t e = 0; e < c.elementCount(); ++e)
     {
       for (const Side side : { Side::Front, Side::Back })
@@ -236,7 +261,8 @@ void finishFrames(const ChunkPlan& plan, std::size_t chunk, const Estimate& befo
         }
         if (errors)
         {
-          d.stdErrorData()[id] = blendError(c.stdErrorData()[ic], wc, b.stdErrorData()[ib], wb);
+          d.stdErrorData()[id] =
+            blendError(c.stdErrorData()[ic], wc, b.stdErrorData()[ib], wb, rho);
         }
       }
     }
@@ -343,6 +369,100 @@ void accumulate(const ErrorEstimateSummary& c, bool first, ErrorEstimateSummary&
 }
 }
 
+namespace
+{
+/// What ended a chunk's batches, as a number that a sum over ranks carries.
+constexpr std::array<const char*, 5> StopReasons = { "", "batches", "target", "time limit",
+  "path limit" };
+
+/// Every field of a chunk's statistics and error summary, in one order, for the ranks that
+/// share chunks out (visit(field) with a reference to each).
+template <typename Visit>
+void visitChunkFigures(
+  SolverStatistics& s, ErrorEstimateSummary& e, std::uint64_t& stop, Visit visit)
+{
+  visit(s.frames), visit(s.chunks), visit(s.framesPerChunk), visit(s.patches), visit(s.elements);
+  visit(s.effectivePathsPerFrame), visit(s.pathsCast), visit(s.shootingRays);
+  visit(s.shadowRays), visit(s.shadowRaysBlocked), visit(s.firstHits), visit(s.gatheringRays);
+  visit(s.missedRays), visit(s.gatheringSides), visit(s.reachabilityRays);
+  visit(s.reachableSides), visit(s.overflowSides), visit(s.sources), visit(s.staticPathsCast);
+  visit(s.pilotRays), visit(s.smallestPositionShare), visit(s.largestPositionShare);
+  visit(s.meanPathLength), visit(s.secondsRemeshing), visit(s.patchEdgeLength);
+  visit(s.secondsSetup), visit(s.secondsShooting), visit(s.secondsGathering);
+  visit(s.secondsReducing), visit(s.secondsTotal), visit(s.memoryEstimateBytes);
+  visit(s.accumulatorCopyPerWorker), visit(s.threads), visit(s.reuseShooting);
+  visit(s.reuseGathering), visit(s.twoSided);
+  visit(e.batches), visit(e.rounds), visit(e.pathsPerFrame), visit(e.target), visit(stop);
+}
+
+/**
+ * Gives every rank the figures of the chunk that one rank (`mine`) solved: a sum over ranks
+ * of doubles where the others give zeros, exact for the counts (below 2^53) and the rest.
+ * The error summary's per-frame figures stay behind: each frame's come with it.
+ */
+void exchangeFigures(const SolverOptions& options, bool mine, SolverStatistics& statistics,
+  ErrorEstimateSummary& errors, double& seconds)
+{
+  std::uint64_t stop = 0;
+  for (std::size_t i = 0; i < StopReasons.size(); ++i)
+  {
+    stop = errors.stoppedBy == StopReasons[i] ? i : stop;
+  }
+  std::vector<double> values;
+  visitChunkFigures(statistics, errors, stop,
+    [&](auto& field) { values.push_back(mine ? static_cast<double>(field) : 0.0); });
+  const auto begin = std::chrono::steady_clock::now();
+  options.sumDoublesAcrossRanks(values.data(), values.size());
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  std::size_t next = 0;
+  visitChunkFigures(statistics, errors, stop,
+    [&](auto& field)
+    {
+      using T = std::decay_t<decltype(field)>;
+      if constexpr (std::is_same<T, bool>::value)
+      {
+        field = values[next++] != 0;
+      }
+      else
+      {
+        field = static_cast<T>(values[next++]);
+      }
+    });
+  errors.stoppedBy = StopReasons[std::min<std::size_t>(stop, StopReasons.size() - 1)];
+  errors.relativeErrorMedian.clear();
+  errors.relativeErrorP95.clear();
+  errors.litElements.clear();
+}
+
+/// Gives every rank the sides one rank (`mine`) chose; the others give Front (0).
+void exchangeSides(
+  const SolverOptions& options, bool mine, std::vector<Side>& sides, double& seconds)
+{
+  std::vector<std::int64_t> values(sides.size(), 0);
+  if (mine)
+  {
+    std::transform(sides.begin(), sides.end(), values.begin(),
+      [](Side side) { return static_cast<std::int64_t>(side); });
+  }
+  sumAcrossRanks(options, values.data(), values.size(), seconds);
+  std::transform(values.begin(), values.end(), sides.begin(),
+    [](std::int64_t v) { return v == 0 ? Side::Front : Side::Back; });
+}
+
+/// Gives every rank the frames of `frames` that one rank filled: the others give zeros, and
+/// a sum of one float and zeros is that float, bit for bit.
+void exchangeFrames(const SolverOptions& options, Solution& frames, double& seconds)
+{
+  for (std::vector<PackedRgb>* data :
+    { &frames.directData(), &frames.indirectData(), &frames.stdErrorData(), &frames.patchData() })
+  {
+    static_assert(sizeof(PackedRgb) == 3 * sizeof(float), "PackedRgb is three floats");
+    sumFloatsAcrossRanks(
+      options, reinterpret_cast<float*>(data->data()), 3 * data->size(), seconds);
+  }
+}
+}
+
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames)
 {
@@ -364,11 +484,25 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     return solution;
   }
 
-  // Progress: each chunk's share is its positions' share of all the positions solved.
-  double positionsSolved = 0;
-  for (const ChunkPlan::Chunk& c : plan.chunks)
+  // Streamed over several ranks, with a chunk for each at least, the ranks take whole chunks:
+  // rank r solves chunks r, r + R, ... alone, and hands on their frames only.
+  const std::size_t chunkCount = plan.chunks.size();
+  const bool overRanks = static_cast<bool>(onFrames) && options.ranks > 1 &&
+    chunkCount >= static_cast<std::size_t>(options.ranks);
+  const std::size_t ranks = overRanks ? static_cast<std::size_t>(options.ranks) : 1;
+  const std::size_t rank = overRanks ? static_cast<std::size_t>(options.rank) : 0;
+  SolverOptions chunkOptions = options;
+  if (overRanks)
   {
-    positionsSolved += static_cast<double>(c.solveEnd - c.solveBegin);
+    chunkOptions.ranks = 1;
+    chunkOptions.rank = 0;
+  }
+
+  // Progress: each chunk's share is its positions' share of the positions this rank solves.
+  double positionsSolved = 0;
+  for (std::size_t k = rank; k < chunkCount; k += ranks)
+  {
+    positionsSolved += static_cast<double>(plan.chunks[k].solveEnd - plan.chunks[k].solveBegin);
   }
   Solution whole; // every frame, without onFrames
   Solution result;
@@ -377,47 +511,97 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   ErrorEstimateSummary errors;
   std::vector<Side> litSides, patchLitSides;
   std::vector<std::string> warnings;
-  // The estimate of the frames around the last seam, which the next chunk blends with.
+  // The estimate of the frames around the seam before this rank's next chunk, which that
+  // chunk blends with, and (over ranks) a solved chunk's shape for the seams received.
   std::optional<Solution> tail;
   std::size_t tailFirst = 0;
+  Solution shape;
   double progressBase = 0;
+  double secondsExchanging = 0;
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+  for (std::size_t round = 0; round * ranks < chunkCount; ++round)
   {
-    const ChunkPlan::Chunk& c = plan.chunks[k];
-    const std::size_t positions = c.solveEnd - c.solveBegin;
-    SolverOptions chunkOptions = options;
-    chunkOptions.seed = chunkSeed(options.seed, k);
-    const double share = static_cast<double>(positions) / positionsSolved;
-    ProgressCallback chunkProgress;
-    if (progress)
+    const std::size_t k = round * ranks + rank;
+    const bool solving = k < chunkCount;
+    Solution current;
+    if (solving)
     {
-      chunkProgress = [&, base = progressBase, share](double f)
-      { return progress(base + share * f); };
-    }
-    progressBase += share;
-    if (options.log)
-    {
-      options.log("chunk " + std::to_string(k + 1) + " of " + std::to_string(plan.chunks.size()) +
-        ": frames " + std::to_string(c.begin) + " to " + std::to_string(c.end - 1) +
-        ", solving positions " + std::to_string(c.solveBegin) + " to " +
-        std::to_string(c.solveEnd - 1));
-    }
-    Solution current =
-      solve(scene, sliceRig(rig, c.solveBegin, positions), chunkOptions, chunkProgress);
-    accumulate(current.statistics, k == 0, stats);
-    if (current.hasErrorEstimate())
-    {
-      accumulate(current.errorEstimate, k == 0, errors);
-    }
-    for (const std::string& w : current.warnings)
-    {
-      if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
+      const ChunkPlan::Chunk& c = plan.chunks[k];
+      const std::size_t positions = c.solveEnd - c.solveBegin;
+      const double share = static_cast<double>(positions) / positionsSolved;
+      ProgressCallback chunkProgress;
+      if (progress)
       {
-        warnings.push_back(w);
+        chunkProgress = [&, base = progressBase, share](double f)
+        { return progress(base + share * f); };
+      }
+      progressBase += share;
+      if (options.log)
+      {
+        options.log("chunk " + std::to_string(k + 1) + " of " + std::to_string(chunkCount) +
+          ": frames " + std::to_string(c.begin) + " to " + std::to_string(c.end - 1) +
+          ", solving positions " + std::to_string(c.solveBegin) + " to " +
+          std::to_string(c.solveEnd - 1));
+      }
+      // Over ranks a chunk is solved alone; a failure or cancel on any rank stops every rank
+      // here, before the exchange.
+      auto solveChunk = [&] {
+        current = solve(scene, sliceRig(rig, c.solveBegin, positions), chunkOptions, chunkProgress);
+      };
+      if (overRanks)
+      {
+        agreeAcrossRanks(options, solveChunk, &secondsExchanging);
+      }
+      else
+      {
+        solveChunk();
+      }
+      for (const std::string& w : current.warnings)
+      {
+        if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
+        {
+          warnings.push_back(w);
+        }
+      }
+      if (shape.elementCount() == 0)
+      {
+        shape = shapedLike(current, 1);
       }
     }
-    if (k == 0)
+    else
+    {
+      agreeAcrossRanks(
+        options, [] {}, &secondsExchanging);
+    }
+
+    // This rank's chunk is finished as soon as the seam before it is here (rank 0's from the
+    // round before, rank r's from slot r - 1), so that no more than the two estimates of a
+    // seam and the finished frames are held at once.
+    std::optional<Solution> before = std::move(tail);
+    std::size_t beforeFirst = tailFirst;
+    tail.reset();
+    auto finishMine = [&]
+    {
+      const std::size_t begin = plan.finishedBegin(k), end = plan.finishedEnd(k);
+      Solution finished;
+      Solution& dest = onFrames ? finished : whole;
+      if (onFrames)
+      {
+        finished = shapedLike(current, end - begin);
+      }
+      finishFrames(plan, k, { before ? &*before : nullptr, beforeFirst },
+        { &current, plan.chunks[k].solveBegin }, begin, end, { &dest, onFrames ? begin : 0 });
+      before.reset();
+      if (onFrames)
+      {
+        finished.litSideData() = litSides;
+        finished.patchLitSideData() = patchLitSides;
+        summariseErrors(finished, current.errorEstimate);
+        finished.statistics = current.statistics;
+        onFrames(begin, finished);
+      }
+    };
+    if (solving && k == 0)
     {
       litSides = current.litSideData();
       patchLitSides = current.patchLitSideData();
@@ -426,37 +610,69 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         whole = shapedLike(current, frames);
       }
     }
+    if (solving && rank == 0)
+    {
+      finishMine();
+    }
 
-    const std::size_t begin = plan.finishedBegin(k), end = plan.finishedEnd(k);
-    Solution finished;
-    Solution& dest = onFrames ? finished : whole;
-    if (onFrames)
+    // The figures and the seams of this round's chunks, in chunk order on every rank: each
+    // from the rank that solved it (over ranks, a sum where the others give zeros).
+    for (std::size_t slot = 0; slot < ranks && round * ranks + slot < chunkCount; ++slot)
     {
-      finished = shapedLike(current, end - begin);
-    }
-    const Estimate estimate{ &current, c.solveBegin };
-    finishFrames(plan, k, { tail ? &*tail : nullptr, tailFirst }, estimate, begin, end,
-      { &dest, onFrames ? begin : 0 });
-    // The next chunk's blend needs this chunk's estimate of the seam between them only.
-    tail.reset();
-    if (k + 1 < plan.chunks.size())
-    {
-      tailFirst = end;
-      tail.emplace(shapedLike(current, c.solveEnd - end));
-      copyFrames(estimate, end, c.solveEnd, { &*tail, end });
-    }
-    const ErrorEstimateSummary chunkErrors = current.errorEstimate;
-    const SolverStatistics chunkStatistics = current.statistics;
-    current = Solution();
-    if (onFrames)
-    {
-      finished.litSideData() = litSides;
-      finished.patchLitSideData() = patchLitSides;
-      summariseErrors(finished, chunkErrors);
-      finished.statistics = chunkStatistics;
-      onFrames(begin, finished);
+      const std::size_t j = round * ranks + slot;
+      const bool mine = slot == rank;
+      const ChunkPlan::Chunk& cj = plan.chunks[j];
+      SolverStatistics chunkStatistics = mine ? current.statistics : SolverStatistics();
+      ErrorEstimateSummary chunkErrors = mine ? current.errorEstimate : ErrorEstimateSummary();
+      if (overRanks)
+      {
+        exchangeFigures(options, mine, chunkStatistics, chunkErrors, secondsExchanging);
+      }
+      accumulate(chunkStatistics, j == 0, stats);
+      if (chunkErrors.batches > 0)
+      {
+        accumulate(chunkErrors, j == 0, errors);
+      }
+      if (j == 0 && overRanks)
+      {
+        litSides.resize(scene.elementCount(), Side::Front);
+        patchLitSides.resize(scene.patchCount(), Side::Front);
+        exchangeSides(options, mine, litSides, secondsExchanging);
+        exchangeSides(options, mine, patchLitSides, secondsExchanging);
+      }
+      // The estimate of the seam after chunk j, for the rank of the chunk after it.
+      const bool forMe = (j + 1) % ranks == rank;
+      if (j + 1 < chunkCount && (mine || forMe || overRanks))
+      {
+        const std::size_t seamFirst = plan.finishedEnd(j);
+        Solution seam = shapedLike(mine ? current : shape, cj.solveEnd - seamFirst);
+        if (mine)
+        {
+          copyFrames({ &current, cj.solveBegin }, seamFirst, cj.solveEnd, { &seam, seamFirst });
+        }
+        if (overRanks)
+        {
+          exchangeFrames(options, seam, secondsExchanging);
+        }
+        if (forMe && j + 1 == k)
+        {
+          before = std::move(seam);
+          beforeFirst = seamFirst;
+          finishMine();
+        }
+        else if (forMe)
+        {
+          tail = std::move(seam);
+          tailFirst = seamFirst;
+        }
+      }
+      if (mine)
+      {
+        current = Solution();
+      }
     }
   }
+  stats.secondsReducing += secondsExchanging;
   // A chunk where every light is off (a night) warns that no light arrived; the animation
   // only when none arrived anywhere.
   if (stats.firstHits > 0)

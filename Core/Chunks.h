@@ -57,12 +57,9 @@ struct ChunkPlan
 /// chunk). Throws mlr::Error for 1 frame per chunk.
 ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk);
 
-/// The seed chunk `chunk` solves with: a SplitMix64 mix of the solve's seed and the chunk, so
-/// that no two chunks share a random stream.
-std::uint64_t chunkSeed(std::uint64_t seed, std::size_t chunk);
-
 /// The rig restricted to frames [first, first + count): every moving light keeps those poses,
-/// static lights stay as they are.
+/// static lights stay as they are, and its firstFrame says where the slice starts, so that its
+/// positions cast the paths they cast in any other slice.
 LightRig sliceRig(const LightRig& rig, std::size_t first, std::size_t count);
 
 /// Receives frames [firstFrame, firstFrame + frames.frameCount()) once they are final; the
@@ -72,11 +69,18 @@ using ChunkFramesCallback = std::function<void(std::size_t firstFrame, Solution&
 /**
  * Solves the animation in the chunks of planChunks(frames, framesPerChunk). With one chunk
  * this is solve(scene, rig, options, progress), bit for bit. With several, each is a solve of
- * sliceRig over its positions with chunkSeed; the result is bit-identical for any thread count.
+ * sliceRig over its positions with the same seed, so that chunks cast the same paths from the
+ * positions they share; the result is bit-identical for any thread count.
  * With `onFrames` the finished frames of each chunk go to it and are then freed (the returned
  * Solution holds the statistics only); without, the returned Solution holds every frame. Lit
  * sides: with onFrames, those of the first chunk for every chunk (a frame streamed cannot wait
- * for the last); without, chosen over the whole animation. Throws as solve() does.
+ * for the last); without, chosen over the whole animation.
+ * Over ranks (options.ranks > 1) with onFrames and at least as many chunks as ranks, the ranks
+ * take whole chunks: rank r solves chunks r, r + R, ... alone and hands on their frames only,
+ * the same bits as a serial solve's; the returned statistics are the animation's on every
+ * rank, the warnings this rank's. Otherwise the ranks split each chunk's paths and every rank
+ * gets every frame. Throws as solve() does; a failure or cancel on one rank stops every rank
+ * after the chunks of that round.
  */
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress = {},

@@ -433,9 +433,10 @@ std::size_t SkySource::kernel(const EmittedPath& path, const Vec3&, const Vec3&,
 
 // --- The one interface -----------------------------------------------------------------------
 
-LightSource::LightSource(Kind kind, std::uint64_t stream)
+LightSource::LightSource(Kind kind, std::uint64_t stream, std::size_t firstFrame)
   : What(std::move(kind))
   , Stream(stream)
+  , FirstFrame(firstFrame)
 {
   std::visit(
     [&](const auto& light)
@@ -517,7 +518,7 @@ std::vector<LightSource> lightSources(
   auto nextStream = [&] { return static_cast<std::uint64_t>(sources.size()) << 32; };
   for (const MovingLight& light : rig.areaLights)
   {
-    sources.emplace_back(AreaSource(light), nextStream());
+    sources.emplace_back(AreaSource(light), nextStream(), rig.firstFrame);
   }
   for (const MovingLight& light : emitters)
   {
@@ -525,17 +526,17 @@ std::vector<LightSource> lightSources(
   }
   for (const PointLight& light : rig.pointLights)
   {
-    sources.emplace_back(PointSource(light), nextStream());
+    sources.emplace_back(PointSource(light), nextStream(), rig.firstFrame);
   }
   const Vec3 centre = (scene.boundsMin() + scene.boundsMax()) * 0.5;
   const double radius = std::max(0.5 * scene.diagonal(), 1e-9 * std::max(1.0, length(centre)));
   for (const DirectionalLight& light : rig.directionalLights)
   {
-    sources.emplace_back(DirectionalSource(light, centre, radius), nextStream());
+    sources.emplace_back(DirectionalSource(light, centre, radius), nextStream(), rig.firstFrame);
   }
   for (const Sky& sky : rig.skies)
   {
-    sources.emplace_back(SkySource(sky, centre, radius), nextStream());
+    sources.emplace_back(SkySource(sky, centre, radius), nextStream(), rig.firstFrame);
   }
   return sources;
 }

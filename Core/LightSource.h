@@ -37,6 +37,11 @@ struct LightRig
   std::vector<PointLight> pointLights;
   std::vector<DirectionalLight> directionalLights;
   std::vector<Sky> skies;
+  /// The frame of the whole animation that this rig's first pose is (sliceRig sets it): the
+  /// random streams of a moving light's positions are keyed by their frame in the animation,
+  /// so that a chunk solving a slice casts the same paths from a position as every other
+  /// chunk that solves it.
+  std::size_t firstFrame = 0;
 };
 
 /// The number of frames of a rig: the pose count of its moving lights, or 1 when nothing
@@ -191,7 +196,9 @@ public:
 
   /// `stream` keys this source's random streams apart from the other sources' (0 for the
   /// first): lights of one rig are independent estimates, not the same numbers replayed.
-  LightSource(Kind kind, std::uint64_t stream);
+  /// `firstFrame`: the animation's frame of position 0 (LightRig::firstFrame; 0 for a static
+  /// light, which every frame shares).
+  LightSource(Kind kind, std::uint64_t stream, std::size_t firstFrame = 0);
 
   std::size_t positions() const { return this->Positions; }
   bool isStatic() const { return this->Positions == 1; }
@@ -204,6 +211,13 @@ public:
   /// The positions that emit, in order.
   const std::vector<std::size_t>& activePositions() const { return this->Active; }
   std::uint64_t stream() const { return this->Stream; }
+  /// The key of the paths cast from `position` (the b of their RandomStream): the source's
+  /// stream and the position's frame in the whole animation, so that path i of a frame is the
+  /// same path in every chunk, and in a classic solve of that frame.
+  std::uint64_t positionStream(std::size_t position) const
+  {
+    return this->Stream + (this->isStatic() ? 0 : this->FirstFrame) + position + 1;
+  }
   const Kind& kind() const { return this->What; }
 
   /// A path's start at `position`, lifted `offset` off the light.
@@ -229,6 +243,7 @@ private:
   std::vector<double> On;
   std::vector<std::size_t> Active;
   std::uint64_t Stream = 0;
+  std::size_t FirstFrame = 0;
 };
 
 /// The scene's emissive patches as static area lights, one per distinct emission (an area

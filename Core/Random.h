@@ -26,8 +26,6 @@ enum class StreamPurpose : std::uint64_t
   Sensors = 4,
   /// The pilot paths that choose how many paths each light position casts.
   Pilot = 5,
-  /// The seeds of the chunks of a long animation (Chunks.h).
-  Chunks = 6,
 };
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state advanced by a Weyl step and

@@ -150,13 +150,15 @@ public:
       sumOne(this->PatchPower, this->SceneRef.patchCount(), secondsReducing);
   }
 
-  /// Which active position path `path` of a reuse solve starts from: paths are numbered
-  /// position by position, M_k of them for the k-th active position.
-  std::size_t positionOfPath(std::uint64_t path) const
+  /// Which active position path `path` of a reuse solve starts from, and its index among that
+  /// position's paths: paths are numbered position by position, M_k of them for the k-th
+  /// active position.
+  std::size_t positionOfPath(std::uint64_t path, std::uint64_t& index) const
   {
     const auto next = std::upper_bound(this->FirstPath.begin(), this->FirstPath.end(), path);
-    return this->SourceRef
-      .activePositions()[static_cast<std::size_t>(next - this->FirstPath.begin() - 1)];
+    const auto a = static_cast<std::size_t>(next - this->FirstPath.begin() - 1);
+    index = path - this->FirstPath[a];
+    return this->SourceRef.activePositions()[a];
   }
 
   /// M_k of every position (0 for positions that are off).
@@ -357,8 +359,13 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
 {
   WorkerCounters& counters = this->Counters[static_cast<std::size_t>(worker)];
   KernelScratch& scratch = this->Scratch[static_cast<std::size_t>(worker)];
-  const std::size_t origin = this->positionOfPath(path);
-  RandomStream random(this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream());
+  // Keyed by the position's frame and the path's index there, not by `path`: a chunk that
+  // solves the same position with as many paths casts the same ones, so that two chunks'
+  // estimates of the frames they share are correlated and their blend does not flicker.
+  std::uint64_t index = 0;
+  const std::size_t origin = this->positionOfPath(path, index);
+  RandomStream random(
+    this->Options.seed, StreamPurpose::Shooting, index, this->SourceRef.positionStream(origin));
 
   EmittedPath emitted;
   RayHit hit;
@@ -555,7 +562,7 @@ namespace
 void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int worker)
 {
   RandomStream random(
-    this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.stream() + position + 1);
+    this->Options.seed, StreamPurpose::Shooting, path, this->SourceRef.positionStream(position));
   EmittedPath emitted;
   RayHit hit;
   if (!this->emit(random, position, worker, emitted, hit))

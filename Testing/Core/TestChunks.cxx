@@ -1,14 +1,18 @@
 // Animations solved in chunks: the plan and its blend weights, bits independent of the thread
 // count, one chunk as the plain solve, streaming as assembling, an unbiased seam, and a memory
-// limit that leaves room for 2 frames per chunk.
+// limit that leaves room for 2 frames per chunk, and ranks that take whole chunks.
 #include "Animation.h"
 #include "Chunks.h"
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
+#include "ThreadRanks.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <thread>
+#include <vector>
 
 using namespace mlr;
 
@@ -146,7 +150,7 @@ TEST(Chunks, ThreadCountDoesNotChangeABit)
     EXPECT_TRUE(checks::sameBits(one.stdErrorData(), s->stdErrorData()));
     EXPECT_EQ(one.statistics.shadowRays, s->statistics.shadowRays);
   }
-  // Chunks differ from the plain solve: their seeds and positions are their own.
+  // Chunks differ from the plain solve: each reuses paths over its own positions only.
   Solution plain = solve(scene, rig(), o);
   EXPECT_FALSE(checks::sameBits(one.directData(), plain.directData()));
 }
@@ -285,4 +289,168 @@ TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
   options.sensors.points.push_back(Vec3(0.5, 0.5, 0.01));
   options.sensors.normals.push_back(Vec3(0, 0, 1));
   checks::expectError([&] { solveAnimation(soup, rig(), options); }, "sensors");
+}
+
+namespace
+{
+/// The bits of every streamed frame: direct, indirect and standard error of each element side,
+/// then each patch side, as floats.
+using FrameBits = std::map<std::size_t, std::vector<float>>;
+
+void recordFrames(std::size_t first, Solution& s, FrameBits& out)
+{
+  for (std::size_t f = 0; f < s.frameCount(); ++f)
+  {
+    std::vector<float>& bits = out[first + f];
+    auto add = [&](const PackedRgb& c) { bits.insert(bits.end(), { c.r, c.g, c.b }); };
+    for (std::size_t e = 0; e < s.elementCount(); ++e)
+    {
+      for (const Side side : { Side::Front, Side::Back })
+      {
+        const std::size_t i = s.elementIndex(f, e, side);
+        add(s.directData()[i]);
+        add(s.indirectData()[i]);
+        add(s.stdErrorData()[i]);
+      }
+    }
+    for (std::size_t p = 0; p < s.patchCount(); ++p)
+    {
+      for (const Side side : { Side::Front, Side::Back })
+      {
+        add(s.patchData()[s.patchIndex(f, p, side)]);
+      }
+    }
+  }
+}
+}
+
+TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
+{
+  // 12 frames in chunks of 3 (m = 1): 4 chunks, so 3 ranks leave one idle in the second round.
+  const Scene scene = box();
+  SolverOptions o = options(20000, 11, 1);
+  o.errorBatches = 2;
+  constexpr std::size_t perChunk = 3;
+  const ChunkPlan plan = planChunks(Frames, perChunk);
+  ASSERT_EQ(plan.chunks.size(), 4u);
+  FrameBits serial;
+  std::vector<Side> serialSides;
+  const Solution serialStats = solveInChunks(scene, rig(), o, perChunk, {},
+    [&](std::size_t first, Solution& frames)
+    {
+      recordFrames(first, frames, serial);
+      serialSides = frames.litSideData();
+    });
+  ASSERT_EQ(serial.size(), Frames);
+
+  for (const int ranks : { 1, 2, 3 })
+  {
+    for (const int threads : { 1, 2 })
+    {
+      checks::ThreadRanks group(ranks);
+      std::vector<FrameBits> got(static_cast<std::size_t>(ranks));
+      std::vector<std::vector<std::size_t>> firsts(static_cast<std::size_t>(ranks));
+      std::vector<Solution> stats(static_cast<std::size_t>(ranks));
+      std::vector<std::string> errors(static_cast<std::size_t>(ranks));
+      std::vector<std::vector<Side>> sides(static_cast<std::size_t>(ranks));
+      std::vector<std::thread> workers;
+      for (int r = 0; r < ranks; ++r)
+      {
+        workers.emplace_back(
+          [&, r]
+          {
+            const auto i = static_cast<std::size_t>(r);
+            SolverOptions mine = group.optionsFor(r, o);
+            mine.threads = threads;
+            try
+            {
+              stats[i] = solveInChunks(scene, rig(), mine, perChunk, {},
+                [&](std::size_t first, Solution& frames)
+                {
+                  firsts[i].push_back(first);
+                  recordFrames(first, frames, got[i]);
+                  sides[i] = frames.litSideData();
+                });
+            }
+            catch (const std::exception& e)
+            {
+              errors[i] = e.what();
+            }
+          });
+      }
+      for (std::thread& t : workers)
+      {
+        t.join();
+      }
+      std::size_t handedOn = 0;
+      for (std::size_t r = 0; r < static_cast<std::size_t>(ranks); ++r)
+      {
+        SCOPED_TRACE("rank " + std::to_string(r) + " of " + std::to_string(ranks) + ", " +
+          std::to_string(threads) + " threads");
+        ASSERT_EQ(errors[r], "");
+        // Rank r hands on the frames of chunks r, r + R, ... and no others.
+        std::vector<std::size_t> expected;
+        for (std::size_t k = r; k < plan.chunks.size(); k += static_cast<std::size_t>(ranks))
+        {
+          expected.push_back(plan.finishedBegin(k));
+        }
+        EXPECT_EQ(firsts[r], expected);
+        for (const auto& [frame, bits] : got[r])
+        {
+          EXPECT_EQ(bits, serial.at(frame)) << "frame " << frame;
+        }
+        handedOn += got[r].size();
+        EXPECT_EQ(sides[r], serialSides);
+        // The figures of every chunk reach every rank.
+        EXPECT_EQ(stats[r].statistics.shadowRays, serialStats.statistics.shadowRays);
+        EXPECT_EQ(stats[r].statistics.pathsCast, serialStats.statistics.pathsCast);
+        EXPECT_EQ(stats[r].statistics.gatheringRays, serialStats.statistics.gatheringRays);
+        EXPECT_EQ(stats[r].statistics.chunks, 4u);
+        EXPECT_EQ(stats[r].errorEstimate.batches, serialStats.errorEstimate.batches);
+        EXPECT_EQ(stats[r].errorEstimate.stoppedBy, serialStats.errorEstimate.stoppedBy);
+      }
+      EXPECT_EQ(handedOn, Frames);
+    }
+  }
+}
+
+TEST(Chunks, ACancelOnOneRankStopsEveryRankBetweenChunks)
+{
+  const Scene scene = box();
+  const SolverOptions o = options(20000, 5, 1);
+  constexpr int ranks = 2;
+  checks::ThreadRanks group(ranks);
+  std::vector<std::string> outcome(ranks);
+  std::vector<std::thread> workers;
+  for (int r = 0; r < ranks; ++r)
+  {
+    workers.emplace_back(
+      [&, r]
+      {
+        // Rank 1 cancels in its second chunk (the third of the animation).
+        bool second = false;
+        try
+        {
+          solveInChunks(
+            scene, rig(), group.optionsFor(r, o), 3,
+            [&](double fraction) { return !(r == 1 && second && fraction > 0.6); },
+            [&](std::size_t, Solution&) { second = true; });
+          outcome[static_cast<std::size_t>(r)] = "finished";
+        }
+        catch (const Cancelled&)
+        {
+          outcome[static_cast<std::size_t>(r)] = "cancelled";
+        }
+        catch (const std::exception& e)
+        {
+          outcome[static_cast<std::size_t>(r)] = e.what();
+        }
+      });
+  }
+  for (std::thread& t : workers)
+  {
+    t.join();
+  }
+  EXPECT_EQ(outcome[0], "cancelled");
+  EXPECT_EQ(outcome[1], "cancelled");
 }

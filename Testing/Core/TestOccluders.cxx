@@ -273,9 +273,11 @@ void expectDirectLightMatchesLambert(bool reuse)
   {
     // Unbiased, with a variance near the binomial one; wider tails in penumbrae, where the
     // positions that see the element are few and their weights G_j / sum_k M_k G_k larger.
+    // Over seeds 17 to 24 the largest |z| of the 6,414 ranged from 5.5 to 8.0 (mean z^2 1.44
+    // to 1.58): the bound catches a misweighted path, whose z is in the tens, not that tail.
     EXPECT_LT(meanSquare, 2.0);
     EXPECT_GT(meanSquare, 0.3);
-    EXPECT_LT(maxAbs, 7.0);
+    EXPECT_LT(maxAbs, 10.0);
   }
   else
   {

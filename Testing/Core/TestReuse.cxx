@@ -169,7 +169,7 @@ TEST(Reuse, BalancedSharesBringTheEndsErrorDown)
   double smallest = 1, largest = 1;
   for (int balanced = 0; balanced < 2; ++balanced)
   {
-    for (int r = 0; r < 12; ++r)
+    for (int r = 0; r < 24; ++r)
     {
       SolverOptions o = modeOptions(true, 18000, 500 + r);
       o.balanceFrames = balanced == 1;
@@ -188,7 +188,9 @@ TEST(Reuse, BalancedSharesBringTheEndsErrorDown)
     ends[1] / ends[0], middle[1] / middle[0], smallest, largest);
   EXPECT_LT(smallest, 1.0);
   EXPECT_GT(largest, 1.2);
-  EXPECT_LT(ends[1], 0.9 * ends[0]);
+  // Over 72 seeds in sets of 12 the ratio was 0.80 to 0.91 (mean 0.87, standard deviation
+  // 0.035 per set): over 24 seeds 0.95 is 3 deviations above the mean and 2 below no gain.
+  EXPECT_LT(ends[1], 0.95 * ends[0]);
   EXPECT_LT(middle[1], 1.3 * middle[0]);
 }
 

@@ -342,19 +342,22 @@ TEST(Sun, NightFrameIsDarkAndCastsNothing)
         EXPECT_EQ(a.total(1, e, side), Rgb()) << mode << " element " << e;
         EXPECT_EQ(a.patchRadiosity(1, Scene::patchOfElement(e), side), Rgb()) << mode;
         day += a.total(0, e, side).sum() + a.total(2, e, side).sum();
-        // The first frame draws the same random numbers either way; with reuse every day frame
-        // does, since the night casts no path and takes no share of the N paths.
-        EXPECT_EQ(a.total(0, e, side), b.total(0, e, side)) << mode << " element " << e;
-        if (reuse)
+        // Classic's first frame draws the same random numbers either way (a position's paths
+        // are keyed by its frame, so with reuse the evening's differ: frame 2 here, 1 there).
+        if (!reuse)
         {
-          EXPECT_EQ(a.total(2, e, side), b.total(1, e, side)) << mode << " element " << e;
+          EXPECT_EQ(a.total(0, e, side), b.total(0, e, side)) << mode << " element " << e;
         }
       }
     }
     EXPECT_GT(day, 0.0);
     if (reuse)
     {
-      EXPECT_EQ(a.statistics.shadowRays, b.statistics.shadowRays)
+      // The night takes no share of the N paths and no shadow ray goes towards it: a first
+      // hit asks for the visibility of the other day position only, at most one ray.
+      EXPECT_EQ(a.statistics.pathsCast, b.statistics.pathsCast);
+      EXPECT_GT(a.statistics.shadowRays, 0u);
+      EXPECT_LE(a.statistics.shadowRays, a.statistics.firstHits)
         << "no shadow ray towards the night";
     }
   }
