@@ -76,10 +76,11 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     [&](std::size_t patches, std::size_t elements, std::size_t points, bool approximate)
   {
     const std::uint64_t outputs = outputBytes(options, lights, soupEmits, elements, points, frames);
+    const bool kept = streamed && options.keepsStreamedFrames;
     framesPerChunk = chooseFramesPerChunk(
-      patches, elements, points, frames, options.solver, lightCount, outputs, streamed);
+      patches, elements, points, frames, options.solver, lightCount, outputs, streamed, kept);
     checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
-                       options.solver, lightCount, outputs, streamed),
+                       options.solver, lightCount, outputs, streamed, kept),
       streamed ? std::min(frames, framesPerChunk) : frames, patches, elements, options.solver,
       approximate);
   };

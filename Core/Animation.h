@@ -40,6 +40,9 @@ struct AnimationOptions
   /// are solved and are freed after (Chunks.h), and Animation::solution keeps the statistics
   /// only. The memory policy then counts one chunk's frames, not all.
   AnimationFramesCallback chunkFrames;
+  /// The caller keeps the frames chunkFrames gets (the filter over ranks that take whole
+  /// chunks): the memory policy counts them, this rank's share.
+  bool keepsStreamedFrames = false;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.

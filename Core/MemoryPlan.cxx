@@ -102,7 +102,7 @@ std::uint64_t estimateSolveMemory(
 
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed)
+  std::uint64_t fixedBytes, bool streamed, bool keepsStreamed)
 {
   if (framesPerChunk == 0 || framesPerChunk >= frames)
   {
@@ -117,14 +117,21 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
       sizeof(PackedRgb) });
   const std::uint64_t solving = estimateSolveMemory(
     patches, elements, points, std::min(frames, framesPerChunk + 2 * m), options, lights);
-  const std::uint64_t held =
-    saturatingProduct(perFrame, 2 * m + (streamed ? framesPerChunk : frames));
+  std::size_t finished = streamed ? framesPerChunk : frames;
+  if (streamed && keepsStreamed)
+  {
+    const std::size_t chunks = planChunks(frames, framesPerChunk).chunks.size();
+    const auto ranks = static_cast<std::size_t>(std::max(options.ranks, 1));
+    finished =
+      chunks >= ranks ? std::min(frames, (chunks + ranks - 1) / ranks * framesPerChunk) : frames;
+  }
+  const std::uint64_t held = saturatingProduct(perFrame, 2 * m + finished);
   return saturatingSum(saturatingSum(solving, held), fixedBytes);
 }
 
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed)
+  bool streamed, bool keepsStreamed)
 {
   if (options.framesPerChunk > 0)
   {
@@ -133,8 +140,8 @@ std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std:
   const std::uint64_t limit = memoryLimitBytes(options);
   auto fits = [&](std::size_t c)
   {
-    return estimateChunkedMemory(
-             patches, elements, points, frames, c, options, lights, fixedBytes, streamed) <= limit;
+    return estimateChunkedMemory(patches, elements, points, frames, c, options, lights, fixedBytes,
+             streamed, keepsStreamed) <= limit;
   };
   if (frames <= MinimumFramesPerChunk || fits(frames))
   {

@@ -59,18 +59,21 @@ std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std
  * The peak of a solve of `frames` frames in chunks of `framesPerChunk` (Chunks.h; 0 or
  * `frames` and more: one chunk, the plain solve): one chunk's solve, the estimate of its seam
  * kept for the next, and the finished frames, those of one chunk when they are `streamed` to
- * the caller, else all. `fixedBytes` (the caller's outputs) is added.
+ * the caller, else all. A caller that `keepsStreamed` frames holds its share of them: the
+ * frames of every R-th chunk when R = options.ranks ranks take whole chunks (at least R
+ * chunks, Chunks.h), else all. `fixedBytes` (the caller's
+ * outputs) is added.
  */
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed);
+  std::uint64_t fixedBytes, bool streamed, bool keepsStreamed = false);
 
 /// C: options.framesPerChunk when set, else every frame when that fits the memory limit,
 /// else the most frames per chunk whose estimateChunkedMemory does (at least 2: the memory
 /// check then says what does not fit).
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed);
+  bool streamed, bool keepsStreamed = false);
 
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);

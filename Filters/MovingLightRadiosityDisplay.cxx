@@ -46,15 +46,20 @@ std::array<unsigned char, 3> displayColor(const Rgb& radiosity, double exposureS
     srgbByte(acesFilmic(exposureScale * radiosity.b)) };
 }
 
-double autoExposure(const Solution& solution)
+namespace
 {
-  // A histogram of log2 luminance rather than a sort: frames x elements values may not fit
-  // in memory twice, and 1/64 EV is far below what the eye can tell.
-  constexpr int StepsPerEV = 64;
-  constexpr int LowestEV = -100, HighestEV = 100;
-  std::vector<std::uint64_t> histogram(
-    static_cast<std::size_t>((HighestEV - LowestEV) * StepsPerEV), 0);
-  std::uint64_t unlit = 0, total = 0;
+// A histogram of log2 luminance rather than a sort: frames x elements values may not fit in
+// memory twice, and 1/64 EV is far below what the eye can tell.
+constexpr int StepsPerEV = 64;
+constexpr int LowestEV = -100, HighestEV = 100;
+constexpr std::size_t ExposureBins = static_cast<std::size_t>((HighestEV - LowestEV) * StepsPerEV);
+}
+
+std::vector<std::uint64_t> exposureHistogram(const Solution& solution)
+{
+  std::vector<std::uint64_t> histogram(ExposureBins + 2, 0);
+  std::uint64_t& unlit = histogram[ExposureBins];
+  std::uint64_t& total = histogram[ExposureBins + 1];
   for (std::size_t e = 0; e < solution.elementCount(); ++e)
   {
     const Side lit = solution.litSide(e);
@@ -69,10 +74,16 @@ double autoExposure(const Solution& solution)
       }
       const double bin = std::floor((std::log2(l) - LowestEV) * StepsPerEV);
       const auto index =
-        static_cast<std::size_t>(std::clamp(bin, 0.0, static_cast<double>(histogram.size() - 1)));
+        static_cast<std::size_t>(std::clamp(bin, 0.0, static_cast<double>(ExposureBins - 1)));
       ++histogram[index];
     }
   }
+  return histogram;
+}
+
+double exposureOf(const std::vector<std::uint64_t>& histogram)
+{
+  const std::uint64_t unlit = histogram[ExposureBins], total = histogram[ExposureBins + 1];
   if (total == unlit)
   {
     return 0;
@@ -82,7 +93,7 @@ double autoExposure(const Solution& solution)
   const auto rank = static_cast<std::uint64_t>(std::ceil(0.99 * static_cast<double>(total)));
   std::uint64_t seen = unlit;
   std::size_t index = 0;
-  for (std::size_t i = 0; i < histogram.size(); ++i)
+  for (std::size_t i = 0; i < ExposureBins; ++i)
   {
     if (histogram[i] == 0)
     {
@@ -97,6 +108,11 @@ double autoExposure(const Solution& solution)
   }
   const double log2Level = LowestEV + (static_cast<double>(index) + 0.5) / StepsPerEV;
   return std::log2(AutoExposureTarget) - log2Level;
+}
+
+double autoExposure(const Solution& solution)
+{
+  return exposureOf(exposureHistogram(solution));
 }
 
 SmoothShading smoothShading(const Scene& scene, const Solution& solution)

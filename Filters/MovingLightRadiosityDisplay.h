@@ -35,6 +35,13 @@ std::array<unsigned char, 3> displayColor(const Rgb& radiosity, double exposureS
 /// steps of 1/64 EV; 0 when nothing is lit.
 double autoExposure(const Solution& solution);
 
+/// The histogram autoExposure counts, with the unlit values and all values as its last two
+/// entries: histograms of frames apart (ranks that hold different frames) add up to theirs.
+std::vector<std::uint64_t> exposureHistogram(const Solution& solution);
+
+/// autoExposure from the sum of the exposureHistogram of every frame.
+double exposureOf(const std::vector<std::uint64_t>& histogram);
+
 /// The exposed value the 99th percentile maps to: acesFilmic(1) = 0.80 (sRGB 231 of 255),
 /// bright but short of white, so that brighter spots (under the light) keep some gradation.
 constexpr double AutoExposureTarget = 1.0;

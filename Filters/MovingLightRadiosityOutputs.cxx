@@ -158,7 +158,7 @@ void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, s
 
 void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution)
 {
-  if (!solution.hasErrorEstimate())
+  if (solution.errorEstimate.batches == 0)
   {
     return;
   }

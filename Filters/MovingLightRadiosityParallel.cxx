@@ -1,6 +1,8 @@
 #include "MovingLightRadiosityParallel.h"
 
 #include "Error.h"
+#include "ErrorEstimate.h"
+#include "MovingLightRadiosityDisplay.h"
 
 #include "vtkCellData.h"
 #include "vtkCharArray.h"
@@ -29,6 +31,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -468,6 +471,125 @@ void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
 
 /// Sums go in chunks: MPI counts are ints.
 constexpr std::size_t Chunk = std::size_t(1) << 24;
+
+RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t frames,
+  const Solution& statistics, const SolverOptions& options)
+{
+  RankFramesDisplay display;
+  if (blocks.empty())
+  {
+    throw Error("internal error: no frame reached this rank");
+  }
+  std::size_t held = 0;
+  for (const FrameBlock& b : blocks)
+  {
+    held += b.frames.frameCount();
+  }
+  display.apart = held < frames;
+  const Solution& like = blocks.front().frames;
+  const std::size_t elements = like.elementCount(), patches = like.patchCount();
+
+  // The lit sides: each element's totals on both sides over every frame (and its irradiance,
+  // for a black element), and each patch's, summed frame by frame as chooseLitSides does.
+  std::vector<double> sums(4 * elements + 2 * patches, 0.0);
+  for (const FrameBlock& b : blocks)
+  {
+    const Solution& s = b.frames;
+    for (std::size_t e = 0; e < elements; ++e)
+    {
+      for (std::size_t f = 0; f < s.frameCount(); ++f)
+      {
+        sums[4 * e] += s.total(f, e, Side::Front).sum();
+        sums[4 * e + 1] += s.total(f, e, Side::Back).sum();
+        sums[4 * e + 2] += s.irradiance(f, e, Side::Front).sum();
+        sums[4 * e + 3] += s.irradiance(f, e, Side::Back).sum();
+      }
+    }
+    for (std::size_t p = 0; p < patches; ++p)
+    {
+      for (std::size_t f = 0; f < s.frameCount(); ++f)
+      {
+        sums[4 * elements + 2 * p] += s.patchRadiosity(f, p, Side::Front).sum();
+        sums[4 * elements + 2 * p + 1] += s.patchRadiosity(f, p, Side::Back).sum();
+      }
+    }
+  }
+  if (display.apart)
+  {
+    options.sumDoublesAcrossRanks(sums.data(), sums.size());
+  }
+  Solution& summary = display.summary;
+  summary = Solution(0, elements, patches);
+  for (std::size_t e = 0; e < elements; ++e)
+  {
+    const bool black = sums[4 * e] == 0 && sums[4 * e + 1] == 0;
+    const double front = black ? sums[4 * e + 2] : sums[4 * e];
+    const double back = black ? sums[4 * e + 3] : sums[4 * e + 1];
+    summary.litSideData()[e] = back > front ? Side::Back : Side::Front;
+  }
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    summary.patchLitSideData()[p] =
+      sums[4 * elements + 2 * p + 1] > sums[4 * elements + 2 * p] ? Side::Back : Side::Front;
+  }
+  for (FrameBlock& b : blocks)
+  {
+    b.frames.litSideData() = summary.litSideData();
+    b.frames.patchLitSideData() = summary.patchLitSideData();
+  }
+
+  // One exposure over every frame, from the histograms of the frames held.
+  std::vector<std::uint64_t> histogram;
+  for (const FrameBlock& b : blocks)
+  {
+    const std::vector<std::uint64_t> h = vtkoutputs::exposureHistogram(b.frames);
+    histogram.resize(h.size(), 0);
+    std::transform(h.begin(), h.end(), histogram.begin(), histogram.begin(), std::plus<>());
+  }
+  if (display.apart)
+  {
+    std::vector<std::int64_t> counts(histogram.begin(), histogram.end());
+    options.sumAcrossRanks(counts.data(), counts.size());
+    std::copy(counts.begin(), counts.end(), histogram.begin());
+  }
+  display.exposure = vtkoutputs::exposureOf(histogram);
+
+  // Every frame's error figures, on the sides just chosen.
+  summary.statistics = statistics.statistics;
+  summary.errorEstimate = statistics.errorEstimate;
+  if (like.hasErrorEstimate())
+  {
+    std::vector<double> figures(3 * frames, 0.0);
+    for (const FrameBlock& b : blocks)
+    {
+      const Solution& s = b.frames;
+      for (std::size_t f = 0; f < s.frameCount(); ++f)
+      {
+        const FrameError e = frameError(s, f,
+          [&](std::size_t element, Side side) { return s.radiosityStdError(f, element, side); });
+        const std::size_t i = 3 * (b.first + f);
+        figures[i] = e.median;
+        figures[i + 1] = e.p95;
+        figures[i + 2] = static_cast<double>(e.litElements);
+      }
+    }
+    if (display.apart)
+    {
+      options.sumDoublesAcrossRanks(figures.data(), figures.size());
+    }
+    ErrorEstimateSummary& errors = summary.errorEstimate;
+    errors.relativeErrorMedian.assign(frames, 0.0);
+    errors.relativeErrorP95.assign(frames, 0.0);
+    errors.litElements.assign(frames, 0);
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      errors.relativeErrorMedian[f] = figures[3 * f];
+      errors.relativeErrorP95[f] = figures[3 * f + 1];
+      errors.litElements[f] = static_cast<std::uint64_t>(figures[3 * f + 2]);
+    }
+  }
+  return display;
+}
 
 void shareSolve(vtkMultiProcessController* controller, SolverOptions& options)
 {

@@ -64,6 +64,38 @@ double rankWaitLimit();
 /// Sets options.rank, ranks and the sums over ranks (the controller's AllReduce).
 void shareSolve(vtkMultiProcessController* controller, SolverOptions& options);
 
+/// Frames of an animation held by a rank: a block of consecutive frames from `first`.
+struct FrameBlock
+{
+  std::size_t first = 0;
+  Solution frames;
+};
+
+/// What the ranks show of the frames that they hold apart.
+struct RankFramesDisplay
+{
+  /// No frame, with every element's and patch's lit side, the animation's statistics and the
+  /// error summary of every frame.
+  Solution summary;
+  /// The auto exposure of every frame (autoExposure).
+  double exposure = 0;
+  /// Whether each rank holds its own chunks' frames only (else every rank holds every frame).
+  bool apart = false;
+};
+
+/**
+ * The frames of an animation of `frames` frames streamed to this rank (Core's ranks take
+ * whole chunks when there are at least as many as ranks; otherwise every rank gets every
+ * frame). Chooses every element's and patch's lit side over the whole animation, as
+ * Solution::chooseLitSides does, and sets it in every block; gives every frame's error
+ * figures and one auto exposure over every frame. With the frames apart, their sums go over
+ * the ranks (`options`' sums: a collective call), so that every rank shows the same; the
+ * lit sides then match the serial choice but for elements whose two sides' totals agree to
+ * the rounding of the sum.
+ */
+RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t frames,
+  const Solution& statistics, const SolverOptions& options);
+
 /// What the ranks agreed on: whether any failed or was cancelled, and the message to report
 /// (this rank's own, or the first failed rank's, named).
 struct Verdict

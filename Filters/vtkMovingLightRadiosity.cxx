@@ -84,6 +84,11 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// The frame Solution starts at: 0 but when chunks were streamed to the ChunkObserver,
   /// which leaves the last chunk's frames.
   std::size_t FirstFrame = 0;
+  /// Several ranks: the frames this rank holds, in blocks (Solution then holds no frame).
+  /// With FramesApart each rank holds the chunks it solved, outputs the whole of their time
+  /// steps and an empty piece at the others'; else every rank holds every frame.
+  std::vector<mlr::vtkparallel::FrameBlock> RankFrames;
+  bool FramesApart = false;
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
@@ -617,8 +622,29 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
   };
   // A scene lit only by things that do not move (its emitters, static lights) is solved once,
   // whatever time steps the Trajectory or NumberOfPositions declare: every step shows it.
-  // Streamed chunks leave only the last chunk's frames, from FirstFrame on.
-  if (cache.Solution.frameCount() > 1 &&
+  // The frames of this time step: in the Solution, or in a block of this rank's. Streamed
+  // chunks leave only the last chunk's frames, from FirstFrame on.
+  const mlr::Solution* frames = &cache.Solution;
+  std::size_t solved = 0;
+  bool held = true;
+  if (!cache.RankFrames.empty())
+  {
+    held = false;
+    for (mlr::vtkparallel::FrameBlock& block : cache.RankFrames)
+    {
+      const std::size_t n = block.frames.frameCount();
+      // One frame solved serves every time step (a scene lit by things that do not move).
+      if ((n == 1 && block.first == 0 && cache.RankFrames.size() == 1) ||
+        (frame >= block.first && frame < block.first + n))
+      {
+        frames = &block.frames;
+        solved = n == 1 ? 0 : frame - block.first;
+        held = true;
+        break;
+      }
+    }
+  }
+  else if (cache.Solution.frameCount() > 1 &&
     (frame < cache.FirstFrame || frame >= cache.FirstFrame + cache.Solution.frameCount()))
   {
     vtkErrorMacro(<< "time step " << frame << " was streamed to the chunk observer and is no "
@@ -627,22 +653,30 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
                   << " are): solve again without the observer to keep every frame");
     return false;
   }
-  const std::size_t solved = cache.Solution.frameCount() > 1 ? frame - cache.FirstFrame : 0;
+  else
+  {
+    solved = cache.Solution.frameCount() > 1 ? frame - cache.FirstFrame : 0;
+  }
+  // Frames apart: the rank that holds this time step outputs all of it, the others nothing.
+  const bool cut = cache.Distributed && !cache.FramesApart;
   if (cache.Elements)
   {
-    if (port == ELEMENTS_PORT)
+    if ((port == ELEMENTS_PORT || port == PATCHES_PORT) && !held)
+    {
+      output->Initialize();
+    }
+    else if (port == ELEMENTS_PORT)
     {
       output->ShallowCopy(cache.Elements);
-      mlr::vtkoutputs::addElementRadiosity(
-        cache.Solution, solved, cache.TwoSided, output->GetCellData());
-      mlr::vtkoutputs::addDisplayArrays(cache.Solution, cache.Shading, solved,
+      mlr::vtkoutputs::addElementRadiosity(*frames, solved, cache.TwoSided, output->GetCellData());
+      mlr::vtkoutputs::addDisplayArrays(*frames, cache.Shading, solved,
         std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
         output->GetCellData());
-      mlr::vtkoutputs::addIrradianceArrays(cache.Solution, cache.Shading, solved,
-        efficacyOf(cache, frame), output->GetPointData(), output->GetCellData());
+      mlr::vtkoutputs::addIrradianceArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
+        output->GetPointData(), output->GetCellData());
       mlr::vtkoutputs::addStdErrorArrays(
-        cache.Solution, cache.Shading, solved, output->GetPointData(), output->GetCellData());
-      if (cache.Distributed)
+        *frames, cache.Shading, solved, output->GetPointData(), output->GetCellData());
+      if (cut)
       {
         // Cut from the whole frame, so that the point arrays at the cut average over the
         // cells of both sides, as in serial.
@@ -653,8 +687,8 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     {
       output->ShallowCopy(cache.Patches);
       mlr::vtkoutputs::addPatchRadiosity(
-        cache.Solution, cache.PatchLitSides, solved, output->GetCellData());
-      if (cache.Distributed)
+        *frames, cache.PatchLitSides, solved, output->GetCellData());
+      if (cut)
       {
         output->ShallowCopy(mlr::vtkparallel::extractCells(output, cache.OwnedPatches));
       }
@@ -1080,7 +1114,20 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     // solve in one chunk comes whole, and is kept as without the observer.
     std::optional<mlr::Solution> whole;
     bool streamed = false;
-    if (this->ChunkFramesObserver && !controller && options.sensors.empty())
+    // Several ranks keep the frames as they come, chunk by chunk: each rank those of the
+    // chunks it solved when there are at least as many chunks as ranks (Core's ranks then
+    // take whole chunks), so that a long animation's frames are shared out, not repeated.
+    const bool keepsRankFrames =
+      controller && !this->ChunkFramesObserver && options.sensors.empty();
+    std::vector<mlr::vtkparallel::FrameBlock> rankFrames;
+    if (keepsRankFrames)
+    {
+      options.keepsStreamedFrames = true;
+      options.chunkFrames = [&](const mlr::Animation&, std::size_t first, mlr::Solution& frames) {
+        rankFrames.push_back({ first, std::move(frames) });
+      };
+    }
+    else if (this->ChunkFramesObserver && !controller && options.sensors.empty())
     {
       options.chunkFrames =
         [&](const mlr::Animation& solving, std::size_t first, mlr::Solution& frames)
@@ -1142,6 +1189,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       animation.solution = std::move(*whole);
     }
     mlr::Solution& solution = animation.solution;
+    std::optional<mlr::vtkparallel::RankFramesDisplay> apart;
+    if (keepsRankFrames)
+    {
+      apart = mlr::vtkparallel::combineRankFrames(
+        rankFrames, static_cast<std::size_t>(solution.statistics.frames), solution, solverOptions);
+      solution = std::move(apart->summary);
+    }
     if (streamed)
     {
       this->CheckAbort();
@@ -1158,7 +1212,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.Rig = std::move(rig);
       cache.Shading = mlr::vtkoutputs::smoothShading(scene, solution);
       cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
-      cache.AutoExposure = mlr::vtkoutputs::autoExposure(solution);
+      cache.AutoExposure = apart ? apart->exposure : mlr::vtkoutputs::autoExposure(solution);
       cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
       cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
       mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
@@ -1192,6 +1246,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     {
       cache.Solution = std::move(solution);
       cache.TwoSided = solverOptions.twoSided;
+    }
+    if (apart)
+    {
+      cache.RankFrames = std::move(rankFrames);
+      cache.FramesApart = apart->apart;
     }
     if (controller)
     {

@@ -20,7 +20,9 @@ run_parallel.py compares. Cases:
 - waitlimit: a solve, then rank 0 alone sets a property and updates (run with
   MLR_RANK_WAIT_LIMIT set: rank 0 names the ranks it waits for, then aborts the job);
 - bad: rank 1's Scene piece lacks the Reflectance array (the ranks' pieces disagree), then,
-  with consistent pieces, rank 1 alone has a memory limit the solve does not fit in.
+  with consistent pieces, rank 1 alone has a memory limit the solve does not fit in;
+- chunks: FramesPerChunk 8 (4 chunks of the 30 frames), every time step in turn: each rank
+  holds the frames of the chunks it solved and outputs them whole, nothing at the others'.
 """
 import argparse
 import os
@@ -31,7 +33,8 @@ import numpy as np
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--plugin", required=True)
-parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "waitlimit", "bad"])
+parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "waitlimit", "bad",
+                             "chunks"])
 parser.add_argument("--out", required=True, help="prefix of the .rank<r>.npz files written")
 parser.add_argument("--paths", type=int, default=20000)
 args = parser.parse_args()
@@ -146,6 +149,10 @@ if args.case in ("whole", "split"):
         elements = record(f"f{int(f)}_", f)
     if args.case == "split":
         results["own_excess"] = np.array(own_piece_excess(algorithm.GetOutputDataObject(0)))
+elif args.case == "chunks":
+    radiosity.FramesPerChunk = 8
+    for f in range(30):
+        record(f"f{f}_", float(f))
 elif args.case == "time":
     for step, f in enumerate((0.0, 29.0, 14.0, 29.0, 0.0)):
         record(f"s{step}_", f)

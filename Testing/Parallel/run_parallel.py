@@ -23,6 +23,9 @@ waitlimit: after a solve, rank 0 alone sets a property and updates, under
        an error saying so, rather than hanging.
 bad:   rank 1's piece lacks Reflectance: every rank reports an error naming it; rank 1 alone
        over its memory limit: every rank reports the limit. No rank hangs (the timeout).
+chunks: 30 frames in 4 chunks of 8 (overlap 1): rank k mod R holds chunk k's frames (0-6,
+       7-14, 15-22, 23-29) and outputs them whole, the other ranks nothing, and the union of
+       the ranks' outputs is the serial output bit for bit in every frame.
 """
 import argparse
 import glob
@@ -216,6 +219,24 @@ def main():
                       f"rank {r}: an element lies {float(data['own_excess']):.3g} m farther from this "
                       "rank's own piece of the scene than from the whole scene: it comes from "
                       "another rank's cells")
+    elif args.case == "chunks":
+        run(pvbatch + ["--case", "chunks", "--out", os.path.join(args.work, "serial")], "serial")
+        reference = load(os.path.join(args.work, "serial"))[0]
+        finished = [(0, 7), (7, 15), (15, 23), (23, 30)]
+        for f in range(30):
+            prefix = f"f{f}_"
+            owner = next(k for k, (b, e) in enumerate(finished) if b <= f < e) % args.ranks
+            cells = [int(r[prefix + "e_cells"]) for r in ranks]
+            serial_cells = int(reference[prefix + "e_cells"])
+            check(cells[owner] == serial_cells and sum(cells) == serial_cells,
+                  f"frame {f}: elements per rank {cells}: rank {owner} should hold all {serial_cells}")
+            for r, data in enumerate(ranks):
+                check(int(data[prefix + "frame"]) == f, f"rank {r}: FrameIndex {data[prefix + 'frame']} at time {f}")
+                check(int(data[prefix + "solves"]) == 1, f"rank {r}: SolveCount {data[prefix + 'solves']}")
+            for kind in ("e", "p"):
+                compare(checks, reference, ranks, prefix, kind, ordered=True)
+        for r, data in enumerate(ranks):
+            check(len(data["errors"]) == 0, f"rank {r}: errors {list(data['errors'])}")
     elif args.case == "time":
         for r, data in enumerate(ranks):
             solves = [int(data[f"s{s}_solves"]) for s in range(5)]
