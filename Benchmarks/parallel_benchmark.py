@@ -13,7 +13,14 @@ bit-identical for any number of ranks and threads).
     Benchmarks/parallel_benchmark.py --plugin build/.../MovingLightRadiosity.so [--quick]
 
 The same file is the script each rank runs (--rank-script). --quick runs a small
-configuration (PatchSize 0.12, 20,000 paths) in seconds."""
+configuration (PatchSize 0.12, 20,000 paths) in seconds.
+
+    Benchmarks/parallel_benchmark.py --plugin ... --chunks [--frames 1200 --frames-per-chunk 100]
+
+solves a long animation of the same box (the light moving along the trajectory's line in
+--frames frames, N = 100,000) in chunks, on 1 rank and on 2 ranks x 1 thread, and prints
+each rank's peak resident memory and frames held, the ratio of the 2-rank peak to the 1-rank
+peak, the times, and whether the frames (every 97th) are the same bits in both runs."""
 import argparse
 import json
 import os
@@ -44,15 +51,35 @@ def rank_script(args):
     trajectory = XMLPolyDataReader(FileName=[os.path.join(DATA, "cornell_trajectory.vtp")])
     for source in (box, light, trajectory):
         source.UpdatePipeline()
+    # A long animation: the trajectory's line in many more positions, in chunks.
+    path = dict(PathStart=[0.12, 0.5478, 0.0995], PathEnd=[0.436, 0.5478, 0.4595],
+                NumberOfPositions=args.frames, FramesPerChunk=args.frames_per_chunk) \
+        if args.frames else dict(Trajectory=trajectory)
     radiosity = MovingLightRadiosity(  # noqa: F821
-        Scene=box, Light=light, Trajectory=trajectory, PatchSize=args.patch_size,
+        Scene=box, Light=light, PatchSize=args.patch_size,
         NumberOfPaths=args.paths, GatheringRatio=1.0, FirstBounceSurvival=0.25,
-        ReuseShooting=1, ReuseGathering=1, Seed=1, NumberOfThreads=args.threads)
+        ReuseShooting=1, ReuseGathering=1, Seed=1, NumberOfThreads=args.threads, **path)
     start = time.perf_counter()
     cpu = time.process_time()
     radiosity.UpdatePipeline(time=0.0)
     update = time.perf_counter() - start
     cpu = time.process_time() - cpu
+    if args.frames:
+        # Every 97th frame's radiosity, from the rank that holds it; then this rank's peak.
+        digests = {}
+        for f in range(0, args.frames, 97):
+            radiosity.UpdatePipeline(time=float(f))
+            data = radiosity.GetClientSideObject().GetOutputDataObject(0)
+            if data.GetNumberOfCells() > 0:
+                digests[f] = hashlib.sha256(vtk_to_numpy(
+                    data.GetCellData().GetArray("Radiosity")).tobytes()).hexdigest()[:16]
+        with open("/proc/self/status") as status:
+            peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM"))
+        held = {int(f) for f in digests}
+        with open(f"{args.out}.rank{rank}", "w") as f:
+            json.dump({"peak": peak, "update": update, "digests": digests,
+                       "frames_held": len(held)}, f)
+        return
     elements = radiosity.GetClientSideObject().GetOutputDataObject(0)
     fields = elements.GetFieldData()
 
@@ -92,6 +119,51 @@ def measure(args, ranks, threads, work):
     return stats
 
 
+def measure_chunks(args, ranks, work):
+    out = os.path.join(work, f"chunks{ranks}")
+    command = [args.mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", str(ranks),
+               args.pvbatch, "--symmetric", "--force-offscreen-rendering", os.path.abspath(__file__),
+               "--rank-script", "--plugin", args.plugin, "--out", out, "--threads", "1",
+               "--paths", str(args.paths), "--patch-size", str(args.patch_size),
+               "--frames", str(args.frames), "--frames-per-chunk", str(args.frames_per_chunk)]
+    subprocess.run(command, check=True, timeout=TIMEOUT, stdout=subprocess.DEVNULL)
+    runs = []
+    for r in range(ranks):
+        with open(f"{out}.rank{r}") as f:
+            runs.append(json.load(f))
+    return runs
+
+
+def chunks_main(args):
+    work = tempfile.mkdtemp(prefix="mlr-parallel-chunks-")
+    try:
+        one = measure_chunks(args, 1, work)
+        two = measure_chunks(args, 2, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    mib = 1024.0 * 1024.0
+    print(f"Cornell box (PatchSize {args.patch_size}), {args.frames} frames in chunks of "
+          f"{args.frames_per_chunk}, N = {args.paths}, full reuse, 1 thread per rank")
+    print(f"{'configuration':<16}{'update s':>10}  peak resident MiB per rank")
+    for name, runs in (("1 rank", one), ("2 ranks", two)):
+        print(f"{name:<16}{max(r['update'] for r in runs):>10.2f}  "
+              + ", ".join(f"{r['peak'] / mib:.1f}" for r in runs))
+    ratio = max(r["peak"] for r in two) / one[0]["peak"]
+    print(f"2-rank peak / 1-rank peak: {ratio:.2f} (target at most 0.6: "
+          f"{'met' if ratio <= 0.6 else 'MISSED'}); update time 1 rank / 2 ranks: "
+          f"{one[0]['update'] / max(r['update'] for r in two):.2f}x")
+    merged = {}
+    for r in two:
+        for f, d in r["digests"].items():
+            merged[f] = merged.get(f, []) + [d]
+    same = all(len(merged.get(f, [])) == 1 and merged[f][0] == d for f, d in one[0]["digests"].items())
+    shown = [len(r["digests"]) for r in two]
+    print(f"sampled frames shown per rank: {shown} of {len(one[0]['digests'])}; the same bits as "
+          f"one rank: {'yes' if same else 'NO'}")
+    if not same:
+        sys.exit(1)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--plugin", required=True, help="MovingLightRadiosity.so")
@@ -103,9 +175,15 @@ def main():
     parser.add_argument("--patch-size", type=float, default=None)
     parser.add_argument("--mpiexec", default=shutil.which("mpiexec"))
     parser.add_argument("--pvbatch", default=shutil.which("pvbatch"))
+    parser.add_argument("--chunks", action="store_true",
+                        help="a long animation in chunks on 1 and 2 ranks: peak memory per rank")
+    parser.add_argument("--frames", type=int, default=0)
+    parser.add_argument("--frames-per-chunk", type=int, default=100)
     args = parser.parse_args()
+    if args.chunks and not args.frames:
+        args.frames = 1200
     if args.paths is None:
-        args.paths = 20000 if args.quick else 600000
+        args.paths = 20000 if args.quick else (100000 if args.frames else 600000)
     if args.patch_size is None:
         # 0.046 m remeshes the Cornell box into 2,686 patches, the paper's count.
         args.patch_size = 0.12 if args.quick else 0.046
@@ -114,6 +192,9 @@ def main():
         return
     if not args.mpiexec or not args.pvbatch:
         sys.exit("mpiexec and pvbatch are needed (apt-get install paraview openmpi-bin)")
+    if args.chunks:
+        chunks_main(args)
+        return
     work = tempfile.mkdtemp(prefix="mlr-parallel-benchmark-")
     try:
         runs = {}
