@@ -504,7 +504,10 @@ public:
    * seam, so that the solve's memory depends on the chunk, not on the animation's length;
    * 0 lets MemoryLimit choose: every frame at once when that fits, else the longest chunks
    * that do. 1 is refused (the blends of a chunk's two seams would overlap). The frames are
-   * kept for the time steps; the chunks' seeds derive from Seed. Default 0.
+   * kept for the time steps; every chunk solves with Seed, a position casting the same paths
+   * in every chunk that solves it. On several MPI ranks with at least as many chunks as ranks
+   * (and no Sensors), each rank solves whole chunks and keeps their frames: the rank holding a
+   * time step outputs it whole, the others an empty piece. Default 0.
    */
   vtkSetClampMacro(FramesPerChunk, int, 0, VTK_INT_MAX);
   vtkGetMacro(FramesPerChunk, int);
@@ -619,7 +622,8 @@ public:
    * `observer` gets each of them in order, as the Elements output of that time step would be,
    * and they are freed after: only the last chunk's frames stay for the time steps. The
    * display's exposure and the lit sides are then those of the first chunk. A solve in one
-   * chunk, with sensors or over several ranks keeps every frame as without an observer.
+   * chunk or with sensors keeps every frame as without an observer; over several ranks the
+   * observer is not used (each rank keeps the frames of the chunks it solved).
    * An empty observer turns streaming off.
    */
   using ChunkObserver = std::function<void(std::size_t frame, vtkPolyData* elements)>;
