@@ -563,7 +563,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
           warnings.push_back(w);
         }
       }
-      if (shape.elementCount() == 0)
+      if (overRanks && shape.elementCount() == 0)
       {
         shape = shapedLike(current, 1);
       }

@@ -266,6 +266,31 @@ TEST(Chunks, MemoryLimitForTwoFramesPerChunkGivesTheRightResult)
   }
 }
 
+TEST(Chunks, RanksThatKeepTheirFramesAreEstimatedTheirShare)
+{
+  // 40 frames in chunks of 10 (4 chunks, m = 1): a caller that keeps what is streamed to it
+  // holds the frames of every R-th chunk over R ranks, all of them when there are fewer chunks
+  // than ranks. The estimate's difference from a streamed one is those frames, less the one
+  // chunk a streamed solve holds.
+  constexpr std::size_t Long = 40, C = 10;
+  const Scene scene = box();
+  SolverOptions o = options(20000, 11);
+  const auto estimate = [&](int ranks, bool streamed, bool kept)
+  {
+    o.ranks = ranks;
+    return estimateChunkedMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
+      Long, C, o, 1, 0, streamed, kept);
+  };
+  const std::uint64_t streamed = estimate(1, true, false);
+  const std::uint64_t perFrame = (estimate(1, false, false) - streamed) / (Long - C);
+  ASSERT_GT(perFrame, 0u);
+  EXPECT_EQ(estimate(1, true, true), estimate(1, false, false));
+  EXPECT_EQ(estimate(2, true, true), streamed + perFrame * (2 * C - C));
+  EXPECT_EQ(estimate(3, true, true), streamed + perFrame * (2 * C - C));
+  EXPECT_EQ(estimate(4, true, true), streamed + perFrame * (C - C));
+  EXPECT_EQ(estimate(5, true, true), estimate(1, false, false)); // fewer chunks than ranks
+}
+
 TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
 {
   // Through the one entry point: a set C is used, the frames stream, the statistics say so.
