@@ -76,7 +76,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     [&](std::size_t patches, std::size_t elements, std::size_t points, bool approximate)
   {
     const std::uint64_t outputs = outputBytes(options, lights, soupEmits, elements, points, frames);
-    const bool kept = streamed && options.keepsStreamedFrames;
+    const std::size_t kept = streamed ? options.keptStreamedChunks : 0;
     framesPerChunk = chooseFramesPerChunk(
       patches, elements, points, frames, options.solver, lightCount, outputs, streamed, kept);
     checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,

@@ -40,9 +40,10 @@ struct AnimationOptions
   /// are solved and are freed after (Chunks.h), and Animation::solution keeps the statistics
   /// only. The memory policy then counts one chunk's frames, not all.
   AnimationFramesCallback chunkFrames;
-  /// The caller keeps the frames chunkFrames gets (the filter over ranks that take whole
-  /// chunks): the memory policy counts them, this rank's share.
-  bool keepsStreamedFrames = false;
+  /// The chunks of frames the caller keeps of those chunkFrames gets, at most (the filter
+  /// over ranks keeps all it gets, its cache of chunks some): the memory policy counts them
+  /// (estimateChunkedMemory). 0: none beyond the chunk handed on.
+  std::size_t keptStreamedChunks = 0;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.

@@ -318,6 +318,25 @@ void summariseErrors(Solution& s, const ErrorEstimateSummary& like)
   }
 }
 
+/**
+ * The frames chunk `chunk` finishes, as they are handed on: blended across its first seam
+ * with `before`, the estimate of the chunk before (none for the first chunk), with the lit
+ * sides given, the error figures of each frame and the chunk's statistics.
+ */
+Solution handedOn(const ChunkPlan& plan, std::size_t chunk, const Estimate& before,
+  Solution& current, const std::vector<Side>& litSides, const std::vector<Side>& patchLitSides)
+{
+  const std::size_t begin = plan.finishedBegin(chunk), end = plan.finishedEnd(chunk);
+  Solution finished = shapedLike(current, end - begin);
+  finishFrames(plan, chunk, before, { &current, plan.chunks[chunk].solveBegin }, begin, end,
+    { &finished, begin });
+  finished.litSideData() = litSides;
+  finished.patchLitSideData() = patchLitSides;
+  summariseErrors(finished, current.errorEstimate);
+  finished.statistics = current.statistics;
+  return finished;
+}
+
 /// Adds a chunk's statistics to the animation's.
 void accumulate(const SolverStatistics& c, bool first, SolverStatistics& s)
 {
@@ -582,23 +601,18 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     tail.reset();
     auto finishMine = [&]
     {
-      const std::size_t begin = plan.finishedBegin(k), end = plan.finishedEnd(k);
-      Solution finished;
-      Solution& dest = onFrames ? finished : whole;
+      const Estimate seam{ before ? &*before : nullptr, beforeFirst };
       if (onFrames)
       {
-        finished = shapedLike(current, end - begin);
+        Solution finished = handedOn(plan, k, seam, current, litSides, patchLitSides);
+        before.reset();
+        onFrames(plan.finishedBegin(k), finished);
       }
-      finishFrames(plan, k, { before ? &*before : nullptr, beforeFirst },
-        { &current, plan.chunks[k].solveBegin }, begin, end, { &dest, onFrames ? begin : 0 });
-      before.reset();
-      if (onFrames)
+      else
       {
-        finished.litSideData() = litSides;
-        finished.patchLitSideData() = patchLitSides;
-        summariseErrors(finished, current.errorEstimate);
-        finished.statistics = current.statistics;
-        onFrames(begin, finished);
+        finishFrames(plan, k, seam, { &current, plan.chunks[k].solveBegin }, plan.finishedBegin(k),
+          plan.finishedEnd(k), { &whole, 0 });
+        before.reset();
       }
     };
     if (solving && k == 0)
@@ -703,6 +717,45 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.warnings = std::move(warnings);
   return std::move(out);
+}
+
+Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  std::size_t framesPerChunk, std::size_t chunk, const std::vector<Side>& litSides,
+  const std::vector<Side>& patchLitSides, const ProgressCallback& progress)
+{
+  const std::size_t frames = frameCount(rig, scene.hasEmission());
+  const ChunkPlan plan = planChunks(frames, framesPerChunk);
+  if (chunk >= plan.chunks.size())
+  {
+    throw Error("chunk " + std::to_string(chunk) + " of an animation in " +
+      std::to_string(plan.chunks.size()) + " chunks");
+  }
+  // The chunk before, for its estimate of the seam between them; then this chunk.
+  const std::size_t first = chunk > 0 ? chunk - 1 : chunk;
+  std::optional<Solution> seam;
+  for (std::size_t k = first; k <= chunk; ++k)
+  {
+    const ChunkPlan::Chunk& c = plan.chunks[k];
+    ProgressCallback part;
+    if (progress)
+    {
+      const double base = static_cast<double>(k - first) / static_cast<double>(chunk - first + 1);
+      const double share = 1.0 / static_cast<double>(chunk - first + 1);
+      part = [&progress, base, share](double f) { return progress(base + share * f); };
+    }
+    Solution current =
+      solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin), options, part);
+    if (k < chunk)
+    {
+      const std::size_t seamFirst = plan.finishedEnd(k);
+      seam.emplace(shapedLike(current, c.solveEnd - seamFirst));
+      copyFrames({ &current, c.solveBegin }, seamFirst, c.solveEnd, { &*seam, seamFirst });
+      continue;
+    }
+    return handedOn(plan, chunk, { seam ? &*seam : nullptr, plan.finishedEnd(first) }, current,
+      litSides, patchLitSides);
+  }
+  return Solution();
 }
 
 } // namespace mlr

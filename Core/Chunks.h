@@ -86,4 +86,16 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   std::size_t framesPerChunk, const ProgressCallback& progress = {},
   const ChunkFramesCallback& onFrames = {});
 
+/**
+ * The frames that chunk `chunk` of planChunks(frames, framesPerChunk) finishes, solved again
+ * alone (a cache that dropped them): that chunk and, for the blend at its first seam, the
+ * chunk before it, so about twice one chunk's solve. The same bits as the frames
+ * solveInChunks hands on for it with the same scene, rig and options (any thread count), with
+ * `litSides` and `patchLitSides` (those solveInChunks gave: the first chunk's). One rank
+ * only. Throws as solve() does, and mlr::Error for a chunk past the last.
+ */
+Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  std::size_t framesPerChunk, std::size_t chunk, const std::vector<Side>& litSides,
+  const std::vector<Side>& patchLitSides, const ProgressCallback& progress = {});
+
 } // namespace mlr

@@ -102,7 +102,7 @@ std::uint64_t estimateSolveMemory(
 
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed, bool keepsStreamed)
+  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks)
 {
   if (framesPerChunk == 0 || framesPerChunk >= frames)
   {
@@ -118,12 +118,12 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
   const std::uint64_t solving = estimateSolveMemory(
     patches, elements, points, std::min(frames, framesPerChunk + 2 * m), options, lights);
   std::size_t finished = streamed ? framesPerChunk : frames;
-  if (streamed && keepsStreamed)
+  if (streamed && keptChunks > 0)
   {
     const std::size_t chunks = planChunks(frames, framesPerChunk).chunks.size();
     const auto ranks = static_cast<std::size_t>(std::max(options.ranks, 1));
-    finished =
-      chunks >= ranks ? std::min(frames, (chunks + ranks - 1) / ranks * framesPerChunk) : frames;
+    const std::size_t received = chunks >= ranks ? (chunks + ranks - 1) / ranks : chunks;
+    finished = std::min(frames, std::min(keptChunks, received) * framesPerChunk);
   }
   const std::uint64_t held = saturatingProduct(perFrame, 2 * m + finished);
   return saturatingSum(saturatingSum(solving, held), fixedBytes);
@@ -131,7 +131,7 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
 
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed, bool keepsStreamed)
+  bool streamed, std::size_t keptChunks)
 {
   if (options.framesPerChunk > 0)
   {
@@ -141,7 +141,7 @@ std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std:
   auto fits = [&](std::size_t c)
   {
     return estimateChunkedMemory(patches, elements, points, frames, c, options, lights, fixedBytes,
-             streamed, keepsStreamed) <= limit;
+             streamed, keptChunks) <= limit;
   };
   if (frames <= MinimumFramesPerChunk || fits(frames))
   {

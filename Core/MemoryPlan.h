@@ -59,21 +59,22 @@ std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std
  * The peak of a solve of `frames` frames in chunks of `framesPerChunk` (Chunks.h; 0 or
  * `frames` and more: one chunk, the plain solve): one chunk's solve, the estimate of its seam
  * kept for the next, and the finished frames, those of one chunk when they are `streamed` to
- * the caller, else all. A caller that `keepsStreamed` frames holds its share of them: the
- * frames of every R-th chunk when R = options.ranks ranks take whole chunks (at least R
- * chunks, Chunks.h), else all. `fixedBytes` (the caller's
+ * the caller, else all. A caller that keeps the frames streamed to it holds up to
+ * `keptChunks` chunks' frames of those it gets (0: none beyond the one handed on): over
+ * R = options.ranks ranks that take whole chunks (at least R chunks, Chunks.h) every R-th
+ * chunk's, else every chunk's. `fixedBytes` (the caller's
  * outputs) is added.
  */
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed, bool keepsStreamed = false);
+  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks = 0);
 
 /// C: options.framesPerChunk when set, else every frame when that fits the memory limit,
 /// else the most frames per chunk whose estimateChunkedMemory does (at least 2: the memory
 /// check then says what does not fit).
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed, bool keepsStreamed = false);
+  bool streamed, std::size_t keptChunks = 0);
 
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);

@@ -25,6 +25,7 @@
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -39,6 +40,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <new>
 #include <optional>
 #include <sstream>
@@ -89,6 +92,23 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// steps and an empty piece at the others'; else every rank holds every frame.
   std::vector<mlr::vtkparallel::FrameBlock> RankFrames;
   bool FramesApart = false;
+  /// CachedChunks: the blocks of RankFrames are whole chunks, the last asked for first, and
+  /// what solving a dropped chunk again takes is kept.
+  std::shared_ptr<const mlr::Scene> ChunkScene;
+  mlr::SolverOptions ChunkOptions;
+  std::size_t FramesPerChunk = 0;
+  std::vector<mlr::Side> FirstChunkLitSides, FirstChunkPatchLitSides;
+  int ChunksSolvedAgain = 0;
+
+  /// Puts a chunk's frames first among the cached ones, dropping the oldest beyond `kept`.
+  void cacheChunk(std::size_t first, mlr::Solution frames, std::size_t kept)
+  {
+    this->RankFrames.insert(this->RankFrames.begin(), { first, std::move(frames) });
+    if (this->RankFrames.size() > kept)
+    {
+      this->RankFrames.resize(kept);
+    }
+  }
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
@@ -139,6 +159,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->NumberOfPositions = 10;
   this->MemoryLimit = 0;
   this->FramesPerChunk = 0;
+  this->CachedChunks = 0;
   this->SolveCount = 0;
   this->Exposure = 0.0;
   this->LuminousEfficacy = 179.0;
@@ -634,7 +655,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     {
       const std::size_t n = block.frames.frameCount();
       // One frame solved serves every time step (a scene lit by things that do not move).
-      if ((n == 1 && block.first == 0 && cache.RankFrames.size() == 1) ||
+      if ((n == 1 && block.first == 0 && cache.RankFrames.size() == 1 && !cache.ChunkScene) ||
         (frame >= block.first && frame < block.first + n))
       {
         frames = &block.frames;
@@ -656,6 +677,52 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
   else
   {
     solved = cache.Solution.frameCount() > 1 ? frame - cache.FirstFrame : 0;
+  }
+  if (!held && cache.ChunkScene && (port == ELEMENTS_PORT || port == PATCHES_PORT))
+  {
+    // A chunk the cache dropped: solved again, with the chunk before it for its seam.
+    const mlr::ChunkPlan plan = mlr::planChunks(cache.Times.size(), cache.FramesPerChunk);
+    std::size_t chunk = 0;
+    while (chunk + 1 < plan.chunks.size() && frame >= plan.finishedEnd(chunk))
+    {
+      ++chunk;
+    }
+    try
+    {
+      cache.cacheChunk(plan.finishedBegin(chunk),
+        mlr::solveChunk(*cache.ChunkScene, cache.Rig, cache.ChunkOptions, cache.FramesPerChunk,
+          chunk, cache.FirstChunkLitSides, cache.FirstChunkPatchLitSides,
+          [this](double fraction)
+          {
+            this->UpdateProgress(fraction);
+            return !this->CheckAbort();
+          }),
+        static_cast<std::size_t>(this->CachedChunks));
+    }
+    catch (const mlr::Cancelled&)
+    {
+      vtkErrorMacro(<< "aborted while solving chunk " << chunk + 1 << " again for time step "
+                    << frame);
+      return false;
+    }
+    catch (const std::exception& e)
+    {
+      vtkErrorMacro(<< "solving chunk " << chunk + 1 << " again for time step " << frame
+                    << " failed: " << e.what());
+      return false;
+    }
+    ++cache.ChunksSolvedAgain;
+    frames = &cache.RankFrames.front().frames;
+    solved = frame - cache.RankFrames.front().first;
+    held = true;
+  }
+  else if (held && cache.ChunkScene && frames != &cache.RankFrames.front().frames)
+  {
+    // A hit moves its chunk first, so that the cache drops the chunk asked for longest ago.
+    auto hit = std::find_if(cache.RankFrames.begin(), cache.RankFrames.end(),
+      [&](const mlr::vtkparallel::FrameBlock& b) { return &b.frames == frames; });
+    std::rotate(cache.RankFrames.begin(), hit, hit + 1);
+    frames = &cache.RankFrames.front().frames;
   }
   // Frames apart: the rank that holds this time step outputs all of it, the others nothing.
   const bool cut = cache.Distributed && !cache.FramesApart;
@@ -746,6 +813,11 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
       translation = position - light.position(0);
     }
     mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
+    if (cache.ChunkScene)
+    {
+      mlr::vtkoutputs::addValue<vtkIntArray>(
+        fieldData, "ChunksSolvedAgain", cache.ChunksSolvedAgain);
+    }
     if (!cache.Rig.directionalLights.empty())
     {
       const mlr::DirectionalLight& sun = cache.Rig.directionalLights.front();
@@ -1120,15 +1192,23 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     const bool keepsRankFrames =
       controller && !this->ChunkFramesObserver && options.sensors.empty();
     std::vector<mlr::vtkparallel::FrameBlock> rankFrames;
+    // CachedChunks: the frames come chunk by chunk, and the last chunks stay.
+    const bool cachesChunks = this->CachedChunks > 0 && !this->ChunkFramesObserver && !controller &&
+      options.sensors.empty();
+    mlr::ErrorEstimateSummary chunkErrors;
     if (keepsRankFrames)
     {
-      options.keepsStreamedFrames = true;
+      options.keptStreamedChunks = std::numeric_limits<std::size_t>::max();
       options.chunkFrames = [&](const mlr::Animation&, std::size_t first, mlr::Solution& frames) {
         rankFrames.push_back({ first, std::move(frames) });
       };
     }
-    else if (this->ChunkFramesObserver && !controller && options.sensors.empty())
+    else if ((this->ChunkFramesObserver || cachesChunks) && !controller && options.sensors.empty())
     {
+      if (cachesChunks)
+      {
+        options.keptStreamedChunks = static_cast<std::size_t>(this->CachedChunks);
+      }
       options.chunkFrames =
         [&](const mlr::Animation& solving, std::size_t first, mlr::Solution& frames)
       {
@@ -1147,10 +1227,25 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           cache.Patches = mlr::vtkoutputs::patchMesh(solving.scene, solving.patches.points.size());
           cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(frames);
           cache.TwoSided = solverOptions.twoSided;
+          cache.FirstChunkLitSides = frames.litSideData();
+          cache.FirstChunkPatchLitSides = frames.patchLitSideData();
           streamed = true;
         }
         // The frames carry the statistics of their chunk; the last update, the animation's.
         cache.Statistics = mlr::vtkoutputs::statisticsFieldData(frames.statistics, solverOptions);
+        if (cachesChunks)
+        {
+          // Every frame's error figures, for the field data of every time step.
+          const mlr::ErrorEstimateSummary& e = frames.errorEstimate;
+          chunkErrors.relativeErrorMedian.insert(chunkErrors.relativeErrorMedian.end(),
+            e.relativeErrorMedian.begin(), e.relativeErrorMedian.end());
+          chunkErrors.relativeErrorP95.insert(chunkErrors.relativeErrorP95.end(),
+            e.relativeErrorP95.begin(), e.relativeErrorP95.end());
+          chunkErrors.litElements.insert(
+            chunkErrors.litElements.end(), e.litElements.begin(), e.litElements.end());
+          cache.cacheChunk(first, std::move(frames), static_cast<std::size_t>(this->CachedChunks));
+          return;
+        }
         cache.Solution = std::move(frames);
         cache.FirstFrame = first;
         for (std::size_t f = first; f < first + cache.Solution.frameCount(); ++f)
@@ -1203,9 +1298,18 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       {
         throw mlr::Cancelled();
       }
-      // The frames went to the observer; the last chunk's stay, with the whole solve's
-      // statistics.
+      // The frames went to the observer, or to the cache of chunks; the last chunk's stay,
+      // with the whole solve's statistics.
       cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
+      if (cachesChunks)
+      {
+        mlr::Solution summary;
+        summary.errorEstimate = solution.errorEstimate;
+        summary.errorEstimate.relativeErrorMedian = std::move(chunkErrors.relativeErrorMedian);
+        summary.errorEstimate.relativeErrorP95 = std::move(chunkErrors.relativeErrorP95);
+        summary.errorEstimate.litElements = std::move(chunkErrors.litElements);
+        mlr::vtkoutputs::addErrorFieldData(cache.Statistics, summary);
+      }
     }
     else
     {
@@ -1294,6 +1398,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       {
         throw mlr::Error(verdict.message);
       }
+    }
+    if (cachesChunks && streamed)
+    {
+      cache.ChunkScene = std::make_shared<const mlr::Scene>(std::move(animation.scene));
+      cache.ChunkOptions = solverOptions;
+      cache.ChunkOptions.log = {};
+      cache.FramesPerChunk = static_cast<std::size_t>(solution.statistics.framesPerChunk);
     }
     cache.HasResult = true;
     // A statistic, not a property: it must not change the MTime and invalidate the cache.
@@ -1389,6 +1500,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
   os << indent << "FramesPerChunk: " << this->FramesPerChunk << "\n";
+  os << indent << "CachedChunks: " << this->CachedChunks << "\n";
   os << indent << "ErrorBatches: " << this->ErrorBatches << "\n";
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
   os << indent << "TimeLimit: " << this->TimeLimit << " s\n";

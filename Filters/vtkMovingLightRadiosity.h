@@ -513,6 +513,20 @@ public:
   vtkGetMacro(FramesPerChunk, int);
   ///@}
 
+  ///@{
+  /**
+   * With a solve in several chunks, keep the frames of at most this many chunks, the last
+   * ones asked for, rather than every frame: a time step outside them solves its chunk
+   * again, with the chunk before it for the blend at its seam (about twice one chunk's
+   * solve), the same bits as the first solve; the field data `ChunksSolvedAgain` counts
+   * them. The memory limit counts the chunks kept. The display's exposure and lit sides are
+   * then those of the first chunk, as when streaming. 0 keeps every frame. One process only:
+   * on several MPI ranks, and with Sensors, every frame is kept. Default 0.
+   */
+  vtkSetClampMacro(CachedChunks, int, 0, VTK_INT_MAX);
+  vtkGetMacro(CachedChunks, int);
+  ///@}
+
   // ---------------------------------------------------------------- Error estimate
   ///@{
   /**
@@ -658,6 +672,7 @@ protected:
   int NumberOfPositions;
   int MemoryLimit;
   int FramesPerChunk;
+  int CachedChunks;
   int LightType;
   double SunIrradiance;
   int SkyModel;

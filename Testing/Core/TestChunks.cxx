@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <thread>
 #include <vector>
@@ -270,25 +271,28 @@ TEST(Chunks, RanksThatKeepTheirFramesAreEstimatedTheirShare)
 {
   // 40 frames in chunks of 10 (4 chunks, m = 1): a caller that keeps what is streamed to it
   // holds the frames of every R-th chunk over R ranks, all of them when there are fewer chunks
-  // than ranks. The estimate's difference from a streamed one is those frames, less the one
-  // chunk a streamed solve holds.
+  // than ranks, or as many chunks as its cache takes. The estimate's difference from a streamed one
+  // is those frames, less the one chunk a streamed solve holds.
   constexpr std::size_t Long = 40, C = 10;
   const Scene scene = box();
   SolverOptions o = options(20000, 11);
-  const auto estimate = [&](int ranks, bool streamed, bool kept)
+  const auto estimate = [&](int ranks, bool streamed, std::size_t kept)
   {
     o.ranks = ranks;
     return estimateChunkedMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
       Long, C, o, 1, 0, streamed, kept);
   };
-  const std::uint64_t streamed = estimate(1, true, false);
-  const std::uint64_t perFrame = (estimate(1, false, false) - streamed) / (Long - C);
+  constexpr std::size_t all = std::numeric_limits<std::size_t>::max();
+  const std::uint64_t streamed = estimate(1, true, 0);
+  const std::uint64_t perFrame = (estimate(1, false, 0) - streamed) / (Long - C);
   ASSERT_GT(perFrame, 0u);
-  EXPECT_EQ(estimate(1, true, true), estimate(1, false, false));
-  EXPECT_EQ(estimate(2, true, true), streamed + perFrame * (2 * C - C));
-  EXPECT_EQ(estimate(3, true, true), streamed + perFrame * (2 * C - C));
-  EXPECT_EQ(estimate(4, true, true), streamed + perFrame * (C - C));
-  EXPECT_EQ(estimate(5, true, true), estimate(1, false, false)); // fewer chunks than ranks
+  EXPECT_EQ(estimate(1, true, all), estimate(1, false, 0));
+  EXPECT_EQ(estimate(2, true, all), streamed + perFrame * (2 * C - C));
+  EXPECT_EQ(estimate(3, true, all), streamed + perFrame * (2 * C - C));
+  EXPECT_EQ(estimate(4, true, all), streamed + perFrame * (C - C));
+  EXPECT_EQ(estimate(5, true, all), estimate(1, false, 0)); // fewer chunks than ranks
+  // A cache of 3 chunks on one rank.
+  EXPECT_EQ(estimate(1, true, 3), streamed + perFrame * (3 * C - C));
 }
 
 TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
@@ -437,6 +441,46 @@ TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
       EXPECT_EQ(handedOn, Frames);
     }
   }
+}
+
+TEST(Chunks, AChunkSolvedAgainHasTheBitsOfTheWholeRun)
+{
+  // 12 frames in chunks of 3: each chunk's frames, solved again alone (on another thread
+  // count), are the frames the whole run handed on, error figures included.
+  const Scene scene = box();
+  SolverOptions o = options(20000, 13, 2);
+  o.errorBatches = 2;
+  constexpr std::size_t perChunk = 3;
+  FrameBits whole;
+  std::vector<Side> sides, patchSides;
+  std::vector<std::vector<double>> p95;
+  solveInChunks(scene, rig(), o, perChunk, {},
+    [&](std::size_t first, Solution& frames)
+    {
+      recordFrames(first, frames, whole);
+      if (first == 0)
+      {
+        sides = frames.litSideData();
+        patchSides = frames.patchLitSideData();
+      }
+      p95.push_back(frames.errorEstimate.relativeErrorP95);
+    });
+  const ChunkPlan plan = planChunks(Frames, perChunk);
+  o.threads = 1;
+  for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+  {
+    Solution again = solveChunk(scene, rig(), o, perChunk, k, sides, patchSides);
+    FrameBits bits;
+    recordFrames(plan.finishedBegin(k), again, bits);
+    ASSERT_EQ(again.frameCount(), plan.finishedEnd(k) - plan.finishedBegin(k)) << "chunk " << k;
+    for (const auto& [frame, b] : bits)
+    {
+      EXPECT_EQ(b, whole.at(frame)) << "chunk " << k << ", frame " << frame;
+    }
+    EXPECT_EQ(again.errorEstimate.relativeErrorP95, p95[k]) << "chunk " << k;
+  }
+  checks::expectError([&] { solveChunk(scene, rig(), o, perChunk, 4, sides, patchSides); },
+    "chunk 4 of an animation in 4 chunks");
 }
 
 TEST(Chunks, ACancelOnOneRankStopsEveryRankBetweenChunks)

@@ -184,6 +184,41 @@ TEST(FilterTime, SwitchingTimeServesTheCacheWithoutSolvingOrUpdatingInputs)
   EXPECT_EQ(filter->GetInputDataObject(0, 0)->GetMTime(), sceneTime);
 }
 
+TEST(FilterTime, CachedChunksSolveADroppedChunkAgainWithTheSameValues)
+{
+  // 12 frames in chunks of 3 (m = 1; chunks finish frames 0-1, 2-4, 5-7, 8-11). A cache of
+  // one chunk against a cache of all four: the same arrays at every time step, asked in an
+  // order that drops and brings back chunks; each miss solves one chunk again, a hit none.
+  BoxSetup setup = closedBoxSetup(12);
+  auto all = fastFilter(setup);
+  all->SetFramesPerChunk(3);
+  all->SetCachedChunks(4);
+  auto one = fastFilter(setup);
+  one->SetFramesPerChunk(3);
+  one->SetCachedChunks(1);
+  int again = 0;
+  for (const double t : { 0.0, 11.0, 1.0, 3.0, 4.0, 2.0, 11.0, 9.0, 6.0, 0.0 })
+  {
+    ASSERT_TRUE(all->UpdateTimeStep(t));
+    ASSERT_TRUE(one->UpdateTimeStep(t));
+    for (const char* name : { "Radiosity", "Irradiance", "RadiosityStdError", "Color" })
+    {
+      const std::vector<float> expected = arrayValues(all->GetOutput(), name);
+      ASSERT_FALSE(expected.empty()) << name;
+      EXPECT_EQ(arrayValues(one->GetOutput(), name), expected) << name << " at time " << t;
+    }
+    EXPECT_EQ(fieldValue(one->GetOutput(), "FrameIndex"), t);
+    EXPECT_EQ(fieldValue(one->GetOutput(), "RelativeErrorP95"),
+      fieldValue(all->GetOutput(), "RelativeErrorP95"));
+    EXPECT_EQ(one->GetSolveCount(), 1);
+    // After the first solve the last chunk (8-11) is the one kept.
+    static const std::vector<int> expectedAgain = { 1, 2, 3, 4, 4, 4, 5, 5, 6, 7 };
+    EXPECT_EQ(fieldValue(one->GetOutput(), "ChunksSolvedAgain"), expectedAgain[again++])
+      << "time " << t;
+  }
+  EXPECT_EQ(fieldValue(all->GetOutput(), "ChunksSolvedAgain"), 0);
+}
+
 TEST(FilterTime, TheFiltersTimeIsNotPassedUpstream)
 {
   BoxSetup setup = closedBoxSetup(3);

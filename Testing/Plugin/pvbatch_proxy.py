@@ -108,8 +108,8 @@ ADVANCED |= {"BalanceFrames"}
 # The sensors' properties.
 EXPECTED |= {"DaylightAutonomyThreshold", "SensorRays"}
 # The chunks of a long animation.
-EXPECTED |= {"FramesPerChunk"}
-ADVANCED |= {"FramesPerChunk"}
+EXPECTED |= {"FramesPerChunk", "CachedChunks"}
+ADVANCED |= {"FramesPerChunk", "CachedChunks"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
