@@ -23,9 +23,9 @@ std::string runChunkedAnimation(const ScaleCaseOptions& options);
 
 /**
  * The large scene (the paper room in about 100,000 patches) over 3,000 frames, N = 4,000,000,
- * full reuse, streamed in the chunks that an 8 GiB memory limit chooses (or that of
+ * full reuse, streamed in the chunks that a 7 GiB memory limit chooses (or that of
  * --memory-limit-mib): the chunk length, seconds, peak resident memory against the estimate.
- * Target: the process within 8 GB. Returns the results as JSON.
+ * Target: the process within 8 GB (10^9 bytes). Returns the results as JSON.
  */
 std::string runLargeChunked(const ScaleCaseOptions& options);
 

@@ -102,7 +102,7 @@ void usage()
     "  chunks:   only the chunks part of long\n"
     "  large:    the room in about 100,000 patches, 120 frames, N = 4,000,000, full reuse: time\n"
     "            and peak memory against the estimate (about 3 minutes, not in all); then the\n"
-    "            same over 3,000 frames in the chunks an 8 GiB limit chooses, streamed\n"
+    "            same over 3,000 frames in the chunks a 7 GiB limit chooses, streamed\n"
     "  large-chunks: only that second part of large\n"
     "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half "
     "the\n"
