@@ -28,7 +28,7 @@ void Solution::chooseLitSides()
 {
   for (std::size_t e = 0; e < this->Elements; ++e)
   {
-    double front = 0, back = 0;
+    double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
     for (std::size_t f = 0; f < this->Frames; ++f)
     {
       front += this->total(f, e, Side::Front).sum();
@@ -39,11 +39,11 @@ void Solution::chooseLitSides()
       // A black element: the side light arrives on is the one its irradiance is shown for.
       for (std::size_t f = 0; f < this->Frames; ++f)
       {
-        front += this->irradiance(f, e, Side::Front).sum();
-        back += this->irradiance(f, e, Side::Back).sum();
+        irradianceFront += this->irradiance(f, e, Side::Front).sum();
+        irradianceBack += this->irradiance(f, e, Side::Back).sum();
       }
     }
-    this->LitSide[e] = back > front ? Side::Back : Side::Front;
+    this->LitSide[e] = litSideOf(front, back, irradianceFront, irradianceBack);
   }
   for (std::size_t p = 0; p < this->Patches; ++p)
   {

@@ -181,6 +181,14 @@ public:
   Side patchLitSide(std::size_t patch) const { return this->PatchLitSide[patch]; }
   /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete.
   void chooseLitSides();
+  /// The rule chooseLitSides applies to an element's totals over the frames on its two sides
+  /// (its irradiance's, for a black element whose totals are both 0): the larger, front on a
+  /// tie. For callers that sum the frames elsewhere (ranks holding frames apart).
+  static Side litSideOf(double front, double back, double irradianceFront, double irradianceBack)
+  {
+    const bool black = front == 0 && back == 0;
+    return (black ? irradianceBack > irradianceFront : back > front) ? Side::Back : Side::Front;
+  }
 
   /// Whether the solve estimated its error (SolverOptions::errorBatches > 1).
   bool hasErrorEstimate() const { return !this->StdError.empty(); }

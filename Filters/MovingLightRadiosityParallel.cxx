@@ -522,10 +522,8 @@ RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t
   summary = Solution(0, elements, patches);
   for (std::size_t e = 0; e < elements; ++e)
   {
-    const bool black = sums[4 * e] == 0 && sums[4 * e + 1] == 0;
-    const double front = black ? sums[4 * e + 2] : sums[4 * e];
-    const double back = black ? sums[4 * e + 3] : sums[4 * e + 1];
-    summary.litSideData()[e] = back > front ? Side::Back : Side::Front;
+    summary.litSideData()[e] =
+      Solution::litSideOf(sums[4 * e], sums[4 * e + 1], sums[4 * e + 2], sums[4 * e + 3]);
   }
   for (std::size_t p = 0; p < patches; ++p)
   {
