@@ -120,7 +120,7 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
     scene.patchCount(), scene.elementCount(), frames, static_cast<unsigned long long>(paths));
   std::printf("Memory bound before reachability (every side): %.2f GiB (%.1f bytes per "
               "element-frame): results %.2f GiB "
-              "(single precision), shooting accumulators %.2f GiB (%s), other %.2f GiB\n",
+              "(16 bits per channel), shooting accumulators %.2f GiB (%s), other %.2f GiB\n",
     double(plan.peak) / GiB, double(plan.peak) / elementFrames, double(plan.results) / GiB,
     double(plan.accumulators) / GiB,
     plan.accumulatorCopyPerWorker ? "a copy per worker" : "one copy shared by the workers",

@@ -277,11 +277,12 @@ void finishFrames(const ChunkPlan& plan, std::size_t chunk, const Estimate& befo
   }
 }
 
-/// An empty Solution of `frames` frames shaped as `like`: its reflectance, emission and
-/// arrays (the indirect light and standard errors when `like` has them).
+/// An empty Solution of `frames` frames shaped as `like`: its storage scale, reflectance,
+/// emission and arrays (the indirect light and standard errors when `like` has them).
 Solution shapedLike(Solution& like, std::size_t frames)
 {
   Solution s(frames, like.elementCount(), like.patchCount());
+  s.setStorageScale(like.storageScale());
   s.reflectanceData() = like.reflectanceData();
   s.emissionData() = like.emissionData();
   s.allocateIndirect();
@@ -468,16 +469,13 @@ void exchangeSides(
     [](std::int64_t v) { return v == 0 ? Side::Front : Side::Back; });
 }
 
-/// Gives every rank the frames of `frames` that one rank filled: the others give zeros, and
-/// a sum of one float and zeros is that float, bit for bit.
+/// Gives every rank the frames of `frames` that one rank filled (the others give zeros).
 void exchangeFrames(const SolverOptions& options, Solution& frames, double& seconds)
 {
   for (std::vector<PackedRgb>* data :
     { &frames.directData(), &frames.indirectData(), &frames.stdErrorData(), &frames.patchData() })
   {
-    static_assert(sizeof(PackedRgb) == 3 * sizeof(float), "PackedRgb is three floats");
-    sumFloatsAcrossRanks(
-      options, reinterpret_cast<float*>(data->data()), 3 * data->size(), seconds);
+    sumStoredAcrossRanks(options, data->data(), data->size(), seconds);
   }
 }
 }

@@ -37,14 +37,18 @@ std::uint64_t splitMix(std::uint64_t z)
 constexpr std::size_t MergeSidesPerTask = 4096;
 
 /// The mean of the batches so far and the sum of squared deviations of their total
-/// irradiance (Welford's update, in batch order): the result is the running mean, kept in the
-/// Solution's own single-precision arrays, and the squares are in double.
+/// irradiance (Welford's update, in batch order). The running mean is kept in single
+/// precision, where an update of one batch in thousands still counts, and the result's stored
+/// arrays get it rounded once after each batch; the squares are in double.
 class BatchSpread
 {
 public:
   BatchSpread(Solution& result, int workers)
     : Result(result)
     , Workers(workers)
+    , MeanDirect(result.directData().size())
+    , MeanIndirect(result.directData().size())
+    , MeanPatch(result.patchData().size())
     , SquaredDeviations(result.directData().size())
   {
   }
@@ -74,10 +78,13 @@ public:
         for (std::size_t i = task * MergeSidesPerTask * frames; i < end; ++i)
         {
           const Rgb xDirect = batchDirect[i], xIndirect = batchIndirect[i];
-          const Rgb before = Rgb(direct[i]) + Rgb(indirect[i]);
-          direct[i] = PackedRgb(Rgb(direct[i]) + (xDirect - Rgb(direct[i])) * inverse);
-          indirect[i] = PackedRgb(Rgb(indirect[i]) + (xIndirect - Rgb(indirect[i])) * inverse);
-          const Rgb after = Rgb(direct[i]) + Rgb(indirect[i]);
+          const Rgb meanDirect = this->MeanDirect[i], meanIndirect = this->MeanIndirect[i];
+          const Rgb before = meanDirect + meanIndirect;
+          this->MeanDirect[i] = FloatRgb(meanDirect + (xDirect - meanDirect) * inverse);
+          this->MeanIndirect[i] = FloatRgb(meanIndirect + (xIndirect - meanIndirect) * inverse);
+          direct[i] = PackedRgb(this->MeanDirect[i]);
+          indirect[i] = PackedRgb(this->MeanIndirect[i]);
+          const Rgb after = Rgb(this->MeanDirect[i]) + Rgb(this->MeanIndirect[i]);
           const Rgb x = xDirect + xIndirect;
           this->SquaredDeviations[i] += (x - before) * (x - after);
         }
@@ -85,11 +92,14 @@ public:
       [](std::size_t) { return true; });
     for (std::size_t i = 0; i < patch.size(); ++i)
     {
-      patch[i] = PackedRgb(Rgb(patch[i]) + (Rgb(batchPatch[i]) - Rgb(patch[i])) * inverse);
+      const Rgb mean = this->MeanPatch[i];
+      this->MeanPatch[i] = FloatRgb(mean + (Rgb(batchPatch[i]) - mean) * inverse);
+      patch[i] = PackedRgb(this->MeanPatch[i]);
     }
   }
 
-  /// The standard error of the mean irradiance at storage index i: the batches' unbiased
+  /// The standard error of the mean irradiance at storage index i, in the storage unit (the
+  /// batches are the result's scene's: Solution::storageScale): the batches' unbiased
   /// standard deviation over sqrt(B).
   Rgb stdError(std::size_t i) const
   {
@@ -108,13 +118,14 @@ public:
   Rgb radiosityStdError(std::size_t frame, std::size_t element, Side side) const
   {
     return this->Result.reflectanceData()[element] *
-      this->stdError(this->Result.elementIndex(frame, element, side));
+      this->stdError(this->Result.elementIndex(frame, element, side)) * this->Result.storageScale();
   }
 
 private:
   Solution& Result;
   int Workers;
   std::uint64_t Count = 0;
+  std::vector<FloatRgb> MeanDirect, MeanIndirect, MeanPatch;
   std::vector<Rgb> SquaredDeviations;
 };
 
@@ -229,8 +240,10 @@ std::uint64_t errorEstimateBytes(
     return 0;
   }
   const std::uint64_t sides = saturatingProduct({ frames, elements, 2 });
-  const std::uint64_t mean = saturatingSum(saturatingProduct(sides, 2 * sizeof(PackedRgb)),
-    saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) }));
+  // The mean in the result's stored arrays and in single precision (BatchSpread).
+  const std::uint64_t mean =
+    saturatingSum(saturatingProduct(sides, 2 * (sizeof(PackedRgb) + sizeof(FloatRgb))),
+      saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) + sizeof(FloatRgb) }));
   const std::uint64_t spread = saturatingProduct(sides, sizeof(Rgb) + sizeof(PackedRgb));
   return saturatingSum(mean, spread);
 }

@@ -96,10 +96,11 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
     }
     addPending();
   }
-  const double scale = 1.0 / static_cast<double>(rays);
+  const double perRay = 1.0 / static_cast<double>(rays);
   for (std::size_t f = 0; f < frames; ++f)
   {
-    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(sum[f] * scale);
+    // The rows were read as stored, in the solution's storage unit, which the mean keeps.
+    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(sum[f] * perRay);
   }
 }
 
@@ -193,10 +194,8 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
     fraction, secondsReducing);
   // Each element side gathered on one rank and is exactly zero on the others, so the sum
   // over ranks is that rank's value, bit for bit.
-  static_assert(sizeof(PackedRgb) == 3 * sizeof(float), "PackedRgb is three floats");
   std::vector<PackedRgb>& indirect = solution.indirectData();
-  sumFloatsAcrossRanks(
-    options, reinterpret_cast<float*>(indirect.data()), 3 * indirect.size(), secondsReducing);
+  sumStoredAcrossRanks(options, indirect.data(), indirect.size(), secondsReducing);
   GatheringResult result;
   result.sides = sides.size();
   for (const WorkerCounters& c : counters)
@@ -223,7 +222,7 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {
           solution.indirectData()[solution.elementIndex(f, e, static_cast<Side>(s))] =
-            PackedRgb(rest);
+            solution.store(rest);
         }
       }
     }

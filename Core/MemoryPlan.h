@@ -14,7 +14,8 @@ namespace mlr
 
 /**
  * How a solve uses memory: the one policy behind the estimate, the limit check and the
- * allocations. Results are single precision (PackedRgb): direct irradiance per element side,
+ * allocations. Results take 16 bits per channel (PackedRgb, rounded to within 0.1%): direct
+ * irradiance per element side,
  * patch radiosity per patch side, and indirect irradiance per element side, allocated when
  * gathering starts, after the shooting accumulators are freed. The peak is the larger of the
  * two phases. Shooting accumulators (64-bit fixed point, for the reachable sides once they are

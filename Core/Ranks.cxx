@@ -149,24 +149,33 @@ void sumAcrossRanks(
     [](std::int64_t v) { return static_cast<std::uint64_t>(v); });
 }
 
-void sumFloatsAcrossRanks(
-  const SolverOptions& options, float* values, std::size_t count, double& secondsReducing)
+void sumStoredAcrossRanks(
+  const SolverOptions& options, PackedRgb* values, std::size_t count, double& secondsReducing)
 {
   if (options.ranks <= 1)
   {
     return;
   }
   const auto start = Clock::now();
-  constexpr std::size_t block = std::size_t(1) << 20;
-  std::vector<double> buffer(std::min(count, block));
+  constexpr std::size_t block = std::size_t(1) << 18;
+  std::vector<double> buffer(3 * std::min(count, block));
   for (std::size_t first = 0; first < count; first += block)
   {
     const std::size_t n = std::min(block, count - first);
-    std::copy(values + first, values + first + n, buffer.begin());
-    options.sumDoublesAcrossRanks(buffer.data(), n);
     for (std::size_t i = 0; i < n; ++i)
     {
-      values[first + i] = static_cast<float>(buffer[i]);
+      const PackedRgb& c = values[first + i];
+      buffer[3 * i] = c.r;
+      buffer[3 * i + 1] = c.g;
+      buffer[3 * i + 2] = c.b;
+    }
+    options.sumDoublesAcrossRanks(buffer.data(), 3 * n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      PackedRgb& c = values[first + i];
+      c.r = static_cast<std::uint16_t>(buffer[3 * i]);
+      c.g = static_cast<std::uint16_t>(buffer[3 * i + 1]);
+      c.b = static_cast<std::uint16_t>(buffer[3 * i + 2]);
     }
   }
   secondsReducing += secondsSince(start);

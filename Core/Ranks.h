@@ -3,6 +3,7 @@
 // sums go through SolverOptions' hooks.
 #pragma once
 
+#include "Rgb.h"
 #include "SolverOptions.h"
 
 #include <cstddef>
@@ -45,10 +46,11 @@ void sumAcrossRanks(
 void sumAcrossRanks(
   const SolverOptions& options, std::uint64_t* values, std::size_t count, double& secondsReducing);
 
-/// Sums floats over the ranks in place, as doubles (exact for floats, and exact for the sum of
-/// one value and zeros), a block at a time so that no copy of the whole array is needed.
-void sumFloatsAcrossRanks(
-  const SolverOptions& options, float* values, std::size_t count, double& secondsReducing);
+/// Gives every rank the stored results that one rank filled, the others holding zeros: the
+/// channels' codes are summed as doubles (so the sum is the one rank's code, bit for bit), a
+/// block at a time so that no copy of the whole array is needed.
+void sumStoredAcrossRanks(
+  const SolverOptions& options, PackedRgb* values, std::size_t count, double& secondsReducing);
 
 /// FNV-1a over the bytes of the values added.
 struct Digest

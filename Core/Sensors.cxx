@@ -337,8 +337,8 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
   for (std::size_t frame = 0; frame < frames; ++frame)
   {
     result.irradianceData()[s * frames + frame] =
-      PackedRgb(scratch.total[frame] + scratch.sun[frame]);
-    result.sunData()[s * frames + frame] = PackedRgb(scratch.sun[frame]);
+      FloatRgb(scratch.total[frame] + scratch.sun[frame]);
+    result.sunData()[s * frames + frame] = FloatRgb(scratch.sun[frame]);
   }
 }
 }
@@ -439,9 +439,9 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
   {
     return 0;
   }
-  // The two results (a PackedRgb each) and the unit points and normals.
+  // The two results (a FloatRgb each) and the unit points and normals.
   const std::uint64_t results =
-    saturatingSum(saturatingProduct({ 2 * sizeof(PackedRgb), sensors, frames }),
+    saturatingSum(saturatingProduct({ 2 * sizeof(FloatRgb), sensors, frames }),
       saturatingProduct(2 * sizeof(Vec3), sensors));
   const auto workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
   const std::uint64_t scratch = saturatingProduct(workers,

@@ -93,14 +93,14 @@ public:
     return this->Sun[sensor * this->Frames + frame];
   }
   /// Sensor-major with frames innermost, as Solution.
-  std::vector<PackedRgb>& irradianceData() { return this->Irradiance; }
-  std::vector<PackedRgb>& sunData() { return this->Sun; }
+  std::vector<FloatRgb>& irradianceData() { return this->Irradiance; }
+  std::vector<FloatRgb>& sunData() { return this->Sun; }
   const SensorStatistics& statistics() const { return this->Statistics; }
   SensorStatistics& statistics() { return this->Statistics; }
 
 private:
   std::size_t Frames = 0, Sensors = 0;
-  std::vector<PackedRgb> Irradiance, Sun;
+  std::vector<FloatRgb> Irradiance, Sun;
   SensorStatistics Statistics;
 };
 

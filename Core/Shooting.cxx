@@ -600,8 +600,9 @@ void ShootingRun::addTo(Solution& solution) const
         this->ElementShare.read(run, positionOf(f), &share);
         if (share != 0)
         {
-          direct[solution.elementIndex(f, e, static_cast<Side>(s))] +=
-            irradiance * this->SourceRef.factor(positionOf(f)) * share;
+          PackedRgb& stored = direct[solution.elementIndex(f, e, static_cast<Side>(s))];
+          stored = solution.store(
+            solution.load(stored) + irradiance * this->SourceRef.factor(positionOf(f)) * share);
         }
       }
     }
@@ -623,8 +624,9 @@ void ShootingRun::addTo(Solution& solution) const
         const std::size_t k = positionOf(f);
         double sums[3];
         this->PatchPower.read(power, k, sums);
-        patch[solution.patchIndex(f, p, static_cast<Side>(s))] +=
-          Rgb(sums[0], sums[1], sums[2]) * this->SourceRef.factor(k) * inverseArea;
+        PackedRgb& stored = patch[solution.patchIndex(f, p, static_cast<Side>(s))];
+        stored = solution.store(solution.load(stored) +
+          Rgb(sums[0], sums[1], sums[2]) * this->SourceRef.factor(k) * inverseArea);
       }
     }
   }

@@ -1,6 +1,7 @@
 #include "Solution.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace mlr
 {
@@ -15,6 +16,15 @@ Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches
   , LitSide(elements, Side::Front)
   , PatchLitSide(patches, Side::Front)
 {
+}
+
+double Solution::storageScaleFor(double totalArea)
+{
+  if (!(totalArea > 0) || !std::isfinite(totalArea))
+  {
+    return 1;
+  }
+  return std::ldexp(1.0, -static_cast<int>(std::lround(std::log2(totalArea))));
 }
 
 void Solution::clearRadiosity()

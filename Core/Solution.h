@@ -119,14 +119,15 @@ public:
   /// The irradiance (W/m^2) of an element side from the lights' and emitters' first hits.
   Rgb directIrradiance(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Direct[this->elementIndex(frame, element, side)];
+    return this->load(this->Direct[this->elementIndex(frame, element, side)]);
   }
   /// The irradiance from the rest of the scene: gathering's mean of the patch radiosity its
   /// rays reach (k = 0: see indirectFromPatches). Zero until gathering has run.
   Rgb indirectIrradiance(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Indirect.empty() ? Rgb()
-                                  : Rgb(this->Indirect[this->elementIndex(frame, element, side)]);
+    return this->Indirect.empty()
+      ? Rgb()
+      : this->load(this->Indirect[this->elementIndex(frame, element, side)]);
   }
   /// All the light arriving on an element side: total() = emitted() + rho_e irradiance().
   Rgb irradiance(std::size_t frame, std::size_t element, Side side) const
@@ -161,7 +162,7 @@ public:
   /// reflected: the part gathering reads as a patch mean.
   Rgb patchBounced(std::size_t frame, std::size_t patch, Side side) const
   {
-    return this->Patch[this->patchIndex(frame, patch, side)];
+    return this->load(this->Patch[this->patchIndex(frame, patch, side)]);
   }
   /**
    * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`)
@@ -196,8 +197,9 @@ public:
   /// and indirect light together; zero without an error estimate.
   Rgb irradianceStdError(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->StdError.empty() ? Rgb()
-                                  : Rgb(this->StdError[this->elementIndex(frame, element, side)]);
+    return this->StdError.empty()
+      ? Rgb()
+      : this->load(this->StdError[this->elementIndex(frame, element, side)]);
   }
   /// The standard error of total(): the emission is exact, so rho_e times irradianceStdError().
   Rgb radiosityStdError(std::size_t frame, std::size_t element, Side side) const
@@ -219,7 +221,21 @@ public:
   {
     return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
   }
-  // Results are stored in single precision (PackedRgb); see MemoryPlan.
+  // Results are stored in 16 bits per channel (PackedRgb: within 0.1% of the value, 6 bytes
+  // per RGB; see MemoryPlan), divided by storageScale().
+  /**
+   * The unit of the stored values, a power of two (so that scaling is exact): a value is
+   * stored as load() / storageScale(). The solver sets it to the inverse of the scene's area
+   * (storageScaleFor), so that any scene in any unit stores its irradiance as about its
+   * lights' power, in the middle of PackedRgb's range of 2^-62 to 2^64. Results of one scene
+   * share it, so blends and sums of stored values need no scaling.
+   */
+  double storageScale() const { return this->Scale; }
+  void setStorageScale(double scale) { this->Scale = scale; }
+  /// 2^-round(log2(area)), or 1 for an area that is not positive and finite.
+  static double storageScaleFor(double totalArea);
+  Rgb load(const PackedRgb& stored) const { return Rgb(stored) * this->Scale; }
+  PackedRgb store(const Rgb& value) const { return PackedRgb(value / this->Scale); }
   /// The direct irradiance of every element side and frame.
   std::vector<PackedRgb>& directData() { return this->Direct; }
   /// The indirect irradiance. Empty until allocateIndirect(): the solver allocates it once the
@@ -243,6 +259,7 @@ public:
 
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
+  double Scale = 1;
   std::vector<PackedRgb> Direct, Indirect, Patch, StdError;
   std::vector<Rgb> Emission, Reflectance;
   std::vector<Side> LitSide, PatchLitSide;

@@ -199,6 +199,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       }
       tracerStorage.emplace(scene);
       solution = Solution(frames, scene.elementCount(), scene.patchCount());
+      solution.setStorageScale(Solution::storageScaleFor(scene.totalArea()));
       for (std::size_t e = 0; e < scene.elementCount(); ++e)
       {
         solution.reflectanceData()[e] = scene.elementReflectance(e);
@@ -307,6 +308,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     // The batches solve into one more Solution, with the same reflectance and emission,
     // whose light is merged into `solution` after each.
     Solution batch(frames, scene.elementCount(), scene.patchCount());
+    batch.setStorageScale(solution.storageScale());
     batch.reflectanceData() = solution.reflectanceData();
     batch.emissionData() = solution.emissionData();
     solveInBatches(

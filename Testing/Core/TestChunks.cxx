@@ -323,14 +323,14 @@ TEST(Chunks, SolveAnimationChoosesChunksAndStreams)
 namespace
 {
 /// The bits of every streamed frame: direct, indirect and standard error of each element side,
-/// then each patch side, as floats.
-using FrameBits = std::map<std::size_t, std::vector<float>>;
+/// then each patch side, as the stored codes.
+using FrameBits = std::map<std::size_t, std::vector<std::uint16_t>>;
 
 void recordFrames(std::size_t first, Solution& s, FrameBits& out)
 {
   for (std::size_t f = 0; f < s.frameCount(); ++f)
   {
-    std::vector<float>& bits = out[first + f];
+    std::vector<std::uint16_t>& bits = out[first + f];
     auto add = [&](const PackedRgb& c) { bits.insert(bits.end(), { c.r, c.g, c.b }); };
     for (std::size_t e = 0; e < s.elementCount(); ++e)
     {

@@ -122,11 +122,13 @@ TEST(Gathering, ReadsTheDirectLightOfTheElementItReaches)
   }
   // What the sensors read with, and the patch's radiosity: its direct part the mean of its
   // elements' (equal areas), rho E / 4.
-  EXPECT_NEAR(
-    solution.gatheredRadiosity(0, f.lit, Side::Front).r, Rho * LitIrradiance + Bounced, 1e-6);
-  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit + 1, Side::Front).r, Bounced, 1e-6);
-  EXPECT_NEAR(
-    solution.patchRadiosity(0, 0, Side::Front).r, Rho * LitIrradiance / 4 + Bounced, 1e-6);
+  // Each is a sum of stored values, each rounded to within PackedRgb::RelativeRounding.
+  const auto stored = [](double x) { return PackedRgb::RelativeRounding * x; };
+  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit, Side::Front).r, Rho * LitIrradiance + Bounced,
+    stored(Rho * LitIrradiance + Bounced));
+  EXPECT_NEAR(solution.gatheredRadiosity(0, f.lit + 1, Side::Front).r, Bounced, stored(Bounced));
+  EXPECT_NEAR(solution.patchRadiosity(0, 0, Side::Front).r, Rho * LitIrradiance / 4 + Bounced,
+    stored(Rho * LitIrradiance / 4 + Bounced));
   EXPECT_NEAR(f.scene.elementArea(f.lit), f.scene.patchArea(0) / 4, 1e-12);
 }
 

@@ -242,8 +242,10 @@ def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):
             lit = runs["none"][frame] > 0
             assert lit.any()
             ratio = runs["tilt"][frame][lit] / runs["none"][frame][lit]
-            # The arrays are float32: a few ulps.
-            assert abs(ratio - factor).max() < 1e-6, (kind, frame, ratio.min(), ratio.max())
+            # Results are stored to within 2^-10 of themselves (16 bits per channel): each
+            # of the 16 error batches, then their mean; a ratio of two is within 4 x 2^-10.
+            assert abs(ratio / factor - 1).max() < 4 * 2.0 ** -10, \
+                (kind, frame, ratio.min(), ratio.max())
     # Tilted beyond the table: the end factor, with a warning naming the position.
     normals.SetTuple3(1, 0, 0, 1)  # aimed straight up: 180 degrees
     normals.Modified()

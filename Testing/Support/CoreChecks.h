@@ -20,9 +20,10 @@ namespace mlr::checks
 {
 
 /// The same results to the last bit (solutions whose sums must not depend on threads or ranks).
-inline bool sameBits(const std::vector<PackedRgb>& a, const std::vector<PackedRgb>& b)
+template <typename Stored>
+bool sameBits(const std::vector<Stored>& a, const std::vector<Stored>& b)
 {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(PackedRgb)) == 0;
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Stored)) == 0;
 }
 
 /// Runs `action`, expects mlr::Error, and checks that its message contains `words`.
