@@ -61,8 +61,9 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     soupEmits = soupEmits || m.emission.maxComponent() > 0;
   }
   const std::size_t frames = frameCount(lights, soupEmits);
+  // The sources the solver shoots, the scene's emitters counted as one at least.
   const std::size_t lightCount = lights.areaLights.size() + lights.pointLights.size() +
-    lights.directionalLights.size() + lights.skies.size();
+    lights.directionalLights.size() + lights.skies.size() + (soupEmits ? 1 : 0);
   const bool streamed = static_cast<bool>(options.chunkFrames);
   if (streamed && !options.sensors.empty())
   {

@@ -147,8 +147,7 @@ void copyFrames(const Estimate& src, std::size_t begin, std::size_t end, const E
   Solution& s = *src.solution;
   Solution& d = *dest.solution;
   const std::size_t n = end - begin;
-  auto copy =
-    [n](std::vector<PackedRgb>& from, std::size_t i, std::vector<PackedRgb>& to, std::size_t j)
+  auto copy = [n](StoredArray& from, std::size_t i, StoredArray& to, std::size_t j)
   {
     if (!from.empty())
     {
@@ -288,7 +287,7 @@ Solution shapedLike(Solution& like, std::size_t frames)
   s.allocateIndirect();
   if (like.hasErrorEstimate())
   {
-    s.stdErrorData().assign(s.directData().size(), PackedRgb());
+    s.stdErrorData() = StoredArray(s.directData().size());
   }
   return s;
 }
@@ -472,7 +471,7 @@ void exchangeSides(
 /// Gives every rank the frames of `frames` that one rank filled (the others give zeros).
 void exchangeFrames(const SolverOptions& options, Solution& frames, double& seconds)
 {
-  for (std::vector<PackedRgb>* data :
+  for (StoredArray* data :
     { &frames.directData(), &frames.indirectData(), &frames.stdErrorData(), &frames.patchData() })
   {
     sumStoredAcrossRanks(options, data->data(), data->size(), seconds);

@@ -61,12 +61,12 @@ public:
   {
     ++this->Count;
     const double inverse = 1.0 / static_cast<double>(this->Count);
-    std::vector<PackedRgb>& direct = this->Result.directData();
-    std::vector<PackedRgb>& indirect = this->Result.indirectData();
-    std::vector<PackedRgb>& patch = this->Result.patchData();
-    const std::vector<PackedRgb>& batchDirect = batch.directData();
-    const std::vector<PackedRgb>& batchIndirect = batch.indirectData();
-    const std::vector<PackedRgb>& batchPatch = batch.patchData();
+    StoredArray& direct = this->Result.directData();
+    StoredArray& indirect = this->Result.indirectData();
+    StoredArray& patch = this->Result.patchData();
+    const StoredArray& batchDirect = batch.directData();
+    const StoredArray& batchIndirect = batch.indirectData();
+    const StoredArray& batchPatch = batch.patchData();
     const std::size_t frames = this->Result.frameCount();
     const std::size_t sides = 2 * this->Result.elementCount();
     const std::size_t tasks = (sides + MergeSidesPerTask - 1) / MergeSidesPerTask;
@@ -423,8 +423,8 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
   result.chooseLitSides();
   summary.batches = spread.count();
   summary.stoppedBy = stoppedBy;
-  std::vector<PackedRgb>& stdError = result.stdErrorData();
-  stdError.resize(result.directData().size());
+  StoredArray& stdError = result.stdErrorData();
+  stdError = StoredArray(result.directData().size());
   for (std::size_t i = 0; i < stdError.size(); ++i)
   {
     stdError[i] = PackedRgb(spread.stdError(i));

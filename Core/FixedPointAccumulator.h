@@ -315,17 +315,22 @@ public:
 
   /// Adds every worker's copy into the first and zeroes the others: the sums are unchanged,
   /// and the first copy (copySize() values) can then be summed over processes as a whole.
+  /// The others' pages go back to the system, so the results the sums become can take their
+  /// memory (MemoryPlan).
   std::int64_t* collapse()
   {
     std::int64_t* first = this->Values.get();
     for (std::size_t w = 1; w * this->Stride < this->Size; ++w)
     {
-      std::int64_t* copy = first + w * this->Stride;
+      const std::int64_t* copy = first + w * this->Stride;
       for (std::size_t i = 0; i < this->Stride; ++i)
       {
         first[i] += copy[i];
-        copy[i] = 0;
       }
+    }
+    if (this->Size > this->Stride)
+    {
+      zeroAndRelease(first + this->Stride, this->Size - this->Stride);
     }
     return first;
   }
@@ -380,6 +385,27 @@ private:
     std::array<double, Channels> a;
     a.fill(value);
     return a;
+  }
+
+  /// Zeroes `count` values: the whole pages among them are given back (they read as zero
+  /// again, and take memory only when written), the rest are written.
+  static void zeroAndRelease(std::int64_t* values, std::size_t count)
+  {
+    char* begin = reinterpret_cast<char*>(values);
+    char* end = begin + count * sizeof(std::int64_t);
+#ifdef __linux__
+    constexpr std::uintptr_t Page = 4096;
+    char* pagesBegin =
+      reinterpret_cast<char*>((reinterpret_cast<std::uintptr_t>(begin) + Page - 1) / Page * Page);
+    char* pagesEnd = reinterpret_cast<char*>(reinterpret_cast<std::uintptr_t>(end) / Page * Page);
+    if (pagesBegin < pagesEnd && madvise(pagesBegin, pagesEnd - pagesBegin, MADV_DONTNEED) == 0)
+    {
+      std::memset(begin, 0, pagesBegin - begin);
+      std::memset(pagesEnd, 0, end - pagesEnd);
+      return;
+    }
+#endif
+    std::memset(begin, 0, end - begin);
   }
 
   struct Free

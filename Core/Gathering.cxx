@@ -194,7 +194,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
     fraction, secondsReducing);
   // Each element side gathered on one rank and is exactly zero on the others, so the sum
   // over ranks is that rank's value, bit for bit.
-  std::vector<PackedRgb>& indirect = solution.indirectData();
+  StoredArray& indirect = solution.indirectData();
   sumStoredAcrossRanks(options, indirect.data(), indirect.size(), secondsReducing);
   GatheringResult result;
   result.sides = sides.size();

@@ -74,10 +74,18 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t gathering = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
     standardErrors);
+  // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
+  // in Solution.h), when a source's sums are turned into them, after the workers' copies were
+  // collapsed into one and the others' pages given back. With one source that is the larger
+  // of its copies while it shoots and one copy beside the results as they are written; a
+  // later source shoots beside the results of the ones before.
   const auto peakWith = [&](std::uint64_t copies)
   {
-    return saturatingSum(
-      base, std::max(saturatingSum(saturatingSum(direct, patch), accumulators(copies)), gathering));
+    const std::uint64_t results = saturatingSum(direct, patch);
+    const std::uint64_t shooting = lights <= 1
+      ? std::max(accumulators(copies), saturatingSum(accumulators(1), results))
+      : saturatingSum(results, accumulators(copies));
+    return saturatingSum(base, std::max(shooting, gathering));
   };
   plan.accumulatorCopyPerWorker =
     workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;

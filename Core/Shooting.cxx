@@ -580,8 +580,8 @@ void ShootingRun::addTo(Solution& solution) const
   const std::size_t elements = this->SceneRef.elementCount();
   const std::size_t patches = this->SceneRef.patchCount();
   const std::size_t frames = solution.frameCount();
-  std::vector<PackedRgb>& direct = solution.directData();
-  std::vector<PackedRgb>& patch = solution.patchData();
+  StoredArray& direct = solution.directData();
+  StoredArray& patch = solution.patchData();
   auto positionOf = [&](std::size_t f) { return this->SourceRef.isStatic() ? 0 : f; };
   for (std::size_t e = 0; e < elements; ++e)
   {

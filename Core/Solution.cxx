@@ -29,9 +29,10 @@ double Solution::storageScaleFor(double totalArea)
 
 void Solution::clearRadiosity()
 {
-  std::fill(this->Direct.begin(), this->Direct.end(), PackedRgb());
-  std::fill(this->Patch.begin(), this->Patch.end(), PackedRgb());
-  std::vector<PackedRgb>().swap(this->Indirect);
+  // Fresh arrays rather than zeros written: untouched, they take no memory until shot.
+  this->Direct = StoredArray(this->Direct.size());
+  this->Patch = StoredArray(this->Patch.size());
+  StoredArray().swap(this->Indirect);
 }
 
 void Solution::chooseLitSides()

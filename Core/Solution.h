@@ -5,9 +5,14 @@
 #include "Rgb.h"
 #include "Scene.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <new>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace mlr
@@ -83,6 +88,57 @@ struct ErrorEstimateSummary
   std::vector<double> relativeErrorMedian, relativeErrorP95;
   std::vector<std::uint64_t> litElements;
 };
+
+/**
+ * Allocates results as memory the kernel maps only once it is written (calloc of a large
+ * block is fresh anonymous memory, already zero): a solve's direct light and patches take no
+ * memory while the shooting sums they will be made of do (MemoryPlan). A default-constructed
+ * element is left as the zero bytes it already is. So an array may only grow by a fresh
+ * allocation (constructed at its size, or from empty), never back into capacity it had.
+ */
+template <typename T>
+struct ZeroedAllocator
+{
+  static_assert(std::is_trivially_copyable<T>::value, "zero bytes must be a default T");
+  using value_type = T;
+  ZeroedAllocator() = default;
+  template <typename U>
+  ZeroedAllocator(const ZeroedAllocator<U>&) noexcept
+  {
+  }
+  T* allocate(std::size_t n)
+  {
+    void* p = std::calloc(std::max<std::size_t>(n, 1), sizeof(T));
+    if (!p)
+    {
+      throw std::bad_alloc();
+    }
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t) noexcept { std::free(p); }
+  template <typename U>
+  void construct(U*) noexcept
+  {
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args)
+  {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+  template <typename U>
+  bool operator==(const ZeroedAllocator<U>&) const noexcept
+  {
+    return true;
+  }
+  template <typename U>
+  bool operator!=(const ZeroedAllocator<U>&) const noexcept
+  {
+    return false;
+  }
+};
+
+/// The results of every (element or patch) side and frame, stored (PackedRgb).
+using StoredArray = std::vector<PackedRgb, ZeroedAllocator<PackedRgb>>;
 
 /**
  * Radiosity (W/m^2) of every element and patch side, for every frame, and the irradiance
@@ -237,18 +293,18 @@ public:
   Rgb load(const PackedRgb& stored) const { return Rgb(stored) * this->Scale; }
   PackedRgb store(const Rgb& value) const { return PackedRgb(value / this->Scale); }
   /// The direct irradiance of every element side and frame.
-  std::vector<PackedRgb>& directData() { return this->Direct; }
+  StoredArray& directData() { return this->Direct; }
   /// The indirect irradiance. Empty until allocateIndirect(): the solver allocates it once the
   /// shooting accumulators are freed, so that the two never take memory at once.
-  std::vector<PackedRgb>& indirectData() { return this->Indirect; }
-  void allocateIndirect() { this->Indirect.assign(this->Direct.size(), PackedRgb()); }
+  StoredArray& indirectData() { return this->Indirect; }
+  void allocateIndirect() { this->Indirect = StoredArray(this->Direct.size()); }
   /// Zeroes the direct light and the patches and frees the indirect light, for the next
   /// batch of a batched solve (the reflectance and emission stay).
   void clearRadiosity();
   /// The standard error of the irradiance of every element side and frame, or empty.
-  std::vector<PackedRgb>& stdErrorData() { return this->StdError; }
+  StoredArray& stdErrorData() { return this->StdError; }
   /// The patches' bounced light (patchBounced()) of every patch side and frame.
-  std::vector<PackedRgb>& patchData() { return this->Patch; }
+  StoredArray& patchData() { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
   /// One per element, or empty when nothing emits.
@@ -260,7 +316,7 @@ public:
 private:
   std::size_t Frames = 0, Elements = 0, Patches = 0;
   double Scale = 1;
-  std::vector<PackedRgb> Direct, Indirect, Patch, StdError;
+  StoredArray Direct, Indirect, Patch, StdError;
   std::vector<Rgb> Emission, Reflectance;
   std::vector<Side> LitSide, PatchLitSide;
 };

@@ -12,7 +12,7 @@ TEST(Solution, LitSidesAreTheSidesThatReceivedMoreOverTheAnimation)
   // Two frames, one patch of four elements. Frame 0 lights the front, frame 1 the back more
   // brightly: over the animation the back received more.
   Solution solution(2, 4, 1);
-  auto set = [](std::vector<PackedRgb>& data, std::size_t index, double value)
+  auto set = [](StoredArray& data, std::size_t index, double value)
   { data[index] = PackedRgb(Rgb(value, value, value)); };
   set(solution.patchData(), solution.patchIndex(0, 0, Side::Front), 3.0);
   set(solution.patchData(), solution.patchIndex(1, 0, Side::Back), 4.0);

@@ -20,8 +20,8 @@ namespace mlr::checks
 {
 
 /// The same results to the last bit (solutions whose sums must not depend on threads or ranks).
-template <typename Stored>
-bool sameBits(const std::vector<Stored>& a, const std::vector<Stored>& b)
+template <typename Stored, typename Allocator>
+bool sameBits(const std::vector<Stored, Allocator>& a, const std::vector<Stored, Allocator>& b)
 {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Stored)) == 0;
 }
