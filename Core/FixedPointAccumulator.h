@@ -336,6 +336,40 @@ public:
   }
   std::size_t copySize() const { return this->Stride; }
 
+  /**
+   * After collapse() and mergeOverflow(), once the sums of the records before `record` were
+   * read for the last time: gives back the whole 2 MiB pages of the first copy that hold
+   * theirs alone, where each side's frames are contiguous (FramesInner, or one frame; else
+   * nothing), so that the results they become can take that memory (MemoryPlan). Records
+   * are released in order; those pages read as zero afterwards.
+   */
+  void releaseBefore(std::size_t record)
+  {
+    if (this->SideStride != this->Frames * Channels && this->Frames != 1)
+    {
+      return;
+    }
+    const std::size_t limit = std::min(record, this->Records) * 2;
+    for (; this->ReleaseKey < limit; ++this->ReleaseKey)
+    {
+      if (this->storedIndex(this->ReleaseKey / 2, static_cast<int>(this->ReleaseKey % 2)) !=
+        Unstored)
+      {
+        ++this->ReleasedSides;
+      }
+    }
+    const std::size_t bytes = this->ReleasedSides * this->SideStride * sizeof(std::int64_t);
+    const std::size_t end = bytes / FixedPointPageBytes * FixedPointPageBytes;
+    if (end > this->ReleasedBytes)
+    {
+#ifdef __linux__
+      madvise(reinterpret_cast<char*>(this->Values.get()) + this->ReleasedBytes,
+        end - this->ReleasedBytes, MADV_DONTNEED);
+#endif
+      this->ReleasedBytes = end;
+    }
+  }
+
   /// Bytes of `copies` copies (the worker count, or 1 when shared) with slots for both
   /// sides of `records` records.
   static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
@@ -444,6 +478,9 @@ private:
   bool Shared;            ///< one copy for several workers: atomic adds
   std::size_t Size;
   std::unique_ptr<std::int64_t[], Free> Values;
+  /// releaseBefore's progress: the next (record, side) key, the stored sides before it and
+  /// the bytes given back.
+  std::size_t ReleaseKey = 0, ReleasedSides = 0, ReleasedBytes = 0;
   /// The stored index of each record * 2 + side, Unstored for none; empty when all are.
   std::vector<std::uint32_t> Slot;
   /// Per worker, the frames of the sides without slots that it scored (node-based, so that

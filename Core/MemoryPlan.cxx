@@ -24,27 +24,31 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t patch = saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) });
   const std::uint64_t indirect = direct;
   plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
-  // The accumulators of `copies` copies: a scalar share per element side and RGB power per
-  // patch side, for every frame, each buffer in whole pages; once reachability is known, for
-  // the reachable sides alone, with an index of the sides. The overflow of sides the probes
-  // missed is not counted: a few sides at most.
+  // The accumulators of `copies` copies, for elements and for patches: a scalar share per
+  // element side and RGB power per patch side, for every frame, each buffer in whole pages;
+  // once reachability is known, for the reachable sides alone, with an index of the sides.
+  // The overflow of sides the probes missed is not counted: a few sides at most.
+  struct Accumulators
+  {
+    std::uint64_t elements = 0, patches = 0;
+    std::uint64_t all() const { return saturatingSum(elements, patches); }
+  };
   const auto accumulators = [&](std::uint64_t copies)
   {
     const int c = static_cast<int>(copies);
     if (reachablePatchSides == AllPatchSides)
     {
-      return saturatingSum(FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
-        FixedPointAccumulator<3>::allocatedBytes(c, patches, frames));
+      return Accumulators{ FixedPointAccumulator<1>::allocatedBytes(c, elements, frames),
+        FixedPointAccumulator<3>::allocatedBytes(c, patches, frames) };
     }
     const std::uint64_t patchSides = std::min<std::uint64_t>(reachablePatchSides, 2 * patches);
     const std::uint64_t elementSides = elements == 0
       ? 0
       : saturatingProduct({ patchSides, elements / std::max<std::size_t>(patches, 1) });
-    return saturatingSum(
-      saturatingSum(
-        FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames),
-        FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames)),
-      saturatingProduct({ elements, 2 })); // the element sides' flags
+    return Accumulators{ saturatingSum(FixedPointAccumulator<1>::allocatedStoredBytes(
+                                         c, elements, elementSides, frames),
+                           saturatingProduct({ elements, 2 })), // the element sides' flags
+      FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames) };
   };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,
@@ -77,20 +81,32 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
   // in Solution.h), when a source's sums are turned into them, after the workers' copies were
   // collapsed into one and the others' pages given back. With one source that is the larger
-  // of its copies while it shoots and one copy beside the results as they are written; a
-  // later source shoots beside the results of the ones before.
+  // of its copies while it shoots and what the conversion holds: where each side's frames
+  // are contiguous in the sums (reuse, or one frame) their pages are given back as they are
+  // read (FixedPointAccumulator::releaseBefore), so the elements' sums shrink as the direct
+  // light grows, then the patches' as the patches grow; else one copy beside the results.
+  // A later source shoots beside the results of the ones before.
+  const bool released = frames == 1 || options.reuseShooting;
   const auto peakWith = [&](std::uint64_t copies)
   {
     const std::uint64_t results = saturatingSum(direct, patch);
-    const std::uint64_t shooting = lights <= 1
-      ? std::max(accumulators(copies), saturatingSum(accumulators(1), results))
-      : saturatingSum(results, accumulators(copies));
-    return saturatingSum(base, std::max(shooting, gathering));
+    const Accumulators shooting = accumulators(copies), one = accumulators(1);
+    std::uint64_t peak = saturatingSum(results, shooting.all());
+    if (lights <= 1 && released)
+    {
+      peak = std::max({ shooting.all(), saturatingSum(one.patches, std::max(one.elements, direct)),
+        saturatingSum(direct, std::max(one.patches, patch)) });
+    }
+    else if (lights <= 1)
+    {
+      peak = std::max(shooting.all(), saturatingSum(one.all(), results));
+    }
+    return saturatingSum(base, std::max(peak, gathering));
   };
   plan.accumulatorCopyPerWorker =
     workers == 1 || peakWith(workers) <= memoryLimitBytes(options) / 2;
   const std::uint64_t copies = plan.accumulatorCopyPerWorker ? workers : 1;
-  plan.accumulators = accumulators(copies);
+  plan.accumulators = accumulators(copies).all();
   plan.peak = peakWith(copies);
   return plan;
 }

@@ -17,8 +17,9 @@ namespace mlr
  * allocations. Results take 16 bits per channel (PackedRgb, rounded to within 0.1%): direct
  * irradiance per element side and patch radiosity per patch side, which take memory only
  * once the shooting accumulators are turned into them (after the workers' copies are
- * collapsed into one), and indirect irradiance per element side, allocated when gathering
- * starts, after the shooting accumulators are freed. The peak is the larger of the two
+ * collapsed into one, and, with reuse, as the accumulators' pages are given back), and
+ * indirect irradiance per element side, allocated when gathering starts, after the shooting
+ * accumulators are freed. The peak is the larger of the two
  * phases. Shooting accumulators (64-bit fixed point, for the reachable sides once they are
  * known; see planSolveMemory) take one copy per worker (plain
  * adds, the fastest) when that peak fits in half the memory limit, and otherwise one copy

@@ -136,7 +136,8 @@ public:
   /// Adds this source's light to `solution` (the elements' irradiance, the patches'
   /// radiosity): frame f gets position f, or the one position of a static source, times
   /// that position's power factor.
-  void addTo(Solution& solution) const;
+  /// The sums' pages are given back as they are read (releaseBefore): the run ends here.
+  void addTo(Solution& solution);
 
   const std::vector<WorkerCounters>& counters() const { return this->Counters; }
 
@@ -573,7 +574,7 @@ void ShootingRun::shootClassic(std::size_t position, std::uint64_t path, int wor
   this->scoreAndWalk(random, hit, &share, position, 1, worker);
 }
 
-void ShootingRun::addTo(Solution& solution) const
+void ShootingRun::addTo(Solution& solution)
 {
   // The sums are collapsed and merged (sumAcrossWorkersAndRanks): each side's run is looked
   // up once, and sides nothing scored (the unreachable ones) are skipped.
@@ -606,6 +607,7 @@ void ShootingRun::addTo(Solution& solution) const
         }
       }
     }
+    this->ElementShare.releaseBefore(e + 1);
   }
   // The patches keep the light that has bounced (Solution::patchBounced): their direct part is
   // their elements', which the Solution adds where the whole patch radiosity is asked for.
@@ -629,6 +631,7 @@ void ShootingRun::addTo(Solution& solution) const
           Rgb(sums[0], sums[1], sums[2]) * this->SourceRef.factor(k) * inverseArea);
       }
     }
+    this->PatchPower.releaseBefore(p + 1);
   }
 }
 

@@ -15,6 +15,10 @@
 #include <utility>
 #include <vector>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 namespace mlr
 {
 
@@ -90,9 +94,9 @@ struct ErrorEstimateSummary
 };
 
 /**
- * Allocates results as memory the kernel maps only once it is written (calloc of a large
- * block is fresh anonymous memory, already zero): a solve's direct light and patches take no
- * memory while the shooting sums they will be made of do (MemoryPlan). A default-constructed
+ * Allocates results as memory the kernel maps only once it is written (a large array is a
+ * fresh anonymous mapping, already zero): a solve's direct light and patches take no memory
+ * while the shooting sums they will be made of do (MemoryPlan). A default-constructed
  * element is left as the zero bytes it already is. So an array may only grow by a fresh
  * allocation (constructed at its size, or from empty), never back into capacity it had.
  */
@@ -101,6 +105,8 @@ struct ZeroedAllocator
 {
   static_assert(std::is_trivially_copyable<T>::value, "zero bytes must be a default T");
   using value_type = T;
+  /// From this size on, an array is a mapping of its own.
+  static constexpr std::size_t MappedBytes = std::size_t(1) << 20;
   ZeroedAllocator() = default;
   template <typename U>
   ZeroedAllocator(const ZeroedAllocator<U>&) noexcept
@@ -108,14 +114,38 @@ struct ZeroedAllocator
   }
   T* allocate(std::size_t n)
   {
-    void* p = std::calloc(std::max<std::size_t>(n, 1), sizeof(T));
+    const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
+#ifdef __linux__
+    // Large arrays are fresh mappings, zero until written, and unmapped when freed.
+    if (bytes >= MappedBytes)
+    {
+      void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED)
+      {
+        throw std::bad_alloc();
+      }
+      return static_cast<T*>(p);
+    }
+#endif
+    void* p = std::calloc(1, bytes);
     if (!p)
     {
       throw std::bad_alloc();
     }
     return static_cast<T*>(p);
   }
-  void deallocate(T* p, std::size_t) noexcept { std::free(p); }
+  void deallocate(T* p, std::size_t n) noexcept
+  {
+#ifdef __linux__
+    const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
+    if (bytes >= MappedBytes)
+    {
+      munmap(p, bytes);
+      return;
+    }
+#endif
+    std::free(p);
+  }
   template <typename U>
   void construct(U*) noexcept
   {
@@ -267,15 +297,17 @@ public:
   ErrorEstimateSummary errorEstimate;
   std::vector<std::string> warnings;
 
-  // Storage is element- (patch-) major with frames innermost: scoring one hit for all
-  // frames touches one contiguous run.
+  // Storage is side-major, then element- (patch-) major with frames innermost: scoring one
+  // hit for all frames touches one contiguous run, and the sides light cannot reach (the
+  // outsides of a closed room, the insides of its blocks) lie in long runs of one side's
+  // array that shooting and gathering never write (ZeroedAllocator).
   std::size_t elementIndex(std::size_t frame, std::size_t element, Side side) const
   {
-    return (element * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+    return (static_cast<std::size_t>(side) * this->Elements + element) * this->Frames + frame;
   }
   std::size_t patchIndex(std::size_t frame, std::size_t patch, Side side) const
   {
-    return (patch * 2 + static_cast<std::size_t>(side)) * this->Frames + frame;
+    return (static_cast<std::size_t>(side) * this->Patches + patch) * this->Frames + frame;
   }
   // Results are stored in 16 bits per channel (PackedRgb: within 0.1% of the value, 6 bytes
   // per RGB; see MemoryPlan), divided by storageScale().

@@ -229,16 +229,19 @@ TEST(Chunks, MeanOverSeedsAtASeamIsClassics)
 
 TEST(Chunks, MemoryLimitForTwoFramesPerChunkGivesTheRightResult)
 {
-  // Enough frames that the frames, not the scene's fixed buffers, decide the memory.
+  // Enough elements and frames that the frames, not the scene's fixed buffers (the shooting
+  // sums' 2 MiB pages above all), decide the memory; one worker, so that one copy of the sums
+  // does on any machine.
   constexpr std::size_t Long = 40;
-  const Scene scene = box();
-  SolverOptions o = options(20000, 11);
+  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(16, true, { Rgb(0.6, 0.5, 0.4) }));
+  SolverOptions o = options(20000, 11, 1);
   const auto estimate = [&](std::size_t c)
   {
     return estimateChunkedMemory(
       scene.patchCount(), scene.elementCount(), scene.points().size(), Long, c, o, 1, 0, true);
   };
   ASSERT_LT(estimate(2), estimate(3));
+  ASSERT_LT(estimate(3), estimate(Long));
   o.memoryLimitBytes = (estimate(2) + estimate(3)) / 2;
   const std::size_t c = chooseFramesPerChunk(
     scene.patchCount(), scene.elementCount(), scene.points().size(), Long, o, 1, 0, true);

@@ -72,6 +72,8 @@ TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
   SolverOptions o;
   o.threads = 3;
   o.memoryLimitBytes = std::uint64_t(1) << 40;
+  o.reuseShooting = shooting; // reuse gives the sums' pages back as they are read
+  o.reuseGathering = gathering;
   const auto plan = [&]
   {
     return planSolveMemory(

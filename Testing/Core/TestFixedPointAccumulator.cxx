@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include <sys/mman.h>
+
 using namespace mlr;
 
 namespace
@@ -396,4 +398,42 @@ TEST(FixedPointAccumulator, SidesWithoutSlotsOverflowAndLoseNothing)
     }
   }
   EXPECT_EQ(merged, reference);
+}
+
+TEST(FixedPointAccumulator, ReadSumsGiveTheirPagesBackAndTheRestStay)
+{
+  // 2,000 records x 2 sides x 300 frames, FramesInner: 9.6 MB, four whole 2 MiB pages and a
+  // part. Once the first half of the records is read, the pages holding only theirs go back
+  // to the system (mincore: not resident), and the other records keep their sums.
+  constexpr std::size_t Many = 2000, Long = 300;
+  FixedPointAccumulator<1> sums(1, true, Many, Long, 1.0, FrameLayout::FramesInner);
+  const double one = 1;
+  for (std::size_t r = 0; r < Many; ++r)
+  {
+    for (std::size_t f = 0; f < Long; ++f)
+    {
+      sums.add(sums.slots(0, r, 0), f, &one);
+    }
+  }
+  std::int64_t* first = sums.collapse();
+  const std::size_t pageBytes = FixedPointPageBytes;
+  auto resident = [&](std::size_t page)
+  {
+    unsigned char flag = 0;
+    EXPECT_EQ(mincore(reinterpret_cast<char*>(first) + page * pageBytes, 4096, &flag), 0);
+    return (flag & 1) != 0;
+  };
+  EXPECT_TRUE(resident(0));
+  sums.releaseBefore(Many / 2);
+  // The first half's slots: 1000 records x 2 sides x 300 frames x 8 bytes = 4.8 MB, two whole
+  // pages.
+  EXPECT_FALSE(resident(0));
+  EXPECT_FALSE(resident(1));
+  EXPECT_TRUE(resident(2));
+  for (std::size_t r = Many / 2; r < Many; ++r)
+  {
+    double t = 0;
+    sums.total(r, 0, Long - 1, &t);
+    ASSERT_EQ(t, 1.0) << r;
+  }
 }

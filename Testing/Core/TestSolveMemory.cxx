@@ -1,4 +1,5 @@
-// The solver's memory estimate against the bytes a solve allocates.
+// The solver's memory estimate against the bytes a solve allocates, and against the resident
+// memory it takes.
 //
 // This executable replaces the C allocator (malloc, its aligned variants, realloc and free;
 // glibc's documented way of replacing malloc) with counting wrappers around glibc's own, so
@@ -25,6 +26,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <malloc.h>
+#include <string>
 #include <unistd.h>
 #include <vector>
 
@@ -189,12 +193,58 @@ struct Measurement
   std::uint64_t live() const { return static_cast<std::uint64_t>(liveBytes.load() - this->base); }
 };
 
-/// 192 patches (768 elements) and a light in 1000 positions: the results and accumulators,
-/// proportional to frames x elements, are most of the memory, as on any scene with many
-/// frames; everything else (the tracer, per-thread scratch, reachability) is under 1%.
+/// A value of /proc/self/status ("VmRSS:", "VmHWM:"), in bytes.
+std::uint64_t status(const char* key)
+{
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+  {
+    if (line.rfind(key, 0) == 0)
+    {
+      return std::stoull(line.substr(std::strlen(key))) * 1024;
+    }
+  }
+  return 0;
+}
+
+/**
+ * The process's resident memory, after glibc gave back the heap it holds free, and its peak
+ * since, reset (clear_refs 5): what a solve takes of the machine. The solver's results are
+ * mappings of their own that take memory only once written (ZeroedAllocator), which the heap
+ * count above cannot see.
+ */
+struct Resident
+{
+  std::uint64_t base = 0;
+  Resident()
+  {
+    malloc_trim(0);
+    std::ofstream("/proc/self/clear_refs") << "5";
+    this->base = status("VmRSS:");
+    EXPECT_LE(status("VmHWM:"), this->base + (std::uint64_t(1) << 20)) << "the peak was reset";
+  }
+  std::uint64_t peak() const { return status("VmHWM:") - this->base; }
+  std::uint64_t live() const
+  {
+    malloc_trim(0);
+    const std::uint64_t now = status("VmRSS:");
+    return now > this->base ? now - this->base : 0;
+  }
+};
+
+/// A box of `cells` x `cells` per face (8: 768 patches, 3,072 elements) and a light in 1000
+/// positions: the results and accumulators, proportional to frames x elements, are most of
+/// the memory (tens of megabytes at 8, well above the process's own resident noise), as on
+/// any scene with many frames; everything else (the tracer, per-thread scratch,
+/// reachability) is about 1%.
 struct ManyFrames
 {
-  Scene scene = Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.5) }));
+  explicit ManyFrames(int cells = 8)
+    : scene(Scene::fromPatchMesh(scenes::closedBox(cells, true, { Rgb(0.5) })))
+  {
+  }
+  Scene scene;
   MovingLight light{ scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(10),
     scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.2, 0.9 }, { 0.8, 0.8, 0.9 }, 1000) };
 };
@@ -234,7 +284,7 @@ struct Measured
 {
   const char* mode = "";
   MemoryPlan plan;
-  std::uint64_t peak = 0; ///< the heap's peak during the solve, above what was live before
+  std::uint64_t peak = 0; ///< the resident peak during the solve, above what was before
   std::uint64_t held = 0; ///< what the solution holds after it
 };
 
@@ -272,7 +322,7 @@ std::vector<Measured> measureTheModes()
     r.mode = mode.name;
     r.plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(),
       frames, mode.options, 1, reachable);
-    const Measurement m;
+    const Resident m;
     const Solution solution = solve(f.scene, f.light, mode.options);
     r.peak = m.peak();
     r.held = m.live();
@@ -297,20 +347,25 @@ TEST(SolveMemory, TheEstimateBoundsThePeakAndTheResultsTightly)
   for (const Measured& r : measureTheModes())
   {
     const char* mode = r.mode;
-    // An upper bound, and a tight one:
-    // results and accumulators make up the shooting peak, the results (the indirect light
-    // with them) the gathering one. Twice either term would put the estimate 22% (the
-    // direct and patch results, three copies) to 79% (all results, one shared copy) over the
-    // measured peak, half of either below it. The generous parts, Embree's 256 bytes per
-    // element above all, are under 1% of it here.
-    EXPECT_LE(r.peak, r.plan.peak) << mode;
-    EXPECT_LE(static_cast<double>(r.plan.peak), 1.1 * static_cast<double>(r.peak)) << mode;
+    // An upper bound, and a tight one: the workers' copies of the sums make the shooting
+    // peak with a copy per worker, the results the gathering one otherwise. The bound holds
+    // up to the process's own resident noise (code pages first run, the threads' stacks and
+    // heaps: up to 2% here). The results of the sides light cannot reach (half of them here:
+    // the box's outside) are never written, and a kernel that maps no page for a read of
+    // them holds none of them: the tight side allows for that. Twice the sums or the results
+    // still fail it.
+    const double unwritten = 0.5 * static_cast<double>(r.plan.results);
+    EXPECT_LE(static_cast<double>(r.peak), 1.03 * static_cast<double>(r.plan.peak)) << mode;
+    EXPECT_LE(static_cast<double>(r.plan.peak), 1.1 * static_cast<double>(r.peak) + unwritten)
+      << mode;
 
-    // After the solve the solution holds the results: direct, indirect and patch radiosity,
-    // and besides them only the lit side of the elements and the statistics (in "other").
-    // Half or twice the indirect light, which the shooting peak does not show, fails here.
-    EXPECT_GE(r.held, r.plan.results) << mode;
-    EXPECT_LE(r.held, r.plan.results + r.plan.other) << mode;
+    // After the solve the solution holds the results: direct, indirect and patch radiosity
+    // (those written at least), and besides them only the lit side of the elements and the
+    // statistics (in "other"). Twice the results, or a quarter, fails here.
+    EXPECT_GE(static_cast<double>(r.held), static_cast<double>(r.plan.results) - unwritten) << mode;
+    EXPECT_LE(
+      static_cast<double>(r.held), 1.03 * static_cast<double>(r.plan.results + r.plan.other))
+      << mode;
   }
 }
 
@@ -319,7 +374,8 @@ TEST(SolveMemory, TheEstimateBoundsABatchedSolve)
   // Four batches of one path per position: the running mean, the squared deviations and the
   // standard errors (MemoryPlan::errorEstimate) come on top of one batch's solve, the standard
   // errors only once the last batch's accumulators are gone. Leaving them out, or counting
-  // them in the shooting peak, is 11% off: the bound must hold within 10%.
+  // them in the shooting peak, is 11% off: the bound must hold within 10%, up to the
+  // process's own resident noise (2%).
   const ManyFrames f;
   const std::size_t frames = f.light.frameCount();
   solve(f.scene,
@@ -332,14 +388,14 @@ TEST(SolveMemory, TheEstimateBoundsABatchedSolve)
   const MemoryPlan plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
     f.scene.points().size(), frames, options, 1, reachable);
   EXPECT_GT(plan.errorEstimate, 0u);
-  const Measurement m;
+  const Resident m;
   const Solution solution = solve(f.scene, f.light, options);
   const std::uint64_t peak = m.peak();
   std::printf("batched: estimate %.3f MB (error estimate %.3f); measured peak %.3f MB\n",
     plan.peak / 1e6, plan.errorEstimate / 1e6, peak / 1e6);
   EXPECT_TRUE(solution.hasErrorEstimate());
   EXPECT_EQ(solution.statistics.memoryEstimateBytes, plan.peak);
-  EXPECT_LE(peak, plan.peak);
+  EXPECT_LE(static_cast<double>(peak), 1.02 * static_cast<double>(plan.peak));
   EXPECT_LE(static_cast<double>(plan.peak), 1.1 * static_cast<double>(peak));
 }
 
@@ -350,7 +406,7 @@ TEST(SolveMemory, TheSensorEstimateBoundsWhatTheSensorsAllocate)
   // and each worker's per-frame sums and shadow-ray batch (0.16 MB) the rest. Leaving out the
   // tracer or the workers' buffers puts the estimate under the measured peak, counting them
   // twice 7% (one worker) to 11% (three) over it: the bound must hold within 5%.
-  const ManyFrames f;
+  const ManyFrames f(4);
   const std::size_t frames = f.light.frameCount();
   LightRig rig;
   rig.areaLights.push_back(f.light);
