@@ -39,7 +39,9 @@ constexpr std::size_t MergeSidesPerTask = 4096;
 /// The mean of the batches so far and the sum of squared deviations of their total
 /// irradiance (Welford's update, in batch order). The running mean is kept in single
 /// precision, where an update of one batch in thousands still counts, and the result's stored
-/// arrays get it rounded once after each batch; the squares are in double.
+/// arrays get it rounded once after each batch. The sums of squared deviations are in single
+/// precision too: each is a sum of non-negative terms, in batch order, and a standard error
+/// needs two significant digits, where single precision keeps six over thousands of batches.
 class BatchSpread
 {
 public:
@@ -86,7 +88,8 @@ public:
           indirect[i] = PackedRgb(this->MeanIndirect[i]);
           const Rgb after = Rgb(this->MeanDirect[i]) + Rgb(this->MeanIndirect[i]);
           const Rgb x = xDirect + xIndirect;
-          this->SquaredDeviations[i] += (x - before) * (x - after);
+          this->SquaredDeviations[i] =
+            FloatRgb(Rgb(this->SquaredDeviations[i]) + (x - before) * (x - after));
         }
       },
       [](std::size_t) { return true; });
@@ -108,7 +111,7 @@ public:
       return Rgb();
     }
     const double n = static_cast<double>(this->Count);
-    const Rgb& m2 = this->SquaredDeviations[i];
+    const Rgb m2 = this->SquaredDeviations[i];
     const double scale = 1.0 / ((n - 1) * n);
     return Rgb(std::sqrt(std::max(0.0, m2.r * scale)), std::sqrt(std::max(0.0, m2.g * scale)),
       std::sqrt(std::max(0.0, m2.b * scale)));
@@ -126,7 +129,7 @@ private:
   int Workers;
   std::uint64_t Count = 0;
   std::vector<FloatRgb> MeanDirect, MeanIndirect, MeanPatch;
-  std::vector<Rgb> SquaredDeviations;
+  std::vector<FloatRgb> SquaredDeviations;
 };
 
 std::string percent(double fraction)
@@ -244,7 +247,7 @@ std::uint64_t errorEstimateBytes(
   const std::uint64_t mean =
     saturatingSum(saturatingProduct(sides, 2 * (sizeof(PackedRgb) + sizeof(FloatRgb))),
       saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) + sizeof(FloatRgb) }));
-  const std::uint64_t spread = saturatingProduct(sides, sizeof(Rgb) + sizeof(PackedRgb));
+  const std::uint64_t spread = saturatingProduct(sides, sizeof(FloatRgb) + sizeof(PackedRgb));
   return saturatingSum(mean, spread);
 }
 
