@@ -109,9 +109,10 @@ std::string runChunkedAnimation(const ScaleCaseOptions& scale)
 {
   constexpr std::size_t framesPerChunk = 100;
   std::printf("\nLong animations in chunks of %zu frames (overlap %zu), streamed, N = %llu, "
-              "full reuse\n%8s %7s %9s %9s %12s %12s %14s\n",
+              "full reuse\n%8s %7s %9s %9s %9s %9s %12s %12s %14s\n",
     framesPerChunk, chunkOverlap(framesPerChunk), static_cast<unsigned long long>(Paths), "frames",
-    "chunks", "total s", "ms/frame", "solve MiB", "process MiB", "estimate MiB");
+    "chunks", "total s", "ms/frame", "shoot s", "gather s", "solve MiB", "process MiB",
+    "estimate MiB");
   std::fflush(stdout);
   std::ostringstream json;
   json << "{\"frames_per_chunk\": " << framesPerChunk << ", \"runs\": [";
@@ -133,9 +134,10 @@ std::string runChunkedAnimation(const ScaleCaseOptions& scale)
     const std::uint64_t solvePeak = peak > before ? peak - before : 0;
     const std::uint64_t estimate = estimateChunkedMemory(r.scene.patchCount(),
       r.scene.elementCount(), r.scene.points().size(), frames, framesPerChunk, o, 1, 0, true);
-    std::printf("%8zu %7llu %9.2f %9.2f %12.1f %12.1f %14.1f\n", frames,
+    std::printf("%8zu %7llu %9.2f %9.2f %9.2f %9.2f %12.1f %12.1f %14.1f\n", frames,
       static_cast<unsigned long long>(s.chunks), s.secondsTotal, 1000 * s.secondsTotal / frames,
-      double(solvePeak) / MiB, double(peak) / MiB, double(estimate) / MiB);
+      s.secondsShooting, s.secondsGathering, double(solvePeak) / MiB, double(peak) / MiB,
+      double(estimate) / MiB);
     std::fflush(stdout);
     json << (frames == 300 ? "" : ", ") << "{\"frames\": " << frames << ", \"chunks\": " << s.chunks
          << ", \"seconds\": " << s.secondsTotal << ", \"peak_bytes\": " << solvePeak

@@ -242,35 +242,51 @@ void finishFrames(const ChunkPlan& plan, std::size_t chunk, const Estimate& befo
   Solution& d = *dest.solution;
   const bool errors = c.hasErrorEstimate();
   const bool indirect = !c.indirectData().empty();
-  for (std::size_t f = begin; f < blendEnd; ++f)
+  // Each side's frames are contiguous (side-major storage): the frames run innermost.
+  const std::size_t n = blendEnd - begin;
+  std::vector<double> wc(n), rho(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
   {
-    const double wc = plan.weight(chunk, f), wb = 1 - wc;
-    const std::size_t fc = f - current.first, fb = f - before.first, fd = f - dest.first;
-    const double rho = errors ? correlationOf(c, fc, b, fb) : 0.0;
-    for (std::size_t e = 0; e < c.elementCount(); ++e)
+    wc[i] = plan.weight(chunk, begin + i);
+    if (errors)
     {
-      for (const Side side : { Side::Front, Side::Back })
+      rho[i] = correlationOf(c, begin + i - current.first, b, begin + i - before.first);
+    }
+  }
+  const std::size_t fc = begin - current.first, fb = begin - before.first, fd = begin - dest.first;
+  for (std::size_t e = 0; e < c.elementCount(); ++e)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      const std::size_t ic = c.elementIndex(fc, e, side), ib = b.elementIndex(fb, e, side);
+      const std::size_t id = d.elementIndex(fd, e, side);
+      for (std::size_t i = 0; i < n; ++i)
       {
-        const std::size_t ic = c.elementIndex(fc, e, side), ib = b.elementIndex(fb, e, side);
-        const std::size_t id = d.elementIndex(fd, e, side);
-        d.directData()[id] = blend(c.directData()[ic], wc, b.directData()[ib], wb);
+        d.directData()[id + i] =
+          blend(c.directData()[ic + i], wc[i], b.directData()[ib + i], 1 - wc[i]);
         if (indirect)
         {
-          d.indirectData()[id] = blend(c.indirectData()[ic], wc, b.indirectData()[ib], wb);
+          d.indirectData()[id + i] =
+            blend(c.indirectData()[ic + i], wc[i], b.indirectData()[ib + i], 1 - wc[i]);
         }
         if (errors)
         {
-          d.stdErrorData()[id] =
-            blendError(c.stdErrorData()[ic], wc, b.stdErrorData()[ib], wb, rho);
+          d.stdErrorData()[id + i] = blendError(
+            c.stdErrorData()[ic + i], wc[i], b.stdErrorData()[ib + i], 1 - wc[i], rho[i]);
         }
       }
     }
-    for (std::size_t p = 0; p < c.patchCount(); ++p)
+  }
+  for (std::size_t p = 0; p < c.patchCount(); ++p)
+  {
+    for (const Side side : { Side::Front, Side::Back })
     {
-      for (const Side side : { Side::Front, Side::Back })
+      const std::size_t ic = c.patchIndex(fc, p, side), ib = b.patchIndex(fb, p, side);
+      const std::size_t id = d.patchIndex(fd, p, side);
+      for (std::size_t i = 0; i < n; ++i)
       {
-        d.patchData()[d.patchIndex(fd, p, side)] = blend(c.patchData()[c.patchIndex(fc, p, side)],
-          wc, b.patchData()[b.patchIndex(fb, p, side)], wb);
+        d.patchData()[id + i] =
+          blend(c.patchData()[ic + i], wc[i], b.patchData()[ib + i], 1 - wc[i]);
       }
     }
   }

@@ -122,15 +122,17 @@ struct PackedRgb
     }
     return rounded - Offset >= Infinity ? Infinity : static_cast<std::uint16_t>(rounded - Offset);
   }
-  /// Branch-free, so that a row of frames decodes in SIMD: the code's exponent and mantissa
-  /// placed in a float's, offset so that exponent 127 lands on the float's infinity and NaN,
-  /// then scaled exactly by 2^-64; code 0 is 0.
+  /// The code's exponent and mantissa placed in a float's, offset so that exponent 127 lands
+  /// on the float's infinity and NaN, then scaled exactly by 2^-64; code 0 is masked to 0.
+  /// Without a branch: rows of frames mix zeros and values, and a branch on them mispredicts
+  /// (it made gathering twice as slow).
   static double decode(std::uint16_t code)
   {
-    const std::uint32_t bits = (std::uint32_t(code) << 14) + (std::uint32_t(128) << 23);
+    const std::uint32_t bits = ((std::uint32_t(code) << 14) + (std::uint32_t(128) << 23)) &
+      (0u - static_cast<std::uint32_t>(code != 0));
     float value;
     std::memcpy(&value, &bits, sizeof value);
-    return static_cast<double>(value * 0x1.0p-64f * static_cast<float>(code != 0));
+    return static_cast<double>(value * 0x1.0p-64f);
   }
 
 private:
