@@ -17,6 +17,7 @@
 #pragma once
 
 #include "MemoryBudget.h"
+#include "ZeroedMemory.h"
 
 #include <algorithm>
 #include <array>
@@ -444,26 +445,19 @@ private:
 
   struct Free
   {
-    void operator()(std::int64_t* p) const { std::free(p); }
+    std::size_t bytes = 0;
+    void operator()(std::int64_t* p) const { unmapZeroed(p, this->bytes); }
   };
 
   /// Scores land on random records all over the buffer (megabytes per worker): with 4 KiB
   /// pages nearly every score misses the TLB. 2 MiB pages, where the kernel grants them, cut
-  /// those misses by 512.
+  /// those misses by 512. The buffer is a mapping of its own (mapZeroed).
   static std::unique_ptr<std::int64_t[], Free> allocateZeroed(std::size_t count)
   {
     const std::size_t bytes = std::max<std::size_t>(count * sizeof(std::int64_t), 1);
     const std::size_t rounded = static_cast<std::size_t>(fixedPointBufferBytes(bytes));
-    void* memory = std::aligned_alloc(FixedPointPageBytes, rounded);
-    if (!memory)
-    {
-      throw std::bad_alloc();
-    }
-#ifdef MADV_HUGEPAGE
-    madvise(memory, rounded, MADV_HUGEPAGE);
-#endif
-    std::memset(memory, 0, bytes);
-    return std::unique_ptr<std::int64_t[], Free>(static_cast<std::int64_t*>(memory));
+    return std::unique_ptr<std::int64_t[], Free>(
+      static_cast<std::int64_t*>(mapZeroed(rounded, FixedPointPageBytes)), Free{ rounded });
   }
 
   std::size_t Records;

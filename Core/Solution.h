@@ -4,20 +4,14 @@
 
 #include "Rgb.h"
 #include "Scene.h"
+#include "ZeroedMemory.h"
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <new>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
-
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 
 namespace mlr
 {
@@ -91,85 +85,6 @@ struct ErrorEstimateSummary
   /// percentile of the relative error, and how many elements are lit.
   std::vector<double> relativeErrorMedian, relativeErrorP95;
   std::vector<std::uint64_t> litElements;
-};
-
-/**
- * Allocates results as memory the kernel maps only once it is written (a large array is a
- * fresh anonymous mapping, already zero): a solve's direct light and patches take no memory
- * while the shooting sums they will be made of do (MemoryPlan). A default-constructed
- * element is left as the zero bytes it already is. So an array may only grow by a fresh
- * allocation (constructed at its size, or from empty), never back into capacity it had.
- */
-template <typename T>
-struct ZeroedAllocator
-{
-  static_assert(std::is_trivially_copyable<T>::value, "zero bytes must be a default T");
-  using value_type = T;
-  /// From this size on, an array is a mapping of its own.
-  static constexpr std::size_t MappedBytes = std::size_t(1) << 20;
-  ZeroedAllocator() = default;
-  template <typename U>
-  ZeroedAllocator(const ZeroedAllocator<U>&) noexcept
-  {
-  }
-  T* allocate(std::size_t n)
-  {
-    const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
-#ifdef __linux__
-    // Large arrays are fresh mappings, zero until written, and unmapped when freed.
-    if (bytes >= MappedBytes)
-    {
-      void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-      if (p == MAP_FAILED)
-      {
-        throw std::bad_alloc();
-      }
-#ifdef MADV_HUGEPAGE
-      // A page fault costs about as much as writing the page: 2 MiB pages, where the kernel
-      // grants them, take 512 times fewer (every chunk of a long run maps its results anew).
-      madvise(p, bytes, MADV_HUGEPAGE);
-#endif
-      return static_cast<T*>(p);
-    }
-#endif
-    void* p = std::calloc(1, bytes);
-    if (!p)
-    {
-      throw std::bad_alloc();
-    }
-    return static_cast<T*>(p);
-  }
-  void deallocate(T* p, std::size_t n) noexcept
-  {
-#ifdef __linux__
-    const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
-    if (bytes >= MappedBytes)
-    {
-      munmap(p, bytes);
-      return;
-    }
-#endif
-    std::free(p);
-  }
-  template <typename U>
-  void construct(U*) noexcept
-  {
-  }
-  template <typename U, typename... Args>
-  void construct(U* p, Args&&... args)
-  {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-  template <typename U>
-  bool operator==(const ZeroedAllocator<U>&) const noexcept
-  {
-    return true;
-  }
-  template <typename U>
-  bool operator!=(const ZeroedAllocator<U>&) const noexcept
-  {
-    return false;
-  }
 };
 
 /// The results of every (element or patch) side and frame, stored (PackedRgb).
