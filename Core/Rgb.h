@@ -125,7 +125,7 @@ struct PackedRgb
   /// The code's exponent and mantissa placed in a float's, offset so that exponent 127 lands
   /// on the float's infinity and NaN, then scaled exactly by 2^-64; code 0 is masked to 0.
   /// Without a branch: rows of frames mix zeros and values, and a branch on them mispredicts
-  /// (it made gathering twice as slow).
+  /// (gathering took 1.5 times as long with one).
   static double decode(std::uint16_t code)
   {
     const std::uint32_t bits = ((std::uint32_t(code) << 14) + (std::uint32_t(128) << 23)) &

@@ -21,9 +21,10 @@ namespace mlr
 /**
  * `bytes` of zeroed memory aligned to `alignment` (a power of two), a mapping of its own:
  * its pages are resident only once written, and it goes back to the system when freed.
- * From the heap instead, large buffers that come and go (a long run's chunks) leave it
- * fragmented: the same solves peaked anywhere from 82 to 147 MiB, against 74 to 78 MiB as
- * mappings. Throws std::bad_alloc. Free with unmapZeroed().
+ * From the heap instead, buffers of tens of MiB that come and go (a long run's chunks) fall
+ * under glibc's dynamic mmap threshold, fragment it and stay resident once freed, so that
+ * the peak wanders above the memory plan (Performance.md, "Long animations in chunks").
+ * Throws std::bad_alloc. Free with unmapZeroed().
  */
 inline void* mapZeroed(std::size_t bytes, std::size_t alignment)
 {
