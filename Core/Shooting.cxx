@@ -601,9 +601,8 @@ void ShootingRun::addTo(Solution& solution)
         this->ElementShare.read(run, positionOf(f), &share);
         if (share != 0)
         {
-          PackedRgb& stored = direct[solution.elementIndex(f, e, static_cast<Side>(s))];
-          stored = solution.store(
-            solution.load(stored) + irradiance * this->SourceRef.factor(positionOf(f)) * share);
+          solution.addTo(direct[solution.elementIndex(f, e, static_cast<Side>(s))],
+            irradiance * this->SourceRef.factor(positionOf(f)) * share);
         }
       }
     }
@@ -626,8 +625,7 @@ void ShootingRun::addTo(Solution& solution)
         const std::size_t k = positionOf(f);
         double sums[3];
         this->PatchPower.read(power, k, sums);
-        PackedRgb& stored = patch[solution.patchIndex(f, p, static_cast<Side>(s))];
-        stored = solution.store(solution.load(stored) +
+        solution.addTo(patch[solution.patchIndex(f, p, static_cast<Side>(s))],
           Rgb(sums[0], sums[1], sums[2]) * this->SourceRef.factor(k) * inverseArea);
       }
     }

@@ -244,6 +244,11 @@ public:
   static double storageScaleFor(double totalArea);
   Rgb load(const PackedRgb& stored) const { return Rgb(stored) * this->Scale; }
   PackedRgb store(const Rgb& value) const { return PackedRgb(value / this->Scale); }
+  /// Adds `value` (W/m^2) to a stored value, rounded once.
+  void addTo(PackedRgb& stored, const Rgb& value) const
+  {
+    stored = this->store(this->load(stored) + value);
+  }
   /// The direct irradiance of every element side and frame.
   StoredArray& directData() { return this->Direct; }
   /// The indirect irradiance. Empty until allocateIndirect(): the solver allocates it once the
