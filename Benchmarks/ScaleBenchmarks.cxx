@@ -133,16 +133,15 @@ std::string runLargeScene(const ScaleCaseOptions& scale)
   const std::uint64_t peak = statusBytes("VmHWM");
   const std::uint64_t solvePeak = peak > before ? peak - before : 0;
   const double ratio = double(solvePeak) / double(s.memoryEstimateBytes);
-  const MemoryPlan reached = planSolveMemory(scene.patchCount(), scene.elementCount(),
-    scene.points().size(), frames, options, 1, s.reachableSides);
   std::printf("Reachable patch sides: %llu of %zu (%.1f%%); sides without slots that paths hit "
               "(overflow): %llu. Memory estimate with them: %.2f GiB (%.1f bytes per "
-              "element-frame): shooting accumulators %.2f GiB (%s)\n",
+              "element-frame): results written %.2f GiB, shooting accumulators %.2f GiB (%s)\n",
     static_cast<unsigned long long>(s.reachableSides), 2 * scene.patchCount(),
     100.0 * double(s.reachableSides) / double(2 * scene.patchCount()),
-    static_cast<unsigned long long>(s.overflowSides), double(reached.peak) / GiB,
-    double(reached.peak) / elementFrames, double(reached.accumulators) / GiB,
-    reached.accumulatorCopyPerWorker ? "a copy per worker" : "one copy shared by the workers");
+    static_cast<unsigned long long>(s.overflowSides), double(s.memoryEstimateBytes) / GiB,
+    double(s.memoryEstimateBytes) / elementFrames, double(s.memoryResultBytes) / GiB,
+    double(s.memoryAccumulatorBytes) / GiB,
+    s.accumulatorCopyPerWorker ? "a copy per worker" : "one copy shared by the workers");
   std::printf("Threads: %d. Solve %.1f s (%.0f ms per frame): shooting %.1f s, gathering %.1f s; "
               "%llu shadow rays, %llu nearest-hit rays, %llu gathering rays\n",
     s.threads, s.secondsTotal, 1000 * s.secondsTotal / frames, s.secondsShooting,

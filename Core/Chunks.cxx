@@ -383,6 +383,8 @@ void accumulate(const SolverStatistics& c, bool first, SolverStatistics& s)
   s.secondsGathering += c.secondsGathering;
   s.secondsReducing += c.secondsReducing;
   s.memoryEstimateBytes = std::max(s.memoryEstimateBytes, c.memoryEstimateBytes);
+  s.memoryResultBytes = std::max(s.memoryResultBytes, c.memoryResultBytes);
+  s.memoryAccumulatorBytes = std::max(s.memoryAccumulatorBytes, c.memoryAccumulatorBytes);
   s.accumulatorCopyPerWorker = s.accumulatorCopyPerWorker && c.accumulatorCopyPerWorker;
 }
 
@@ -425,6 +427,7 @@ void visitChunkFigures(
   visit(s.meanPathLength), visit(s.secondsRemeshing), visit(s.patchEdgeLength);
   visit(s.secondsSetup), visit(s.secondsShooting), visit(s.secondsGathering);
   visit(s.secondsReducing), visit(s.secondsTotal), visit(s.memoryEstimateBytes);
+  visit(s.memoryResultBytes), visit(s.memoryAccumulatorBytes);
   visit(s.accumulatorCopyPerWorker), visit(s.threads), visit(s.reuseShooting);
   visit(s.reuseGathering), visit(s.twoSided);
   visit(e.batches), visit(e.rounds), visit(e.pathsPerFrame), visit(e.target), visit(stop);

@@ -48,16 +48,13 @@ enum class FrameLayout
   FramesOuter,
 };
 
-/// FixedPointAccumulator's buffers are aligned to and allocated in whole 2 MiB pages (see
-/// allocateZeroed). With transparent huge pages the last page is resident whole, so the
-/// memory plan counts the rounded size.
-constexpr std::uint64_t FixedPointPageBytes = std::uint64_t(2) << 20;
-
-/// The bytes a buffer of `bytes` takes once rounded up to whole pages (saturating).
+/// The bytes a buffer of `bytes` takes once rounded up to whole pages (saturating):
+/// FixedPointAccumulator's buffers are aligned to and allocated in whole huge pages
+/// (allocateZeroed), and the last one is resident whole.
 inline std::uint64_t fixedPointBufferBytes(std::uint64_t bytes)
 {
-  const std::uint64_t pages = bytes / FixedPointPageBytes + (bytes % FixedPointPageBytes != 0);
-  return pages > UINT64_MAX / FixedPointPageBytes ? UINT64_MAX : pages * FixedPointPageBytes;
+  const std::uint64_t pages = bytes / HugePageBytes + (bytes % HugePageBytes != 0);
+  return pages > UINT64_MAX / HugePageBytes ? UINT64_MAX : pages * HugePageBytes;
 }
 
 /// Where add() writes the frames of one (record, side): slots `frameStride` apart, with
@@ -360,7 +357,7 @@ public:
       }
     }
     const std::size_t bytes = this->ReleasedSides * this->SideStride * sizeof(std::int64_t);
-    const std::size_t end = bytes / FixedPointPageBytes * FixedPointPageBytes;
+    const std::size_t end = bytes / HugePageBytes * HugePageBytes;
     if (end > this->ReleasedBytes)
     {
 #ifdef __linux__
@@ -457,7 +454,7 @@ private:
     const std::size_t bytes = std::max<std::size_t>(count * sizeof(std::int64_t), 1);
     const std::size_t rounded = static_cast<std::size_t>(fixedPointBufferBytes(bytes));
     return std::unique_ptr<std::int64_t[], Free>(
-      static_cast<std::int64_t*>(mapZeroed(rounded, FixedPointPageBytes)), Free{ rounded });
+      static_cast<std::int64_t*>(mapZeroed(rounded, HugePageBytes)), Free{ rounded });
   }
 
   std::size_t Records;

@@ -218,6 +218,10 @@ void indirectFromPatches(const Scene& scene, Solution& solution)
       for (std::size_t f = 0; f < solution.frameCount(); ++f)
       {
         const Rgb b = solution.patchBounced(f, p, static_cast<Side>(s));
+        if (b.r == 0 && b.g == 0 && b.b == 0)
+        {
+          continue; // the zeros are there: a side light cannot reach stays unwritten
+        }
         const Rgb rest(irradiance(b.r, rho.r), irradiance(b.g, rho.g), irradiance(b.b, rho.b));
         for (std::size_t e = p * 4; e < p * 4 + 4; ++e)
         {

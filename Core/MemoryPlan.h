@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace mlr
 {
@@ -39,16 +40,24 @@ struct MemoryPlan
   std::uint64_t peak = 0; ///< the estimate: the larger phase, shooting or gathering
 };
 
-/// Every patch side has shooting accumulators: the plan before reachability is known.
-constexpr std::uint64_t AllPatchSides = UINT64_MAX;
-
 /// The plan of a solve of `frames` frames lit by `lights` light sources (area lights, scene
-/// emitters and directional lights; their per-frame data is counted). `reachablePatchSides`:
-/// the patch sides light can reach (Reachability.h), which alone, with their elements' sides,
-/// have shooting accumulators; AllPatchSides, the bound before the probes, counts every side.
+/// emitters and directional lights; their per-frame data is counted). `reachable`: the flags
+/// of the patch sides light can reach (patch * 2 + side, Reachability.h), which alone, with
+/// their elements' sides, have shooting accumulators and results written; null, the bound
+/// before the probes, counts every side.
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights = 1,
-  std::uint64_t reachablePatchSides = AllPatchSides);
+  const std::vector<std::uint8_t>* reachable = nullptr);
+
+/**
+ * The bytes of a result array that writing the frames of the reachable sides makes
+ * resident: the array holds `frames` PackedRgb per (record, side), side-major, records
+ * `recordsPerPatch` to a patch (Solution::elementIndex, patchIndex); it is a fresh mapping
+ * aligned to 2 MiB (ZeroedAllocator) whose pages become resident whole once written. Null
+ * `reachable`: every side, the whole array.
+ */
+std::uint64_t writtenResultBytes(std::size_t patches, std::size_t recordsPerPatch,
+  std::size_t frames, const std::vector<std::uint8_t>* reachable);
 
 /// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
 std::uint64_t estimateSolveMemory(

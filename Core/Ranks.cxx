@@ -172,10 +172,18 @@ void sumStoredAcrossRanks(
     options.sumDoublesAcrossRanks(buffer.data(), 3 * n);
     for (std::size_t i = 0; i < n; ++i)
     {
+      // Only what changed is written: the runs no rank wrote (the sides light cannot reach)
+      // stay pages never written, which take no memory (MemoryPlan).
       PackedRgb& c = values[first + i];
-      c.r = static_cast<std::uint16_t>(buffer[3 * i]);
-      c.g = static_cast<std::uint16_t>(buffer[3 * i + 1]);
-      c.b = static_cast<std::uint16_t>(buffer[3 * i + 2]);
+      const auto r = static_cast<std::uint16_t>(buffer[3 * i]);
+      const auto g = static_cast<std::uint16_t>(buffer[3 * i + 1]);
+      const auto b = static_cast<std::uint16_t>(buffer[3 * i + 2]);
+      if (c.r != r || c.g != g || c.b != b)
+      {
+        c.r = r;
+        c.g = g;
+        c.b = b;
+      }
     }
   }
   secondsReducing += secondsSince(start);

@@ -62,7 +62,11 @@ struct SolverStatistics
   /// between phases (waiting for slower ranks included); 0 on one rank.
   double secondsReducing = 0;
   double secondsTotal = 0;
+  /// The memory plan the solve ran under (MemoryPlan): its peak, the results written and
+  /// the shooting accumulators of one source, all copies.
   std::uint64_t memoryEstimateBytes = 0;
+  std::uint64_t memoryResultBytes = 0;
+  std::uint64_t memoryAccumulatorBytes = 0;
   /// The shooting accumulators had one copy per worker (else one shared copy, MemoryPlan).
   bool accumulatorCopyPerWorker = true;
   int threads = 0;

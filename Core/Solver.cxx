@@ -66,6 +66,8 @@ void finish(const Scene& scene, const SolverOptions& options, std::size_t frames
         options.firstBounceSurvival
                                              : 0.0;
   stats.memoryEstimateBytes = plan.peak;
+  stats.memoryResultBytes = plan.results;
+  stats.memoryAccumulatorBytes = plan.accumulators;
   stats.accumulatorCopyPerWorker = plan.accumulatorCopyPerWorker;
   stats.firstHits = firstHits - backAbsorbed;
   stats.threads = workers;
@@ -250,7 +252,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   stats.reachableSides =
     static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
   plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames,
-    options, sources.size(), stats.reachableSides);
+    options, sources.size(), reachable.empty() ? nullptr : &reachable);
 
   // One pass: shooting every source, then gathering, into `into`. A batched solve runs one per
   // batch, sharing the scene, the tracer and the reachable sides (which do not depend on the

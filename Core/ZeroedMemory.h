@@ -18,6 +18,10 @@
 namespace mlr
 {
 
+/// The transparent huge page: mapZeroed asks for them, and a written byte makes its whole
+/// 2 MiB resident where the kernel grants one (MemoryPlan counts written pages at this size).
+constexpr std::size_t HugePageBytes = std::size_t(2) << 20;
+
 /**
  * `bytes` of zeroed memory aligned to `alignment` (a power of two), a mapping of its own:
  * its pages are resident only once written, and it goes back to the system when freed.
@@ -112,7 +116,9 @@ struct ZeroedAllocator
     const std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
     if (bytes >= MappedBytes)
     {
-      return static_cast<T*>(mapZeroed(bytes, 1));
+      // Aligned to huge pages, so that the pages a write makes resident are those MemoryPlan
+      // counts (writtenResultBytes).
+      return static_cast<T*>(mapZeroed(bytes, bytes >= HugePageBytes ? HugePageBytes : 1));
     }
     void* p = std::calloc(1, bytes);
     if (!p)

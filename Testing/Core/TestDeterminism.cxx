@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 using namespace mlr;
 
 namespace
@@ -19,14 +21,18 @@ Scene box()
   return Scene::fromPatchMesh(scenes::closedBox(4, true, { Rgb(0.6, 0.5, 0.4) }));
 }
 
+MovingLight boxLight()
+{
+  return MovingLight(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1, 2, 3),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, Frames));
+}
+
 /// `memoryLimit` 0 is the default limit, under which this small solve takes one accumulator
 /// copy per worker.
 Solution solveWith(int threads, std::uint64_t seed, bool reuseShooting, bool reuseGathering,
   std::uint64_t memoryLimit = 0)
 {
   const Scene scene = box();
-  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1, 2, 3),
-    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.3, 0.3, 0.9 }, { 0.7, 0.7, 0.9 }, Frames));
   SolverOptions o;
   o.pathsPerFrame = 30000;
   o.threads = threads;
@@ -34,7 +40,7 @@ Solution solveWith(int threads, std::uint64_t seed, bool reuseShooting, bool reu
   o.reuseShooting = reuseShooting;
   o.reuseGathering = reuseGathering;
   o.memoryLimitBytes = memoryLimit;
-  return solve(scene, light, o);
+  return solve(scene, boxLight(), o);
 }
 }
 
@@ -67,17 +73,22 @@ TEST_P(Determinism, SharedAccumulatorsGiveTheSameBits)
   const Scene scene = box();
   Solution one = solveWith(1, 42, shooting, gathering);
   // The plan counts accumulators for the sides light can reach (the inside of the box).
-  const std::uint64_t reachable = one.statistics.reachableSides;
-  EXPECT_EQ(reachable, scene.patchCount());
   SolverOptions o;
+  LightRig rig;
+  rig.areaLights.push_back(boxLight());
+  const std::vector<std::uint8_t> reachableFlags = checks::reachableOf(scene, rig, o);
+  const auto reachable =
+    static_cast<std::size_t>(std::count(reachableFlags.begin(), reachableFlags.end(), 1));
+  EXPECT_EQ(one.statistics.reachableSides, reachable);
+  EXPECT_EQ(reachable, scene.patchCount());
   o.threads = 3;
   o.memoryLimitBytes = std::uint64_t(1) << 40;
   o.reuseShooting = shooting; // reuse gives the sums' pages back as they are read
   o.reuseGathering = gathering;
   const auto plan = [&]
   {
-    return planSolveMemory(
-      scene.patchCount(), scene.elementCount(), scene.points().size(), Frames, o, 1, reachable);
+    return planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), Frames,
+      o, 1, &reachableFlags);
   };
   const MemoryPlan roomy = plan();
   ASSERT_TRUE(roomy.accumulatorCopyPerWorker);

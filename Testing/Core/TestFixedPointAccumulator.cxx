@@ -416,7 +416,7 @@ TEST(FixedPointAccumulator, ReadSumsGiveTheirPagesBackAndTheRestStay)
     }
   }
   std::int64_t* first = sums.collapse();
-  const std::size_t pageBytes = FixedPointPageBytes;
+  const std::size_t pageBytes = HugePageBytes;
   auto resident = [&](std::size_t page)
   {
     unsigned char flag = 0;

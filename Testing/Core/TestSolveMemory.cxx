@@ -8,6 +8,7 @@
 // (its BVH and buffers: about 80 bytes per element once built and 140 at the build's peak,
 // measured here, against the estimate's generous 256). The counting is why this is an
 // executable of its own.
+#include "CoreChecks.h"
 #include "FixedPointAccumulator.h"
 #include "GeneratedScenes.h"
 #include "MovingLight.h"
@@ -301,9 +302,14 @@ std::vector<Measured> measureTheModes()
     optionsFor(2, 0));
 
   // The plan counts accumulators for the sides light can reach, which a solve reports.
-  const std::uint64_t reachable =
-    solve(f.scene, f.light, optionsFor(1, 0)).statistics.reachableSides;
-  EXPECT_EQ(reachable, f.scene.patchCount()) << "the inside of the box";
+  LightRig rig;
+  rig.areaLights.push_back(f.light);
+  const std::vector<std::uint8_t> reachableFlags =
+    checks::reachableOf(f.scene, rig, optionsFor(1, 0));
+  const auto* reachable = &reachableFlags;
+  EXPECT_EQ(static_cast<std::size_t>(std::count(reachableFlags.begin(), reachableFlags.end(), 1)),
+    f.scene.patchCount())
+    << "the inside of the box";
   const int threads = 3;
   const MemoryPlan perWorker = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
     f.scene.points().size(), frames, optionsFor(threads, 0), 1, reachable);
@@ -384,7 +390,10 @@ TEST(SolveMemory, TheEstimateBoundsABatchedSolve)
   SolverOptions options = optionsFor(3, 0);
   options.pathsPerFrame = 4000;
   options.errorBatches = 4;
-  const std::uint64_t reachable = f.scene.patchCount(); // the inside of the box
+  LightRig rig;
+  rig.areaLights.push_back(f.light);
+  const std::vector<std::uint8_t> reachableFlags = checks::reachableOf(f.scene, rig, options);
+  const auto* reachable = &reachableFlags;
   const MemoryPlan plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
     f.scene.points().size(), frames, options, 1, reachable);
   EXPECT_GT(plan.errorEstimate, 0u);

@@ -4,7 +4,11 @@
 
 #include "Error.h"
 #include "FormFactor.h"
+#include "LightSource.h"
+#include "Parallel.h"
 #include "PolygonTriangulation.h"
+#include "RayTracer.h"
+#include "Reachability.h"
 #include "Scene.h"
 #include "Solver.h"
 
@@ -24,6 +28,19 @@ template <typename Stored, typename Allocator>
 bool sameBits(const std::vector<Stored, Allocator>& a, const std::vector<Stored, Allocator>& b)
 {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Stored)) == 0;
+}
+
+/// The flags of the patch sides light can reach (patch * 2 + side) that a solve of `rig`
+/// finds, and its memory plan counts (planSolveMemory).
+inline std::vector<std::uint8_t> reachableOf(
+  const Scene& scene, const LightRig& rig, const SolverOptions& options)
+{
+  const std::vector<MovingLight> emitters = sceneEmitters(scene);
+  const RayTracer tracer(scene);
+  std::uint64_t rays = 0;
+  return reachableSides(
+    scene, tracer, lightSources(scene, rig, emitters), options, resolveThreadCount(options.threads),
+    [](double) { return true; }, rays);
 }
 
 /// Runs `action`, expects mlr::Error, and checks that its message contains `words`.
