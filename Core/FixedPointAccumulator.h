@@ -2,11 +2,17 @@
 //
 // Integer addition is associative, so the sums do not depend on which worker traced which
 // path, nor in which order: with per-path random streams the solve is bit-identical for any
-// thread count. Workers add either to a copy of their own (plain adds) or to one copy shared
-// by all (relaxed atomic adds: the memory does not grow with the core count; the locked adds
-// make shooting 1.5x to 1.8x slower where the sums stay in cache, and the smaller footprint
-// makes it faster where they do not). The solver picks per-worker copies when they fit in
-// half the memory limit (MemoryPlan, planSolveMemory in Solver.h).
+// thread count. While paths are scored, a slot's 64 bits are split: each worker adds to 32
+// low bits of its own (plain adds), and carries into 32 high bits that all workers share
+// (relaxed atomic adds, rare: the solver's quantum makes a typical add about 2^20 quanta,
+// FixedPointTypicalAddBits, so a low word carries once in about 4,096 adds). Two workers
+// then take 12 bytes a slot instead of the 16 of two 64-bit copies, a worker's scoring
+// writes half the bytes, and the high words take memory only where a slot carried. Where even that
+// is too much, the workers share the low words too (atomic adds: the memory does not grow with the
+// core count; the locked adds make shooting 1.5x to 1.8x slower where the sums stay in cache, and
+// the smaller footprint makes it faster where they do not). The solver picks per-worker low words
+// when they fit in half the memory limit (MemoryPlan, planSolveMemory). Once shooting ends,
+// collapse() adds the words into one 64-bit sum per slot.
 //
 // Only the (record, side) pairs light can reach need slots (Reachability.h): the outsides of
 // a closed room and the insides of closed blocks are about half of all sides, so the
@@ -48,6 +54,11 @@ enum class FrameLayout
   FramesOuter,
 };
 
+/// The solver's quantum makes a typical add (one path's light in one frame) 2^20 to 2^21
+/// quanta (quantumFor in Shooting.cxx): rounded to within 2^-21 of itself, far below what
+/// the results keep (PackedRgb, 2^-10), and 4,096 such adds before a low word carries.
+constexpr int FixedPointTypicalAddBits = 20;
+
 /// The bytes a buffer of `bytes` takes once rounded up to whole pages (saturating):
 /// FixedPointAccumulator's buffers are aligned to and allocated in whole huge pages
 /// (allocateZeroed), and the last one is resident whole.
@@ -57,20 +68,31 @@ inline std::uint64_t fixedPointBufferBytes(std::uint64_t bytes)
   return pages > UINT64_MAX / HugePageBytes ? UINT64_MAX : pages * HugePageBytes;
 }
 
-/// Where add() writes the frames of one (record, side): slots `frameStride` apart, with
-/// atomic adds when the run is in a copy several workers share.
+/// Where add() writes the frames of one (record, side): the low words of the worker (or of
+/// all, shared) and the high words they carry into, slots `frameStride` apart.
 struct SlotRun
 {
-  std::int64_t* base = nullptr;
+  std::uint32_t* low = nullptr;
+  std::uint32_t* high = nullptr;
   std::size_t frameStride = 0;
-  bool atomic = false;
+  bool atomicLow = false;  ///< the low words are shared by several workers
+  bool atomicHigh = false; ///< the high words are shared by several workers
+};
+
+/// After collapse(): the 64-bit sums of one (record, side), frame f's channels at
+/// base + f * frameStride; a null base for a side nothing scored.
+struct SummedRun
+{
+  const std::int64_t* base = nullptr;
+  std::size_t frameStride = 0;
 };
 
 /**
- * `Channels` (1 or 3) fixed-point sums for every (record, side, frame), in one copy per
- * worker or one shared copy. The caller picks the quantum: values are rounded to multiples
- * of it, and a slot holds up to 2^63 quanta. `stored` (record * 2 + side flags, or null for
- * all) names the sides that get slots; the others overflow into per-worker entries.
+ * `Channels` (1 or 3) fixed-point sums for every (record, side, frame): low words per worker
+ * (or one shared set) and shared high words while scoring, one 64-bit sum each once
+ * collapsed. The caller picks the quantum: values are rounded to multiples of it, and a slot
+ * holds up to 2^63 quanta. `stored` (record * 2 + side flags, or null for all) names the
+ * sides that get slots; the others overflow into per-worker entries.
  */
 template <int Channels>
 class FixedPointAccumulator
@@ -95,10 +117,12 @@ public:
     , SideStride(layout == FrameLayout::FramesInner ? frames * Channels : Channels)
     , FrameStride(layout == FrameLayout::FramesInner ? Channels : StoredSides * Channels)
     , Quantum(quantum)
+    , Copies(copyPerWorker ? std::max(workers, 1) : 1)
     , CopyStride(copyPerWorker ? Stride : 0)
-    , Shared(!copyPerWorker && workers > 1)
-    , Size(static_cast<std::size_t>(copyPerWorker ? workers : 1) * Stride)
-    , Values(allocateZeroed(Size))
+    , SharedLow(!copyPerWorker && workers > 1)
+    , SharedHigh(workers > 1)
+    , Low(allocateWords<std::uint32_t>(static_cast<std::size_t>(Copies) * Stride))
+    , High(allocateWords<std::uint32_t>(Stride))
     , Overflow(stored ? static_cast<std::size_t>(workers) : 0)
   {
     for (int c = 0; c < Channels; ++c)
@@ -120,55 +144,74 @@ public:
   }
 
   /// The slots of (record, side) that `worker` adds to; add() steps to the frames. A side
-  /// without slots gets (once) an overflow entry of the worker's own.
+  /// without slots gets (once) an overflow entry of the worker's own: its low words, then
+  /// its high words.
   SlotRun slots(int worker, std::size_t record, int side)
   {
     const std::size_t s = this->storedIndex(record, side);
     if (s != Unstored)
     {
-      return { this->Values.get() + static_cast<std::size_t>(worker) * this->CopyStride +
-          s * this->SideStride,
-        this->FrameStride, this->Shared };
+      const std::size_t offset = s * this->SideStride;
+      return { this->Low.get() + static_cast<std::size_t>(worker) * this->CopyStride + offset,
+        this->High.get() + offset, this->FrameStride, this->SharedLow, this->SharedHigh };
     }
-    std::vector<std::int64_t>& entry =
+    std::vector<std::uint32_t>& entry =
       this->Overflow[static_cast<std::size_t>(worker)][record * 2 + static_cast<std::size_t>(side)];
     if (entry.empty())
     {
-      entry.assign(this->Frames * Channels, 0);
+      entry.assign(2 * this->Frames * Channels, 0);
     }
-    return { entry.data(), Channels, false };
+    return { entry.data(), entry.data() + this->Frames * Channels, Channels, false, false };
   }
 
   /// Adds non-negative values to one frame's slot (`values` has Channels entries).
   void add(const SlotRun& run, std::size_t frame, const double* values) const
   {
-    std::int64_t* s = run.base + frame * run.frameStride;
+    std::uint32_t* low = run.low + frame * run.frameStride;
+    std::uint32_t* high = run.high + frame * run.frameStride;
     for (int c = 0; c < Channels; ++c)
     {
       // Values are >= 0, so truncating x + 0.5 rounds to nearest.
-      const auto quanta = static_cast<std::int64_t>(values[c] * this->InverseQuantum[c] + 0.5);
-      if (!run.atomic)
+      const auto quanta = static_cast<std::uint64_t>(values[c] * this->InverseQuantum[c] + 0.5);
+      const auto part = static_cast<std::uint32_t>(quanta);
+      auto carry = static_cast<std::uint32_t>(quanta >> 32);
+      if (!run.atomicLow)
       {
-        s[c] += quanta;
+        const std::uint32_t sum = low[c] + part;
+        carry += sum < part;
+        low[c] = sum;
       }
-      else if (quanta != 0) // frames a path does not light cost no locked write
+      else if (part != 0) // frames a path does not light cost no locked write
       {
-        __atomic_fetch_add(&s[c], quanta, __ATOMIC_RELAXED);
+        carry += __atomic_add_fetch(&low[c], part, __ATOMIC_RELAXED) < part;
+      }
+      if (carry == 0)
+      {
+        continue;
+      }
+      if (run.atomicHigh)
+      {
+        __atomic_fetch_add(&high[c], carry, __ATOMIC_RELAXED);
+      }
+      else
+      {
+        high[c] += carry;
       }
     }
   }
 
-  /// Asks the cache for the slots add() will touch for frames [first, first + count), so
-  /// that the miss overlaps work done before the add. Always inlined: GCC's IPA finds a
-  /// function that only prefetches free of side effects and deletes calls to it.
+  /// Asks the cache for the low words add() will touch for frames [first, first + count), so
+  /// that the miss overlaps work done before the add (the high words are rarely written).
+  /// Always inlined: GCC's IPA finds a function that only prefetches free of side effects
+  /// and deletes calls to it.
   [[gnu::always_inline]] void prefetch(
     const SlotRun& run, std::size_t first, std::size_t count) const
   {
-    const std::int64_t* begin = run.base + first * run.frameStride;
+    const std::uint32_t* begin = run.low + first * run.frameStride;
     if (run.frameStride == Channels)
     {
-      const std::int64_t* end = begin + count * Channels;
-      for (const std::int64_t* p = begin; p < end; p += 8)
+      const std::uint32_t* end = begin + count * Channels;
+      for (const std::uint32_t* p = begin; p < end; p += 16)
       {
         __builtin_prefetch(p);
       }
@@ -181,31 +224,31 @@ public:
     }
   }
 
-  /// The sums of (record, side, frame) over workers, written to `out` (Channels entries).
+  /// The sums of (record, side, frame) over workers, written to `out` (Channels entries),
+  /// before or after collapse().
   void total(std::size_t record, int side, std::size_t frame, double* out) const
   {
-    std::int64_t sum[Channels] = {};
+    std::uint64_t sum[Channels] = {};
     const std::size_t s = this->storedIndex(record, side);
+    const std::size_t key = record * 2 + static_cast<std::size_t>(side);
     if (s != Unstored)
     {
-      const std::int64_t* v = this->Values.get() + s * this->SideStride + frame * this->FrameStride;
-      for (std::size_t w = 0; w * this->Stride < this->Size; ++w, v += this->Stride)
+      const std::size_t i = s * this->SideStride + frame * this->FrameStride;
+      for (int c = 0; c < Channels; ++c)
       {
-        for (int c = 0; c < Channels; ++c)
-        {
-          sum[c] += v[c];
-        }
+        sum[c] = this->Summed ? static_cast<std::uint64_t>(this->Summed.get()[i + c])
+                              : this->wordsAt(i + c);
       }
     }
     else
     {
-      const std::size_t key = record * 2 + static_cast<std::size_t>(side);
       const auto merged = this->Merged.find(key);
       if (merged != this->Merged.end())
       {
         for (int c = 0; c < Channels; ++c)
         {
-          sum[c] += this->MergedValues[merged->second + frame * Channels + c];
+          sum[c] +=
+            static_cast<std::uint64_t>(this->MergedValues[merged->second + frame * Channels + c]);
         }
       }
       for (const auto& worker : this->Overflow)
@@ -215,14 +258,15 @@ public:
         {
           for (int c = 0; c < Channels; ++c)
           {
-            sum[c] += entry->second[frame * Channels + c];
+            sum[c] += entry->second[frame * Channels + c] +
+              (std::uint64_t(entry->second[(this->Frames + frame) * Channels + c]) << 32);
           }
         }
       }
     }
     for (int c = 0; c < Channels; ++c)
     {
-      out[c] = static_cast<double>(sum[c]) * this->Quantum[c];
+      out[c] = static_cast<double>(static_cast<std::int64_t>(sum[c])) * this->Quantum[c];
     }
   }
 
@@ -239,9 +283,9 @@ public:
     }
   }
 
-  /// Moves the workers' overflow entries into one block with an entry for every side whose
-  /// flag is set (in side order, so that every process has the same block): returns it, of
-  /// `count` values, to be summed over processes as a whole.
+  /// Moves the workers' overflow entries into one block of 64-bit sums with an entry for
+  /// every side whose flag is set (in side order, so that every process has the same
+  /// block): returns it, of `count` values, to be summed over processes as a whole.
   std::int64_t* mergeOverflow(const std::vector<std::int64_t>& flags, std::size_t& count)
   {
     std::size_t entries = 0;
@@ -254,14 +298,16 @@ public:
       }
     }
     this->MergedValues.assign(entries * this->Frames * Channels, 0);
+    const std::size_t n = this->Frames * Channels;
     for (auto& worker : this->Overflow)
     {
       for (const auto& entry : worker)
       {
         std::int64_t* into = this->MergedValues.data() + this->Merged.at(entry.first);
-        for (std::size_t i = 0; i < entry.second.size(); ++i)
+        for (std::size_t i = 0; i < n; ++i)
         {
-          into[i] += entry.second[i];
+          into[i] +=
+            static_cast<std::int64_t>(entry.second[i] + (std::uint64_t(entry.second[n + i]) << 32));
         }
       }
       worker.clear();
@@ -270,26 +316,25 @@ public:
     return this->MergedValues.data();
   }
 
-  /// After collapse() and mergeOverflow(): the sums of (record, side), frame f's channels at
-  /// run.base + f * run.frameStride, or a null base for a side nothing scored.
-  SlotRun summed(std::size_t record, int side) const
+  /// After collapse() and mergeOverflow(): the sums of (record, side), or a null base for a
+  /// side nothing scored.
+  SummedRun summed(std::size_t record, int side) const
   {
     const std::size_t s = this->storedIndex(record, side);
     if (s != Unstored)
     {
-      return { this->Values.get() + s * this->SideStride, this->FrameStride, false };
+      return { this->Summed.get() + s * this->SideStride, this->FrameStride };
     }
     const auto merged = this->Merged.find(record * 2 + static_cast<std::size_t>(side));
     if (merged == this->Merged.end())
     {
       return {};
     }
-    return { const_cast<std::int64_t*>(this->MergedValues.data()) + merged->second, Channels,
-      false };
+    return { this->MergedValues.data() + merged->second, Channels };
   }
 
   /// One frame's channels of a summed() run, in the values' units.
-  void read(const SlotRun& run, std::size_t frame, double* out) const
+  void read(const SummedRun& run, std::size_t frame, double* out) const
   {
     for (int c = 0; c < Channels; ++c)
     {
@@ -311,33 +356,49 @@ public:
     return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), 1));
   }
 
-  /// Adds every worker's copy into the first and zeroes the others: the sums are unchanged,
-  /// and the first copy (copySize() values) can then be summed over processes as a whole.
-  /// The others' pages go back to the system, so the results the sums become can take their
-  /// memory (MemoryPlan).
+  /**
+   * Adds every worker's low words and the high words into one 64-bit sum per slot (the sums
+   * are unchanged): returns them, copySize() values, to be summed over processes as a whole.
+   * The words' pages go back to the system as they are added, so that the sums take their
+   * memory: the peak stays that of the words (MemoryPlan). Later calls return the same sums.
+   */
   std::int64_t* collapse()
   {
-    std::int64_t* first = this->Values.get();
-    for (std::size_t w = 1; w * this->Stride < this->Size; ++w)
+    if (this->Summed)
     {
-      const std::int64_t* copy = first + w * this->Stride;
-      for (std::size_t i = 0; i < this->Stride; ++i)
+      return this->Summed.get();
+    }
+    this->Summed = allocateWords<std::int64_t>(this->Stride);
+    // A huge page of words at a time.
+    constexpr std::size_t Block = HugePageBytes / sizeof(std::uint32_t);
+    for (std::size_t begin = 0; begin < this->Stride; begin += Block)
+    {
+      const std::size_t end = std::min(this->Stride, begin + Block);
+      for (std::size_t i = begin; i < end; ++i)
       {
-        first[i] += copy[i];
+        // Zeros are not written: the pages of sides nothing scored stay without memory.
+        if (const std::uint64_t sum = this->wordsAt(i))
+        {
+          this->Summed.get()[i] = static_cast<std::int64_t>(sum);
+        }
       }
+      for (int copy = 0; copy < this->Copies; ++copy)
+      {
+        release(
+          this->Low.get() + static_cast<std::size_t>(copy) * this->Stride + begin, end - begin);
+      }
+      release(this->High.get() + begin, end - begin);
     }
-    if (this->Size > this->Stride)
-    {
-      zeroAndRelease(first + this->Stride, this->Size - this->Stride);
-    }
-    return first;
+    this->Low.reset();
+    this->High.reset();
+    return this->Summed.get();
   }
   std::size_t copySize() const { return this->Stride; }
 
   /**
    * After collapse() and mergeOverflow(), once the sums of the records before `record` were
-   * read for the last time: gives back the whole 2 MiB pages of the first copy that hold
-   * theirs alone, where each side's frames are contiguous (FramesInner, or one frame; else
+   * read for the last time: gives back the whole 2 MiB pages of the sums that hold theirs
+   * alone, where each side's frames are contiguous (FramesInner, or one frame; else
    * nothing), so that the results they become can take that memory (MemoryPlan). Records
    * are released in order; those pages read as zero afterwards.
    */
@@ -361,15 +422,15 @@ public:
     if (end > this->ReleasedBytes)
     {
 #ifdef __linux__
-      madvise(reinterpret_cast<char*>(this->Values.get()) + this->ReleasedBytes,
+      madvise(reinterpret_cast<char*>(this->Summed.get()) + this->ReleasedBytes,
         end - this->ReleasedBytes, MADV_DONTNEED);
 #endif
       this->ReleasedBytes = end;
     }
   }
 
-  /// Bytes of `copies` copies (the worker count, or 1 when shared) with slots for both
-  /// sides of `records` records.
+  /// Bytes of the words of `copies` low-word copies (the worker count, or 1 when shared) and
+  /// the shared high words, with slots for both sides of `records` records.
   static std::uint64_t bytes(int copies, std::size_t records, std::size_t frames)
   {
     return storedBytes(copies, saturatingProduct({ records, 2 }), frames);
@@ -379,26 +440,64 @@ public:
   static std::uint64_t storedBytes(int copies, std::uint64_t sides, std::size_t frames)
   {
     return saturatingProduct(
-      { static_cast<std::uint64_t>(copies), sides, frames, Channels, sizeof(std::int64_t) });
+      { static_cast<std::uint64_t>(copies) + 1, sides, frames, Channels, sizeof(std::uint32_t) });
   }
 
-  /// What those copies allocate: bytes() rounded up to whole pages.
+  /// What those words allocate: each buffer rounded up to whole pages.
   static std::uint64_t allocatedBytes(int copies, std::size_t records, std::size_t frames)
   {
-    return fixedPointBufferBytes(bytes(copies, records, frames));
+    return allocatedWords(copies, saturatingProduct({ records, 2 }), frames);
   }
 
-  /// storedBytes() rounded up to whole pages, and the index of the stored sides (4 bytes per
-  /// record side).
+  /// The same for `sides` stored sides, with their index (4 bytes per record side), and
+  /// without the high words where `highWords` is false: they take memory only where a low
+  /// word carried.
   static std::uint64_t allocatedStoredBytes(
-    int copies, std::size_t records, std::uint64_t sides, std::size_t frames)
+    int copies, std::size_t records, std::uint64_t sides, std::size_t frames, bool highWords = true)
   {
-    return saturatingSum(fixedPointBufferBytes(storedBytes(copies, sides, frames)),
-      saturatingProduct({ records, 2, sizeof(std::uint32_t) }));
+    const std::uint64_t words = highWords
+      ? allocatedWords(copies, sides, frames)
+      : fixedPointBufferBytes(saturatingProduct(
+          { static_cast<std::uint64_t>(copies), sides, frames, Channels, sizeof(std::uint32_t) }));
+    return saturatingSum(words, saturatingProduct({ records, 2, sizeof(std::uint32_t) }));
+  }
+
+  /**
+   * Whether the high words of `sides` stored sides are likely to be written, with N `paths`
+   * per frame scored by `workers` low-word copies (1 when shared): a slot's low word carries
+   * after about 2^(32 - FixedPointTypicalAddBits) typical adds, and a slot takes N / sides of
+   * them on average per frame (every frame's weights sum to about one per path). Below 1/16
+   * of that on average, even slots 16 times as lit as the mean (under a light) rarely carry.
+   */
+  static bool highWordsWritten(std::uint64_t paths, int workers, std::uint64_t sides)
+  {
+    constexpr std::uint64_t AddsBeforeACarry = std::uint64_t(1) << (32 - FixedPointTypicalAddBits);
+    return paths >=
+      saturatingProduct({ AddsBeforeACarry / 16, static_cast<std::uint64_t>(std::max(workers, 1)),
+        std::max<std::uint64_t>(sides, 1) });
   }
 
 private:
   static constexpr std::uint32_t Unstored = 0xffffffffu;
+
+  static std::uint64_t allocatedWords(int copies, std::uint64_t sides, std::size_t frames)
+  {
+    const std::uint64_t one = saturatingProduct({ sides, frames, Channels, sizeof(std::uint32_t) });
+    return saturatingSum(
+      fixedPointBufferBytes(saturatingProduct({ static_cast<std::uint64_t>(copies), one })),
+      fixedPointBufferBytes(one));
+  }
+
+  /// The sum of every copy's low word and the high word of slot i.
+  std::uint64_t wordsAt(std::size_t i) const
+  {
+    std::uint64_t sum = std::uint64_t(this->High.get()[i]) << 32;
+    for (int copy = 0; copy < this->Copies; ++copy)
+    {
+      sum += this->Low.get()[static_cast<std::size_t>(copy) * this->Stride + i];
+    }
+    return sum;
+  }
 
   std::size_t storedIndex(std::size_t record, int side) const
   {
@@ -419,42 +518,44 @@ private:
     return a;
   }
 
-  /// Zeroes `count` values: the whole pages among them are given back (they read as zero
-  /// again, and take memory only when written), the rest are written.
-  static void zeroAndRelease(std::int64_t* values, std::size_t count)
+  /// Gives the whole pages among `count` words back to the system: they are read no more.
+  template <typename Word>
+  static void release(Word* words, std::size_t count)
   {
-    char* begin = reinterpret_cast<char*>(values);
-    char* end = begin + count * sizeof(std::int64_t);
 #ifdef __linux__
     constexpr std::uintptr_t Page = 4096;
-    char* pagesBegin =
-      reinterpret_cast<char*>((reinterpret_cast<std::uintptr_t>(begin) + Page - 1) / Page * Page);
-    char* pagesEnd = reinterpret_cast<char*>(reinterpret_cast<std::uintptr_t>(end) / Page * Page);
-    if (pagesBegin < pagesEnd && madvise(pagesBegin, pagesEnd - pagesBegin, MADV_DONTNEED) == 0)
+    const auto begin = reinterpret_cast<std::uintptr_t>(words);
+    const auto end = reinterpret_cast<std::uintptr_t>(words + count);
+    const std::uintptr_t pagesBegin = (begin + Page - 1) / Page * Page;
+    const std::uintptr_t pagesEnd = end / Page * Page;
+    if (pagesBegin < pagesEnd)
     {
-      std::memset(begin, 0, pagesBegin - begin);
-      std::memset(pagesEnd, 0, end - pagesEnd);
-      return;
+      madvise(reinterpret_cast<void*>(pagesBegin), pagesEnd - pagesBegin, MADV_DONTNEED);
     }
+#else
+    (void)words;
+    (void)count;
 #endif
-    std::memset(begin, 0, end - begin);
   }
 
   struct Free
   {
     std::size_t bytes = 0;
-    void operator()(std::int64_t* p) const { unmapZeroed(p, this->bytes); }
+    void operator()(void* p) const { unmapZeroed(p, this->bytes); }
   };
+  template <typename Word>
+  using Words = std::unique_ptr<Word[], Free>;
 
   /// Scores land on random records all over the buffer (megabytes per worker): with 4 KiB
   /// pages nearly every score misses the TLB. 2 MiB pages, where the kernel grants them, cut
-  /// those misses by 512. The buffer is a mapping of its own (mapZeroed).
-  static std::unique_ptr<std::int64_t[], Free> allocateZeroed(std::size_t count)
+  /// those misses by 512. The buffer is a mapping of its own (mapZeroed), untouched (and
+  /// taking no memory) until written.
+  template <typename Word>
+  static Words<Word> allocateWords(std::size_t count)
   {
-    const std::size_t bytes = std::max<std::size_t>(count * sizeof(std::int64_t), 1);
+    const std::size_t bytes = std::max<std::size_t>(count * sizeof(Word), 1);
     const std::size_t rounded = static_cast<std::size_t>(fixedPointBufferBytes(bytes));
-    return std::unique_ptr<std::int64_t[], Free>(
-      static_cast<std::int64_t*>(mapZeroed(rounded, HugePageBytes)), Free{ rounded });
+    return Words<Word>(static_cast<Word*>(mapZeroed(rounded, HugePageBytes)), Free{ rounded });
   }
 
   std::size_t Records;
@@ -465,18 +566,21 @@ private:
   std::size_t FrameStride;
   std::array<double, Channels> Quantum;
   std::array<double, Channels> InverseQuantum;
-  std::size_t CopyStride; ///< 0 when the copy is shared
-  bool Shared;            ///< one copy for several workers: atomic adds
-  std::size_t Size;
-  std::unique_ptr<std::int64_t[], Free> Values;
+  int Copies;             ///< copies of the low words: the workers, or 1 when shared
+  std::size_t CopyStride; ///< 0 when the low words are shared
+  bool SharedLow;         ///< one set of low words for several workers: atomic adds
+  bool SharedHigh;        ///< several workers: atomic carries
+  Words<std::uint32_t> Low, High;
+  /// The 64-bit sums, once collapsed (and the words gone).
+  Words<std::int64_t> Summed;
   /// releaseBefore's progress: the next (record, side) key, the stored sides before it and
   /// the bytes given back.
   std::size_t ReleaseKey = 0, ReleasedSides = 0, ReleasedBytes = 0;
   /// The stored index of each record * 2 + side, Unstored for none; empty when all are.
   std::vector<std::uint32_t> Slot;
-  /// Per worker, the frames of the sides without slots that it scored (node-based, so that
-  /// the runs slots() hands out stay valid as entries are added).
-  std::vector<std::unordered_map<std::size_t, std::vector<std::int64_t>>> Overflow;
+  /// Per worker, the low and high words of the sides without slots that it scored
+  /// (node-based, so that the runs slots() hands out stay valid as entries are added).
+  std::vector<std::unordered_map<std::size_t, std::vector<std::uint32_t>>> Overflow;
   /// After mergeOverflow(): each overflowed side's offset in MergedValues.
   std::map<std::size_t, std::size_t> Merged;
   std::vector<std::int64_t> MergedValues;

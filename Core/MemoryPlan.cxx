@@ -71,7 +71,9 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     std::uint64_t elements = 0, patches = 0;
     std::uint64_t all() const { return saturatingSum(elements, patches); }
   };
-  const auto accumulators = [&](std::uint64_t copies)
+  // `collapsed`: the one 64-bit sum per slot that the words become once shooting ends (the
+  // same bytes as one copy of the words with its high words).
+  const auto accumulators = [&](std::uint64_t copies, bool collapsed = false)
   {
     const int c = static_cast<int>(copies);
     if (!reachable)
@@ -84,10 +86,15 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     const std::uint64_t elementSides = elements == 0
       ? 0
       : saturatingProduct({ patchSides, elements / std::max<std::size_t>(patches, 1) });
-    return Accumulators{ saturatingSum(FixedPointAccumulator<1>::allocatedStoredBytes(
-                                         c, elements, elementSides, frames),
-                           saturatingProduct({ elements, 2 })), // the element sides' flags
-      FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames) };
+    const std::uint64_t paths = options.pathsPerFrame;
+    return Accumulators{
+      saturatingSum(
+        FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames,
+          collapsed || FixedPointAccumulator<1>::highWordsWritten(paths, c, elementSides)),
+        saturatingProduct({ elements, 2 })), // the element sides' flags
+      FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames,
+        collapsed || FixedPointAccumulator<3>::highWordsWritten(paths, c, patchSides))
+    };
   };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,
@@ -131,7 +138,7 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const auto peakWith = [&](std::uint64_t copies)
   {
     const std::uint64_t results = saturatingSum(direct, patch);
-    const Accumulators shooting = accumulators(copies), one = accumulators(1);
+    const Accumulators shooting = accumulators(copies), one = accumulators(1, true);
     std::uint64_t peak = saturatingSum(results, shooting.all());
     if (lights <= 1 && released)
     {

@@ -38,11 +38,17 @@ constexpr double BalanceLowest = 0.25;
 constexpr double BalanceHighest = 4.0;
 constexpr int BalanceIterations = 40;
 
-/// The rounding quantum of a fixed-point channel whose largest value per path is `scale`:
-/// one per channel, so that a channel 10^6 weaker than the others keeps its precision.
-double quantumFor(double scale)
+/// The rounding quantum of a fixed-point channel whose value per path is about `scale` / N
+/// for N `paths` per frame: a power of two that makes that value 2^20 to 2^21 quanta
+/// (FixedPointTypicalAddBits). Above 2^30 paths the quantum stays that of 2^30, so that a
+/// slot holds at least 2^13 times `scale` (a closed white box reflects its light about
+/// 1 / (1 - rho) times).
+double quantumFor(double scale, std::uint64_t paths)
 {
-  return scale > 0 && std::isfinite(scale) ? scale * 0x1.0p-40 : 1.0;
+  const int pathBits =
+    std::min(30, std::ilogb(static_cast<double>(std::max<std::uint64_t>(paths, 1))));
+  return scale > 0 && std::isfinite(scale) ? std::ldexp(scale, -FixedPointTypicalAddBits - pathBits)
+                                           : 1.0;
 }
 
 /// M_k for the k-th of `active` positions, adding up to N: equal counts for empty `shares`;
@@ -97,12 +103,14 @@ public:
     , Frames(source.positions())
     , Reuse(options.reuseShooting && source.positions() > 1)
     , StoredElementSides(reachable.empty() ? std::vector<std::uint8_t>() : expand(reachable))
-    , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions(), 0x1.0p-50,
+    , ElementShare(workers, copyPerWorker, scene.elementCount(), source.positions(),
+        quantumFor(1.0, options.pathsPerFrame),
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter,
         reachable.empty() ? nullptr : &StoredElementSides)
     , PatchPower(workers, copyPerWorker, scene.patchCount(), source.positions(),
-        { quantumFor(source.power().r), quantumFor(source.power().g),
-          quantumFor(source.power().b) },
+        { quantumFor(source.power().r, options.pathsPerFrame),
+          quantumFor(source.power().g, options.pathsPerFrame),
+          quantumFor(source.power().b, options.pathsPerFrame) },
         Reuse ? FrameLayout::FramesInner : FrameLayout::FramesOuter,
         reachable.empty() ? nullptr : &reachable)
     , Counters(static_cast<std::size_t>(workers))
@@ -277,7 +285,7 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
   Rgb pendingPower;
   auto scorePending = [&]
   {
-    if (pendingSlots.base)
+    if (pendingSlots.low)
     {
       for (std::size_t f = 0; f < frameCount; ++f)
       {
@@ -285,7 +293,7 @@ void ShootingRun::scoreAndWalk(RandomStream& random, const RayHit& firstHit, con
           pendingPower.b * shares[f] };
         this->PatchPower.add(pendingSlots, firstFrame + f, power);
       }
-      pendingSlots.base = nullptr;
+      pendingSlots.low = nullptr;
     }
   };
   RayHit hit = firstHit;
@@ -590,7 +598,7 @@ void ShootingRun::addTo(Solution& solution)
     const Rgb irradiance = this->SourceRef.power() / this->SceneRef.elementArea(e);
     for (int s = 0; s < 2; ++s)
     {
-      const SlotRun run = this->ElementShare.summed(e, s);
+      const SummedRun run = this->ElementShare.summed(e, s);
       if (!run.base)
       {
         continue;
@@ -615,7 +623,7 @@ void ShootingRun::addTo(Solution& solution)
     const double inverseArea = 1.0 / this->SceneRef.patchArea(p);
     for (int s = 0; s < 2; ++s)
     {
-      const SlotRun power = this->PatchPower.summed(p, s);
+      const SummedRun power = this->PatchPower.summed(p, s);
       if (!power.base)
       {
         continue; // zeros: adding them changes no bit
@@ -716,8 +724,8 @@ ShootingResult shoot(const Scene& scene, const LightSource& source, const Solver
   if (!positions.empty())
   {
     result.overflowSides = run.sumAcrossWorkersAndRanks(secondsReducing);
+    run.addTo(solution);
   }
-  run.addTo(solution);
   for (const WorkerCounters& c : run.counters())
   {
     result.counters += c;

@@ -47,13 +47,13 @@ std::vector<Score> someScores(std::size_t count)
 }
 
 /// The expected sums, in quanta: each value rounded to the nearest quantum, then added.
-std::vector<std::int64_t> expectedQuanta(const std::vector<Score>& scores)
+std::vector<std::int64_t> expectedQuanta(const std::vector<Score>& scores, double quantum = Quantum)
 {
   std::vector<std::int64_t> q(Records * 2 * Frames, 0);
   for (const Score& s : scores)
   {
     q[(s.record * 2 + static_cast<std::size_t>(s.side)) * Frames + s.frame] +=
-      std::llround(s.value / Quantum);
+      std::llround(s.value / quantum);
   }
   return q;
 }
@@ -125,39 +125,54 @@ TEST(FixedPointAccumulator, SumsDoNotDependOnOrderWorkersSharingOrLayout)
   }
 }
 
-TEST(FixedPointAccumulator, ConcurrentAddsToOneSharedCopyLoseNothing)
+TEST(FixedPointAccumulator, ConcurrentAddsAndCarriesLoseNothing)
 {
-  // Every thread adds the same scores to the one shared copy at once: a plain (non-atomic)
-  // read-modify-write would lose some of them.
+  // Every thread adds the same scores at once, to low words of its own or to one shared set,
+  // and carries into the high words they all share: a plain (non-atomic) read-modify-write
+  // of shared words would lose some of them. At 2^-30 a value is up to 3 x 2^30 quanta and
+  // a low word carries every other add or so; at 2^-33 every add has quanta above 32 bits.
   const std::vector<Score> scores = someScores(200000);
-  const std::vector<std::int64_t> quanta = expectedQuanta(scores);
   constexpr int threads = 4;
-  FixedPointAccumulator<1> sums(threads, false, Records, Frames, Quantum, FrameLayout::FramesInner);
-  std::vector<std::thread> pool;
-  for (int w = 0; w < threads; ++w)
+  for (const double quantum : { Quantum, 0x1.0p-30, 0x1.0p-33 })
   {
-    pool.emplace_back(
-      [&, w]
-      {
-        for (const Score& s : scores)
-        {
-          sums.add(sums.slots(w, s.record, s.side), s.frame, &s.value);
-        }
-      });
-  }
-  for (std::thread& t : pool)
-  {
-    t.join();
-  }
-  for (std::size_t r = 0; r < Records; ++r)
-  {
-    for (int side = 0; side < 2; ++side)
+    const std::vector<std::int64_t> quanta = expectedQuanta(scores, quantum);
+    for (const bool copyPerWorker : { false, true })
     {
-      for (std::size_t f = 0; f < Frames; ++f)
+      FixedPointAccumulator<1> sums(
+        threads, copyPerWorker, Records, Frames, quantum, FrameLayout::FramesInner);
+      std::vector<std::thread> pool;
+      for (int w = 0; w < threads; ++w)
       {
-        double t = 0;
-        sums.total(r, side, f, &t);
-        EXPECT_EQ(t, threads * static_cast<double>(quanta[(r * 2 + side) * Frames + f]) * Quantum);
+        pool.emplace_back(
+          [&, w]
+          {
+            for (const Score& s : scores)
+            {
+              sums.add(sums.slots(w, s.record, s.side), s.frame, &s.value);
+            }
+          });
+      }
+      for (std::thread& t : pool)
+      {
+        t.join();
+      }
+      for (bool collapsed : { false, true })
+      {
+        for (std::size_t r = 0; r < Records; ++r)
+        {
+          for (int side = 0; side < 2; ++side)
+          {
+            for (std::size_t f = 0; f < Frames; ++f)
+            {
+              double t = 0;
+              sums.total(r, side, f, &t);
+              ASSERT_EQ(
+                t, threads * static_cast<double>(quanta[(r * 2 + side) * Frames + f]) * quantum)
+                << quantum << " copy per worker " << copyPerWorker << " collapsed " << collapsed;
+            }
+          }
+        }
+        sums.collapse();
       }
     }
   }
@@ -330,11 +345,13 @@ TEST(FixedPointAccumulator, ExactNearTheCapacityOfASlot)
 
 TEST(FixedPointAccumulator, BytesCountEveryCopy)
 {
-  // copies x records x 2 sides x frames x channels x 8 bytes.
+  // (copies of the low words + the high words) x records x 2 sides x frames x channels x 4
+  // bytes: two copies take 12 bytes a slot, one takes 8.
   EXPECT_EQ(FixedPointAccumulator<1>::bytes(1, 10, 7), 10u * 2 * 7 * 8);
-  EXPECT_EQ(FixedPointAccumulator<3>::bytes(4, 10, 7), 4u * 10 * 2 * 7 * 3 * 8);
+  EXPECT_EQ(FixedPointAccumulator<1>::bytes(2, 10, 7), 10u * 2 * 7 * 12);
+  EXPECT_EQ(FixedPointAccumulator<3>::bytes(4, 10, 7), 5u * 10 * 2 * 7 * 3 * 4);
   // Large counts do not wrap in 32 bits.
-  EXPECT_EQ(FixedPointAccumulator<3>::bytes(8, 1000000, 1000), 8ull * 1000000 * 2 * 1000 * 3 * 8);
+  EXPECT_EQ(FixedPointAccumulator<3>::bytes(8, 1000000, 1000), 9ull * 1000000 * 2 * 1000 * 3 * 4);
 }
 
 TEST(FixedPointAccumulator, SidesWithoutSlotsOverflowAndLoseNothing)
