@@ -14,6 +14,77 @@
 namespace mlr
 {
 
+namespace
+{
+/// The huge pages that written runs make resident in a fresh mapping aligned to them, the
+/// runs added in increasing order of offset: each page is counted once.
+class WrittenPages
+{
+public:
+  void add(std::uint64_t begin, std::uint64_t bytes)
+  {
+    if (bytes == 0)
+    {
+      return;
+    }
+    const std::uint64_t first = std::max(begin / HugePageBytes, this->Next);
+    const std::uint64_t last = (begin + bytes - 1) / HugePageBytes;
+    if (last >= first)
+    {
+      this->Pages += last - first + 1;
+      this->Next = last + 1;
+    }
+  }
+  std::uint64_t bytes() const { return saturatingProduct({ this->Pages, HugePageBytes }); }
+
+private:
+  std::uint64_t Pages = 0, Next = 0;
+};
+
+/**
+ * The bytes of `copies` copies (one after the other in one mapping) of the elements' shooting
+ * sums, words of `wordBytes`, that direct light writes: the runs of `frames` words of the
+ * element sides of the `firstHits` patch sides, among the stored (`reachable`) ones in their
+ * order (FixedPointAccumulator, FramesInner).
+ */
+std::uint64_t writtenShareBytes(std::size_t patches, std::size_t frames,
+  const std::vector<std::uint8_t>& reachable, const std::vector<std::uint8_t>& firstHits,
+  std::uint64_t copies, std::uint64_t wordBytes)
+{
+  const std::uint64_t run = saturatingProduct({ frames, wordBytes });
+  const std::uint64_t stored = saturatingProduct(
+    { static_cast<std::uint64_t>(
+        std::count_if(reachable.begin(), reachable.end(), [](std::uint8_t r) { return r != 0; })),
+      Scene::ElementsPerPatch });
+  const std::uint64_t whole = fixedPointBufferBytes(saturatingProduct({ copies, stored, run }));
+  if (whole == UINT64_MAX)
+  {
+    return whole;
+  }
+  WrittenPages pages;
+  for (std::uint64_t copy = 0; copy < copies; ++copy)
+  {
+    std::uint64_t index = copy * stored;
+    for (std::size_t e = 0; e < patches * Scene::ElementsPerPatch; ++e)
+    {
+      for (std::size_t s = 0; s < 2; ++s)
+      {
+        const std::size_t key = Scene::patchOfElement(e) * 2 + s;
+        if (reachable[key])
+        {
+          if (firstHits[key])
+          {
+            pages.add(index * run, run);
+          }
+          ++index;
+        }
+      }
+    }
+  }
+  return std::min(whole, pages.bytes());
+}
+}
+
 std::uint64_t writtenResultBytes(std::size_t patches, std::size_t recordsPerPatch,
   std::size_t frames, const std::vector<std::uint8_t>* reachable)
 {
@@ -24,43 +95,40 @@ std::uint64_t writtenResultBytes(std::size_t patches, std::size_t recordsPerPatc
   {
     return whole;
   }
-  // Offsets grow with (side, patch): each page is counted once, at its first written run.
-  std::uint64_t pages = 0, next = 0;
+  // Offsets grow with (side, patch).
+  WrittenPages pages;
   for (std::size_t s = 0; s < 2; ++s)
   {
     for (std::size_t p = 0; p < patches; ++p)
     {
-      if (!(*reachable)[2 * p + s])
+      if ((*reachable)[2 * p + s])
       {
-        continue;
-      }
-      const std::uint64_t begin = (s * patches + p) * run;
-      const std::uint64_t first = std::max<std::uint64_t>(begin / HugePageBytes, next);
-      const std::uint64_t last = (begin + run - 1) / HugePageBytes;
-      if (last >= first)
-      {
-        pages += last - first + 1;
-        next = last + 1;
+        pages.add((s * patches + p) * run, run);
       }
     }
   }
-  return std::min(whole, saturatingProduct({ pages, HugePageBytes }));
+  return std::min(whole, pages.bytes());
 }
 
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights,
-  const std::vector<std::uint8_t>* reachable)
+  const std::vector<std::uint8_t>* reachable, const std::vector<std::uint8_t>* firstHits)
 {
   const std::uint64_t workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
   MemoryPlan plan;
   // Results are written for the reachable sides alone (and the few sides of the overflow,
-  // not counted): shooting turns their sums into direct light and patches, and gathering
-  // runs from them, into the pages of those sides' runs.
-  const std::uint64_t direct = elements == patches * Scene::ElementsPerPatch
-    ? writtenResultBytes(patches, Scene::ElementsPerPatch, frames, reachable)
+  // not counted), into the pages of those sides' runs: the patches where paths bounce, the
+  // indirect light where gathering runs, the direct light where first hits land. Those the
+  // probes from the lights found are a sample of the last: a side lit only by chance, in a
+  // page no probe found, is not counted.
+  const bool perPatch = elements == patches * Scene::ElementsPerPatch;
+  const bool lit = firstHits && reachable && firstHits->size() == reachable->size();
+  const std::uint64_t direct = perPatch
+    ? writtenResultBytes(patches, Scene::ElementsPerPatch, frames, lit ? firstHits : reachable)
     : saturatingProduct({ frames, elements, 2, sizeof(PackedRgb) });
   const std::uint64_t patch = writtenResultBytes(patches, 1, frames, reachable);
-  const std::uint64_t indirect = direct;
+  const std::uint64_t indirect =
+    perPatch ? writtenResultBytes(patches, Scene::ElementsPerPatch, frames, reachable) : direct;
   plan.results = saturatingSum(saturatingSum(direct, patch), indirect);
   // The accumulators of `copies` copies, for elements and for patches: a scalar share per
   // element side and RGB power per patch side, for every frame, each buffer in whole pages;
@@ -87,14 +155,25 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
       ? 0
       : saturatingProduct({ patchSides, elements / std::max<std::size_t>(patches, 1) });
     const std::uint64_t paths = options.pathsPerFrame;
-    return Accumulators{
-      saturatingSum(
-        FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames,
-          collapsed || FixedPointAccumulator<1>::highWordsWritten(paths, c, elementSides)),
-        saturatingProduct({ elements, 2 })), // the element sides' flags
+    const bool highWords =
+      collapsed || FixedPointAccumulator<1>::highWordsWritten(paths, c, elementSides);
+    std::uint64_t shares =
+      FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames, highWords);
+    if (lit && perPatch && options.reuseShooting && frames > 1)
+    {
+      // Frames innermost: the words of the sides no first hit lands on stay unwritten. The
+      // low words (or the 64-bit sums once collapsed), the high words, the index.
+      shares = saturatingSum(
+        saturatingSum(writtenShareBytes(patches, frames, *reachable, *firstHits,
+                        collapsed ? 1 : copies, collapsed ? 8 : 4),
+          !collapsed && highWords ? writtenShareBytes(patches, frames, *reachable, *firstHits, 1, 4)
+                                  : 0),
+        saturatingProduct({ elements, 2, sizeof(std::uint32_t) }));
+    }
+    return Accumulators{ saturatingSum(
+                           shares, saturatingProduct({ elements, 2 })), // the element sides' flags
       FixedPointAccumulator<3>::allocatedStoredBytes(c, patches, patchSides, frames,
-        collapsed || FixedPointAccumulator<3>::highWordsWritten(paths, c, patchSides))
-    };
+        collapsed || FixedPointAccumulator<3>::highWordsWritten(paths, c, patchSides)) };
   };
   // Per worker: the weights, targets, frames and visibility of one path, and a gathering row.
   const std::uint64_t scratch = saturatingProduct({ workers, frames,

@@ -44,10 +44,13 @@ struct MemoryPlan
 /// emitters and directional lights; their per-frame data is counted). `reachable`: the flags
 /// of the patch sides light can reach (patch * 2 + side, Reachability.h), which alone, with
 /// their elements' sides, have shooting accumulators and results written; null, the bound
-/// before the probes, counts every side.
+/// before the probes, counts every side. `firstHits`: of those, the sides the probes from
+/// the lights hit first (reachableSides), where alone direct light is written, in the
+/// results and in the elements' shooting sums; null counts every reachable side.
 MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights = 1,
-  const std::vector<std::uint8_t>* reachable = nullptr);
+  const std::vector<std::uint8_t>* reachable = nullptr,
+  const std::vector<std::uint8_t>* firstHits = nullptr);
 
 /**
  * The bytes of a result array that writing the frames of the reachable sides makes

@@ -23,7 +23,8 @@ constexpr std::size_t ReachabilityPatchesPerTask = 64;
 
 std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tracer,
   const std::vector<LightSource>& sources, const SolverOptions& options, int workers,
-  const std::function<bool(double)>& keepGoing, std::uint64_t& rays)
+  const std::function<bool(double)>& keepGoing, std::uint64_t& rays,
+  std::vector<std::uint8_t>* firstHits)
 {
   const std::size_t patches = scene.patchCount();
   const std::size_t sides = 2 * patches;
@@ -156,6 +157,17 @@ std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tr
   for (std::uint32_t s : seeds)
   {
     visit(s);
+  }
+  if (firstHits)
+  {
+    firstHits->assign(sides, 0);
+    for (std::uint32_t s : seeds)
+    {
+      if (s != None)
+      {
+        (*firstHits)[s] = 1;
+      }
+    }
   }
   for (std::size_t head = 0; head < queue.size(); ++head)
   {

@@ -24,10 +24,13 @@ constexpr int ReachabilityProbesPerSide = 32;
  * hit first. Then a side is reachable when one of ReachabilityProbesPerSide cosine rays from
  * it reaches a reachable side, or one from a reachable side reaches it (light paths are
  * reversible). The inside of a closed block is never reached; a side that random shooting
- * happened to miss still is. `rays` is increased by the probes cast.
+ * happened to miss still is. `rays` is increased by the probes cast. `firstHits`, when
+ * given, gets the flags of the seeds alone: a sample of the sides the lights reach directly,
+ * for the memory plan (the results of direct light are written there alone).
  */
 std::vector<std::uint8_t> reachableSides(const Scene& scene, const RayTracer& tracer,
   const std::vector<LightSource>& sources, const SolverOptions& options, int workers,
-  const std::function<bool(double)>& keepGoing, std::uint64_t& rays);
+  const std::function<bool(double)>& keepGoing, std::uint64_t& rays,
+  std::vector<std::uint8_t>* firstHits = nullptr);
 
 } // namespace mlr

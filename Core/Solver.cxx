@@ -239,20 +239,21 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   // The patch sides light can reach, from geometry alone (deterministic and cheap: every rank
   // probes every side): only they get shooting accumulators and gather. With them known, the
   // plan counts the accumulators they take, and may give each worker a copy after all.
-  std::vector<std::uint8_t> reachable;
+  std::vector<std::uint8_t> reachable, firstHits;
   agreeAcrossRanks(
     options,
     [&]
     {
       reachable = reachableSides(
         scene, tracer, sources, options, workers,
-        [&](double) { return !progress || progress(0.0); }, stats.reachabilityRays);
+        [&](double) { return !progress || progress(0.0); }, stats.reachabilityRays, &firstHits);
     },
     &secondsReducing);
   stats.reachableSides =
     static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
   plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames,
-    options, sources.size(), reachable.empty() ? nullptr : &reachable);
+    options, sources.size(), reachable.empty() ? nullptr : &reachable,
+    reachable.empty() ? nullptr : &firstHits);
 
   // One pass: shooting every source, then gathering, into `into`. A batched solve runs one per
   // batch, sharing the scene, the tracer and the reachable sides (which do not depend on the

@@ -63,6 +63,29 @@ TEST(Reachability, EverySideLightCanReachAndNoOther)
     // ReachabilityProbesPerSide from every side.
     EXPECT_EQ(rays, 16384 / 3 * 3 + scene.patchCount() * 2 * ReachabilityProbesPerSide);
   }
+  // The sides the light probes hit first: reached, some of them, and the same for any
+  // worker count (the memory plan counts direct light there).
+  std::vector<std::uint8_t> oneWorker, twoWorkers;
+  {
+    const RayTracer tracer(scene);
+    const std::vector<LightSource> sources = lightSources(scene, rig, sceneEmitters(scene));
+    std::uint64_t rays = 0;
+    reachableSides(
+      scene, tracer, sources, options, 1, [](double) { return true; }, rays, &oneWorker);
+    reachableSides(
+      scene, tracer, sources, options, 2, [](double) { return true; }, rays, &twoWorkers);
+  }
+  EXPECT_EQ(oneWorker, twoWorkers);
+  ASSERT_EQ(oneWorker.size(), expected.size());
+  std::size_t firstHits = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i)
+  {
+    EXPECT_LE(oneWorker[i], expected[i]) << "side " << i;
+    firstHits += oneWorker[i];
+  }
+  EXPECT_GT(firstHits, 0u);
+  EXPECT_LT(firstHits, static_cast<std::size_t>(std::count(expected.begin(), expected.end(), 1)))
+    << "some reachable sides are lit only by bounces";
   // From geometry alone: the solve's seed and N do not change it.
   options.seed = 99;
   options.pathsPerFrame = 17;

@@ -304,15 +304,13 @@ std::vector<Measured> measureTheModes()
   // The plan counts accumulators for the sides light can reach, which a solve reports.
   LightRig rig;
   rig.areaLights.push_back(f.light);
-  const std::vector<std::uint8_t> reachableFlags =
-    checks::reachableOf(f.scene, rig, optionsFor(1, 0));
-  const auto* reachable = &reachableFlags;
-  EXPECT_EQ(static_cast<std::size_t>(std::count(reachableFlags.begin(), reachableFlags.end(), 1)),
+  const checks::Reached reached = checks::reachableOf(f.scene, rig, optionsFor(1, 0));
+  EXPECT_EQ(static_cast<std::size_t>(std::count(reached.sides.begin(), reached.sides.end(), 1)),
     f.scene.patchCount())
     << "the inside of the box";
   const int threads = 3;
   const MemoryPlan perWorker = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
-    f.scene.points().size(), frames, optionsFor(threads, 0), 1, reachable);
+    f.scene.points().size(), frames, optionsFor(threads, 0), 1, &reached.sides, &reached.firstHits);
   EXPECT_TRUE(perWorker.accumulatorCopyPerWorker);
   // A limit just under twice the per-worker peak leaves no room for the copies (they need it
   // to be within half the limit): the workers share one copy.
@@ -327,7 +325,7 @@ std::vector<Measured> measureTheModes()
     Measured r;
     r.mode = mode.name;
     r.plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(), f.scene.points().size(),
-      frames, mode.options, 1, reachable);
+      frames, mode.options, 1, &reached.sides, &reached.firstHits);
     const Resident m;
     const Solution solution = solve(f.scene, f.light, mode.options);
     r.peak = m.peak();
@@ -392,10 +390,9 @@ TEST(SolveMemory, TheEstimateBoundsABatchedSolve)
   options.errorBatches = 4;
   LightRig rig;
   rig.areaLights.push_back(f.light);
-  const std::vector<std::uint8_t> reachableFlags = checks::reachableOf(f.scene, rig, options);
-  const auto* reachable = &reachableFlags;
+  const checks::Reached reached = checks::reachableOf(f.scene, rig, options);
   const MemoryPlan plan = planSolveMemory(f.scene.patchCount(), f.scene.elementCount(),
-    f.scene.points().size(), frames, options, 1, reachable);
+    f.scene.points().size(), frames, options, 1, &reached.sides, &reached.firstHits);
   EXPECT_GT(plan.errorEstimate, 0u);
   const Resident m;
   const Solution solution = solve(f.scene, f.light, options);

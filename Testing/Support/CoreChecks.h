@@ -30,17 +30,23 @@ bool sameBits(const std::vector<Stored, Allocator>& a, const std::vector<Stored,
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Stored)) == 0;
 }
 
-/// The flags of the patch sides light can reach (patch * 2 + side) that a solve of `rig`
-/// finds, and its memory plan counts (planSolveMemory).
-inline std::vector<std::uint8_t> reachableOf(
-  const Scene& scene, const LightRig& rig, const SolverOptions& options)
+/// The flags of the patch sides light can reach (patch * 2 + side), and of those the light
+/// probes hit first, that a solve of `rig` finds and its memory plan counts
+/// (planSolveMemory).
+struct Reached
+{
+  std::vector<std::uint8_t> sides, firstHits;
+};
+inline Reached reachableOf(const Scene& scene, const LightRig& rig, const SolverOptions& options)
 {
   const std::vector<MovingLight> emitters = sceneEmitters(scene);
   const RayTracer tracer(scene);
   std::uint64_t rays = 0;
-  return reachableSides(
+  Reached r;
+  r.sides = reachableSides(
     scene, tracer, lightSources(scene, rig, emitters), options, resolveThreadCount(options.threads),
-    [](double) { return true; }, rays);
+    [](double) { return true; }, rays, &r.firstHits);
+  return r;
 }
 
 /// Runs `action`, expects mlr::Error, and checks that its message contains `words`.
