@@ -159,7 +159,8 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
       collapsed || FixedPointAccumulator<1>::highWordsWritten(paths, c, elementSides);
     std::uint64_t shares =
       FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames, highWords);
-    if (lit && perPatch && options.reuseShooting && frames > 1)
+    // Over several ranks the collapsed sums are summed in place, every slot written.
+    if (lit && perPatch && options.reuseShooting && frames > 1 && !(collapsed && options.ranks > 1))
     {
       // Frames innermost: the words of the sides no first hit lands on stay unwritten. The
       // low words (or the 64-bit sums once collapsed), the high words, the index.
