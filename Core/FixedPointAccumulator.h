@@ -29,8 +29,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <cstring>
 #include <map>
 #include <memory>
 #include <new>
@@ -455,11 +453,8 @@ public:
   static std::uint64_t allocatedStoredBytes(
     int copies, std::size_t records, std::uint64_t sides, std::size_t frames, bool highWords = true)
   {
-    const std::uint64_t words = highWords
-      ? allocatedWords(copies, sides, frames)
-      : fixedPointBufferBytes(saturatingProduct(
-          { static_cast<std::uint64_t>(copies), sides, frames, Channels, sizeof(std::uint32_t) }));
-    return saturatingSum(words, saturatingProduct({ records, 2, sizeof(std::uint32_t) }));
+    return saturatingSum(allocatedWords(copies, sides, frames, highWords),
+      saturatingProduct({ records, 2, sizeof(std::uint32_t) }));
   }
 
   /**
@@ -480,12 +475,14 @@ public:
 private:
   static constexpr std::uint32_t Unstored = 0xffffffffu;
 
-  static std::uint64_t allocatedWords(int copies, std::uint64_t sides, std::size_t frames)
+  /// The low words of `copies` copies, and the high words when `highWords`, in whole pages.
+  static std::uint64_t allocatedWords(
+    int copies, std::uint64_t sides, std::size_t frames, bool highWords = true)
   {
     const std::uint64_t one = saturatingProduct({ sides, frames, Channels, sizeof(std::uint32_t) });
     return saturatingSum(
       fixedPointBufferBytes(saturatingProduct({ static_cast<std::uint64_t>(copies), one })),
-      fixedPointBufferBytes(one));
+      highWords ? fixedPointBufferBytes(one) : 0);
   }
 
   /// The sum of every copy's low word and the high word of slot i.

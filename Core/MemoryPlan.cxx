@@ -157,19 +157,23 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     const std::uint64_t paths = options.pathsPerFrame;
     const bool highWords =
       collapsed || FixedPointAccumulator<1>::highWordsWritten(paths, c, elementSides);
-    std::uint64_t shares =
-      FixedPointAccumulator<1>::allocatedStoredBytes(c, elements, elementSides, frames, highWords);
-    // Over several ranks the collapsed sums are summed in place, every slot written.
+    // Frames innermost, the words of the sides no first hit lands on stay unwritten; but over
+    // several ranks the collapsed sums are summed in place, every slot written.
+    std::uint64_t shares = 0;
     if (lit && perPatch && options.reuseShooting && frames > 1 && !(collapsed && options.ranks > 1))
     {
-      // Frames innermost: the words of the sides no first hit lands on stay unwritten. The
-      // low words (or the 64-bit sums once collapsed), the high words, the index.
+      // The low words (or the 64-bit sums once collapsed), the high words, the index.
       shares = saturatingSum(
         saturatingSum(writtenShareBytes(patches, frames, *reachable, *firstHits,
                         collapsed ? 1 : copies, collapsed ? 8 : 4),
           !collapsed && highWords ? writtenShareBytes(patches, frames, *reachable, *firstHits, 1, 4)
                                   : 0),
         saturatingProduct({ elements, 2, sizeof(std::uint32_t) }));
+    }
+    else
+    {
+      shares = FixedPointAccumulator<1>::allocatedStoredBytes(
+        c, elements, elementSides, frames, highWords);
     }
     return Accumulators{ saturatingSum(
                            shares, saturatingProduct({ elements, 2 })), // the element sides' flags
