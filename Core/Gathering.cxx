@@ -14,16 +14,69 @@ namespace
 {
 constexpr std::size_t GatheringSidesPerTask = 32;
 
+/// The four elements' reconstructed bounced light (LinearStencil::elementValues) of side
+/// `side` of `patch` in `frame`.
+void elementsBounced(const Scene& scene, const Solution& solution, std::size_t frame,
+  std::size_t patch, Side side, Rgb* out)
+{
+  const LinearStencil& stencil = scene.patchStencil(patch);
+  const Side other = side == Side::Front ? Side::Back : Side::Front;
+  const Rgb own = solution.patchBounced(frame, patch, side);
+  Rgb neighbours[LinearStencil::MaxNeighbours];
+  for (int i = 0; i < stencil.count; ++i)
+  {
+    const auto n = static_cast<std::size_t>(i);
+    neighbours[i] =
+      solution.patchBounced(frame, stencil.neighbour[n], stencil.flipped[n] ? other : side);
+  }
+  stencil.elementValues(own, neighbours, out);
+}
+
+/**
+ * What gathering reads at every element side and frame (gatheredRadiosity()), stored, for the
+ * sides of the reachable patch sides (the others read zero and stay unwritten).
+ */
+StoredArray gatheredRows(
+  const Scene& scene, const Solution& solution, const std::vector<std::uint8_t>& reachable)
+{
+  StoredArray rows(solution.directData().size());
+  const std::size_t frames = solution.frameCount();
+  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      if (!reachable[2 * p + static_cast<std::size_t>(side)])
+      {
+        continue;
+      }
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        Rgb bounced[Scene::ElementsPerPatch];
+        elementsBounced(scene, solution, f, p, side, bounced);
+        for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
+        {
+          const std::size_t e = p * Scene::ElementsPerPatch + k;
+          // In the solution's storage unit, as the rows are stored.
+          const Rgb value = Rgb(solution.directData()[solution.elementIndex(f, e, side)]) *
+              solution.reflectance(e) +
+            bounced[k] * (1.0 / solution.storageScale());
+          rows[solution.elementIndex(f, e, side)] = PackedRgb(value);
+        }
+      }
+    }
+  }
+  return rows;
+}
+
 /**
  * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
- * on it; each ray that reaches an element side adds Solution::gatheredRadiosity() there, its
- * patch's bounced row and its own direct row times its reflectance. Their mean is the side's
- * indirect irradiance (the Solution applies rho_e). With reuse one set of rays serves every
- * frame; otherwise each frame casts its own.
+ * on it; each ray that reaches an element side adds the row of what it reads there
+ * (gatheredRows). Their mean is the side's indirect irradiance (the Solution applies rho_e).
+ * With reuse one set of rays serves every frame; otherwise each frame casts its own.
  */
 void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
-  std::uint32_t elementSide, std::uint64_t rays, Solution& solution, std::vector<Rgb>& sum,
-  WorkerCounters& counters)
+  std::uint32_t elementSide, std::uint64_t rays, const StoredArray& readable, Solution& solution,
+  std::vector<Rgb>& sum, WorkerCounters& counters)
 {
   const std::size_t frames = solution.frameCount();
   const bool reuse = options.reuseGathering;
@@ -34,35 +87,23 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   const Vec3 normal = scene.elementSideNormal(element, side);
   sum.assign(frames, Rgb());
 
-  // A hit's rows (its patch's bounced light, its element's direct irradiance) are added after
-  // the next ray is traced: they were prefetched when the hit was found, so the trace hides
-  // their cache misses.
+  // A hit's row is added after the next ray is traced: it was prefetched when the hit was
+  // found, so the trace hides its cache misses.
   const std::size_t passes = reuse ? 1 : frames;
   const std::size_t rowLength = reuse ? frames : 1;
-  const std::vector<Rgb>& reflectance = solution.reflectanceData();
   for (std::size_t pass = 0; pass < passes; ++pass)
   {
     Rgb* into = reuse ? sum.data() : &sum[pass];
     const PackedRgb* pending = nullptr;
-    const PackedRgb* pendingDirect = nullptr;
-    Rgb pendingReflectance;
     auto addPending = [&]
     {
       if (pending)
       {
         for (std::size_t f = 0; f < rowLength; ++f)
         {
-          into[f] += Rgb(pending[f]) + pendingReflectance * Rgb(pendingDirect[f]);
+          into[f] += Rgb(pending[f]);
         }
         pending = nullptr;
-      }
-    };
-    auto prefetch = [rowLength](const PackedRgb* row)
-    {
-      const char* bytes = reinterpret_cast<const char*>(row);
-      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
-      {
-        __builtin_prefetch(bytes + byte);
       }
     };
     RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
@@ -86,13 +127,12 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
       {
         continue;
       }
-      pending = solution.patchData().data() +
-        solution.patchIndex(reuse ? 0 : pass, Scene::patchOfElement(hitElement), hitSide);
-      pendingDirect =
-        solution.directData().data() + solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
-      pendingReflectance = reflectance[hitElement];
-      prefetch(pending);
-      prefetch(pendingDirect);
+      pending = readable.data() + solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
+      const char* bytes = reinterpret_cast<const char*>(pending);
+      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
+      {
+        __builtin_prefetch(bytes + byte);
+      }
     }
     addPending();
   }
@@ -104,6 +144,14 @@ void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& op
   }
 }
 
+}
+
+Rgb gatheredRadiosity(
+  const Scene& scene, const Solution& solution, std::size_t frame, std::size_t element, Side side)
+{
+  Rgb bounced[Scene::ElementsPerPatch];
+  elementsBounced(scene, solution, frame, Scene::patchOfElement(element), side, bounced);
+  return bounced[element % Scene::ElementsPerPatch] + solution.direct(frame, element, side);
 }
 
 std::vector<std::uint32_t> gatheringSides(const Scene& scene,
@@ -177,6 +225,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
       1, std::llround(static_cast<double>(total) / static_cast<double>(black.size()))));
   }
   sides.insert(sides.end(), black.begin(), black.end());
+  const StoredArray readable = gatheredRows(scene, solution, reachable);
   std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
   std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
   const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
@@ -187,7 +236,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
       const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
       for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
       {
-        gather(scene, tracer, options, sides[i], raysPerSide, solution,
+        gather(scene, tracer, options, sides[i], raysPerSide, readable, solution,
           sums[static_cast<std::size_t>(worker)], counters[static_cast<std::size_t>(worker)]);
       }
     },

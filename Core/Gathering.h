@@ -16,6 +16,16 @@ namespace mlr
 class RayTracer;
 
 /**
+ * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`) reads
+ * in `frame`: the bounced light of its patch, reconstructed at the element
+ * (LinearStencil::elementValues: the patch's mean moved along its limited gradient), plus its
+ * own direct radiosity. The direct light, with its shadow edges, is known per element; the
+ * light of later bounces is summed per patch, whose neighbours give its slope.
+ */
+Rgb gatheredRadiosity(
+  const Scene& scene, const Solution& solution, std::size_t frame, std::size_t element, Side side);
+
+/**
  * The element sides that gather: those of reachable patch sides whose reflectance is not
  * zero (a black element reflects nothing it gathers). Returns them as element * 2 + side,
  * in element order, and sets `rays` to the rays each casts so that together they cast about

@@ -207,9 +207,11 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData)),
     plan.errorEstimate - standardErrors);
   plan.other = saturatingSum(base, reachability);
+  // Gathering holds what its rays read beside the indirect light: a row per element side,
+  // written where the indirect light is (Gathering.cxx).
   const std::uint64_t gathering = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
-    standardErrors);
+    saturatingSum(standardErrors, indirect));
   // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
   // in Solution.h), when a source's sums are turned into them, after the workers' copies were
   // collapsed into one and the others' pages given back. With one source that is the larger

@@ -172,6 +172,8 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
         length(triangleAreaVector(scene.Points[e[0]], scene.Points[e[1]], scene.Points[e[2]])));
     }
   }
+  scene.PatchStencils =
+    linearStencils(scene.Points, scene.PatchTriangles, scene.PatchNormals, scene.Reflectance);
   return scene;
 }
 

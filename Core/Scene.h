@@ -1,6 +1,7 @@
 // The radiosity scene: triangular patches, each split 1:4 into elements.
 #pragma once
 
+#include "Reconstruction.h"
 #include "Rgb.h"
 #include "Vec3.h"
 
@@ -77,6 +78,8 @@ public:
   const Vec3& patchNormal(std::size_t p) const { return this->PatchNormals[p]; }
   double patchArea(std::size_t p) const { return this->PatchAreas[p]; }
   const Rgb& patchReflectance(std::size_t p) const { return this->Reflectance[p]; }
+  /// How final gathering reads patch p's bounced light as a linear function (Reconstruction.h).
+  const LinearStencil& patchStencil(std::size_t p) const { return this->PatchStencils[p]; }
 
   const Vec3& elementNormal(std::size_t e) const { return this->PatchNormals[patchOfElement(e)]; }
   double elementArea(std::size_t e) const { return this->ElementAreas[e]; }
@@ -114,6 +117,7 @@ private:
   std::vector<double> PatchAreas;
   std::vector<double> ElementAreas;
   std::vector<Rgb> Reflectance;
+  std::vector<LinearStencil> PatchStencils;
   std::vector<Rgb> Emission; ///< empty when nothing emits
   double TotalArea = 0;
   Vec3 BoundsMin, BoundsMax;

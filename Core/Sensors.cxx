@@ -1,6 +1,7 @@
 #include "Sensors.h"
 
 #include "Error.h"
+#include "Gathering.h"
 #include "MemoryBudget.h"
 #include "Parallel.h"
 #include "Random.h"
@@ -137,7 +138,7 @@ double emittedDensity(const IntensityDistribution& f, const PhotometricFrame& fr
   return f.density(frame.toLocal(towards));
 }
 
-void solveSensor(const RayTracer& tracer, const LightRig& rig,
+void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& rig,
   const std::vector<MovingLight>& emitters, const Solution& solution, const SensorSet& sensors,
   std::size_t s, const SolverOptions& options, const SensorOptions& sensorOptions,
   SensorScratch& scratch, SensorSolution& result)
@@ -206,7 +207,7 @@ void solveSensor(const RayTracer& tracer, const LightRig& rig,
     const Side side = static_cast<Side>(scratch.hits[i] % 2);
     for (std::size_t f = 0; f < frames; ++f)
     {
-      scratch.gathered[f] += solution.gatheredRadiosity(f, element, side) * count;
+      scratch.gathered[f] += gatheredRadiosity(scene, solution, f, element, side) * count;
     }
     i = end;
   }
@@ -483,7 +484,7 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
       const std::size_t end = std::min(sensors.size(), (task + 1) * SensorsPerTask);
       for (std::size_t s = task * SensorsPerTask; s < end; ++s)
       {
-        solveSensor(tracer, rig, emitters, solution, sensors, s, options, sensorOptions,
+        solveSensor(scene, tracer, rig, emitters, solution, sensors, s, options, sensorOptions,
           scratch[static_cast<std::size_t>(worker)], result);
       }
     },

@@ -117,6 +117,8 @@ public:
   std::size_t elementCount() const { return this->Elements; }
   std::size_t patchCount() const { return this->Patches; }
 
+  /// rho_e, which turns an element's irradiance into radiosity.
+  const Rgb& reflectance(std::size_t element) const { return this->Reflectance[element]; }
   Rgb direct(std::size_t frame, std::size_t element, Side side) const
   {
     return this->Reflectance[element] * this->directIrradiance(frame, element, side);
@@ -169,21 +171,10 @@ public:
       direct * (1.0 / static_cast<double>(Scene::ElementsPerPatch));
   }
   /// Of patchRadiosity(), the light that reached the patch after at least one bounce (W/m^2),
-  /// reflected: the part gathering reads as a patch mean.
+  /// reflected: the part gathering reads per patch (gatheredRadiosity() in Gathering.h).
   Rgb patchBounced(std::size_t frame, std::size_t patch, Side side) const
   {
     return this->load(this->Patch[this->patchIndex(frame, patch, side)]);
-  }
-  /**
-   * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`)
-   * reads: its patch's bounced light and its own direct radiosity. The direct light, with its
-   * shadow edges, is known per element; only the light of later bounces, which varies slowly,
-   * is read as a patch mean (Documentation/Method.md, section 3).
-   */
-  Rgb gatheredRadiosity(std::size_t frame, std::size_t element, Side side) const
-  {
-    return this->patchBounced(frame, Scene::patchOfElement(element), side) +
-      this->direct(frame, element, side);
   }
   /// The side of an element that received more power over the whole animation.
   Side litSide(std::size_t element) const { return this->LitSide[element]; }
@@ -255,6 +246,7 @@ public:
   }
   /// The direct irradiance of every element side and frame.
   StoredArray& directData() { return this->Direct; }
+  const StoredArray& directData() const { return this->Direct; }
   /// The indirect irradiance. Empty until allocateIndirect(): the solver allocates it once the
   /// shooting accumulators are freed, so that the two never take memory at once.
   StoredArray& indirectData() { return this->Indirect; }
@@ -266,6 +258,7 @@ public:
   StoredArray& stdErrorData() { return this->StdError; }
   /// The patches' bounced light (patchBounced()) of every patch side and frame.
   StoredArray& patchData() { return this->Patch; }
+  const StoredArray& patchData() const { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
   /// One per element, or empty when nothing emits.

@@ -463,20 +463,38 @@ TEST(WeakChannel, AChannelAMillionTimesWeakerKeepsItsPrecision)
   for (bool reuse : { false, true })
   {
     const Solution solution = solve(scene, lightOf(room), modeOptions(reuse, 20000, 3));
-    double worst = 0;
+    // worst[0]: the direct light and the patches, relative to each value; worst[1]: the
+    // indirect light, relative to the frame's brightest. Gathering reads each patch's bounced
+    // light moved along its gradient (Reconstruction.h), a difference of stored neighbours:
+    // an element far darker than its neighbours reads their rounding, in each channel on its
+    // own, so its ratio is only as precise as its neighbours' light is.
+    double worst[2] = { 0, 0 };
     std::size_t lit = 0;
     for (std::size_t f = 0; f < solution.frameCount(); ++f)
     {
+      double brightest = 0;
       for (std::size_t e = 0; e < scene.elementCount(); ++e)
       {
         for (Side side : { Side::Front, Side::Back })
         {
-          for (const Rgb& B : { solution.direct(f, e, side), solution.indirect(f, e, side),
-                 solution.patchRadiosity(f, Scene::patchOfElement(e), side) })
+          brightest = std::max(brightest, solution.indirect(f, e, side).r);
+        }
+      }
+      for (std::size_t e = 0; e < scene.elementCount(); ++e)
+      {
+        for (Side side : { Side::Front, Side::Back })
+        {
+          const Rgb values[3] = { solution.direct(f, e, side),
+            solution.patchRadiosity(f, Scene::patchOfElement(e), side),
+            solution.indirect(f, e, side) };
+          for (int i = 0; i < 3; ++i)
           {
+            const Rgb& B = values[i];
             if (B.r > 0)
             {
-              worst = std::max(worst, std::abs(B.b / B.r * 1e6 - 1));
+              const double error = std::abs(B.b * 1e6 - B.r);
+              double& w = worst[i == 2 ? 1 : 0];
+              w = std::max(w, error / (i == 2 ? brightest : B.r));
               ++lit;
             }
             else
@@ -487,10 +505,12 @@ TEST(WeakChannel, AChannelAMillionTimesWeakerKeepsItsPrecision)
         }
       }
     }
-    std::printf("%s: worst relative error of blue/red over %zu values: %.3g\n",
-      reuse ? "full reuse" : "classic", lit, worst);
+    std::printf("%s: worst relative error of blue/red over %zu values: %.3g (direct and patches), "
+                "%.3g (indirect, of the brightest)\n",
+      reuse ? "full reuse" : "classic", lit, worst[0], worst[1]);
     EXPECT_GT(lit, scene.elementCount());
-    EXPECT_LT(worst, 4 * PackedRgb::RelativeRounding);
+    EXPECT_LT(worst[0], 4 * PackedRgb::RelativeRounding);
+    EXPECT_LT(worst[1], 4 * PackedRgb::RelativeRounding);
   }
 }
 

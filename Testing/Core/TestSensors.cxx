@@ -4,6 +4,7 @@
 #include "Animation.h"
 #include "CoreChecks.h"
 #include "FormFactor.h"
+#include "Gathering.h"
 #include "GeneratedScenes.h"
 #include "Sensors.h"
 #include "Sky.h"
@@ -117,7 +118,7 @@ TEST(Sensors, LookingDownAtLitGroundGathersItsRadiosity)
   const Scene scene = ground(20, Rgb(0.5));
   LightRig rig;
   rig.skies.emplace_back(SkyModel::Uniform, Vec3(0, 0, 1), std::vector<SkyFrame>{ { {}, 100, 0 } });
-  // It reads the ground element below it (Solution::gatheredRadiosity), whose direct light has
+  // It reads the ground element below it (gatheredRadiosity in Gathering.h), whose direct light has
   // that element's first hits: within 4 of its standard errors (from 16 batches) of rho E_dh.
   SolverOptions options = quick(400000);
   options.errorBatches = 16;
@@ -146,7 +147,7 @@ TEST(Sensors, LookingDownAtLitGroundGathersItsRadiosity)
     (scene.points()[t[0]] + scene.points()[t[1]] + scene.points()[t[2]]) / 3.0 + Vec3(0, 0, 0.01);
   const SensorSolution result =
     solveSensors(scene, rig, solution, oneSensor(over, { 0, 0, -1 }), quick(), counts);
-  const double read = solution.gatheredRadiosity(0, below, Side::Front).r;
+  const double read = gatheredRadiosity(scene, solution, 0, below, Side::Front).r;
   const double standardError = solution.radiosityStdError(0, below, Side::Front).r;
   std::printf("sensor over the ground: %.3f, the element below %.3f (standard error %.3f)\n",
     result.irradiance(0, 0).r, read, standardError);
