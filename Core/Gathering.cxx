@@ -1,5 +1,6 @@
 #include "Gathering.h"
 
+#include "Parallel.h"
 #include "Random.h"
 #include "Ranks.h"
 #include "RayTracer.h"
@@ -32,118 +33,157 @@ void elementsBounced(const Scene& scene, const Solution& solution, std::size_t f
   stencil.elementValues(own, neighbours, out);
 }
 
-/**
- * What gathering reads at every element side and frame (gatheredRadiosity()), stored, for the
- * sides of the reachable patch sides (the others read zero and stay unwritten).
- */
-StoredArray gatheredRows(
-  const Scene& scene, const Solution& solution, const std::vector<std::uint8_t>& reachable)
+/// What gathering reads (gatheredRadiosity()) for frames [begin, begin + length): each
+/// element side's row of `length` values, laid out as the results are (the front sides, then
+/// the back sides), so that the memory plan counts their written pages alike.
+struct ReadRows
 {
-  StoredArray rows(solution.directData().size());
-  const std::size_t frames = solution.frameCount();
-  for (std::size_t p = 0; p < scene.patchCount(); ++p)
+  std::size_t elements = 0, begin = 0, length = 0;
+  StoredArray values;
+  std::size_t index(std::size_t element, std::size_t side) const
   {
-    for (const Side side : { Side::Front, Side::Back })
+    return (side * this->elements + element) * this->length;
+  }
+  const PackedRgb* row(std::uint32_t elementSide) const
+  {
+    return this->values.data() + this->index(elementSide / 2, elementSide % 2);
+  }
+};
+
+/// Fills `rows` for its frames, for the sides of the reachable patch sides (the others read
+/// zero and stay unwritten), in the solution's storage unit.
+void readRows(const Scene& scene, const Solution& solution,
+  const std::vector<std::uint8_t>& reachable, int workers, ReadRows& rows)
+{
+  rows.values = StoredArray(2 * scene.elementCount() * rows.length);
+  const PackedRgb* patches = solution.patchData().data();
+  const PackedRgb* direct = solution.directData().data();
+  constexpr std::size_t PatchesPerTask = 256;
+  // In the solution's storage unit throughout: the reconstruction is linear but for its
+  // limiter, which only compares with zero.
+  auto readPatchSide = [&](std::size_t p, Side side)
+  {
+    const LinearStencil& stencil = scene.patchStencil(p);
+    const Side other = side == Side::Front ? Side::Back : Side::Front;
+    const PackedRgb* own = patches + solution.patchIndex(rows.begin, p, side);
+    const PackedRgb* neighbourRows[LinearStencil::MaxNeighbours];
+    for (int i = 0; i < stencil.count; ++i)
     {
-      if (!reachable[2 * p + static_cast<std::size_t>(side)])
+      const auto n = static_cast<std::size_t>(i);
+      neighbourRows[i] = patches +
+        solution.patchIndex(rows.begin, stencil.neighbour[n], stencil.flipped[n] ? other : side);
+    }
+    const std::size_t first = p * Scene::ElementsPerPatch;
+    for (std::size_t f = 0; f < rows.length; ++f)
+    {
+      Rgb neighbours[LinearStencil::MaxNeighbours], bounced[Scene::ElementsPerPatch];
+      for (int i = 0; i < stencil.count; ++i)
       {
-        continue;
+        neighbours[i] = Rgb(neighbourRows[i][f]);
       }
-      for (std::size_t f = 0; f < frames; ++f)
+      stencil.elementValues(Rgb(own[f]), neighbours, bounced);
+      for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
       {
-        Rgb bounced[Scene::ElementsPerPatch];
-        elementsBounced(scene, solution, f, p, side, bounced);
-        for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
-        {
-          const std::size_t e = p * Scene::ElementsPerPatch + k;
-          // In the solution's storage unit, as the rows are stored.
-          const Rgb value = Rgb(solution.directData()[solution.elementIndex(f, e, side)]) *
-              solution.reflectance(e) +
-            bounced[k] * (1.0 / solution.storageScale());
-          rows[solution.elementIndex(f, e, side)] = PackedRgb(value);
-        }
+        const std::size_t e = first + k;
+        const Rgb value =
+          Rgb(direct[solution.elementIndex(rows.begin + f, e, side)]) * solution.reflectance(e) +
+          bounced[k];
+        rows.values[rows.index(e, static_cast<std::size_t>(side)) + f] = PackedRgb(value);
       }
     }
-  }
-  return rows;
+  };
+  parallelFor((scene.patchCount() + PatchesPerTask - 1) / PatchesPerTask, workers,
+    [&](std::size_t task, int)
+    {
+      for (std::size_t p = task * PatchesPerTask;
+           p < std::min(scene.patchCount(), (task + 1) * PatchesPerTask); ++p)
+      {
+        for (const Side side : { Side::Front, Side::Back })
+        {
+          if (reachable[2 * p + static_cast<std::size_t>(side)])
+          {
+            readPatchSide(p, side);
+          }
+        }
+      }
+    },
+    [](std::size_t) { return true; });
 }
 
-/**
- * Final gathering for one element side: `rays` cosine-distributed rays from uniform points
- * on it; each ray that reaches an element side adds the row of what it reads there
- * (gatheredRows). Their mean is the side's indirect irradiance (the Solution applies rho_e).
- * With reuse one set of rays serves every frame; otherwise each frame casts its own.
- */
-void gather(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
-  std::uint32_t elementSide, std::uint64_t rays, const StoredArray& readable, Solution& solution,
-  std::vector<Rgb>& sum, WorkerCounters& counters)
+/// Appends the element sides (2 element + side) that one side's `rays` rays reach, in ray
+/// order, from the gathering stream `stream` (0 with reuse: one set of rays serves every
+/// frame; 1 + frame without).
+void castRays(const Scene& scene, const RayTracer& tracer, const SolverOptions& options,
+  std::uint32_t elementSide, std::uint64_t rays, std::uint64_t stream,
+  std::vector<std::uint32_t>& hits, WorkerCounters& counters)
 {
-  const std::size_t frames = solution.frameCount();
-  const bool reuse = options.reuseGathering;
   const std::size_t element = elementSide / 2;
   const Side side = static_cast<Side>(elementSide % 2);
   const Triangle& t = scene.elementTriangles()[element];
   const auto& points = scene.points();
   const Vec3 normal = scene.elementSideNormal(element, side);
-  sum.assign(frames, Rgb());
-
-  // A hit's row is added after the next ray is traced: it was prefetched when the hit was
-  // found, so the trace hides its cache misses.
-  const std::size_t passes = reuse ? 1 : frames;
-  const std::size_t rowLength = reuse ? frames : 1;
-  for (std::size_t pass = 0; pass < passes; ++pass)
+  RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, stream);
+  for (std::uint64_t r = 0; r < rays; ++r)
   {
-    Rgb* into = reuse ? sum.data() : &sum[pass];
-    const PackedRgb* pending = nullptr;
-    auto addPending = [&]
+    const double u1 = random.uniform(), u2 = random.uniform();
+    const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
+    const Vec3 direction = sampleCosineDirection(normal, random);
+    ++counters.gatheringRays;
+    std::uint32_t hitElement = 0;
+    Side hitSide = Side::Front;
+    if (!tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide))
     {
-      if (pending)
-      {
-        for (std::size_t f = 0; f < rowLength; ++f)
-        {
-          into[f] += Rgb(pending[f]);
-        }
-        pending = nullptr;
-      }
-    };
-    RandomStream random(options.seed, StreamPurpose::Gathering, elementSide, reuse ? 0 : pass + 1);
-    for (std::uint64_t r = 0; r < rays; ++r)
-    {
-      const double u1 = random.uniform(), u2 = random.uniform();
-      const Vec3 origin = sampleTriangle(points[t[0]], points[t[1]], points[t[2]], u1, u2);
-      const Vec3 direction = sampleCosineDirection(normal, random);
-      ++counters.gatheringRays;
-      std::uint32_t hitElement = 0;
-      Side hitSide = Side::Front;
-      const bool found =
-        tracer.nearestSide(tracer.liftOff(origin, normal), direction, hitElement, hitSide);
-      addPending();
-      if (!found)
-      {
-        ++counters.missedRays;
-        continue;
-      }
-      if (!options.twoSided && hitSide == Side::Back)
-      {
-        continue;
-      }
-      pending = readable.data() + solution.elementIndex(reuse ? 0 : pass, hitElement, hitSide);
-      const char* bytes = reinterpret_cast<const char*>(pending);
-      for (std::size_t byte = 0; byte < rowLength * sizeof(PackedRgb); byte += 64)
-      {
-        __builtin_prefetch(bytes + byte);
-      }
+      ++counters.missedRays;
+      continue;
     }
-    addPending();
-  }
-  const double perRay = 1.0 / static_cast<double>(rays);
-  for (std::size_t f = 0; f < frames; ++f)
-  {
-    // The rows were read as stored, in the solution's storage unit, which the mean keeps.
-    solution.indirectData()[solution.elementIndex(f, element, side)] = PackedRgb(sum[f] * perRay);
+    if (!options.twoSided && hitSide == Side::Back)
+    {
+      continue;
+    }
+    hits.push_back(2 * hitElement + static_cast<std::uint32_t>(hitSide));
   }
 }
 
+/// Adds the rows of `count` hits, frames [first, first + frames) of the rows' block, into
+/// `sum` (one Rgb per frame). Rows are prefetched a few hits ahead, so that their cache
+/// misses overlap the adding of the rows before them.
+void addRows(const ReadRows& rows, const std::uint32_t* hits, std::size_t count, std::size_t first,
+  std::size_t frames, Rgb* sum)
+{
+  constexpr std::size_t Ahead = 16;
+  auto prefetch = [&](std::size_t h)
+  {
+    const char* bytes = reinterpret_cast<const char*>(rows.row(hits[h]) + first);
+    for (std::size_t byte = 0; byte < frames * sizeof(PackedRgb); byte += 64)
+    {
+      __builtin_prefetch(bytes + byte);
+    }
+  };
+  for (std::size_t h = 0; h < std::min(count, Ahead); ++h)
+  {
+    prefetch(h);
+  }
+  for (std::size_t h = 0; h < count; ++h)
+  {
+    if (h + Ahead < count)
+    {
+      prefetch(h + Ahead);
+    }
+    const PackedRgb* row = rows.row(hits[h]) + first;
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      sum[f] += Rgb(row[f]);
+    }
+  }
+}
+
+}
+
+std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames)
+{
+  constexpr std::size_t RowBytes = std::size_t(128) << 20;
+  const std::size_t perFrame = std::max<std::size_t>(2 * elements * sizeof(PackedRgb), 1);
+  return std::clamp<std::size_t>(RowBytes / perFrame, 1, std::max<std::size_t>(frames, 1));
 }
 
 Rgb gatheredRadiosity(
@@ -225,25 +265,122 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
       1, std::llround(static_cast<double>(total) / static_cast<double>(black.size()))));
   }
   sides.insert(sides.end(), black.begin(), black.end());
-  const StoredArray readable = gatheredRows(scene, solution, reachable);
-  std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
-  std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
+  const std::size_t frames = solution.frameCount();
+  const bool reuse = options.reuseGathering;
   const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
-  runOnRanks(
-    tasks, workers, options,
-    [&](std::size_t task, int worker)
+  std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
+  const double perRay = 1.0 / static_cast<double>(std::max<std::uint64_t>(raysPerSide, 1));
+  // The rows of what rays read are held for a block of frames at a time, so that they take
+  // a bounded share of memory (MemoryPlan). With reuse and several blocks, a group of sides
+  // casts its rays once and keeps the element side each reached (4 bytes a ray, at most
+  // GatheringHitBytes), then adds the rows block by block; with one block nothing is kept.
+  const std::size_t block = gatheringBlockFrames(scene.elementCount(), frames);
+  const std::size_t blocks = (frames + block - 1) / block;
+  const bool keepHits = reuse && blocks > 1;
+  const std::size_t tasksPerGroup = keepHits
+    ? std::max<std::size_t>(1,
+        GatheringHitBytes /
+          std::max<std::uint64_t>(1, raysPerSide * GatheringSidesPerTask * sizeof(std::uint32_t)))
+    : std::max<std::size_t>(tasks, 1);
+  const std::size_t groups = (tasks + tasksPerGroup - 1) / tasksPerGroup;
+  std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
+  std::vector<std::vector<std::uint32_t>> scratchHits(static_cast<std::size_t>(workers));
+  StoredArray& indirect = solution.indirectData();
+  ReadRows rows;
+  rows.elements = scene.elementCount();
+  bool held = false;
+  auto holdBlock = [&](std::size_t b)
+  {
+    if (held && rows.begin == b * block)
     {
-      const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
-      for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
-      {
-        gather(scene, tracer, options, sides[i], raysPerSide, readable, solution,
-          sums[static_cast<std::size_t>(worker)], counters[static_cast<std::size_t>(worker)]);
-      }
-    },
-    fraction, secondsReducing);
+      return;
+    }
+    rows.begin = b * block;
+    rows.length = std::min(block, frames - rows.begin);
+    readRows(scene, solution, reachable, workers, rows);
+    held = true;
+  };
+  for (std::size_t g = 0; g < groups; ++g)
+  {
+    const std::size_t first = g * tasksPerGroup;
+    const std::size_t count = std::min(tasksPerGroup, tasks - first);
+    // Progress: the groups in turn; in a group that keeps its hits, casting is most of it.
+    const double castShare = keepHits ? 0.8 : 0.0;
+    auto progress = [&](double inGroup)
+    { return fraction((static_cast<double>(g) + inGroup) / static_cast<double>(groups)); };
+    std::vector<std::vector<std::uint32_t>> hits(keepHits ? count : 0);
+    std::vector<std::vector<std::uint32_t>> hitEnds(keepHits ? count : 0);
+    if (keepHits)
+    {
+      runOnRanks(
+        count, workers, options,
+        [&](std::size_t j, int worker)
+        {
+          const std::size_t task = first + j;
+          const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
+          for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
+          {
+            castRays(scene, tracer, options, sides[i], raysPerSide, 0, hits[j],
+              counters[static_cast<std::size_t>(worker)]);
+            hitEnds[j].push_back(static_cast<std::uint32_t>(hits[j].size()));
+          }
+        },
+        [&](double done) { return progress(castShare * done); }, secondsReducing);
+    }
+    for (std::size_t b = 0; b < blocks; ++b)
+    {
+      holdBlock(b);
+      runOnRanks(
+        count, workers, options,
+        [&](std::size_t j, int worker)
+        {
+          const std::size_t task = first + j;
+          const auto w = static_cast<std::size_t>(worker);
+          std::vector<Rgb>& sum = sums[w];
+          const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
+          for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
+          {
+            const std::uint32_t side = sides[i];
+            sum.assign(rows.length, Rgb());
+            if (keepHits)
+            {
+              const std::size_t k = i - task * GatheringSidesPerTask;
+              const std::size_t from = k == 0 ? 0 : hitEnds[j][k - 1];
+              addRows(
+                rows, hits[j].data() + from, hitEnds[j][k] - from, 0, rows.length, sum.data());
+            }
+            else
+            {
+              // With reuse one set of rays (stream 0) for every frame; without, each frame
+              // casts its own (stream 1 + frame).
+              for (std::size_t f = 0; f < (reuse ? 1 : rows.length); ++f)
+              {
+                scratchHits[w].clear();
+                castRays(scene, tracer, options, side, raysPerSide, reuse ? 0 : rows.begin + f + 1,
+                  scratchHits[w], counters[w]);
+                addRows(rows, scratchHits[w].data(), scratchHits[w].size(), reuse ? 0 : f,
+                  reuse ? rows.length : 1, &sum[reuse ? 0 : f]);
+              }
+            }
+            // The rows were read as stored, in the solution's storage unit, which the mean
+            // keeps.
+            for (std::size_t f = 0; f < rows.length; ++f)
+            {
+              indirect[solution.elementIndex(rows.begin + f, side / 2,
+                static_cast<Side>(side % 2))] = PackedRgb(sum[f] * perRay);
+            }
+          }
+        },
+        [&](double done)
+        {
+          return progress(castShare +
+            (1 - castShare) * (static_cast<double>(b) + done) / static_cast<double>(blocks));
+        },
+        secondsReducing);
+    }
+  }
   // Each element side gathered on one rank and is exactly zero on the others, so the sum
   // over ranks is that rank's value, bit for bit.
-  StoredArray& indirect = solution.indirectData();
   sumStoredAcrossRanks(options, indirect.data(), indirect.size(), secondsReducing);
   GatheringResult result;
   result.sides = sides.size();

@@ -15,6 +15,14 @@ namespace mlr
 
 class RayTracer;
 
+/// Gathering holds what its rays read (a stored value per element side) for this many frames
+/// at a time: as many as fit in 128 MiB, at least one.
+std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames);
+
+/// With reuse and several blocks, gathering keeps the element side each ray reached for a
+/// group of sides, in at most this many bytes (4 a ray).
+constexpr std::size_t GatheringHitBytes = std::size_t(64) << 20;
+
 /**
  * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`) reads
  * in `frame`: the bounced light of its patch, reconstructed at the element

@@ -3,6 +3,7 @@
 #include "Chunks.h"
 #include "ErrorEstimate.h"
 #include "FixedPointAccumulator.h"
+#include "Gathering.h"
 
 #include "Parallel.h"
 #include "Reachability.h"
@@ -207,11 +208,19 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData)),
     plan.errorEstimate - standardErrors);
   plan.other = saturatingSum(base, reachability);
-  // Gathering holds what its rays read beside the indirect light: a row per element side,
-  // written where the indirect light is (Gathering.cxx).
+  // Gathering holds, beside the indirect light, what its rays read for a block of frames (a
+  // row per element side, written where the indirect light is) and, with reuse over several
+  // blocks, the element sides a group of sides' rays reached (Gathering.h).
+  const std::uint64_t readRows = perPatch
+    ? writtenResultBytes(
+        patches, Scene::ElementsPerPatch, gatheringBlockFrames(elements, frames), reachable)
+    : saturatingProduct({ gatheringBlockFrames(elements, frames), elements, 2, sizeof(PackedRgb) });
+  const std::uint64_t gatheringRays =
+    options.reuseGathering && gatheringBlockFrames(elements, frames) < frames ? GatheringHitBytes
+                                                                              : 0;
   const std::uint64_t gathering = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
-    saturatingSum(standardErrors, indirect));
+    saturatingSum(standardErrors, saturatingSum(readRows, gatheringRays)));
   // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
   // in Solution.h), when a source's sums are turned into them, after the workers' copies were
   // collapsed into one and the others' pages given back. With one source that is the larger
