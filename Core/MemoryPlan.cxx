@@ -215,9 +215,12 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     ? writtenResultBytes(
         patches, Scene::ElementsPerPatch, gatheringBlockFrames(elements, frames), reachable)
     : saturatingProduct({ gatheringBlockFrames(elements, frames), elements, 2, sizeof(PackedRgb) });
+  const auto rays = static_cast<std::uint64_t>(
+    std::max(0.0, options.gatheringRatio * static_cast<double>(options.pathsPerFrame)));
   const std::uint64_t gatheringRays =
-    options.reuseGathering && gatheringBlockFrames(elements, frames) < frames ? GatheringHitBytes
-                                                                              : 0;
+    options.reuseGathering && gatheringBlockFrames(elements, frames) < frames
+    ? std::min<std::uint64_t>(GatheringHitBytes, saturatingProduct({ rays, 4 }))
+    : 0;
   const std::uint64_t gathering = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
     saturatingSum(standardErrors, saturatingSum(readRows, gatheringRays)));
