@@ -56,38 +56,22 @@ void readRows(const Scene& scene, const Solution& solution,
   const std::vector<std::uint8_t>& reachable, int workers, ReadRows& rows)
 {
   rows.values = StoredArray(2 * scene.elementCount() * rows.length);
-  const PackedRgb* patches = solution.patchData().data();
-  const PackedRgb* direct = solution.directData().data();
   constexpr std::size_t PatchesPerTask = 256;
-  // In the solution's storage unit throughout: the reconstruction is linear but for its
-  // limiter, which only compares with zero.
+  const double unit = 1.0 / solution.storageScale();
   auto readPatchSide = [&](std::size_t p, Side side)
   {
-    const LinearStencil& stencil = scene.patchStencil(p);
-    const Side other = side == Side::Front ? Side::Back : Side::Front;
-    const PackedRgb* own = patches + solution.patchIndex(rows.begin, p, side);
-    const PackedRgb* neighbourRows[LinearStencil::MaxNeighbours];
-    for (int i = 0; i < stencil.count; ++i)
-    {
-      const auto n = static_cast<std::size_t>(i);
-      neighbourRows[i] = patches +
-        solution.patchIndex(rows.begin, stencil.neighbour[n], stencil.flipped[n] ? other : side);
-    }
-    const std::size_t first = p * Scene::ElementsPerPatch;
     for (std::size_t f = 0; f < rows.length; ++f)
     {
-      Rgb neighbours[LinearStencil::MaxNeighbours], bounced[Scene::ElementsPerPatch];
-      for (int i = 0; i < stencil.count; ++i)
-      {
-        neighbours[i] = Rgb(neighbourRows[i][f]);
-      }
-      stencil.elementValues(Rgb(own[f]), neighbours, bounced);
+      Rgb bounced[Scene::ElementsPerPatch];
+      elementsBounced(scene, solution, rows.begin + f, p, side, bounced);
       for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
       {
-        const std::size_t e = first + k;
+        const std::size_t e = p * Scene::ElementsPerPatch + k;
+        // In the solution's storage unit, as the rows are read.
         const Rgb value =
-          Rgb(direct[solution.elementIndex(rows.begin + f, e, side)]) * solution.reflectance(e) +
-          bounced[k];
+          Rgb(solution.directData()[solution.elementIndex(rows.begin + f, e, side)]) *
+            solution.reflectance(e) +
+          bounced[k] * unit;
         rows.values[rows.index(e, static_cast<std::size_t>(side)) + f] = PackedRgb(value);
       }
     }

@@ -258,7 +258,6 @@ public:
   StoredArray& stdErrorData() { return this->StdError; }
   /// The patches' bounced light (patchBounced()) of every patch side and frame.
   StoredArray& patchData() { return this->Patch; }
-  const StoredArray& patchData() const { return this->Patch; }
   std::vector<Side>& litSideData() { return this->LitSide; }
   std::vector<Side>& patchLitSideData() { return this->PatchLitSide; }
   /// One per element, or empty when nothing emits.
