@@ -500,31 +500,65 @@ std::vector<double> positionShares(const Scene& scene, const LightSource& source
   // drawn from q' = sum_a alpha_a q_a, R_j = E_q'[(q_j / q')^2] / c_j, c_j the share of
   // frame j's own paths that hit the scene, estimated from the pilots by reweighting them
   // from the equal mixture to q'. Shares move by the square root of R until every frame has
-  // the same; sums run in pilot order, so the choice does not depend on the threads.
-  std::vector<double> alpha(n, 1.0 / double(n)), denominator(pilots), ratio(n);
+  // the same. The sums over the pilots run over fixed blocks of them, added in block order:
+  // the choice does not depend on the threads, and the passes over S x n values use them all.
+  constexpr std::size_t PilotsPerBlock = 256;
+  const std::size_t blocks = (pilots + PilotsPerBlock - 1) / PilotsPerBlock;
+  std::vector<double> alpha(n, 1.0 / double(n)), ratio(n), first(n, 0.0), second(n);
+  std::vector<double> blockSums(blocks * n);
+  for (std::size_t s = 0; s < pilots; ++s)
+  {
+    for (std::size_t a = 0; a < n; ++a)
+    {
+      first[a] += u[s * n + a];
+    }
+  }
   const double low = BalanceLowest / double(n), high = BalanceHighest / double(n);
   for (int iteration = 0; iteration < BalanceIterations; ++iteration)
   {
-    for (std::size_t s = 0; s < pilots; ++s)
+    parallelFor(
+      blocks, workers,
+      [&](std::size_t block, int)
+      {
+        double* sums = blockSums.data() + block * n;
+        std::fill(sums, sums + n, 0.0);
+        for (std::size_t s = block * PilotsPerBlock;
+             s < std::min(pilots, (block + 1) * PilotsPerBlock); ++s)
+        {
+          const float* values = u.data() + s * n;
+          // Four running sums, so that the additions do not wait on each other.
+          double d[4] = { 0, 0, 0, 0 };
+          std::size_t a = 0;
+          for (; a + 4 <= n; a += 4)
+          {
+            for (std::size_t l = 0; l < 4; ++l)
+            {
+              d[l] += alpha[a + l] * values[a + l];
+            }
+          }
+          for (; a < n; ++a)
+          {
+            d[0] += alpha[a] * values[a];
+          }
+          const double denominator = (d[0] + d[1]) + (d[2] + d[3]);
+          if (denominator > 0)
+          {
+            const double inverse = 1.0 / denominator;
+            for (a = 0; a < n; ++a)
+            {
+              const double value = values[a];
+              sums[a] += value * value * inverse;
+            }
+          }
+        }
+      },
+      [&](std::size_t) { return !fraction || fraction(0.0); });
+    std::fill(second.begin(), second.end(), 0.0);
+    for (std::size_t block = 0; block < blocks; ++block)
     {
-      double d = 0;
       for (std::size_t a = 0; a < n; ++a)
       {
-        d += alpha[a] * u[s * n + a];
-      }
-      denominator[s] = d;
-    }
-    std::vector<double> second(n, 0.0), first(n, 0.0);
-    for (std::size_t s = 0; s < pilots; ++s)
-    {
-      if (denominator[s] > 0)
-      {
-        for (std::size_t a = 0; a < n; ++a)
-        {
-          const double value = u[s * n + a];
-          second[a] += value * value / denominator[s];
-          first[a] += value;
-        }
+        second[a] += blockSums[block * n + a];
       }
     }
     double lowest = 1e300, highest = 0;

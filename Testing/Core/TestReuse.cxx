@@ -249,8 +249,9 @@ TEST(Reuse, BalancedSharesMeanOverSeedsEqualsClassicPerFace)
 
 TEST(Reuse, BalancedSharesAreTheSameForAnyThreadCount)
 {
-  // The pilot runs in parallel tasks; its sums run in pilot order, so the counts, and with
-  // them every bit of the result, do not depend on the threads.
+  // The pilot traces and balances in parallel tasks; its sums run over fixed blocks of
+  // pilots, added in block order (4 blocks here), so the counts, and with them every bit of
+  // the result, do not depend on the threads.
   const BoxWithLight s;
   const MovingLight light(s.light, Rgb(1),
     scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.15, 0.5, 0.9 }, { 0.85, 0.5, 0.9 }, 9));
