@@ -163,11 +163,11 @@ void addRows(const ReadRows& rows, const std::uint32_t* hits, std::size_t count,
 
 }
 
-std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames)
+std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames, std::uint64_t rowBytes)
 {
-  constexpr std::size_t RowBytes = std::size_t(128) << 20;
-  const std::size_t perFrame = std::max<std::size_t>(2 * elements * sizeof(PackedRgb), 1);
-  return std::clamp<std::size_t>(RowBytes / perFrame, 1, std::max<std::size_t>(frames, 1));
+  const std::uint64_t perFrame = std::max<std::uint64_t>(2 * elements * sizeof(PackedRgb), 1);
+  return static_cast<std::size_t>(
+    std::clamp<std::uint64_t>(rowBytes / perFrame, 1, std::max<std::size_t>(frames, 1)));
 }
 
 Rgb gatheredRadiosity(
@@ -234,7 +234,8 @@ std::vector<std::uint32_t> blackSides(
 
 GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution)
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution,
+  const GatheringBudget& budget)
 {
   std::uint64_t raysPerSide = 0;
   const auto total = static_cast<std::uint64_t>(
@@ -257,13 +258,13 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   // The rows of what rays read are held for a block of frames at a time, so that they take
   // a bounded share of memory (MemoryPlan). With reuse and several blocks, a group of sides
   // casts its rays once and keeps the element side each reached (4 bytes a ray, at most
-  // GatheringHitBytes), then adds the rows block by block; with one block nothing is kept.
-  const std::size_t block = gatheringBlockFrames(scene.elementCount(), frames);
+  // budget.hitBytes), then adds the rows block by block; with one block nothing is kept.
+  const std::size_t block = gatheringBlockFrames(scene.elementCount(), frames, budget.rowBytes);
   const std::size_t blocks = (frames + block - 1) / block;
   const bool keepHits = reuse && blocks > 1;
   const std::size_t tasksPerGroup = keepHits
     ? std::max<std::size_t>(1,
-        GatheringHitBytes /
+        budget.hitBytes /
           std::max<std::uint64_t>(1, raysPerSide * GatheringSidesPerTask * sizeof(std::uint32_t)))
     : std::max<std::size_t>(tasks, 1);
   const std::size_t groups = (tasks + tasksPerGroup - 1) / tasksPerGroup;

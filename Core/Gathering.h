@@ -2,6 +2,7 @@
 // solution, with one set of rays for every frame (reuse) or one per frame.
 #pragma once
 
+#include "MemoryPlan.h"
 #include "Solution.h"
 #include "SolverOptions.h"
 #include "WorkerCounters.h"
@@ -15,13 +16,8 @@ namespace mlr
 
 class RayTracer;
 
-/// Gathering holds what its rays read (a stored value per element side) for this many frames
-/// at a time: as many as fit in 128 MiB, at least one.
-std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames);
-
-/// With reuse and several blocks, gathering keeps the element side each ray reached for a
-/// group of sides, in at most this many bytes (4 a ray).
-constexpr std::size_t GatheringHitBytes = std::size_t(64) << 20;
+/// The frames of a block of rows: as many as fit in `rowBytes`, at least one.
+std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames, std::uint64_t rowBytes);
 
 /**
  * What a gathering ray (or a sensor's ray) that reaches element side (`element`, `side`) reads
@@ -61,12 +57,12 @@ struct GatheringResult
  * Gathers k N rays (options.gatheringRatio) over the gathering sides of the `reachable` patch
  * sides (and as many per side over their blackSides()), shared by the ranks and summed over them,
  * into solution's indirect light (which must be allocated). `fraction` gets the share done; false
- * cancels.
+ * cancels. The result does not depend on `budget`: each frame sums its rays in the same order.
  */
 GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const SolverOptions& options, const std::vector<std::uint8_t>& reachable, int workers,
-  const std::function<bool(double fraction)>& fraction, double& secondsReducing,
-  Solution& solution);
+  const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution,
+  const GatheringBudget& budget = {});
 
 /// Without gathering (k = 0) an element's indirect radiosity is its patch's bounced light
 /// (Solution::patchBounced), and its indirect irradiance that divided by the patch's

@@ -210,16 +210,25 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   plan.other = saturatingSum(base, reachability);
   // Gathering holds, beside the indirect light, what its rays read for a block of frames (a
   // row per element side, written where the indirect light is) and, with reuse over several
-  // blocks, the element sides a group of sides' rays reached (Gathering.h).
+  // blocks, the element sides a group of sides' rays reached (Gathering.h): up to the default
+  // budget, less when the limit leaves less room, a frame of rows at least.
+  const std::uint64_t gatheringHeld = saturatingSum(
+    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
+    saturatingSum(standardErrors, base));
+  const std::uint64_t limit = memoryLimitBytes(options);
+  const GatheringBudget full;
+  const std::uint64_t room = limit > gatheringHeld ? limit - gatheringHeld : 0;
+  const std::uint64_t budget = std::min(saturatingSum(full.rowBytes, full.hitBytes), room);
+  plan.gathering.rowBytes = budget / 3 * 2;
+  plan.gathering.hitBytes = budget / 3;
+  const std::size_t blockFrames = gatheringBlockFrames(elements, frames, plan.gathering.rowBytes);
   const std::uint64_t readRows = perPatch
-    ? writtenResultBytes(
-        patches, Scene::ElementsPerPatch, gatheringBlockFrames(elements, frames), reachable)
-    : saturatingProduct({ gatheringBlockFrames(elements, frames), elements, 2, sizeof(PackedRgb) });
+    ? writtenResultBytes(patches, Scene::ElementsPerPatch, blockFrames, reachable)
+    : saturatingProduct({ blockFrames, elements, 2, sizeof(PackedRgb) });
   const auto rays = static_cast<std::uint64_t>(
     std::max(0.0, options.gatheringRatio * static_cast<double>(options.pathsPerFrame)));
-  const std::uint64_t gatheringRays =
-    options.reuseGathering && gatheringBlockFrames(elements, frames) < frames
-    ? std::min<std::uint64_t>(GatheringHitBytes, saturatingProduct({ rays, 4 }))
+  const std::uint64_t gatheringRays = options.reuseGathering && blockFrames < frames
+    ? std::min<std::uint64_t>(plan.gathering.hitBytes, saturatingProduct({ rays, 4 }))
     : 0;
   const std::uint64_t gathering = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),

@@ -13,6 +13,16 @@
 namespace mlr
 {
 
+/// What gathering holds beside the results (Gathering.h).
+struct GatheringBudget
+{
+  /// What its rays read, a stored value per element side, for a block of frames at a time.
+  std::uint64_t rowBytes = std::uint64_t(128) << 20;
+  /// With reuse and several blocks, the element side each ray of a group of sides reached
+  /// (4 bytes a ray).
+  std::uint64_t hitBytes = std::uint64_t(64) << 20;
+};
+
 /**
  * How a solve uses memory: the one policy behind the estimate, the limit check and the
  * allocations. Results take 16 bits per channel (PackedRgb, rounded to within 0.1%): direct
@@ -38,6 +48,8 @@ struct MemoryPlan
   /// of ErrorEstimate.h); 0 without batches. The rounds of a target add none.
   std::uint64_t errorEstimate = 0;
   std::uint64_t peak = 0; ///< the estimate: the larger phase, shooting or gathering
+  /// What gathering may hold beside the results: its default, or what the limit leaves.
+  GatheringBudget gathering;
 };
 
 /// The plan of a solve of `frames` frames lit by `lights` light sources (area lights, scene

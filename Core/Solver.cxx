@@ -295,7 +295,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     if (passOptions.gatheringRatio > 0)
     {
       const GatheringResult gathered = gatherIndirect(scene, tracer, passOptions, reachable,
-        workers, phaseTick(1.0 - progressBase), secondsReducing, into);
+        workers, phaseTick(1.0 - progressBase), secondsReducing, into, plan.gathering);
       stats.gatheringSides = gathered.sides;
       rays += gathered.counters;
     }

@@ -8,6 +8,7 @@
 #include "RayTracer.h"
 #include "Sensors.h"
 #include "Solution.h"
+#include "Solver.h"
 
 #include <gtest/gtest.h>
 
@@ -158,4 +159,40 @@ TEST(Gathering, SensorsReadTheDirectLightOfTheElementTheyReach)
   EXPECT_NEAR(result.irradiance(0, 0).r, x.mean,
     5 * x.sigma / std::sqrt(double(counts.hemisphereRays)) + 1e-4 * x.mean);
   EXPECT_GT(result.irradiance(0, 0).r, 2.0);
+}
+
+TEST(Gathering, AnyBudgetGivesTheSameBits)
+{
+  // Under a tight memory limit gathering holds its rows a frame at a time and keeps the hits
+  // of a few sides at a time: every frame still sums its rays in the same order.
+  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(
+    3, true, { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
+  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.5, 0.9 }, { 0.8, 0.5, 0.9 }, 5));
+  SolverOptions options = checks::modeOptions(true, 20000, 3);
+  Solution solution = solve(scene, light, options);
+  const RayTracer tracer(scene);
+  const std::vector<std::uint8_t> reachable(2 * scene.patchCount(), 1);
+  auto gathered = [&](const GatheringBudget& budget)
+  {
+    solution.allocateIndirect();
+    double secondsReducing = 0;
+    gatherIndirect(
+      scene, tracer, options, reachable, 2, [](double) { return true; }, secondsReducing, solution,
+      budget);
+    return solution.indirectData();
+  };
+  const StoredArray whole = gathered({});
+  // A frame of rows (a stored value per element side) and the hits of one task at a time.
+  const std::uint64_t frameOfRows = 2 * sizeof(PackedRgb) * scene.elementCount();
+  const StoredArray tight = gathered({ frameOfRows, 1 });
+  EXPECT_EQ(gatheringBlockFrames(scene.elementCount(), 5, frameOfRows), 1u);
+  EXPECT_EQ(gatheringBlockFrames(scene.elementCount(), 5, 2 * frameOfRows), 2u);
+  EXPECT_TRUE(checks::sameBits(whole, tight));
+  double sum = 0;
+  for (const PackedRgb& v : whole)
+  {
+    sum += Rgb(v).sum();
+  }
+  EXPECT_GT(sum, 0) << "gathering read nothing";
 }

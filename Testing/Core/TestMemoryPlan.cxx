@@ -106,3 +106,31 @@ TEST(MemoryPlan, TheKernelHoldsNoMoreThanTheWrittenPagesCounted)
   }
 }
 #endif
+
+TEST(MemoryPlan, GatheringTakesWhatTheLimitLeaves)
+{
+  // The large benchmark scene, 120 frames, one worker: gathering's phase is the peak. Under a
+  // limit that leaves less than the default 192 MiB of rows and hits beside the results,
+  // gathering holds fewer frames of rows at a time, so that the solve fits the limit.
+  const std::size_t patches = 105420, elements = 4 * patches, points = 220000, frames = 120;
+  SolverOptions options;
+  options.pathsPerFrame = 4000000;
+  options.threads = 1;
+  options.memoryLimitBytes = std::uint64_t(1) << 40;
+  const MemoryPlan roomy = planSolveMemory(patches, elements, points, frames, options);
+  EXPECT_EQ(roomy.gathering.rowBytes, GatheringBudget().rowBytes);
+  EXPECT_EQ(roomy.gathering.hitBytes, GatheringBudget().hitBytes);
+
+  options.memoryLimitBytes = roomy.peak - (std::uint64_t(96) << 20);
+  const MemoryPlan tight = planSolveMemory(patches, elements, points, frames, options);
+  EXPECT_LE(tight.peak, options.memoryLimitBytes);
+  EXPECT_LT(tight.gathering.rowBytes, roomy.gathering.rowBytes);
+  EXPECT_LT(tight.gathering.hitBytes, roomy.gathering.hitBytes);
+  EXPECT_GE(tight.gathering.rowBytes, 2 * elements * sizeof(PackedRgb)) << "a frame of rows";
+  EXPECT_EQ(tight.results, roomy.results);
+
+  // A limit below the results themselves is not met by shrinking: the plan says so.
+  options.memoryLimitBytes = roomy.results / 2;
+  EXPECT_GT(
+    planSolveMemory(patches, elements, points, frames, options).peak, options.memoryLimitBytes);
+}
