@@ -963,6 +963,12 @@ Output:
 Files are written under temporary names and renamed once all are complete: a failure
 leaves any earlier series untouched. Exit status: 0 on success, 1 when the inputs cannot
 be read or solved, 2 for a bad command line.
+
+Under mpiexec (mpiexec -n R moving-light-radiosity ...) the R processes solve together:
+with at least R chunks each takes whole chunks and holds only their frames, else they split
+the paths. Each writes the frames it holds; the series is the one process's, bit for bit
+(the Color arrays aside: their exposure is every frame's). Rank 0 reports for all. Not with
+--png, --sensors or --work-plane; give each rank one thread per core it owns (--threads).
 )";
 }
 

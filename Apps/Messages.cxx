@@ -14,6 +14,8 @@ namespace
 {
 std::string Program = "moving-light-radiosity";
 std::size_t Errors = 0;
+std::string LastError;
+bool Quiet = false;
 
 /// "ERROR: In file.cxx, line 12\nvtkSomething (0x1234): what went wrong\n\n" -> "what went wrong"
 std::string condensed(std::string text)
@@ -47,6 +49,10 @@ public:
   {
     ++Errors;
     const std::string message = condensed(text);
+    if (message.find("returned failure for request") == std::string::npos)
+    {
+      LastError = message;
+    }
     // The executive repeats every failed request with a dump of its pipeline information;
     // the algorithm's own error already said what is wrong.
     if (message.find("returned failure for request") == std::string::npos)
@@ -56,10 +62,19 @@ public:
   }
   void DisplayWarningText(const char* text) override
   {
-    std::cerr << Program << ": warning: " << condensed(text) << std::endl;
+    if (!Quiet)
+    {
+      std::cerr << Program << ": warning: " << condensed(text) << std::endl;
+    }
   }
   void DisplayGenericWarningText(const char* text) override { this->DisplayWarningText(text); }
-  void DisplayText(const char* text) override { std::cerr << condensed(text) << std::endl; }
+  void DisplayText(const char* text) override
+  {
+    if (!Quiet)
+    {
+      std::cerr << condensed(text) << std::endl;
+    }
+  }
   void DisplayDebugText(const char*) override {}
 
 protected:
@@ -81,8 +96,22 @@ std::size_t vtkErrorCount()
   return Errors;
 }
 
+const std::string& lastVtkError()
+{
+  return LastError;
+}
+
+void quietMessages()
+{
+  Quiet = true;
+}
+
 void printError(const std::string& message)
 {
+  if (Quiet)
+  {
+    return;
+  }
   std::cerr << Program << ": error: " << message << std::endl;
 }
 

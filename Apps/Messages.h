@@ -14,6 +14,12 @@ void installMessageWindow(const std::string& program);
 /// VTK errors reported so far (those shown and those dropped as repetitions).
 std::size_t vtkErrorCount();
 
+/// The last VTK error reported, condensed (empty when none).
+const std::string& lastVtkError();
+
+/// From now on nothing is printed: under mpiexec, on the ranks other than 0.
+void quietMessages();
+
 /// Prints "program: error: message" on stderr.
 void printError(const std::string& message);
 

@@ -57,6 +57,11 @@ void OutputTransaction::replaceSeries(
   this->ReplacedSeries.push_back({ directory, prefix, suffix });
 }
 
+void OutputTransaction::keep(const fs::path& finalPath)
+{
+  this->KeptFiles.push_back(finalPath);
+}
+
 void OutputTransaction::commit()
 {
   for (const Staged& file : this->StagedFiles)
@@ -75,6 +80,10 @@ void OutputTransaction::commit()
   for (const Staged& file : this->StagedFiles)
   {
     kept.insert(file.final.lexically_normal());
+  }
+  for (const fs::path& file : this->KeptFiles)
+  {
+    kept.insert(file.lexically_normal());
   }
   for (const Series& series : this->ReplacedSeries)
   {

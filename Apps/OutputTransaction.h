@@ -34,6 +34,10 @@ public:
   void replaceSeries(
     const std::filesystem::path& directory, const std::string& prefix, const std::string& suffix);
 
+  /// A file of a replaced series that another process writes and commits before this one:
+  /// kept, though not staged here.
+  void keep(const std::filesystem::path& finalPath);
+
   /// Renames every staged file to its final name. Throws std::runtime_error on failure.
   void commit();
 
@@ -51,6 +55,7 @@ private:
 
   std::vector<Staged> StagedFiles;
   std::vector<Series> ReplacedSeries;
+  std::vector<std::filesystem::path> KeptFiles;
   std::vector<std::filesystem::path> CreatedDirectories;
   bool Committed = false;
 };

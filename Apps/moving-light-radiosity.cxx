@@ -6,6 +6,7 @@
 #include "Messages.h"
 #include "OutputTransaction.h"
 #include "ProgressBar.h"
+#include "RankJob.h"
 #include "Report.h"
 #include "Sensors.h"
 #include "SeriesWriter.h"
@@ -30,6 +31,7 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -54,6 +56,26 @@ constexpr int ExitUsage = 2;
 struct AlreadyReported
 {
 };
+
+/// Under mpiexec, on the ranks that did not fail: the message of the rank that did.
+struct FailedOnAnotherRank : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+/// Under mpiexec: this rank owes the others the agreement on its inputs until it has made it,
+/// so that a rank that fails before it still meets the others there (main() does).
+bool OwesInputAgreement = true;
+
+/// Every rank meets the others here; throws FailedOnAnotherRank when another failed.
+void agreeAcrossRanks(RankJob& job, const std::string& failure = {})
+{
+  const RankJob::Verdict verdict = job.agree(!failure.empty(), failure);
+  if (verdict.failed && failure.empty())
+  {
+    throw FailedOnAnotherRank(verdict.message);
+  }
+}
 
 /// Set by SIGINT/SIGTERM; polled during the solve and between files, so that an interrupted
 /// run still removes its temporary files.
@@ -233,14 +255,145 @@ vtkSmartPointer<vtkPolyData> weatherTrajectory(const Options& options)
     source, options, [](const std::string& reason) { throw InputError("--weather: " + reason); });
 }
 
-int run(int argc, char** argv)
+/**
+ * Under mpiexec, aborts the filter when this process is interrupted. Only rank 0 reports
+ * progress, so the other ranks see no progress event to abort from; until they do, rank 0
+ * waits for them and mpiexec, which stops a job soon after an interrupt, would kill them
+ * before they remove their temporary files.
+ */
+class InterruptWatcher
+{
+public:
+  explicit InterruptWatcher(vtkMovingLightRadiosity* filter)
+    : Thread(
+        [this, filter]
+        {
+          while (!this->Done)
+          {
+            if (Interrupted)
+            {
+              filter->SetAbortExecuteAndUpdateTime();
+              return;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+          }
+        })
+  {
+  }
+  ~InterruptWatcher()
+  {
+    this->Done = true;
+    this->Thread.join();
+  }
+
+private:
+  std::atomic<bool> Done{ false };
+  std::thread Thread;
+};
+
+/// What `step` threw, as a message; empty when it succeeded.
+std::string failureOf(const std::function<void()>& step)
+{
+  try
+  {
+    step();
+  }
+  catch (const AlreadyReported&)
+  {
+    return lastVtkError().empty() ? "failed" : lastVtkError();
+  }
+  catch (const std::exception& e)
+  {
+    return e.what();
+  }
+  return {};
+}
+
+void throwIf(const std::string& failure)
+{
+  if (!failure.empty())
+  {
+    throw InputError(failure);
+  }
+}
+
+/**
+ * Under mpiexec, after the solve: every frame is written by the lowest rank that holds it
+ * (with chunks, the rank that solved its chunk; else rank 0), and every rank keeps the
+ * records of all. The ranks take each frame in turn together, so that an interrupt or a
+ * failed write on one rank stops them all at the same frame.
+ */
+std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* filter,
+  const std::vector<double>& times, const SeriesNaming& naming, OutputTransaction& output)
+{
+  std::vector<FrameRecord> records;
+  std::string failure;
+  bool stopped = false;
+  {
+    // Destroyed before the agreement: no frame is still being written when a failure rolls
+    // back.
+    FrameWriter writer(writerThreads());
+    for (std::size_t f = 0; f < times.size(); ++f)
+    {
+      vtkPolyData* elements = nullptr;
+      if (failure.empty() && !Interrupted)
+      {
+        failure = failureOf([&] { elements = frameAt(filter, times[f]); });
+      }
+      const bool holds = elements && elements->GetNumberOfCells() > 0;
+      const RankJob::Turn turn = job.turn(holds, Interrupted || !failure.empty());
+      if (turn.stop)
+      {
+        stopped = true;
+        break;
+      }
+      if (turn.writer == job.ranks())
+      {
+        throw InputError(f == 0
+            ? "the scene has no polygons or triangle strips to light: "
+              "nothing to write"
+            : "frame " + std::to_string(f) + " is on no rank: nothing was written");
+      }
+      FrameRecord record;
+      record.time = times[f];
+      record.file = naming.frameName(f, ".vtu");
+      tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+      if (turn.writer == job.rank())
+      {
+        failure = failureOf(
+          [&] { writer.write(elements, times[f], output.stage(naming.directory / record.file)); });
+      }
+      records.push_back(record);
+    }
+    if (failure.empty())
+    {
+      failure = failureOf([&] { writer.finish(); });
+    }
+  }
+  agreeAcrossRanks(job, failure);
+  throwIf(failure);
+  if (stopped)
+  {
+    throw InputError("interrupted: nothing was written");
+  }
+  return records;
+}
+
+int run(int argc, char** argv, RankJob& job)
 {
   const Clock::time_point started = Clock::now();
   const Options options = parseCommandLine(argc, argv);
   if (options.help)
   {
     std::cout << helpText();
+    OwesInputAgreement = false; // every rank stops here alike
     return 0;
+  }
+  if (job.parallel() && (!options.png.empty() || options.usesSensors()))
+  {
+    throw UsageError(std::string(options.png.empty() ? "--sensors and --work-plane" : "--png") +
+      " under mpiexec: the ranks write the frames they solved, and pictures and sensors need "
+      "every frame in one process: run it without mpiexec");
   }
   vtkNew<vtkMovingLightRadiosity> filter;
   configureFilter(options, filter);
@@ -386,7 +539,8 @@ int run(int argc, char** argv)
   // A solve in several chunks streams: each chunk's frames are written as soon as they are
   // final, then freed (the filter keeps the last chunk's). Pictures and sensors need every
   // frame kept, and so does a solve in one chunk, whose frames are written after it.
-  const bool streaming = !sensors && options.png.empty();
+  // Under mpiexec the filter keeps each rank's own chunks, and the ranks write them after.
+  const bool streaming = !sensors && options.png.empty() && !job.parallel();
   std::vector<FrameRecord> records;
   std::optional<FrameWriter> streamWriter; // destroyed before `output`, as below
   std::exception_ptr streamFailure;
@@ -419,10 +573,21 @@ int run(int argc, char** argv)
         }
       });
   }
+  if (job.parallel())
+  {
+    // Inputs read and outputs checked on every rank: the solve's collectives may start.
+    OwesInputAgreement = false;
+    agreeAcrossRanks(job);
+  }
   const Clock::time_point solveStarted = Clock::now();
   vtkPolyData* first = nullptr;
   try
   {
+    std::optional<InterruptWatcher> watcher;
+    if (job.parallel())
+    {
+      watcher.emplace(filter);
+    }
     // The solve; streamed, only the last chunk's frames are kept.
     first = frameAt(filter, streaming ? times.back() : times.front());
   }
@@ -441,7 +606,7 @@ int run(int argc, char** argv)
   filter->RemoveObserver(solving);
   bar.finish();
   throwIfInterrupted();
-  if (first->GetNumberOfCells() == 0)
+  if (first->GetNumberOfCells() == 0 && !job.parallel())
   {
     throw InputError("the scene has no polygons or triangle strips to light: nothing to write");
   }
@@ -454,7 +619,19 @@ int run(int argc, char** argv)
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<std::pair<double, std::string>> sensorEntries;
-  if (streamed)
+  if (job.parallel())
+  {
+    records = writeRankFrames(job, filter, times, naming, output);
+    if (job.rank() == 0)
+    {
+      // The other ranks' frames are theirs to commit, before this rank's .pvd names them.
+      for (const FrameRecord& record : records)
+      {
+        output.keep(naming.directory / record.file);
+      }
+    }
+  }
+  else if (streamed)
   {
     streamWriter->finish();
     if (records.size() != times.size())
@@ -492,7 +669,10 @@ int run(int argc, char** argv)
     }
     writer.finish();
   }
-  output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
+  if (job.rank() == 0)
+  {
+    output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
+  }
   if (sensors)
   {
     output.replaceSeries(naming.directory, sensorNaming.framePrefix(), ".vtp");
@@ -522,22 +702,52 @@ int run(int argc, char** argv)
     stages.rendering = secondsSince(renderingStarted);
   }
 
-  std::vector<std::pair<double, std::string>> entries;
-  for (const FrameRecord& record : records)
+  // The index and the statistics: rank 0's under mpiexec.
+  auto writeIndex = [&]
   {
-    entries.emplace_back(record.time, record.file);
-  }
-  const Clock::time_point collectionStarted = Clock::now();
-  writeCollection(output.stage(collection), entries); // staged after its frames
-  stages.writing += secondsSince(collectionStarted);
-  stages.total = secondsSince(started);
-  if (!options.stats.empty())
+    std::vector<std::pair<double, std::string>> entries;
+    for (const FrameRecord& record : records)
+    {
+      entries.emplace_back(record.time, record.file);
+    }
+    const Clock::time_point collectionStarted = Clock::now();
+    writeCollection(output.stage(collection), entries); // staged after its frames
+    stages.writing += secondsSince(collectionStarted);
+    stages.total = secondsSince(started);
+    if (!options.stats.empty())
+    {
+      const fs::path statsPath = options.stats;
+      writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records, stages);
+    }
+  };
+  if (!job.parallel())
   {
-    const fs::path statsPath = options.stats;
-    writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records, stages);
+    writeIndex();
+    throwIfInterrupted();
+    output.commit();
   }
-  throwIfInterrupted();
-  output.commit();
+  else
+  {
+    // Every rank's files are staged before any is renamed; the other ranks rename theirs
+    // before rank 0 renames its frames and then the index that names them all.
+    std::string failure;
+    if (job.rank() == 0)
+    {
+      failure = failureOf(writeIndex);
+    }
+    agreeAcrossRanks(job, failure);
+    throwIf(failure);
+    if (job.rank() > 0)
+    {
+      failure = failureOf([&] { output.commit(); });
+    }
+    agreeAcrossRanks(job, failure);
+    throwIf(failure);
+    if (job.rank() == 0)
+    {
+      output.commit();
+    }
+  }
   bar.finish();
 
   const std::string errors = errorLine(statistics);
@@ -566,22 +776,51 @@ int main(int argc, char** argv)
   installMessageWindow("moving-light-radiosity");
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  std::optional<RankJob> job;
   try
   {
-    return run(argc, argv);
-  }
-  catch (const UsageError& e)
-  {
-    printError(std::string(e.what()) + " (see --help)");
-    return ExitUsage;
-  }
-  catch (const AlreadyReported&)
-  {
-    return ExitFailure;
+    job.emplace(&argc, &argv);
   }
   catch (const std::exception& e)
   {
     printError(e.what());
     return ExitFailure;
+  }
+  if (job->rank() > 0)
+  {
+    // Rank 0 speaks for all: the ranks run alike, and a failure elsewhere reaches it named.
+    quietMessages();
+    if (!std::freopen("/dev/null", "w", stdout))
+    {
+      std::fclose(stdout);
+    }
+  }
+  // A rank that fails before the others agree on their inputs meets them there.
+  auto failed = [&](int code, const std::string& message)
+  {
+    if (job->parallel() && OwesInputAgreement)
+    {
+      OwesInputAgreement = false;
+      job->agree(true, message);
+    }
+    return code;
+  };
+  try
+  {
+    return run(argc, argv, *job);
+  }
+  catch (const UsageError& e)
+  {
+    printError(std::string(e.what()) + " (see --help)");
+    return failed(ExitUsage, e.what());
+  }
+  catch (const AlreadyReported&)
+  {
+    return failed(ExitFailure, lastVtkError().empty() ? "failed" : lastVtkError());
+  }
+  catch (const std::exception& e)
+  {
+    printError(e.what());
+    return failed(ExitFailure, e.what());
   }
 }

@@ -1,0 +1,134 @@
+"""The command line under mpiexec: the ranks solve together (with chunks each rank takes whole
+chunks) and each writes the frames it holds; the series is the one process's, bit for bit in
+every physical array. A usage error is reported once and writes nothing; an interrupt in the
+middle of the solve leaves no file and no process behind.
+
+ctest sets MLR_CLI, MLR_DATA_DIR and MLR_MPIEXEC; by hand:
+    MLR_CLI=build/bin/moving-light-radiosity MLR_MPIEXEC=mpiexec \\
+        /usr/bin/python3 -m pytest Testing/Parallel/test_cli_ranks.py
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run  # noqa: E402
+
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader  # noqa: E402
+import numpy  # noqa: E402
+import pytest  # noqa: E402
+
+MPIEXEC = [os.environ.get("MLR_MPIEXEC", "mpiexec"), "--allow-run-as-root", "--oversubscribe"]
+PATH = ["--from", "0.15,0.5478,0.15", "--to", "0.40,0.5478,0.40"]
+COMMON = ["--scene", SCENE, "--light", LIGHT] + PATH + FAST + ["--threads", "1"]
+
+
+def run_ranks(ranks, args, cwd, timeout=240):
+    return subprocess.run(MPIEXEC + ["-n", str(ranks), CLI] + args, cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def arrays(path):
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    data = reader.GetOutput()
+    out = {"points": vtk_to_numpy(data.GetPoints().GetData())}
+    for kind, attributes in (("cell", data.GetCellData()), ("point", data.GetPointData())):
+        for i in range(attributes.GetNumberOfArrays()):
+            out[kind + " " + attributes.GetArrayName(i)] = vtk_to_numpy(attributes.GetArray(i))
+    return out
+
+
+def assert_same_series(one, many, frames, display):
+    """Every frame's arrays equal bit for bit; the Color arrays only when `display` (a
+    streamed run's exposure is its first chunk's, the ranks' that of every frame)."""
+    assert sorted(f for f in all_files(one) if f.endswith(".vtu")) == \
+        sorted(f for f in all_files(many) if f.endswith(".vtu"))
+    assert len([f for f in all_files(many) if f.endswith(".vtu")]) == frames
+    assert (one / "s.pvd").read_text() == (many / "s.pvd").read_text()
+    for f in range(frames):
+        a, b = arrays(one / f"s_{f:04d}.vtu"), arrays(many / f"s_{f:04d}.vtu")
+        assert sorted(a) == sorted(b), f
+        assert "cell Radiosity" in a and "cell RadiosityStdError" in a
+        for name in a:
+            if name.endswith(" Color") and not display:
+                continue
+            assert a[name].shape == b[name].shape and numpy.array_equal(a[name], b[name]), \
+                (f, name)
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_ranks_with_chunks_write_the_serial_series(tmp_path, ranks):
+    # 12 frames in 3 chunks: with 2 ranks rank 0 solves chunks 1 and 3, with 3 one each.
+    args = COMMON + ["--frames", "12", "--frames-per-chunk", "4"]
+    one = run(args + ["--output", "one/s.pvd"], tmp_path)
+    assert one.returncode == 0, one.stderr
+    many = run_ranks(ranks, args + ["--output", "many/s.pvd", "--stats", "many/s.json"],
+                     tmp_path)
+    assert many.returncode == 0, many.stdout + many.stderr
+    assert many.stdout.count("wrote many/s.pvd and 12 frames") == 1, many.stdout
+    assert_same_series(tmp_path / "one", tmp_path / "many", 12, display=False)
+    stats = json.loads((tmp_path / "many/s.json").read_text())
+    assert stats["statistics"]["Chunks"] == 3 and stats["statistics"]["Frames"] == 12
+    assert all_files(tmp_path / "many") == sorted(
+        ["s.json", "s.pvd"] + [f"s_{f:04d}.vtu" for f in range(12)])
+
+
+def test_ranks_without_chunks_write_the_serial_series(tmp_path):
+    # One chunk: the ranks share the paths, every rank holds every frame, rank 0 writes them.
+    args = COMMON + ["--frames", "5"]
+    one = run(args + ["--output", "one/s.pvd"], tmp_path)
+    assert one.returncode == 0, one.stderr
+    many = run_ranks(2, args + ["--output", "many/s.pvd"], tmp_path)
+    assert many.returncode == 0, many.stdout + many.stderr
+    assert_same_series(tmp_path / "one", tmp_path / "many", 5, display=True)
+
+
+def test_a_usage_error_is_reported_once_and_writes_nothing(tmp_path):
+    result = run_ranks(2, ["--frames", "3", "--output", "u/s.pvd"], tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("--frames needs --from and --to") == 1, result.stderr
+    result = run_ranks(2, COMMON + ["--frames", "3", "--png", "pictures", "--output", "p/s.pvd"],
+                       tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("--png under mpiexec") == 1, result.stderr
+    assert all_files(tmp_path) == []
+
+
+def test_an_interrupt_in_the_second_round_of_chunks_leaves_nothing(tmp_path):
+    process = subprocess.Popen(
+        MPIEXEC + ["-n", "2", CLI] + ["--scene", SCENE, "--light", LIGHT] + PATH +
+        ["--frames", "16", "--frames-per-chunk", "4", "--paths", "3000000", "--patch-size",
+         "0.08", "--threads", "1", "--output", "out/s.pvd"],
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
+    try:
+        seen = []
+        deadline = time.monotonic() + 200
+        while time.monotonic() < deadline:
+            line = process.stdout.readline()
+            if not line:
+                break
+            seen.append(line)
+            if "chunk 3 of 4" in line:  # rank 0 solves chunks 1 and 3
+                break
+        assert any("chunk 3 of 4" in line for line in seen), (seen, process.poll())
+        assert process.poll() is None, "the run ended before it was interrupted"
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=120)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert process.returncode != 0
+    assert "interrupted: nothing was written" in err, err
+    assert all_files(tmp_path) == []
+    # No rank outlives the job.
+    left = subprocess.run(["pgrep", "-f", "--", str(tmp_path / "out")], capture_output=True,
+                          text=True)
+    assert left.stdout == "", left.stdout
