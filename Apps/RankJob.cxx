@@ -108,23 +108,32 @@ RankJob::Verdict RankJob::agree(bool failed, const std::string& message)
   return verdict;
 }
 
-RankJob::Turn RankJob::turn(bool holds, bool stop)
+RankJob::Holders RankJob::holders(bool holds)
 {
-  Turn turn;
-  turn.writer = holds ? this->Rank : this->Ranks;
-  turn.stop = stop;
+  Holders result;
+  result.count = holds ? 1 : 0;
+  result.lowest = holds ? this->Rank : this->Ranks;
 #ifdef MLR_CLI_MPI
   if (this->Controller)
   {
-    // One maximum over ranks: of the stop flag, and of ranks - writer for the lowest writer.
-    int mine[2] = { stop ? 1 : 0, this->Ranks - turn.writer };
-    int all[2] = { 0, 0 };
-    this->Controller->AllReduce(mine, all, 2, vtkCommunicator::MAX_OP);
-    turn.stop = all[0] != 0;
-    turn.writer = this->Ranks - all[1];
+    int count = result.count, lowest = result.lowest;
+    this->Controller->AllReduce(&count, &result.count, 1, vtkCommunicator::SUM_OP);
+    this->Controller->AllReduce(&lowest, &result.lowest, 1, vtkCommunicator::MIN_OP);
   }
 #endif
-  return turn;
+  return result;
+}
+
+long long RankJob::sum(long long value)
+{
+  long long total = value;
+#ifdef MLR_CLI_MPI
+  if (this->Controller)
+  {
+    this->Controller->AllReduce(&value, &total, 1, vtkCommunicator::SUM_OP);
+  }
+#endif
+  return total;
 }
 
 } // namespace mlr::cli

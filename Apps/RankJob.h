@@ -36,14 +36,17 @@ public:
   /// Collective: every rank calls it at the same point with its own outcome.
   Verdict agree(bool failed, const std::string& message);
 
-  /// Collective, once per frame written: the lowest rank that holds the frame (ranks() when
-  /// none does), and whether any rank asks to stop (an interrupt or a failed write).
-  struct Turn
+  /// Collective: how many ranks hold something (a frame), and the lowest that does (ranks()
+  /// when none does).
+  struct Holders
   {
-    int writer = 0;
-    bool stop = false;
+    int count = 0;
+    int lowest = 0;
   };
-  Turn turn(bool holds, bool stop);
+  Holders holders(bool holds);
+
+  /// Collective: the sum of `value` over the ranks.
+  long long sum(long long value);
 
 private:
   vtkMPIController* Controller = nullptr;

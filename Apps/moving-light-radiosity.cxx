@@ -318,52 +318,59 @@ void throwIf(const std::string& failure)
 }
 
 /**
- * Under mpiexec, after the solve: every frame is written by the lowest rank that holds it
- * (with chunks, the rank that solved its chunk; else rank 0), and every rank keeps the
- * records of all. The ranks take each frame in turn together, so that an interrupt or a
- * failed write on one rank stops them all at the same frame.
+ * Under mpiexec, after the solve: each frame is written by the rank that holds it. With
+ * chunks taken by the ranks a frame is on one rank, its chunk's, and every rank writes its
+ * own at once; when every rank holds every frame (the ranks split the paths), the lowest
+ * writes them all. Every rank keeps the records of all the frames. A failure or an
+ * interrupt stops this rank's writing, and the agreement after it stops every rank's.
  */
 std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* filter,
   const std::vector<double>& times, const SeriesNaming& naming, OutputTransaction& output)
 {
   std::vector<FrameRecord> records;
   std::string failure;
-  bool stopped = false;
+  vtkPolyData* first = nullptr;
+  failure = failureOf([&] { first = frameAt(filter, times.front()); });
+  const RankJob::Holders holders = job.holders(first && first->GetNumberOfCells() > 0);
+  agreeAcrossRanks(job, failure);
+  throwIf(failure);
+  if (holders.count == 0)
+  {
+    throw InputError("the scene has no polygons or triangle strips to light: nothing to write");
+  }
+  const bool apart = holders.count == 1;
+  const bool writes = apart || holders.lowest == job.rank();
+  long long written = 0;
   {
     // Destroyed before the agreement: no frame is still being written when a failure rolls
     // back.
     FrameWriter writer(writerThreads());
-    for (std::size_t f = 0; f < times.size(); ++f)
+    for (std::size_t f = 0; f < times.size() && failure.empty(); ++f)
     {
-      vtkPolyData* elements = nullptr;
-      if (failure.empty() && !Interrupted)
-      {
-        failure = failureOf([&] { elements = frameAt(filter, times[f]); });
-      }
-      const bool holds = elements && elements->GetNumberOfCells() > 0;
-      const RankJob::Turn turn = job.turn(holds, Interrupted || !failure.empty());
-      if (turn.stop)
-      {
-        stopped = true;
-        break;
-      }
-      if (turn.writer == job.ranks())
-      {
-        throw InputError(f == 0
-            ? "the scene has no polygons or triangle strips to light: "
-              "nothing to write"
-            : "frame " + std::to_string(f) + " is on no rank: nothing was written");
-      }
-      FrameRecord record;
-      record.time = times[f];
-      record.file = naming.frameName(f, ".vtu");
-      tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
-      if (turn.writer == job.rank())
-      {
-        failure = failureOf(
-          [&] { writer.write(elements, times[f], output.stage(naming.directory / record.file)); });
-      }
-      records.push_back(record);
+      failure = failureOf(
+        [&]
+        {
+          throwIfInterrupted();
+          FrameRecord record;
+          record.time = times[f];
+          record.file = naming.frameName(f, ".vtu");
+          if (writes)
+          {
+            vtkPolyData* elements = frameAt(filter, times[f]);
+            tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+            if (elements->GetNumberOfCells() > 0)
+            {
+              writer.write(elements, times[f], output.stage(naming.directory / record.file));
+              ++written;
+            }
+            else if (!apart)
+            {
+              throw InputError("frame " + std::to_string(f) + " is missing on rank " +
+                std::to_string(job.rank()) + ", which holds the others");
+            }
+          }
+          records.push_back(record);
+        });
     }
     if (failure.empty())
     {
@@ -372,9 +379,11 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
   }
   agreeAcrossRanks(job, failure);
   throwIf(failure);
-  if (stopped)
+  const long long all = job.sum(written);
+  if (all != static_cast<long long>(times.size()))
   {
-    throw InputError("interrupted: nothing was written");
+    throw InputError("the ranks wrote " + std::to_string(all) + " frames of " +
+      std::to_string(times.size()) + ": nothing was written");
   }
   return records;
 }
