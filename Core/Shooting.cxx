@@ -398,11 +398,23 @@ void ShootingRun::shootReused(std::uint64_t path, int worker)
       ++counters.shadowRaysBlocked;
     }
   }
-  double mixture = 0;
-  for (std::size_t j = 0; j < this->Frames; ++j)
+  // Four running sums, so that the additions do not wait on each other (one chain of n
+  // dependent additions per path).
+  const double* counts = this->PathsFromPosition.data();
+  double sums[4] = { 0, 0, 0, 0 };
+  std::size_t k = 0;
+  for (; k + 4 <= this->Frames; k += 4)
   {
-    mixture += this->PathsFromPosition[j] * kernel[j];
+    for (std::size_t l = 0; l < 4; ++l)
+    {
+      sums[l] += counts[k + l] * kernel[k + l];
+    }
   }
+  for (; k < this->Frames; ++k)
+  {
+    sums[0] += counts[k] * kernel[k];
+  }
+  const double mixture = (sums[0] + sums[1]) + (sums[2] + sums[3]);
   if (!(mixture > 0))
   {
     return; // grazing to the last bit: the path carries nothing
