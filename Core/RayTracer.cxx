@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -213,21 +214,38 @@ void occludedPackets(RTCScene scene, const Vec3& origin, const float* dx, const 
     packet.mask[i] = 0xFFFFFFFFu;
     packet.id[i] = static_cast<unsigned>(i);
     packet.flags[i] = 0;
+    packet.tnear[i] = 0.0f; // Embree writes only tfar
   }
   for (std::size_t first = 0; first < count; first += width)
   {
     const std::size_t lanes = std::min(width, count - first);
-    // Branch-free lane set-up: idle lanes repeat the last ray and are switched off in `valid`.
-    for (std::size_t i = 0; i < width; ++i)
+    if (lanes == width)
     {
-      const std::size_t k = first + std::min(i, lanes - 1);
-      const float x = dx[k], y = dy[k], z = dz[k];
-      valid[i] = i < lanes && x * x + y * y + z * z > shortestSquared ? -1 : 0;
-      packet.dir_x[i] = x;
-      packet.dir_y[i] = y;
-      packet.dir_z[i] = z;
-      packet.tnear[i] = 0.0f;
-      packet.tfar[i] = tfar;
+      // A full packet, the common case: straight copies and a test the compiler vectorises
+      // (the lane set-up was a tenth of the solve's time when done lane by lane).
+      std::memcpy(packet.dir_x, dx + first, sizeof(packet.dir_x));
+      std::memcpy(packet.dir_y, dy + first, sizeof(packet.dir_y));
+      std::memcpy(packet.dir_z, dz + first, sizeof(packet.dir_z));
+      for (std::size_t i = 0; i < width; ++i)
+      {
+        const float x = packet.dir_x[i], y = packet.dir_y[i], z = packet.dir_z[i];
+        valid[i] = x * x + y * y + z * z > shortestSquared ? -1 : 0;
+        packet.tfar[i] = tfar;
+      }
+    }
+    else
+    {
+      // Idle lanes repeat the last ray and are switched off in `valid`.
+      for (std::size_t i = 0; i < width; ++i)
+      {
+        const std::size_t k = first + std::min(i, lanes - 1);
+        const float x = dx[k], y = dy[k], z = dz[k];
+        valid[i] = i < lanes && x * x + y * y + z * z > shortestSquared ? -1 : 0;
+        packet.dir_x[i] = x;
+        packet.dir_y[i] = y;
+        packet.dir_z[i] = z;
+        packet.tfar[i] = tfar;
+      }
     }
     rtcOccluded16(valid, scene, &context, &packet);
     for (std::size_t i = 0; i < lanes; ++i)
