@@ -614,7 +614,10 @@ int run(int argc, char** argv, RankJob& job)
   // Later updates only copy frames out of the filter's cache: their progress is not the solve's.
   filter->RemoveObserver(solving);
   bar.finish();
-  throwIfInterrupted();
+  if (!job.parallel()) // under mpiexec the ranks stop together, in writeRankFrames
+  {
+    throwIfInterrupted();
+  }
   if (first->GetNumberOfCells() == 0 && !job.parallel())
   {
     throw InputError("the scene has no polygons or triangle strips to light: nothing to write");
