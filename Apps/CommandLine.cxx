@@ -965,10 +965,10 @@ leaves any earlier series untouched. Exit status: 0 on success, 1 when the input
 be read or solved, 2 for a bad command line.
 
 Under mpiexec (mpiexec -n R moving-light-radiosity ...) the R processes solve together:
-with at least R chunks each takes whole chunks and holds only their frames, else they split
-the paths. Each writes the frames it holds; the series is the one process's, bit for bit
-(the Color arrays aside: their exposure is every frame's). Rank 0 reports for all. Not with
---png, --sensors or --work-plane; give each rank one thread per core it owns (--threads).
+with at least R chunks each takes whole chunks and writes their frames as they are solved,
+else they split the paths and rank 0 writes. The series is the one process's, bit for bit.
+Rank 0 reports for all. Not with --png, --sensors or --work-plane; give each rank one
+thread per core it owns (--threads).
 )";
 }
 

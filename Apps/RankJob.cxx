@@ -136,4 +136,18 @@ long long RankJob::sum(long long value)
   return total;
 }
 
+void RankJob::sum(std::vector<double>& values)
+{
+#ifdef MLR_CLI_MPI
+  if (this->Controller && !values.empty())
+  {
+    const std::vector<double> mine = values;
+    this->Controller->AllReduce(
+      mine.data(), values.data(), static_cast<vtkIdType>(values.size()), vtkCommunicator::SUM_OP);
+  }
+#else
+  (void)values;
+#endif
+}
+
 } // namespace mlr::cli

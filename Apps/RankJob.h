@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 class vtkMPIController;
 
@@ -47,6 +48,8 @@ public:
 
   /// Collective: the sum of `value` over the ranks.
   long long sum(long long value);
+  /// Collective: `values` summed over the ranks, in place.
+  void sum(std::vector<double>& values);
 
 private:
   vtkMPIController* Controller = nullptr;

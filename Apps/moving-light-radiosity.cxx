@@ -388,6 +388,45 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
   return records;
 }
 
+/**
+ * Under mpiexec, after a streamed solve: each rank wrote the frames of its chunks as they
+ * came (`mine`, of the frames `mineFrames`); the ranks agree that every frame was written once, and
+ * every rank gets the records of all, the light's positions summed over the ranks.
+ */
+std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double>& times,
+  const SeriesNaming& naming, std::optional<FrameWriter>& writer,
+  const std::vector<FrameRecord>& mine, const std::vector<std::size_t>& mineFrames)
+{
+  std::string failure;
+  if (writer)
+  {
+    failure = failureOf([&] { writer->finish(); });
+  }
+  agreeAcrossRanks(job, failure);
+  throwIf(failure);
+  const long long all = job.sum(static_cast<long long>(mine.size()));
+  if (all != static_cast<long long>(times.size()))
+  {
+    throw InputError("the ranks streamed " + std::to_string(all) + " frames of " +
+      std::to_string(times.size()) + ": nothing was written");
+  }
+  std::vector<double> positions(3 * times.size(), 0.0);
+  for (std::size_t i = 0; i < mine.size(); ++i)
+  {
+    std::copy(
+      mine[i].lightPosition.begin(), mine[i].lightPosition.end(), &positions[3 * mineFrames[i]]);
+  }
+  job.sum(positions);
+  std::vector<FrameRecord> records(times.size());
+  for (std::size_t f = 0; f < times.size(); ++f)
+  {
+    records[f].time = times[f];
+    records[f].file = naming.frameName(f, ".vtu");
+    std::copy(&positions[3 * f], &positions[3 * f + 3], records[f].lightPosition.begin());
+  }
+  return records;
+}
+
 int run(int argc, char** argv, RankJob& job)
 {
   const Clock::time_point started = Clock::now();
@@ -548,17 +587,24 @@ int run(int argc, char** argv, RankJob& job)
   // A solve in several chunks streams: each chunk's frames are written as soon as they are
   // final, then freed (the filter keeps the last chunk's). Pictures and sensors need every
   // frame kept, and so does a solve in one chunk, whose frames are written after it.
-  // Under mpiexec the filter keeps each rank's own chunks, and the ranks write them after.
-  const bool streaming = !sensors && options.png.empty() && !job.parallel();
+  // Under mpiexec each rank gets the chunks it solved (when the ranks take whole chunks).
+  const bool streaming = !sensors && options.png.empty();
   std::vector<FrameRecord> records;
   std::optional<FrameWriter> streamWriter; // destroyed before `output`, as below
   std::exception_ptr streamFailure;
+  std::size_t framesReceived = 0;
+  std::vector<std::size_t> streamedFrames;
+  bool othersWrite = false;
   if (streaming)
   {
     filter->SetChunkObserver(
       [&](std::size_t f, vtkPolyData* elements)
       {
-        if (streamFailure || Interrupted)
+        ++framesReceived;
+        // Under mpiexec with fewer chunks than ranks every rank gets every frame, starting
+        // with the first, which ranks that take whole chunks leave to rank 0: rank 0 writes.
+        othersWrite = othersWrite || (job.rank() > 0 && f == 0);
+        if (streamFailure || Interrupted || othersWrite)
         {
           return;
         }
@@ -574,6 +620,7 @@ int run(int argc, char** argv, RankJob& job)
           tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
           streamWriter->write(elements, times[f], output.stage(naming.directory / record.file));
           records.push_back(record);
+          streamedFrames.push_back(f);
         }
         catch (...)
         {
@@ -631,7 +678,18 @@ int run(int argc, char** argv, RankJob& job)
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<std::pair<double, std::string>> sensorEntries;
-  if (job.parallel())
+  if (job.parallel() && job.holders(framesReceived > 0).count > 0)
+  {
+    records = finishRankStream(job, times, naming, streamWriter, records, streamedFrames);
+    if (job.rank() == 0)
+    {
+      for (const FrameRecord& record : records)
+      {
+        output.keep(naming.directory / record.file);
+      }
+    }
+  }
+  else if (job.parallel())
   {
     records = writeRankFrames(job, filter, times, naming, output);
     if (job.rank() == 0)

@@ -136,8 +136,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       options.chunkFrames(animation, first, frames);
     };
   }
-  animation.solution =
-    solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress, onFrames);
+  animation.solution = solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress,
+    onFrames, streamed ? options.firstChunkFigure : FirstChunkFigure());
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
   animation.solution.statistics.patchEdgeLength = animation.remeshing.targetEdgeLength;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),

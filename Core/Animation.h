@@ -44,6 +44,8 @@ struct AnimationOptions
   /// over ranks keeps all it gets, its cache of chunks some): the memory policy counts them
   /// (estimateChunkedMemory). 0: none beyond the chunk handed on.
   std::size_t keptStreamedChunks = 0;
+  /// With chunkFrames: a figure of the first chunk's frames for every rank (Chunks.h).
+  FirstChunkFigure firstChunkFigure;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.

@@ -499,7 +499,8 @@ void exchangeFrames(const SolverOptions& options, Solution& frames, double& seco
 }
 
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
-  std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames)
+  std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames,
+  const FirstChunkFigure& figure)
 {
   const std::size_t frames = frameCount(rig, scene.hasEmission());
   const ChunkPlan plan = planChunks(frames, framesPerChunk);
@@ -553,6 +554,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   Solution shape;
   double progressBase = 0;
   double secondsExchanging = 0;
+  double firstFigure = 0;
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t round = 0; round * ranks < chunkCount; ++round)
   {
@@ -622,6 +624,14 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       {
         Solution finished = handedOn(plan, k, seam, current, litSides, patchLitSides);
         before.reset();
+        if (k == 0 && figure.compute)
+        {
+          firstFigure = figure.compute(finished);
+          if (figure.receive)
+          {
+            figure.receive(firstFigure);
+          }
+        }
         onFrames(plan.finishedBegin(k), finished);
       }
       else
@@ -669,6 +679,17 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         patchLitSides.resize(scene.patchCount(), Side::Front);
         exchangeSides(options, mine, litSides, secondsExchanging);
         exchangeSides(options, mine, patchLitSides, secondsExchanging);
+        if (onFrames && figure.compute)
+        {
+          // From the first chunk's rank, which computed it before the slots (a sum where the
+          // others give zero, exact), before the other ranks finish their first chunks.
+          double value = mine ? firstFigure : 0.0;
+          options.sumDoublesAcrossRanks(&value, 1);
+          if (!mine && figure.receive)
+          {
+            figure.receive(value);
+          }
+        }
       }
       // The estimate of the seam after chunk j, for the rank of the chunk after it.
       const bool forMe = (j + 1) % ranks == rank;

@@ -66,6 +66,16 @@ LightRig sliceRig(const LightRig& rig, std::size_t first, std::size_t count);
 /// Solution may be moved from. Chunk by chunk, in frame order.
 using ChunkFramesCallback = std::function<void(std::size_t firstFrame, Solution& frames)>;
 
+/// A figure the caller derives from the first chunk's finished frames (a display's exposure),
+/// the same on every rank: `compute` runs on the rank that solved that chunk, before the
+/// frames go to the ChunkFramesCallback, and every rank gets the value through `receive`
+/// before its first frames do.
+struct FirstChunkFigure
+{
+  std::function<double(const Solution& frames)> compute;
+  std::function<void(double value)> receive;
+};
+
 /**
  * Solves the animation in the chunks of planChunks(frames, framesPerChunk). With one chunk
  * this is solve(scene, rig, options, progress), bit for bit. With several, each is a solve of
@@ -84,7 +94,7 @@ using ChunkFramesCallback = std::function<void(std::size_t firstFrame, Solution&
  */
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress = {},
-  const ChunkFramesCallback& onFrames = {});
+  const ChunkFramesCallback& onFrames = {}, const FirstChunkFigure& figure = {});
 
 /**
  * The frames that chunk `chunk` of planChunks(frames, framesPerChunk) finishes, solved again

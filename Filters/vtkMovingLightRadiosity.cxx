@@ -88,8 +88,9 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// which leaves the last chunk's frames.
   std::size_t FirstFrame = 0;
   /// Several ranks: the frames this rank holds, in blocks (Solution then holds no frame).
-  /// With FramesApart each rank holds the chunks it solved, outputs the whole of their time
-  /// steps and an empty piece at the others'; else every rank holds every frame.
+  /// With FramesApart each rank holds the chunks it solved (streamed to the ChunkObserver,
+  /// the last of them in Solution), outputs the whole of their time steps and an empty piece
+  /// at the others'; else every rank holds every frame.
   std::vector<mlr::vtkparallel::FrameBlock> RankFrames;
   bool FramesApart = false;
   /// CachedChunks: the blocks of RankFrames are whole chunks, the last asked for first, and
@@ -666,6 +667,12 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     }
   }
   else if (cache.Solution.frameCount() > 1 &&
+    (frame < cache.FirstFrame || frame >= cache.FirstFrame + cache.Solution.frameCount()) &&
+    cache.FramesApart)
+  {
+    held = false; // streamed by the rank that solved it, or by this rank before its last chunk
+  }
+  else if (cache.Solution.frameCount() > 1 &&
     (frame < cache.FirstFrame || frame >= cache.FirstFrame + cache.Solution.frameCount()))
   {
     vtkErrorMacro(<< "time step " << frame << " was streamed to the chunk observer and is no "
@@ -1186,6 +1193,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     // solve in one chunk comes whole, and is kept as without the observer.
     std::optional<mlr::Solution> whole;
     bool streamed = false;
+    std::optional<double> firstChunkExposure;
     // Several ranks keep the frames as they come, chunk by chunk: each rank those of the
     // chunks it solved when there are at least as many chunks as ranks (Core's ranks then
     // take whole chunks), so that a long animation's frames are shared out, not repeated.
@@ -1203,8 +1211,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         rankFrames.push_back({ first, std::move(frames) });
       };
     }
-    else if ((this->ChunkFramesObserver || cachesChunks) && !controller && options.sensors.empty())
+    else if ((this->ChunkFramesObserver || cachesChunks) && options.sensors.empty())
     {
+      // The display's exposure is the first chunk's on every rank (over ranks that take
+      // whole chunks, rank 0 solved it), so that every chunk's frames look alike.
+      options.firstChunkFigure.compute = [](const mlr::Solution& frames)
+      { return mlr::vtkoutputs::autoExposure(frames); };
+      options.firstChunkFigure.receive = [&](double exposure) { firstChunkExposure = exposure; };
       if (cachesChunks)
       {
         options.keptStreamedChunks = static_cast<std::size_t>(this->CachedChunks);
@@ -1223,7 +1236,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           cache.Rig = rig;
           cache.Shading = mlr::vtkoutputs::smoothShading(solving.scene, frames);
           cache.Elements = mlr::vtkoutputs::smoothElementMesh(solving.scene, cache.Shading);
-          cache.AutoExposure = mlr::vtkoutputs::autoExposure(frames);
+          cache.AutoExposure =
+            firstChunkExposure ? *firstChunkExposure : mlr::vtkoutputs::autoExposure(frames);
           cache.Patches = mlr::vtkoutputs::patchMesh(solving.scene, solving.patches.points.size());
           cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(frames);
           cache.TwoSided = solverOptions.twoSided;
@@ -1355,6 +1369,10 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     {
       cache.RankFrames = std::move(rankFrames);
       cache.FramesApart = apart->apart;
+    }
+    else if (streamed && controller)
+    {
+      cache.FramesApart = true; // each rank streamed the chunks it solved
     }
     if (controller)
     {

@@ -636,9 +636,10 @@ public:
    * `observer` gets each of them in order, as the Elements output of that time step would be,
    * and they are freed after: only the last chunk's frames stay for the time steps. The
    * display's exposure and the lit sides are then those of the first chunk. A solve in one
-   * chunk or with sensors keeps every frame as without an observer; over several ranks the
-   * observer is not used (each rank keeps the frames of the chunks it solved).
-   * An empty observer turns streaming off.
+   * chunk or with sensors keeps every frame as without an observer. Over several ranks that
+   * take whole chunks, each rank's observer gets the frames of the chunks it solved (the
+   * first chunk's exposure and lit sides on every rank); with fewer chunks than ranks every
+   * rank keeps every frame, as without an observer. An empty observer turns streaming off.
    */
   using ChunkObserver = std::function<void(std::size_t frame, vtkPolyData* elements)>;
   void SetChunkObserver(ChunkObserver observer);

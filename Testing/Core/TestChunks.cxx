@@ -367,13 +367,27 @@ TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
   ASSERT_EQ(plan.chunks.size(), 4u);
   FrameBits serial;
   std::vector<Side> serialSides;
+  // A figure of the first chunk's frames (the filter's display exposure): on every rank, the
+  // same, and there before the rank's first frames.
+  auto figureOf = [](const Solution& frames)
+  {
+    double sum = 0;
+    for (std::size_t e = 0; e < frames.elementCount(); ++e)
+    {
+      sum += frames.total(0, e, Side::Front).sum();
+    }
+    return sum;
+  };
+  double serialFigure = -1;
   const Solution serialStats = solveInChunks(scene, rig(), o, perChunk, {},
     [&](std::size_t first, Solution& frames)
     {
       recordFrames(first, frames, serial);
       serialSides = frames.litSideData();
-    });
+    },
+    { figureOf, [&](double v) { serialFigure = v; } });
   ASSERT_EQ(serial.size(), Frames);
+  ASSERT_GT(serialFigure, 0);
 
   for (const int ranks : { 1, 2, 3 })
   {
@@ -385,6 +399,8 @@ TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
       std::vector<Solution> stats(static_cast<std::size_t>(ranks));
       std::vector<std::string> errors(static_cast<std::size_t>(ranks));
       std::vector<std::vector<Side>> sides(static_cast<std::size_t>(ranks));
+      std::vector<double> figures(static_cast<std::size_t>(ranks), -1);
+      std::vector<int> figuresLate(static_cast<std::size_t>(ranks), 0);
       std::vector<std::thread> workers;
       for (int r = 0; r < ranks; ++r)
       {
@@ -399,10 +415,12 @@ TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
               stats[i] = solveInChunks(scene, rig(), mine, perChunk, {},
                 [&](std::size_t first, Solution& frames)
                 {
+                  figuresLate[i] += figures[i] < 0 ? 1 : 0;
                   firsts[i].push_back(first);
                   recordFrames(first, frames, got[i]);
                   sides[i] = frames.litSideData();
-                });
+                },
+                { figureOf, [&](double v) { figures[i] = v; } });
             }
             catch (const std::exception& e)
             {
@@ -433,6 +451,8 @@ TEST(Chunks, RanksTakeWholeChunksAndHandOnTheSerialBits)
         }
         handedOn += got[r].size();
         EXPECT_EQ(sides[r], serialSides);
+        EXPECT_EQ(figures[r], serialFigure);
+        EXPECT_EQ(figuresLate[r], 0) << "frames before the first chunk's figure";
         // The figures of every chunk reach every rank.
         EXPECT_EQ(stats[r].statistics.shadowRays, serialStats.statistics.shadowRays);
         EXPECT_EQ(stats[r].statistics.pathsCast, serialStats.statistics.pathsCast);
