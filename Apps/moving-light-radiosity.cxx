@@ -67,11 +67,16 @@ struct FailedOnAnotherRank : std::runtime_error
 /// so that a rank that fails before it still meets the others there (main() does).
 bool OwesInputAgreement = true;
 
-/// Every rank meets the others here; throws FailedOnAnotherRank when another failed.
+/// Every rank meets the others here with its `failure` (empty: none); throws it, or
+/// FailedOnAnotherRank when another rank failed.
 void agreeAcrossRanks(RankJob& job, const std::string& failure = {})
 {
   const RankJob::Verdict verdict = job.agree(!failure.empty(), failure);
-  if (verdict.failed && failure.empty())
+  if (!failure.empty())
+  {
+    throw InputError(failure);
+  }
+  if (verdict.failed)
   {
     throw FailedOnAnotherRank(verdict.message);
   }
@@ -309,11 +314,17 @@ std::string failureOf(const std::function<void()>& step)
   return {};
 }
 
-void throwIf(const std::string& failure)
+/// Under mpiexec, once every rank has written its frames (`written` of them, or `failure`):
+/// the ranks agree, and every frame must have been written exactly once.
+void agreeOnFramesWritten(
+  RankJob& job, const std::string& failure, long long written, std::size_t frames)
 {
-  if (!failure.empty())
+  agreeAcrossRanks(job, failure);
+  const long long all = job.sum(written);
+  if (all != static_cast<long long>(frames))
   {
-    throw InputError(failure);
+    throw InputError("the ranks wrote " + std::to_string(all) + " frames of " +
+      std::to_string(frames) + ": nothing was written");
   }
 }
 
@@ -333,7 +344,6 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
   failure = failureOf([&] { first = frameAt(filter, times.front()); });
   const RankJob::Holders holders = job.holders(first && first->GetNumberOfCells() > 0);
   agreeAcrossRanks(job, failure);
-  throwIf(failure);
   if (holders.count == 0)
   {
     throw InputError("the scene has no polygons or triangle strips to light: nothing to write");
@@ -377,14 +387,7 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
       failure = failureOf([&] { writer.finish(); });
     }
   }
-  agreeAcrossRanks(job, failure);
-  throwIf(failure);
-  const long long all = job.sum(written);
-  if (all != static_cast<long long>(times.size()))
-  {
-    throw InputError("the ranks wrote " + std::to_string(all) + " frames of " +
-      std::to_string(times.size()) + ": nothing was written");
-  }
+  agreeOnFramesWritten(job, failure, written, times.size());
   return records;
 }
 
@@ -402,14 +405,7 @@ std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double
   {
     failure = failureOf([&] { writer->finish(); });
   }
-  agreeAcrossRanks(job, failure);
-  throwIf(failure);
-  const long long all = job.sum(static_cast<long long>(mine.size()));
-  if (all != static_cast<long long>(times.size()))
-  {
-    throw InputError("the ranks streamed " + std::to_string(all) + " frames of " +
-      std::to_string(times.size()) + ": nothing was written");
-  }
+  agreeOnFramesWritten(job, failure, static_cast<long long>(mine.size()), times.size());
   std::vector<double> positions(3 * times.size(), 0.0);
   for (std::size_t i = 0; i < mine.size(); ++i)
   {
@@ -806,13 +802,11 @@ int run(int argc, char** argv, RankJob& job)
       failure = failureOf(writeIndex);
     }
     agreeAcrossRanks(job, failure);
-    throwIf(failure);
     if (job.rank() > 0)
     {
       failure = failureOf([&] { output.commit(); });
     }
     agreeAcrossRanks(job, failure);
-    throwIf(failure);
     if (job.rank() == 0)
     {
       output.commit();

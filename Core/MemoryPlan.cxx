@@ -212,9 +212,10 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   // row per element side, written where the indirect light is) and, with reuse over several
   // blocks, the element sides a group of sides' rays reached (Gathering.h): up to the default
   // budget, less when the limit leaves less room, a frame of rows at least.
-  const std::uint64_t gatheringHeld = saturatingSum(
+  const std::uint64_t gatheringResults = saturatingSum(
     saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
-    saturatingSum(standardErrors, base));
+    standardErrors);
+  const std::uint64_t gatheringHeld = saturatingSum(gatheringResults, base);
   const std::uint64_t limit = memoryLimitBytes(options);
   const GatheringBudget full;
   const std::uint64_t room = limit > gatheringHeld ? limit - gatheringHeld : 0;
@@ -230,9 +231,8 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t gatheringRays = options.reuseGathering && blockFrames < frames
     ? std::min<std::uint64_t>(plan.gathering.hitBytes, saturatingProduct({ rays, 4 }))
     : 0;
-  const std::uint64_t gathering = saturatingSum(
-    saturatingSum(saturatingSum(direct, patch), saturatingSum(indirect, reachability)),
-    saturatingSum(standardErrors, saturatingSum(readRows, gatheringRays)));
+  const std::uint64_t gathering =
+    saturatingSum(gatheringResults, saturatingSum(readRows, gatheringRays));
   // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
   // in Solution.h), when a source's sums are turned into them, after the workers' copies were
   // collapsed into one and the others' pages given back. With one source that is the larger
