@@ -525,7 +525,7 @@ SolverOptions paperOptions(const RigCaseOptions& c)
   SolverOptions o;
   o.pathsPerFrame = c.paths;
   o.threads = c.threads;
-  o.gatheringRatio = 1;
+  o.gatheringRatio = c.gatheringRatio;
   o.firstBounceSurvival = 0.25;
   o.seed = 1;
   return o;
@@ -536,6 +536,10 @@ void checkOptions(const RigCaseOptions& c)
   if (c.referenceFactor < 1)
   {
     throw Error("--reference-factor must be at least 1");
+  }
+  if (!(c.gatheringRatio > 0 && c.gatheringRatio <= 64))
+  {
+    throw Error("--gathering-ratio must be above 0 and at most 64");
   }
 }
 

@@ -25,6 +25,8 @@ struct RigCaseOptions
   std::uint64_t paths = 600000; ///< N, effective paths per frame
   std::size_t frames = 30;      ///< the turning light's and the panning spot's frames
   int threads = 0;
+  /// k: gathering rays per frame = k N, in the solves and the reference alike.
+  double gatheringRatio = 1;
   /// The reference is classic with this many times N paths per frame.
   int referenceFactor = 16;
   /// Where references are cached between runs; empty: computed in every run, never stored.

@@ -37,6 +37,7 @@ struct Arguments
   std::string only;          ///< run just this mode (for profiling)
   std::string which = "all"; ///< --case: all, paper, rotating, spotlight, sun, ...
   int referenceFactor = 16;
+  double gatheringRatio = 1; ///< --gathering-ratio for rotating, spotlight and sun
   std::string cache = "output/benchmark-cache";
   std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
   bool pathsGiven = false, referenceFactorGiven = false;
@@ -80,7 +81,7 @@ void usage()
     "                     [--frames n] [--threads T] [--json FILE] [--reference-factor F]\n"
     "                     [--cache DIR] [--only classic|gathering|shooting|full]\n"
     "                     [--memory-limit-mib M] [--seeds S] [--target-error T]\n"
-    "                     [--case ends|error-bars|target-error]\n"
+    "                     [--gathering-ratio k] [--case ends|error-bars|target-error]\n"
     "  paper:    the generated paper-scale room (about 2,800 patches, a small ceiling light on a\n"
     "            diagonal) in the four reuse modes, compared with bare Embree, and remeshing\n"
     "  rotating: a light turning 90 degrees in the same room\n"
@@ -93,7 +94,8 @@ void usage()
     "  all:      paper, rotating and sun in turn (the default)\n"
     "rotating, spotlight and sun compare full reuse with classic, errors against a classic "
     "reference of\n"
-    "F x N paths (default 16), cached in DIR (default output/benchmark-cache; '' keeps none).\n"
+    "F x N paths (default 16), cached in DIR (default output/benchmark-cache; '' keeps none),\n"
+    "all with k N gathering rays per frame (--gathering-ratio, default 1).\n"
     "--frames sets the frames of paper and rotating (30) and spotlight (60); --only profiles one\n"
     "paper mode.\n"
     "  long:     the paper room over 300 frames, classic against full reuse, and where the\n"
@@ -167,6 +169,10 @@ bool parse(int argc, char** argv, Arguments& a)
     {
       a.referenceFactor = std::atoi(argv[++i]);
       a.referenceFactorGiven = true;
+    }
+    else if (flag == "--gathering-ratio" && hasValue)
+    {
+      a.gatheringRatio = std::atof(argv[++i]);
     }
     else if (flag == "--memory-limit-mib" && hasValue)
     {
@@ -408,6 +414,7 @@ int main(int argc, char** argv)
     rigOptions.frames = args.frames;
     rigOptions.threads = args.threads;
     rigOptions.referenceFactor = args.referenceFactor;
+    rigOptions.gatheringRatio = args.gatheringRatio;
     rigOptions.cacheDirectory = args.cache;
     if (args.which == "all" || args.which == "rotating")
     {
