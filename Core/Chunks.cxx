@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "ErrorEstimate.h"
+#include "Parallel.h"
 #include "Ranks.h"
 
 #include <algorithm>
@@ -735,7 +736,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   Solution& out = onFrames ? result : whole;
   if (!onFrames)
   {
-    whole.chooseLitSides();
+    whole.chooseLitSides(resolveThreadCount(options.threads));
     summariseErrors(whole, errors);
   }
   else

@@ -388,7 +388,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
       stoppedBy = "batches";
       break;
     }
-    result.chooseLitSides();
+    result.chooseLitSides(resolveThreadCount(options.threads));
     const auto [p95, frame] = worstFrame(result, spread);
     std::ostringstream s;
     s << "error estimate, round " << summary.rounds << ": " << spread.count() << " batches, "
@@ -423,7 +423,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
     log(s.str());
   }
 
-  result.chooseLitSides();
+  result.chooseLitSides(resolveThreadCount(options.threads));
   summary.batches = spread.count();
   summary.stoppedBy = stoppedBy;
   StoredArray& stdError = result.stdErrorData();

@@ -1,5 +1,7 @@
 #include "Solution.h"
 
+#include "Parallel.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -35,37 +37,50 @@ void Solution::clearRadiosity()
   StoredArray().swap(this->Indirect);
 }
 
-void Solution::chooseLitSides()
+void Solution::chooseLitSides(int workers)
 {
-  for (std::size_t e = 0; e < this->Elements; ++e)
-  {
-    double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
-    for (std::size_t f = 0; f < this->Frames; ++f)
+  // Every element and patch decides alone, over all its frames: blocks of them run on every
+  // worker (the choice does not depend on which).
+  constexpr std::size_t PerTask = 2048;
+  parallelFor((this->Elements + PerTask - 1) / PerTask, workers,
+    [&](std::size_t task, int)
     {
-      front += this->total(f, e, Side::Front).sum();
-      back += this->total(f, e, Side::Back).sum();
-    }
-    if (front == 0 && back == 0)
-    {
-      // A black element: the side light arrives on is the one its irradiance is shown for.
-      for (std::size_t f = 0; f < this->Frames; ++f)
+      for (std::size_t e = task * PerTask; e < std::min(this->Elements, (task + 1) * PerTask); ++e)
       {
-        irradianceFront += this->irradiance(f, e, Side::Front).sum();
-        irradianceBack += this->irradiance(f, e, Side::Back).sum();
+        double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
+        for (std::size_t f = 0; f < this->Frames; ++f)
+        {
+          front += this->total(f, e, Side::Front).sum();
+          back += this->total(f, e, Side::Back).sum();
+        }
+        if (front == 0 && back == 0)
+        {
+          // A black element: the side light arrives on is the one its irradiance is shown for.
+          for (std::size_t f = 0; f < this->Frames; ++f)
+          {
+            irradianceFront += this->irradiance(f, e, Side::Front).sum();
+            irradianceBack += this->irradiance(f, e, Side::Back).sum();
+          }
+        }
+        this->LitSide[e] = litSideOf(front, back, irradianceFront, irradianceBack);
       }
-    }
-    this->LitSide[e] = litSideOf(front, back, irradianceFront, irradianceBack);
-  }
-  for (std::size_t p = 0; p < this->Patches; ++p)
-  {
-    double front = 0, back = 0;
-    for (std::size_t f = 0; f < this->Frames; ++f)
+    },
+    [](std::size_t) { return true; });
+  parallelFor((this->Patches + PerTask - 1) / PerTask, workers,
+    [&](std::size_t task, int)
     {
-      front += this->patchRadiosity(f, p, Side::Front).sum();
-      back += this->patchRadiosity(f, p, Side::Back).sum();
-    }
-    this->PatchLitSide[p] = back > front ? Side::Back : Side::Front;
-  }
+      for (std::size_t p = task * PerTask; p < std::min(this->Patches, (task + 1) * PerTask); ++p)
+      {
+        double front = 0, back = 0;
+        for (std::size_t f = 0; f < this->Frames; ++f)
+        {
+          front += this->patchRadiosity(f, p, Side::Front).sum();
+          back += this->patchRadiosity(f, p, Side::Back).sum();
+        }
+        this->PatchLitSide[p] = back > front ? Side::Back : Side::Front;
+      }
+    },
+    [](std::size_t) { return true; });
 }
 
 } // namespace mlr

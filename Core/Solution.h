@@ -181,8 +181,9 @@ public:
   /// The same for a patch, from its shooting solution: the side whose radiosity (rho/A
   /// times the power it received) has the larger sum over frames and channels.
   Side patchLitSide(std::size_t patch) const { return this->PatchLitSide[patch]; }
-  /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete.
-  void chooseLitSides();
+  /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete, on
+  /// `workers` threads.
+  void chooseLitSides(int workers);
   /// The rule chooseLitSides applies to an element's totals over the frames on its two sides
   /// (its irradiance's, for a black element whose totals are both 0): the larger, front on a
   /// tie. For callers that sum the frames elsewhere (ranks holding frames apart).

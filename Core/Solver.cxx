@@ -342,7 +342,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   stats.secondsReducing = secondsReducing;
   if (!batched)
   {
-    solution.chooseLitSides();
+    solution.chooseLitSides(workers);
   }
   finish(scene, options, frames, plan, workers, counts[4], counts[5], solution);
   stats.secondsTotal = secondsSince(start);

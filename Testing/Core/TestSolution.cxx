@@ -25,7 +25,7 @@ TEST(Solution, LitSidesAreTheSidesThatReceivedMoreOverTheAnimation)
   set(solution.directData(), solution.elementIndex(0, 3, Side::Front), 1.0);
   set(solution.directData(), solution.elementIndex(1, 3, Side::Back), 1.0);
   solution.allocateIndirect();
-  solution.chooseLitSides();
+  solution.chooseLitSides(2);
   EXPECT_EQ(solution.patchLitSide(0), Side::Back);
   EXPECT_EQ(solution.litSide(0), Side::Back);
   EXPECT_EQ(solution.litSide(1), Side::Front);
