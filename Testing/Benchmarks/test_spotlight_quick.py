@@ -83,3 +83,36 @@ def test_one_frame_is_refused():
         capture_output=True, text=True, timeout=60)
     assert result.returncode == 1
     assert "the panning spot needs at least 2 frames (--frames)" in result.stderr
+
+
+def test_gathering_ratio_reaches_every_solve(run, tmp_path):
+    _, results = run
+    default = results["panning_spot"]
+    result = subprocess.run(
+        [os.environ["MLR_BENCHMARK"], "--case", "spotlight", "--paths", "3000", "--frames", "4",
+         "--reference-factor", "2", "--cache", "", "--gathering-ratio", "64",
+         "--json", str(tmp_path / "spot.json")],
+        capture_output=True, text=True, timeout=240)
+    assert result.returncode == 0, result.stderr
+    with open(tmp_path / "spot.json") as f:
+        spot = json.load(f)["panning_spot"]
+    assert default["k"] == 1 and spot["k"] == 64
+    # k N gathering rays per frame over the gathering sides, a whole number per side, at least
+    # one: at N = 3,000 and k = 1 every side casts one, so full reuse's one set counts them.
+    sides = default["modes"][1]["gathering_rays"]
+    assert 3000 < sides and default["modes"][0]["gathering_rays"] == 4 * sides
+    per_side = math.floor(64 * 3000 / sides + 0.5)
+    assert per_side > 1
+    classic, full = spot["modes"]
+    assert full["gathering_rays"] == per_side * sides
+    assert classic["gathering_rays"] == 4 * per_side * sides
+
+
+@pytest.mark.parametrize("ratio", ["0", "-1", "65", "nan"])
+def test_gathering_ratio_out_of_range_is_refused(ratio):
+    result = subprocess.run(
+        [os.environ["MLR_BENCHMARK"], "--case", "spotlight", "--frames", "4", "--cache", "",
+         "--gathering-ratio", ratio],
+        capture_output=True, text=True, timeout=60)
+    assert result.returncode == 1
+    assert "--gathering-ratio must be above 0 and at most 64" in result.stderr
