@@ -231,6 +231,33 @@ std::vector<double> firstHitFactors(const std::vector<std::vector<double>>& m,
   return r;
 }
 
+/// The first-hit factor of every frame when its paths come from a window of `width`
+/// positions alone, as many from each, weighed by the balance heuristic over the window (an
+/// unbiased mixture estimator of its own): runs of `width` positions one after another
+/// (`sliding` false, the last run may be shorter), or the run centred on the frame, shifted
+/// to stay whole at the ends (`sliding` true). A path from position k then scores the frames
+/// whose windows hold k, and needs the kernels of every position of those windows.
+std::vector<double> windowFactors(const std::vector<std::vector<double>>& m,
+  const std::vector<std::vector<double>>& squares, std::size_t width, bool sliding)
+{
+  const std::size_t n = m.size();
+  width = std::clamp<std::size_t>(width, 1, n);
+  std::vector<double> r(n, 0.0);
+  for (std::size_t j = 0; j < n; ++j)
+  {
+    const std::size_t begin =
+      sliding ? std::min(j - std::min(j, width / 2), n - width) : j / width * width;
+    const std::size_t end = std::min(n, begin + width);
+    std::vector<double> alpha(n, 0.0);
+    for (std::size_t k = begin; k < end; ++k)
+    {
+      alpha[k] = 1.0 / double(end - begin);
+    }
+    r[j] = firstHitFactors(m, squares, alpha)[j];
+  }
+  return r;
+}
+
 /// The solver's balancing (Shooting.cxx) on the first-hit masses, with shares clamped to
 /// [low, high] / n: shares times sqrt(R), renormalised, until the frames' R agree within 1%.
 std::vector<double> balancedShares(const std::vector<std::vector<double>>& m,
@@ -360,6 +387,7 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
   // Full reuse over all positions, balanced (the solver's default, shares within 1/4 to 4
   // times N/n) or with equal shares.
   double smallest = 1, largest = 1;
+  SolverStatistics equalShares; // of the last seed's equal-shares solve
   auto reuse = [&](const std::string& name, bool balance)
   {
     Scheme scheme = measure(name, s.frames, seeds,
@@ -371,6 +399,10 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
         const Solution solution = solve(s.scene, whole, o);
         smallest = solution.statistics.smallestPositionShare;
         largest = solution.statistics.largestPositionShare;
+        if (!balance)
+        {
+          equalShares = solution.statistics;
+        }
         for (std::size_t f = 0; f < s.frames; ++f)
         {
           mse[f] = frameMse(
@@ -403,6 +435,66 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
         }
       }
     }));
+  // Centred windows: frame j weighs only the paths of the `window` positions around it (the
+  // run centred on j, shifted to stay whole at the ends), N / window from each, by the
+  // balance heuristic over that window: an unbiased mixture estimator of its own for every
+  // frame. Solved as one whole-reuse solve of the window per frame, whose frame j has exactly
+  // that estimator's distribution, so the MSE is the scheme's; its time is not (n solves of
+  // N paths where the scheme casts n N / window paths in all), and is estimated from the rays
+  // instead (below).
+  const std::size_t width = std::min<std::size_t>(static_cast<std::size_t>(window), s.frames);
+  auto windowStart = [&](std::size_t j)
+  { return std::min(j - std::min(j, width / 2), s.frames - width); };
+  Scheme centred =
+    measure("centred windows of " + std::to_string(width) + " (time from rays)", s.frames, seeds,
+      [&](std::uint64_t seed, std::vector<double>& mse)
+      {
+        SolverOptions o = base;
+        o.seed = seed;
+        o.balanceFrames = false;
+        for (std::size_t j = 0; j < s.frames; ++j)
+        {
+          const std::size_t first = windowStart(j);
+          const Solution solution = solve(s.scene, s.rig(first, width), o);
+          mse[j] = frameMse(s.scene, ref, j,
+            [&](std::size_t e, Side side) { return solution.total(j - first, e, side); });
+        }
+      });
+  {
+    // A path from position k scores the frames whose windows hold k and needs the kernels
+    // (shadow rays) of every position in those windows; the scheme casts N / window paths
+    // per position where full reuse with equal shares casts N / n. Scoring (n N frame-scores)
+    // and gathering (one set of rays) are the same in both, so the estimate, full reuse's
+    // CPU time scaled by the rays, errs on the high side.
+    double kernels = 0;
+    for (std::size_t k = 0; k < s.frames; ++k)
+    {
+      std::size_t lowest = k, highest = k;
+      for (std::size_t j = 0; j < s.frames; ++j)
+      {
+        const std::size_t first = windowStart(j);
+        if (first <= k && k < first + width)
+        {
+          lowest = std::min(lowest, first);
+          highest = std::max(highest, first + width - 1);
+        }
+      }
+      kernels += double(highest - lowest);
+    }
+    const double n = double(s.frames);
+    const double shadow = double(equalShares.shadowRays);
+    const double nearest = double(equalShares.shootingRays);
+    const double shadowScale = kernels / (double(width) * (n - 1));
+    const double nearestScale = n / double(width);
+    const double equalCpu = schemes[2].cpu;
+    const double measuredCpu = centred.cpu;
+    centred.cpu =
+      equalCpu * (shadow * shadowScale + nearest * nearestScale) / std::max(shadow + nearest, 1.0);
+    std::printf("Centred windows of %zu, estimated: %.2fx full reuse's shadow rays and %.2fx its "
+                "nearest-hit rays, %.3f CPU s (measured as %zu solves: %.3f CPU s)\n",
+      width, shadowScale, nearestScale, centred.cpu, s.frames, measuredCpu);
+  }
+  schemes.push_back(centred);
   // A defensive share d: every frame is the count-weighted mean of full reuse with (1 - d) N
   // paths and classic with d N, both unbiased, so the mix is, with N paths per frame.
   for (const double d : { 0.05, 0.15 })
@@ -516,6 +608,25 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
     json << "      {\"shares\": \"" << clamp.name << "\", \"worst\": " << curve.worst
          << ", \"mean\": " << curve.mean << "}" << (&clamp != &clamps[4] ? ",\n" : "\n");
   }
+  // Windows: runs of `window` positions (as the windows scheme above solves them), and the
+  // window centred on each frame (weights over a sliding window of neighbouring positions),
+  // equal shares within the window.
+  json << "    ],\n    \"first_hit_factor_windows\": [\n";
+  for (const bool sliding : { false, true })
+  {
+    const Curve curve =
+      curveOf(windowFactors(meanMass, square, static_cast<std::size_t>(window), sliding));
+    char label[64];
+    std::snprintf(
+      label, sizeof label, "%s of %d positions", sliding ? "centred windows" : "runs", window);
+    std::printf("%-34s %7.2f %7.2f %7.2f %7.2f %7.2f\n", label, curve.worst, curve.first,
+      curve.middle, curve.last, curve.mean);
+    json << "      {\"shares\": \"" << label << "\", \"worst\": " << curve.worst
+         << ", \"mean\": " << curve.mean << "}" << (sliding ? "\n" : ",\n");
+  }
+  std::printf("(runs cast N paths per run; centred windows N / %d per position, %d frames and up "
+              "to %d kernels per path)\n",
+    window, window, 2 * window);
   json << "    ]";
   std::printf("Target: every frame within %.2fx of classic (balanced, chosen): worst %.2f, %s; "
               "full reuse %.1fx faster than classic in CPU time\n",
