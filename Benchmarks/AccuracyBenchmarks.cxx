@@ -614,19 +614,18 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
   json << "    ],\n    \"first_hit_factor_windows\": [\n";
   for (const bool sliding : { false, true })
   {
-    const Curve curve =
-      curveOf(windowFactors(meanMass, square, static_cast<std::size_t>(window), sliding));
+    const Curve curve = curveOf(windowFactors(meanMass, square, width, sliding));
     char label[64];
     std::snprintf(
-      label, sizeof label, "%s of %d positions", sliding ? "centred windows" : "runs", window);
+      label, sizeof label, "%s of %zu positions", sliding ? "centred windows" : "runs", width);
     std::printf("%-34s %7.2f %7.2f %7.2f %7.2f %7.2f\n", label, curve.worst, curve.first,
       curve.middle, curve.last, curve.mean);
     json << "      {\"shares\": \"" << label << "\", \"worst\": " << curve.worst
          << ", \"mean\": " << curve.mean << "}" << (sliding ? "\n" : ",\n");
   }
-  std::printf("(runs cast N paths per run; centred windows N / %d per position, %d frames and up "
-              "to %d kernels per path)\n",
-    window, window, 2 * window);
+  std::printf("(runs cast N paths per run; centred windows N / %zu per position, %zu frames and up "
+              "to %zu kernels per path)\n",
+    width, width, 2 * width - 1);
   json << "    ]";
   std::printf("Target: every frame within %.2fx of classic (balanced, chosen): worst %.2f, %s; "
               "full reuse %.1fx faster than classic in CPU time\n",

@@ -23,12 +23,18 @@ def solve(tmp_path, case, *extra):
 
 def test_ends(tmp_path):
     data, text = solve(tmp_path, "ends")
-    for case in ("paper_room", "turning_light", "sun_over_town"):
+    # --frames 4 clamps the lights' windows to the animation; the sun keeps its 48 frames.
+    for case, width in (("paper_room", 4), ("turning_light", 4), ("sun_over_town", 12)):
         schemes = data["ends"][case]["schemes"]
         assert [s["name"].split(",")[0] for s in schemes][:3] == \
             ["classic", "full reuse", "full reuse"]
         for scheme in schemes:
             assert all(math.isfinite(r) and r > 0 for r in scheme["mse_ratio"]), scheme["name"]
+        assert any(s["name"] == f"centred windows of {width} (time from rays)" for s in schemes)
+        windows = data["ends"][case]["first_hit_factor_windows"]
+        assert [w["shares"] for w in windows] == [f"runs of {width} positions",
+                                                  f"centred windows of {width} positions"]
+        assert all(math.isfinite(w["worst"]) and w["worst"] > 0 for w in windows)
     assert "First-hit variance factor" in text
 
 
