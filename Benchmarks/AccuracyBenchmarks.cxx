@@ -415,10 +415,14 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
   };
   schemes.push_back(reuse("full reuse, balanced 1/4-4x (chosen)", true));
   schemes.push_back(reuse("full reuse, equal shares", false));
+  const std::size_t equalScheme = schemes.size() - 1;
   // Windows: the positions in runs of `window`, each run reused (and balanced) on its own, so
   // that a frame weighs only the paths of the positions near it; every frame still gets N
   // effective paths, at the price of N paths per run.
-  schemes.push_back(measure("windows of " + std::to_string(window) + " positions", s.frames, seeds,
+  schemes.push_back(measure("windows of " +
+      std::to_string(std::min<std::size_t>(static_cast<std::size_t>(window), s.frames)) +
+      " positions",
+    s.frames, seeds,
     [&](std::uint64_t seed, std::vector<double>& mse)
     {
       SolverOptions o = base;
@@ -445,6 +449,7 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
   const std::size_t width = std::min<std::size_t>(static_cast<std::size_t>(window), s.frames);
   auto windowStart = [&](std::size_t j)
   { return std::min(j - std::min(j, width / 2), s.frames - width); };
+  double windowShadow = 0, windowNearest = 0; // over the per-frame solves, per seed
   Scheme centred =
     measure("centred windows of " + std::to_string(width) + " (time from rays)", s.frames, seeds,
       [&](std::uint64_t seed, std::vector<double>& mse)
@@ -456,17 +461,22 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
         {
           const std::size_t first = windowStart(j);
           const Solution solution = solve(s.scene, s.rig(first, width), o);
+          windowShadow += double(solution.statistics.shadowRays) / seeds;
+          windowNearest += double(solution.statistics.shootingRays) / seeds;
           mse[j] = frameMse(s.scene, ref, j,
             [&](std::size_t e, Side side) { return solution.total(j - first, e, side); });
         }
       });
   {
+    // The scheme casts N / window paths per position, n N / window in all, where the n
+    // per-frame solves cast n N: a window solve's paths have the scheme's nearest-hit rays.
     // A path from position k scores the frames whose windows hold k and needs the kernels
-    // (shadow rays) of every position in those windows; the scheme casts N / window paths
-    // per position where full reuse with equal shares casts N / n. Scoring (n N frame-scores)
-    // and gathering (one set of rays) are the same in both, so the estimate, full reuse's
-    // CPU time scaled by the rays, errs on the high side.
-    double kernels = 0;
+    // (shadow rays) of every position in those windows, |U_k| - 1 others where a window
+    // solve's path has window - 1: at the window solves' rate per other position, which the
+    // farther positions of U_k reach no more often. Full reuse's CPU time per ray (equal
+    // shares) then prices the rays; scoring (n N frame-scores) and gathering (one set of
+    // rays) are the same in both and do not grow with the rays, so the estimate errs high.
+    double others = 0;
     for (std::size_t k = 0; k < s.frames; ++k)
     {
       std::size_t lowest = k, highest = k;
@@ -479,20 +489,21 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
           highest = std::max(highest, first + width - 1);
         }
       }
-      kernels += double(highest - lowest);
+      others += double(highest - lowest);
     }
-    const double n = double(s.frames);
-    const double shadow = double(equalShares.shadowRays);
-    const double nearest = double(equalShares.shootingRays);
-    const double shadowScale = kernels / (double(width) * (n - 1));
-    const double nearestScale = n / double(width);
-    const double equalCpu = schemes[2].cpu;
+    const double n = double(s.frames), w = double(width);
+    const double shadow = windowShadow * others / (n * w * std::max(w - 1, 1.0));
+    const double nearest = windowNearest / w;
+    const double fullShadow = double(equalShares.shadowRays);
+    const double fullNearest = double(equalShares.shootingRays);
+    const Scheme& equal = schemes[equalScheme];
     const double measuredCpu = centred.cpu;
-    centred.cpu =
-      equalCpu * (shadow * shadowScale + nearest * nearestScale) / std::max(shadow + nearest, 1.0);
+    centred.cpu = equal.cpu * (shadow + nearest) / std::max(fullShadow + fullNearest, 1.0);
+    centred.wall *= centred.cpu / std::max(measuredCpu, 1e-9);
     std::printf("Centred windows of %zu, estimated: %.2fx full reuse's shadow rays and %.2fx its "
                 "nearest-hit rays, %.3f CPU s (measured as %zu solves: %.3f CPU s)\n",
-      width, shadowScale, nearestScale, centred.cpu, s.frames, measuredCpu);
+      width, shadow / std::max(fullShadow, 1.0), nearest / std::max(fullNearest, 1.0), centred.cpu,
+      s.frames, measuredCpu);
   }
   schemes.push_back(centred);
   // A defensive share d: every frame is the count-weighted mean of full reuse with (1 - d) N
@@ -608,9 +619,9 @@ std::string endsOf(const Scenario& s, const AccuracyCaseOptions& c, double targe
     json << "      {\"shares\": \"" << clamp.name << "\", \"worst\": " << curve.worst
          << ", \"mean\": " << curve.mean << "}" << (&clamp != &clamps[4] ? ",\n" : "\n");
   }
-  // Windows: runs of `window` positions (as the windows scheme above solves them), and the
-  // window centred on each frame (weights over a sliding window of neighbouring positions),
-  // equal shares within the window.
+  // Windows: runs of `width` positions (the windows scheme above, but with equal shares
+  // where that scheme balances each run), and the window centred on each frame (the
+  // centred-windows scheme), equal shares within the window.
   json << "    ],\n    \"first_hit_factor_windows\": [\n";
   for (const bool sliding : { false, true })
   {
@@ -731,7 +742,7 @@ std::string runErrorBars(const AccuracyCaseOptions& c)
   }
 
   std::vector<double> squaredError(frames, 0.0), squaredSe(frames, 0.0), covered(frames, 0.0);
-  std::vector<double> count(frames, 0.0);
+  std::vector<double> count(frames, 0.0), squaredErrorOne(frames, 0.0);
   double seconds = 0;
   for (int seed = 0; seed < seeds; ++seed)
   {
@@ -740,6 +751,26 @@ std::string runErrorBars(const AccuracyCaseOptions& c)
     o.seed = 1000 + static_cast<std::uint64_t>(seed);
     const Solution run = solve(s.scene, rig, o);
     seconds += run.statistics.secondsTotal / seeds;
+    // One solve with the same seed and N: gathering's and shooting's errors multiply within a batch
+    // (Method 17), so the batches' mean may be noisier than one solve of their paths.
+    SolverOptions single = o;
+    single.errorBatches = 1;
+    const Solution one = solve(s.scene, rig, single);
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      for (std::size_t e = 0; e < elements; ++e)
+      {
+        if (lit[f][e])
+        {
+          const Rgb b = one.total(f, e, static_cast<Side>(ref.litSide[e]));
+          for (int c3 = 0; c3 < 3; ++c3)
+          {
+            const double d = b[c3] - at(ref, elements, f, e, c3);
+            squaredErrorOne[f] += d * d;
+          }
+        }
+      }
+    }
     for (std::size_t f = 0; f < frames; ++f)
     {
       for (std::size_t e = 0; e < elements; ++e)
@@ -790,6 +821,20 @@ std::string runErrorBars(const AccuracyCaseOptions& c)
          << ", \"rms_error_raw\": " << raw << ", \"mean_se\": " << se << ", \"ratio\": " << ratio
          << ", \"coverage\": " << coverage << "}" << (f + 1 < frames ? ",\n" : "\n");
   }
+  // MSE against the expectation (less the reference's variance) of the batches' mean over
+  // one solve's, per frame.
+  std::vector<double> batchCost(frames);
+  for (std::size_t f = 0; f < frames; ++f)
+  {
+    const double batched = squaredError[f] / count[f] - referenceVariance[f];
+    const double single = squaredErrorOne[f] / count[f] - referenceVariance[f];
+    batchCost[f] = single > 0 ? batched / single : 0;
+  }
+  const Curve batchCurve = curveOf(batchCost);
+  std::printf("MSE of the %llu batches' mean over one solve's with the same seeds: mean "
+              "of the frames %.3f, highest %.3f (frame %zu)\n",
+    static_cast<unsigned long long>(Batches), batchCurve.mean, batchCurve.worst,
+    batchCurve.worstFrame + 1);
   const bool ratioMet = std::abs(worstRatio - 1) <= 0.2;
   const bool coverageMet = lowCoverage >= 0.60 && highCoverage <= 0.75;
   std::printf("RMS error: over %d seeds, lit values (element, channel) of each frame, against "
@@ -801,7 +846,8 @@ std::string runErrorBars(const AccuracyCaseOptions& c)
               "degrees of freedom, gives 66.7%%), %s\n",
     worstRatio, ratioMet ? "met" : "MISSED", 100 * lowCoverage, 100 * highCoverage,
     100 * allCovered / all, coverageMet ? "met" : "MISSED");
-  json << "    ], \"farthest_ratio\": " << worstRatio << ", \"coverage_lowest\": " << lowCoverage
+  json << "    ], \"batches_mse_over_one_solve\": " << jsonList(batchCost)
+       << ", \"farthest_ratio\": " << worstRatio << ", \"coverage_lowest\": " << lowCoverage
        << ", \"coverage_highest\": " << highCoverage << "\n  }";
   return json.str();
 }

@@ -38,6 +38,7 @@ struct Arguments
   std::string which = "all"; ///< --case: all, paper, rotating, spotlight, sun, ...
   int referenceFactor = 16;
   double gatheringRatio = 1; ///< --gathering-ratio for rotating, spotlight and sun
+  bool gatheringRatioGiven = false;
   std::string cache = "output/benchmark-cache";
   std::uint64_t memoryLimitMiB = 0; ///< --memory-limit-mib for long and large (0: default)
   bool pathsGiven = false, referenceFactorGiven = false;
@@ -95,7 +96,7 @@ void usage()
     "rotating, spotlight and sun compare full reuse with classic, errors against a classic "
     "reference of\n"
     "F x N paths (default 16), cached in DIR (default output/benchmark-cache; '' keeps none),\n"
-    "all with k N gathering rays per frame (--gathering-ratio, default 1).\n"
+    "all with k N gathering rays per frame (--gathering-ratio k, 0 < k <= 64, default 1).\n"
     "--frames sets the frames of paper and rotating (30) and spotlight (60); --only profiles one\n"
     "paper mode.\n"
     "  long:     the paper room over 300 frames, classic against full reuse, and where the\n"
@@ -109,7 +110,7 @@ void usage()
     "--memory-limit-mib M sets the solver's memory limit of paper, long and large (default: half "
     "the\n"
     "physical memory; under twice the per-worker peak the workers share one accumulator copy).\n"
-    "  ends:     every frame's MSE over classic's at equal N (default 200,000) for the paper "
+    "  ends:     every frame's MSE over classic's at equal N (default 100,000) for the paper "
     "room,\n"
     "            the turning light and the sun, in the end-of-animation schemes (--seeds, 2)\n"
     "  error-bars: the paper room with 16 error batches over --seeds (20) seeds (N 100,000)\n"
@@ -172,7 +173,15 @@ bool parse(int argc, char** argv, Arguments& a)
     }
     else if (flag == "--gathering-ratio" && hasValue)
     {
-      a.gatheringRatio = std::atof(argv[++i]);
+      const char* text = argv[++i];
+      char* end = nullptr;
+      a.gatheringRatio = std::strtod(text, &end);
+      if (end == text || *end != '\0' || !(a.gatheringRatio > 0 && a.gatheringRatio <= 64))
+      {
+        std::fprintf(stderr, "mlr-benchmark: --gathering-ratio must be above 0 and at most 64\n");
+        return false;
+      }
+      a.gatheringRatioGiven = true;
     }
     else if (flag == "--memory-limit-mib" && hasValue)
     {
@@ -207,6 +216,15 @@ bool parse(int argc, char** argv, Arguments& a)
       usage();
       return flag == "--help";
     }
+  }
+  if (a.gatheringRatioGiven && a.which != "rotating" && a.which != "spotlight" &&
+    a.which != "sun" && a.which != "all")
+  {
+    std::fprintf(stderr,
+      "mlr-benchmark: --gathering-ratio applies to --case rotating, spotlight and sun (and to "
+      "all, for its rotating and sun parts); --case %s keeps k = 1\n",
+      a.which.c_str());
+    return false;
   }
   return true;
 }

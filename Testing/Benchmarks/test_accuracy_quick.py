@@ -30,7 +30,11 @@ def test_ends(tmp_path):
             ["classic", "full reuse", "full reuse"]
         for scheme in schemes:
             assert all(math.isfinite(r) and r > 0 for r in scheme["mse_ratio"]), scheme["name"]
-        assert any(s["name"] == f"centred windows of {width} (time from rays)" for s in schemes)
+        centred = [s for s in schemes if s["name"] == f"centred windows of {width} (time from rays)"]
+        assert len(centred) == 1
+        # Its time is estimated from the rays: finite, positive.
+        assert math.isfinite(centred[0]["cpu_seconds"]) and centred[0]["cpu_seconds"] > 0
+        assert math.isfinite(centred[0]["seconds"]) and centred[0]["seconds"] > 0
         windows = data["ends"][case]["first_hit_factor_windows"]
         assert [w["shares"] for w in windows] == [f"runs of {width} positions",
                                                   f"centred windows of {width} positions"]

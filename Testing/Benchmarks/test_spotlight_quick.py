@@ -108,11 +108,20 @@ def test_gathering_ratio_reaches_every_solve(run, tmp_path):
     assert classic["gathering_rays"] == 4 * per_side * sides
 
 
-@pytest.mark.parametrize("ratio", ["0", "-1", "65", "nan"])
+@pytest.mark.parametrize("ratio", ["0", "-1", "65", "nan", "4x", ""])
 def test_gathering_ratio_out_of_range_is_refused(ratio):
     result = subprocess.run(
         [os.environ["MLR_BENCHMARK"], "--case", "spotlight", "--frames", "4", "--cache", "",
          "--gathering-ratio", ratio],
         capture_output=True, text=True, timeout=60)
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "--gathering-ratio must be above 0 and at most 64" in result.stderr
+
+
+@pytest.mark.parametrize("case", ["paper", "ends", "long"])
+def test_gathering_ratio_is_refused_where_it_is_ignored(case):
+    result = subprocess.run(
+        [os.environ["MLR_BENCHMARK"], "--gathering-ratio", "2", "--case", case, "--cache", ""],
+        capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert f"--case {case} keeps k = 1" in result.stderr

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 using namespace mlr;
 
@@ -31,6 +33,74 @@ TEST(Solution, LitSidesAreTheSidesThatReceivedMoreOverTheAnimation)
   EXPECT_EQ(solution.litSide(1), Side::Front);
   EXPECT_EQ(solution.litSide(2), Side::Back);
   EXPECT_EQ(solution.litSide(3), Side::Front);
+}
+
+TEST(Solution, LitSidesDoNotDependOnTheWorkers)
+{
+  // More elements and patches than one worker's block, so that blocks end inside the data:
+  // every element's and patch's choice follows litSideOf on its own sums, for 1 and 3 workers.
+  constexpr std::size_t Frames = 3, Patches = 2500, Elements = 4 * Patches;
+  Solution solution(Frames, Elements, Patches);
+  std::uint64_t state = 12345;
+  auto next = [&]
+  {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 40) / double(1ull << 24);
+  };
+  for (std::size_t f = 0; f < Frames; ++f)
+  {
+    for (const Side side : { Side::Front, Side::Back })
+    {
+      for (std::size_t e = 0; e < Elements; ++e)
+      {
+        // A tenth of the elements black on both sides in every frame.
+        const double value = e % 10 == 3 ? 0.0 : next();
+        solution.directData()[solution.elementIndex(f, e, side)] =
+          PackedRgb(Rgb(value, 0.5 * value, 0.25 * value));
+      }
+      for (std::size_t p = 0; p < Patches; ++p)
+      {
+        solution.patchData()[solution.patchIndex(f, p, side)] = PackedRgb(Rgb(next()));
+      }
+    }
+  }
+  solution.allocateIndirect();
+  solution.chooseLitSides(1);
+  const std::vector<Side> one(solution.litSideData()), onePatches(solution.patchLitSideData());
+  solution.litSideData().assign(Elements, Side::Back);
+  solution.patchLitSideData().assign(Patches, Side::Back);
+  solution.chooseLitSides(3);
+  EXPECT_EQ(solution.litSideData(), one);
+  EXPECT_EQ(solution.patchLitSideData(), onePatches);
+  std::size_t backs = 0;
+  for (std::size_t e = 0; e < Elements; ++e)
+  {
+    double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
+    for (std::size_t f = 0; f < Frames; ++f)
+    {
+      front += solution.total(f, e, Side::Front).sum();
+      back += solution.total(f, e, Side::Back).sum();
+      irradianceFront += solution.irradiance(f, e, Side::Front).sum();
+      irradianceBack += solution.irradiance(f, e, Side::Back).sum();
+    }
+    ASSERT_EQ(
+      solution.litSide(e), Solution::litSideOf(front, back, irradianceFront, irradianceBack))
+      << e;
+    backs += solution.litSide(e) == Side::Back;
+  }
+  // Both choices occur, so the comparison above can fail.
+  EXPECT_GT(backs, Elements / 4);
+  EXPECT_LT(backs, 3 * Elements / 4);
+  for (std::size_t p = 0; p < Patches; ++p)
+  {
+    double front = 0, back = 0;
+    for (std::size_t f = 0; f < Frames; ++f)
+    {
+      front += solution.patchRadiosity(f, p, Side::Front).sum();
+      back += solution.patchRadiosity(f, p, Side::Back).sum();
+    }
+    ASSERT_EQ(solution.patchLitSide(p), back > front ? Side::Back : Side::Front) << p;
+  }
 }
 
 TEST(Solution, StoredResultsKeepTheirPrecisionInAnyUnit)
