@@ -178,8 +178,8 @@ Rgb gatheredRadiosity(
   return bounced[element % Scene::ElementsPerPatch] + solution.direct(frame, element, side);
 }
 
-std::vector<std::uint32_t> gatheringSides(const Scene& scene,
-  const std::vector<std::uint8_t>& reachable, std::uint64_t& rays, std::uint64_t total)
+std::vector<std::uint32_t> gatheringSides(
+  const Scene& scene, const std::vector<std::uint8_t>& reachable, double& rays, std::uint64_t total)
 {
   std::vector<std::uint32_t> sides;
   for (std::size_t p = 0; p < scene.patchCount(); ++p)
@@ -202,10 +202,17 @@ std::vector<std::uint32_t> gatheringSides(const Scene& scene,
   }
   std::sort(sides.begin(), sides.end());
   rays = sides.empty()
-    ? 0
-    : static_cast<std::uint64_t>(std::max<long long>(
-        1, std::llround(static_cast<double>(total) / static_cast<double>(sides.size()))));
+    ? 0.0
+    : std::max(1.0, static_cast<double>(total) / static_cast<double>(sides.size()));
   return sides;
+}
+
+std::uint64_t raysOfSide(double raysPerSide, std::uint64_t seed, std::uint32_t elementSide)
+{
+  const double whole = std::floor(raysPerSide);
+  // A stream of its own: the rays' streams have b = 0 (reuse) or 1 + frame.
+  RandomStream dither(seed, StreamPurpose::Gathering, elementSide, ~std::uint64_t(0));
+  return static_cast<std::uint64_t>(whole) + (dither.uniform() < raysPerSide - whole ? 1 : 0);
 }
 
 std::vector<std::uint32_t> blackSides(
@@ -237,7 +244,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const std::function<bool(double fraction)>& fraction, double& secondsReducing, Solution& solution,
   const GatheringBudget& budget)
 {
-  std::uint64_t raysPerSide = 0;
+  double raysPerSide = 0;
   const auto total = static_cast<std::uint64_t>(
     std::llround(options.gatheringRatio * static_cast<double>(options.pathsPerFrame)));
   std::vector<std::uint32_t> sides = gatheringSides(scene, reachable, raysPerSide, total);
@@ -246,15 +253,13 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const std::vector<std::uint32_t> black = blackSides(scene, reachable);
   if (sides.empty() && !black.empty())
   {
-    raysPerSide = static_cast<std::uint64_t>(std::max<long long>(
-      1, std::llround(static_cast<double>(total) / static_cast<double>(black.size()))));
+    raysPerSide = std::max(1.0, static_cast<double>(total) / static_cast<double>(black.size()));
   }
   sides.insert(sides.end(), black.begin(), black.end());
   const std::size_t frames = solution.frameCount();
   const bool reuse = options.reuseGathering;
   const std::size_t tasks = (sides.size() + GatheringSidesPerTask - 1) / GatheringSidesPerTask;
   std::vector<WorkerCounters> counters(static_cast<std::size_t>(workers));
-  const double perRay = 1.0 / static_cast<double>(std::max<std::uint64_t>(raysPerSide, 1));
   // The rows of what rays read are held for a block of frames at a time, so that they take
   // a bounded share of memory (MemoryPlan). With reuse and several blocks, a group of sides
   // casts its rays once and keeps the element side each reached (4 bytes a ray, at most
@@ -265,7 +270,9 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
   const std::size_t tasksPerGroup = keepHits
     ? std::max<std::size_t>(1,
         budget.hitBytes /
-          std::max<std::uint64_t>(1, raysPerSide * GatheringSidesPerTask * sizeof(std::uint32_t)))
+          std::max<std::uint64_t>(1,
+            static_cast<std::uint64_t>(std::ceil(raysPerSide)) * GatheringSidesPerTask *
+              sizeof(std::uint32_t)))
     : std::max<std::size_t>(tasks, 1);
   const std::size_t groups = (tasks + tasksPerGroup - 1) / tasksPerGroup;
   std::vector<std::vector<Rgb>> sums(static_cast<std::size_t>(workers));
@@ -305,7 +312,8 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
           const std::size_t end = std::min(sides.size(), (task + 1) * GatheringSidesPerTask);
           for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
           {
-            castRays(scene, tracer, options, sides[i], raysPerSide, 0, hits[j],
+            castRays(scene, tracer, options, sides[i],
+              raysOfSide(raysPerSide, options.seed, sides[i]), 0, hits[j],
               counters[static_cast<std::size_t>(worker)]);
             hitEnds[j].push_back(static_cast<std::uint32_t>(hits[j].size()));
           }
@@ -326,6 +334,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
           for (std::size_t i = task * GatheringSidesPerTask; i < end; ++i)
           {
             const std::uint32_t side = sides[i];
+            const std::uint64_t rays = raysOfSide(raysPerSide, options.seed, side);
             sum.assign(rows.length, Rgb());
             if (keepHits)
             {
@@ -341,7 +350,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
               for (std::size_t f = 0; f < (reuse ? 1 : rows.length); ++f)
               {
                 scratchHits[w].clear();
-                castRays(scene, tracer, options, side, raysPerSide, reuse ? 0 : rows.begin + f + 1,
+                castRays(scene, tracer, options, side, rays, reuse ? 0 : rows.begin + f + 1,
                   scratchHits[w], counters[w]);
                 addRows(rows, scratchHits[w].data(), scratchHits[w].size(), reuse ? 0 : f,
                   reuse ? rows.length : 1, &sum[reuse ? 0 : f]);
@@ -352,7 +361,7 @@ GatheringResult gatherIndirect(const Scene& scene, const RayTracer& tracer,
             for (std::size_t f = 0; f < rows.length; ++f)
             {
               indirect[solution.elementIndex(rows.begin + f, side / 2,
-                static_cast<Side>(side % 2))] = PackedRgb(sum[f] * perRay);
+                static_cast<Side>(side % 2))] = PackedRgb(sum[f] / static_cast<double>(rays));
             }
           }
         },

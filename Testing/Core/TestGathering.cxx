@@ -196,3 +196,52 @@ TEST(Gathering, AnyBudgetGivesTheSameBits)
   }
   EXPECT_GT(sum, 0) << "gathering read nothing";
 }
+
+TEST(Gathering, SidesCastTheRaysAskedForOnAverage)
+{
+  // A mean of 1.415 rays a side (what rounding made 1, 71% of the rays asked for): each side
+  // casts 1 or 2, 2 with probability 0.415, so 20,000 sides cast 28,300 rays give or take
+  // sqrt(20,000 x 0.415 x 0.585) = 70.
+  constexpr std::uint32_t Sides = 20000;
+  for (const std::uint64_t seed : { 1u, 2u })
+  {
+    std::uint64_t total = 0, twos = 0;
+    for (std::uint32_t side = 0; side < Sides; ++side)
+    {
+      const std::uint64_t rays = raysOfSide(1.415, seed, side);
+      ASSERT_TRUE(rays == 1 || rays == 2) << rays;
+      ASSERT_EQ(rays, raysOfSide(1.415, seed, side)) << "keyed by the seed and the side alone";
+      total += rays;
+      twos += rays == 2 && raysOfSide(1.415, seed + 10, side) == 2;
+    }
+    EXPECT_NEAR(double(total), 1.415 * Sides, 5 * 70.0);
+    // Another seed gives other sides the extra ray: both have it about 0.415^2 of the time.
+    EXPECT_NEAR(double(twos), 0.415 * 0.415 * Sides, 5 * std::sqrt(0.172 * 0.828 * Sides));
+  }
+  // A whole mean is cast exactly.
+  for (std::uint32_t side = 0; side < 100; ++side)
+  {
+    EXPECT_EQ(raysOfSide(3.0, 7, side), 3u);
+    EXPECT_EQ(raysOfSide(1.0, 7, side), 1u);
+  }
+}
+
+TEST(Gathering, ASolveCastsKTimesNRays)
+{
+  // k N = 1,000 rays a frame over the closed box's 432 element sides, 2.31 a side: 1,000
+  // give or take sqrt(432 x 0.31 x 0.69) = 9.6, where rounding the mean to 2 cast 864.
+  // Reuse casts one set, classic one per frame.
+  const Scene scene = Scene::fromPatchMesh(scenes::closedBox(
+    3, true, { Rgb(0.6, 0.3, 0.3), Rgb(0.3, 0.6, 0.3), Rgb(0.6), Rgb(0.6), Rgb(0.5), Rgb(0.7) }));
+  const MovingLight light(scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 }, 0.2), Rgb(1),
+    scenes::translationsAlong({ 0.5, 0.5, 0.9 }, { 0.2, 0.5, 0.9 }, { 0.8, 0.5, 0.9 }, 5));
+  for (const bool reuse : { true, false })
+  {
+    SolverOptions options = checks::modeOptions(reuse, 1000, 2);
+    const Solution solution = solve(scene, light, options);
+    ASSERT_EQ(solution.statistics.gatheringSides, 432u);
+    const double perFrame =
+      double(solution.statistics.gatheringRays) / (reuse ? 1.0 : double(solution.frameCount()));
+    EXPECT_NEAR(perFrame, 1000.0, 5 * 9.6) << (reuse ? "reuse" : "classic");
+  }
+}
