@@ -328,7 +328,8 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
     log(s.str());
   }
   result.allocateIndirect();
-  BatchSpread spread(result, resolveThreadCount(options.threads));
+  const int workers = resolveThreadCount(options.threads);
+  BatchSpread spread(result, workers);
   ErrorEstimateSummary& summary = result.errorEstimate;
   summary.target = target;
   summary.rounds = 1;
@@ -388,7 +389,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
       stoppedBy = "batches";
       break;
     }
-    result.chooseLitSides(resolveThreadCount(options.threads));
+    result.chooseLitSides(workers);
     const auto [p95, frame] = worstFrame(result, spread);
     std::ostringstream s;
     s << "error estimate, round " << summary.rounds << ": " << spread.count() << " batches, "
@@ -423,7 +424,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
     log(s.str());
   }
 
-  result.chooseLitSides(resolveThreadCount(options.threads));
+  result.chooseLitSides(workers);
   summary.batches = spread.count();
   summary.stoppedBy = stoppedBy;
   StoredArray& stdError = result.stdErrorData();

@@ -10,10 +10,9 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
-from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run  # noqa: E402
+from cli_support import CLI, FAST, LIGHT, SCENE, all_files, lines_until, run  # noqa: E402
 
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader  # noqa: E402
@@ -67,15 +66,7 @@ def test_interrupt_in_the_third_chunk_writes_nothing(tmp_path):
          "0.08", "--error-batches", "1", "--output", "out/s.pvd", "--stats", "out/s.json"],
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        seen = []
-        deadline = time.monotonic() + 240
-        while time.monotonic() < deadline:
-            line = process.stdout.readline()
-            if not line:
-                break
-            seen.append(line)
-            if "chunk 3 of 4" in line:
-                break
+        seen = lines_until(process, "chunk 3 of 4", 240)
         assert any("chunk 3 of 4" in line for line in seen), (seen, process.poll())
         assert process.poll() is None, "the run ended before it was interrupted"
         process.send_signal(signal.SIGINT)

@@ -5,6 +5,7 @@ ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); the defaults fit a
 """
 import os
 import subprocess
+import time
 
 from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
 
@@ -21,6 +22,21 @@ FAST = ["--paths", "20000", "--patch-size", "0.08"]
 def run(args, cwd, env=None, timeout=300):
     return subprocess.run([CLI] + args, cwd=cwd, capture_output=True, text=True,
                           timeout=timeout, env=env)
+
+
+def lines_until(process, marker, seconds):
+    """The lines `process` prints on stdout up to the first that holds `marker` (or its end, or
+    `seconds`): a test that interrupts a run at a known point reads them first."""
+    seen = []
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        line = process.stdout.readline()
+        if not line:
+            break
+        seen.append(line)
+        if marker in line:
+            break
+    return seen
 
 
 def all_files(directory):
