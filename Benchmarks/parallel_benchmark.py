@@ -19,8 +19,10 @@ configuration (PatchSize 0.12, 20,000 paths) in seconds.
 
 solves a long animation of the same box (the light moving along the trajectory's line in
 --frames frames, N = 100,000) in chunks, on 1 rank and on 2 ranks x 1 thread, and prints
-each rank's peak resident memory and frames held, the ratio of the 2-rank peak to the 1-rank
-peak, the times, and whether the frames (every 97th) are the same bits in both runs."""
+each rank's peak resident memory and what it held before the filter ran, the ratio of the
+2-rank peak to the 1-rank peak (and of the parts above what the processes held before), the
+times, and whether the frames (every 97th, at least 8) are the same bits in both runs. It exits
+with 1 when they are not, or when a rank of the 2 shows none of them."""
 import argparse
 import json
 import os
@@ -59,15 +61,19 @@ def rank_script(args):
         Scene=box, Light=light, PatchSize=args.patch_size,
         NumberOfPaths=args.paths, GatheringRatio=1.0, FirstBounceSurvival=0.25,
         ReuseShooting=1, ReuseGathering=1, Seed=1, NumberOfThreads=args.threads, **path)
+    # What the process holds before the filter runs: ParaView, Python and the inputs.
+    with open("/proc/self/status") as status:
+        base = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmRSS"))
     start = time.perf_counter()
     cpu = time.process_time()
     radiosity.UpdatePipeline(time=0.0)
     update = time.perf_counter() - start
     cpu = time.process_time() - cpu
     if args.frames:
-        # Every 97th frame's radiosity, from the rank that holds it; then this rank's peak.
+        # Every 97th frame's radiosity (at least 8 frames), from the rank that holds it; then
+        # this rank's peak.
         digests = {}
-        for f in range(0, args.frames, 97):
+        for f in range(0, args.frames, max(1, min(97, args.frames // 8))):
             radiosity.UpdatePipeline(time=float(f))
             data = radiosity.GetClientSideObject().GetOutputDataObject(0)
             if data.GetNumberOfCells() > 0:
@@ -77,7 +83,7 @@ def rank_script(args):
             peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM"))
         held = {int(f) for f in digests}
         with open(f"{args.out}.rank{rank}", "w") as f:
-            json.dump({"peak": peak, "update": update, "digests": digests,
+            json.dump({"peak": peak, "base": base, "update": update, "digests": digests,
                        "frames_held": len(held)}, f)
         return
     elements = radiosity.GetClientSideObject().GetOutputDataObject(0)
@@ -144,14 +150,19 @@ def chunks_main(args):
     mib = 1024.0 * 1024.0
     print(f"Cornell box (PatchSize {args.patch_size}), {args.frames} frames in chunks of "
           f"{args.frames_per_chunk}, N = {args.paths}, full reuse, 1 thread per rank")
-    print(f"{'configuration':<16}{'update s':>10}  peak resident MiB per rank")
+    print(f"{'configuration':<16}{'update s':>10}  peak resident MiB per rank "
+          "(of which before the filter ran: ParaView, Python, the inputs)")
     for name, runs in (("1 rank", one), ("2 ranks", two)):
         print(f"{name:<16}{max(r['update'] for r in runs):>10.2f}  "
-              + ", ".join(f"{r['peak'] / mib:.1f}" for r in runs))
+              + ", ".join(f"{r['peak'] / mib:.1f} ({r['base'] / mib:.1f})" for r in runs))
     ratio = max(r["peak"] for r in two) / one[0]["peak"]
     print(f"2-rank peak / 1-rank peak: {ratio:.2f} (target at most 0.6: "
           f"{'met' if ratio <= 0.6 else 'MISSED'}); update time 1 rank / 2 ranks: "
           f"{one[0]['update'] / max(r['update'] for r in two):.2f}x")
+    # The process's own part does not divide over ranks, so the ratio above falls towards 1/2
+    # only as the frames held outgrow it; the filter's part is what the ranks split.
+    added = max(r["peak"] - r["base"] for r in two) / (one[0]["peak"] - one[0]["base"])
+    print(f"the same above what each process held before the filter ran: {added:.2f}")
     merged = {}
     for r in two:
         for f, d in r["digests"].items():
@@ -160,7 +171,7 @@ def chunks_main(args):
     shown = [len(r["digests"]) for r in two]
     print(f"sampled frames shown per rank: {shown} of {len(one[0]['digests'])}; the same bits as "
           f"one rank: {'yes' if same else 'NO'}")
-    if not same:
+    if not same or min(shown) == 0:
         sys.exit(1)
 
 
