@@ -5,6 +5,7 @@
 #include "Parallel.h"
 #include "Ranks.h"
 #include "Shooting.h"
+#include "ZeroedMemory.h"
 
 #include <algorithm>
 #include <chrono>
@@ -32,26 +33,49 @@ std::uint64_t splitMix(std::uint64_t z)
   return z ^ (z >> 31);
 }
 
-/// Element sides per task of the merge: the merge is element-wise, so any split gives the
-/// same bits.
+/// Element or patch sides per task of the merge: the merge is element-wise, so any split
+/// gives the same bits.
 constexpr std::size_t MergeSidesPerTask = 4096;
 
-/// The mean of the batches so far and the sum of squared deviations of their total
-/// irradiance (Welford's update, in batch order). The running mean is kept in single
-/// precision, where an update of one batch in thousands still counts, and the result's stored
-/// arrays get it rounded once after each batch. The sums of squared deviations are in single
-/// precision too: each is a sum of non-negative terms, in batch order, and a standard error
-/// needs two significant digits, where single precision keeps six over thousands of batches.
+/// Whether every value of a batch's row is zero: a side no path reached in that batch.
+bool zeroRow(const PackedRgb* values, std::size_t count)
+{
+  std::uint32_t any = 0;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    any |= static_cast<std::uint32_t>(values[i].r | values[i].g | values[i].b);
+  }
+  return any == 0;
+}
+
+/**
+ * The mean of the batches so far and the sum of squared deviations of their total
+ * irradiance (Welford's update, in batch order), per element side and frame, and the mean of
+ * the patches' bounced light. The running mean is kept in single precision, where an update
+ * of one batch in thousands still counts, and the result's stored arrays get it rounded once,
+ * when the solve reads it (publish()): after a round, not after every batch. The sums of
+ * squared deviations are in single precision too: each is a sum of non-negative terms, in
+ * batch order, and a standard error needs two significant digits, where single precision
+ * keeps six over thousands of batches.
+ *
+ * A side's frames are a row. A row that every batch so far left at zero (a side no light
+ * reaches: the outside of a closed room, the inside of a block) has a zero mean and spread,
+ * which a zero batch keeps: the merge skips it, and its running sums, fresh mappings, take no
+ * memory until a batch brings light there. Skipping changes no bit.
+ */
 class BatchSpread
 {
 public:
   BatchSpread(Solution& result, int workers)
     : Result(result)
     , Workers(workers)
+    , Frames(std::max<std::size_t>(result.frameCount(), 1))
     , MeanDirect(result.directData().size())
     , MeanIndirect(result.directData().size())
     , MeanPatch(result.patchData().size())
     , SquaredDeviations(result.directData().size())
+    , ElementRowSeen(result.directData().size() / Frames)
+    , PatchRowSeen(result.patchData().size() / Frames)
   {
   }
 
@@ -63,42 +87,96 @@ public:
   {
     ++this->Count;
     const double inverse = 1.0 / static_cast<double>(this->Count);
-    StoredArray& direct = this->Result.directData();
-    StoredArray& indirect = this->Result.indirectData();
-    StoredArray& patch = this->Result.patchData();
     const StoredArray& batchDirect = batch.directData();
     const StoredArray& batchIndirect = batch.indirectData();
     const StoredArray& batchPatch = batch.patchData();
-    const std::size_t frames = this->Result.frameCount();
-    const std::size_t sides = 2 * this->Result.elementCount();
-    const std::size_t tasks = (sides + MergeSidesPerTask - 1) / MergeSidesPerTask;
-    parallelFor(
-      tasks, this->Workers,
-      [&](std::size_t task, int)
+    const std::size_t frames = this->Frames;
+    this->forEachRow(
+      [&](std::size_t row)
       {
-        const std::size_t end = std::min(sides, (task + 1) * MergeSidesPerTask) * frames;
-        for (std::size_t i = task * MergeSidesPerTask * frames; i < end; ++i)
+        const std::size_t begin = row * frames, end = begin + frames;
+        if (!this->ElementRowSeen[row])
+        {
+          if (zeroRow(&batchDirect[begin], frames) && zeroRow(&batchIndirect[begin], frames))
+          {
+            return;
+          }
+          this->ElementRowSeen[row] = 1;
+        }
+        for (std::size_t i = begin; i < end; ++i)
         {
           const Rgb xDirect = batchDirect[i], xIndirect = batchIndirect[i];
           const Rgb meanDirect = this->MeanDirect[i], meanIndirect = this->MeanIndirect[i];
           const Rgb before = meanDirect + meanIndirect;
           this->MeanDirect[i] = FloatRgb(meanDirect + (xDirect - meanDirect) * inverse);
           this->MeanIndirect[i] = FloatRgb(meanIndirect + (xIndirect - meanIndirect) * inverse);
-          direct[i] = PackedRgb(this->MeanDirect[i]);
-          indirect[i] = PackedRgb(this->MeanIndirect[i]);
           const Rgb after = Rgb(this->MeanDirect[i]) + Rgb(this->MeanIndirect[i]);
           const Rgb x = xDirect + xIndirect;
           this->SquaredDeviations[i] =
             FloatRgb(Rgb(this->SquaredDeviations[i]) + (x - before) * (x - after));
         }
       },
-      [](std::size_t) { return true; });
-    for (std::size_t i = 0; i < patch.size(); ++i)
-    {
-      const Rgb mean = this->MeanPatch[i];
-      this->MeanPatch[i] = FloatRgb(mean + (Rgb(batchPatch[i]) - mean) * inverse);
-      patch[i] = PackedRgb(this->MeanPatch[i]);
-    }
+      [&](std::size_t row)
+      {
+        const std::size_t begin = row * frames, end = begin + frames;
+        if (!this->PatchRowSeen[row])
+        {
+          if (zeroRow(&batchPatch[begin], frames))
+          {
+            return;
+          }
+          this->PatchRowSeen[row] = 1;
+        }
+        for (std::size_t i = begin; i < end; ++i)
+        {
+          const Rgb mean = this->MeanPatch[i];
+          this->MeanPatch[i] = FloatRgb(mean + (Rgb(batchPatch[i]) - mean) * inverse);
+        }
+      });
+  }
+
+  /// Rounds the running mean into the result's stored arrays (zero where no batch brought
+  /// light, as they are), for whatever reads the result next: the lit sides, a round's error
+  /// figures, the caller.
+  void publish()
+  {
+    StoredArray& direct = this->Result.directData();
+    StoredArray& indirect = this->Result.indirectData();
+    StoredArray& patch = this->Result.patchData();
+    const std::size_t frames = this->Frames;
+    this->forEachRow(
+      [&](std::size_t row)
+      {
+        for (std::size_t i = row * frames; this->ElementRowSeen[row] && i < (row + 1) * frames; ++i)
+        {
+          direct[i] = PackedRgb(this->MeanDirect[i]);
+          indirect[i] = PackedRgb(this->MeanIndirect[i]);
+        }
+      },
+      [&](std::size_t row)
+      {
+        for (std::size_t i = row * frames; this->PatchRowSeen[row] && i < (row + 1) * frames; ++i)
+        {
+          patch[i] = PackedRgb(this->MeanPatch[i]);
+        }
+      });
+  }
+
+  /// Writes every element side and frame's standard error into the result's (zero) array.
+  void publishStdErrors()
+  {
+    StoredArray& stdError = this->Result.stdErrorData();
+    stdError = StoredArray(this->MeanDirect.size());
+    const std::size_t frames = this->Frames;
+    this->forEachRow(
+      [&](std::size_t row)
+      {
+        for (std::size_t i = row * frames; this->ElementRowSeen[row] && i < (row + 1) * frames; ++i)
+        {
+          stdError[i] = PackedRgb(this->stdError(i));
+        }
+      },
+      [](std::size_t) {});
   }
 
   /// The standard error of the mean irradiance at storage index i, in the storage unit (the
@@ -125,11 +203,48 @@ public:
   }
 
 private:
+  using Sums = std::vector<FloatRgb, ZeroedAllocator<FloatRgb>>;
+
+  /// Calls `elementRow` on every element side's row and `patchRow` on every patch side's, on
+  /// the workers, in blocks of MergeSidesPerTask rows.
+  template <typename ElementRow, typename PatchRow>
+  void forEachRow(const ElementRow& elementRow, const PatchRow& patchRow)
+  {
+    const std::size_t elementRows = this->ElementRowSeen.size();
+    const std::size_t patchRows = this->PatchRowSeen.size();
+    const std::size_t elementTasks = (elementRows + MergeSidesPerTask - 1) / MergeSidesPerTask;
+    const std::size_t patchTasks = (patchRows + MergeSidesPerTask - 1) / MergeSidesPerTask;
+    parallelFor(
+      elementTasks + patchTasks, this->Workers,
+      [&](std::size_t task, int)
+      {
+        const bool element = task < elementTasks;
+        const std::size_t first = (element ? task : task - elementTasks) * MergeSidesPerTask;
+        const std::size_t last =
+          std::min(element ? elementRows : patchRows, first + MergeSidesPerTask);
+        for (std::size_t row = first; row < last; ++row)
+        {
+          if (element)
+          {
+            elementRow(row);
+          }
+          else
+          {
+            patchRow(row);
+          }
+        }
+      },
+      [](std::size_t) { return true; });
+  }
+
   Solution& Result;
   int Workers;
+  std::size_t Frames;
   std::uint64_t Count = 0;
-  std::vector<FloatRgb> MeanDirect, MeanIndirect, MeanPatch;
-  std::vector<FloatRgb> SquaredDeviations;
+  Sums MeanDirect, MeanIndirect, MeanPatch, SquaredDeviations;
+  /// Whether a batch brought light to the row: 1 byte per side, written by the one worker
+  /// that merges its row.
+  std::vector<std::uint8_t> ElementRowSeen, PatchRowSeen;
 };
 
 std::string percent(double fraction)
@@ -389,6 +504,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
       stoppedBy = "batches";
       break;
     }
+    spread.publish();
     result.chooseLitSides(workers);
     const auto [p95, frame] = worstFrame(result, spread);
     std::ostringstream s;
@@ -424,15 +540,11 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
     log(s.str());
   }
 
+  spread.publish();
   result.chooseLitSides(workers);
   summary.batches = spread.count();
   summary.stoppedBy = stoppedBy;
-  StoredArray& stdError = result.stdErrorData();
-  stdError = StoredArray(result.directData().size());
-  for (std::size_t i = 0; i < stdError.size(); ++i)
-  {
-    stdError[i] = PackedRgb(spread.stdError(i));
-  }
+  spread.publishStdErrors();
   double worst = 0;
   std::size_t worstAt = 0;
   for (std::size_t f = 0; f < result.frameCount(); ++f)

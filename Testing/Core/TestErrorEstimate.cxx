@@ -220,6 +220,77 @@ TEST(ErrorEstimate, ThreadCountDoesNotChangeABit)
   }
 }
 
+TEST(ErrorEstimate, ASideFirstLitInALaterBatchGetsTheWholeMeanAndSpread)
+{
+  // Made-up batches of 1 patch (4 elements) over 3 frames. Element 0's front is lit in every
+  // batch; element 1's back only from batch 3 on (a side the reachability probes missed,
+  // which a later batch's path finds); element 2's back never. The merge skips a side that
+  // no batch has lit so far: the side lit late must still get the mean and spread of all
+  // its batches, zeros included, and the dark one zeros.
+  constexpr std::size_t frames = 3, batches = 5;
+  Solution result(frames, 4, 1);
+  Solution batch(frames, 4, 1);
+  const double values[batches] = { 1.0, 3.0, 2.0, 6.0, 4.0 };
+  auto x = [&](std::size_t b, std::size_t f) { return values[b] * static_cast<double>(f + 1); };
+  SolverOptions options = batched(batches * 10, batches, 1);
+  options.threads = 3;
+  std::size_t done = 0;
+  double secondsReducing = 0;
+  solveInBatches(
+    options,
+    [&](const SolverOptions&, const std::function<bool(double)>&) -> Solution&
+    {
+      batch.clearRadiosity();
+      batch.allocateIndirect();
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        batch.directData()[batch.elementIndex(f, 0, Side::Front)] = PackedRgb(Rgb(x(done, f)));
+        batch.indirectData()[batch.elementIndex(f, 0, Side::Front)] = PackedRgb(Rgb(0.5));
+        if (done >= 2)
+        {
+          batch.directData()[batch.elementIndex(f, 1, Side::Back)] = PackedRgb(Rgb(x(done, f)));
+          batch.patchData()[batch.patchIndex(f, 0, Side::Back)] = PackedRgb(Rgb(x(done, f)));
+        }
+      }
+      ++done;
+      return batch;
+    },
+    {}, 0, secondsReducing, result);
+  ASSERT_EQ(done, batches);
+  for (std::size_t f = 0; f < frames; ++f)
+  {
+    // Over all 5 batches, and over the 3 that lit element 1 padded with 2 zeros.
+    double all = 0, late = 0;
+    for (std::size_t b = 0; b < batches; ++b)
+    {
+      all += x(b, f);
+      late += b >= 2 ? x(b, f) : 0;
+    }
+    all /= batches;
+    late /= batches;
+    double allSquares = 0, lateSquares = 0;
+    for (std::size_t b = 0; b < batches; ++b)
+    {
+      allSquares += (x(b, f) - all) * (x(b, f) - all);
+      const double v = b >= 2 ? x(b, f) : 0;
+      lateSquares += (v - late) * (v - late);
+    }
+    const double scale = 1.0 / ((batches - 1) * batches);
+    const double rounding = 2 * PackedRgb::RelativeRounding;
+    EXPECT_NEAR(result.directIrradiance(f, 0, Side::Front).g, all, rounding * all);
+    EXPECT_NEAR(result.indirectIrradiance(f, 0, Side::Front).g, 0.5, rounding * 0.5);
+    EXPECT_NEAR(result.irradianceStdError(f, 0, Side::Front).g, std::sqrt(allSquares * scale),
+      rounding * std::sqrt(allSquares * scale));
+    EXPECT_NEAR(result.directIrradiance(f, 1, Side::Back).g, late, rounding * late);
+    EXPECT_NEAR(result.patchBounced(f, 0, Side::Back).g, late, rounding * late);
+    EXPECT_NEAR(result.irradianceStdError(f, 1, Side::Back).g, std::sqrt(lateSquares * scale),
+      rounding * std::sqrt(lateSquares * scale));
+    EXPECT_EQ(result.irradiance(f, 2, Side::Back).sum(), 0.0);
+    EXPECT_EQ(result.irradianceStdError(f, 2, Side::Back).sum(), 0.0);
+    EXPECT_EQ(result.patchBounced(f, 0, Side::Front).sum(), 0.0);
+  }
+}
+
 TEST(ErrorEstimate, TargetIsReachedAndTheSameForAnyThreadCount)
 {
   const Scene scene = box();
