@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "MemoryBudget.h"
+#include "MemoryPlan.h"
 #include "Parallel.h"
 #include "Ranks.h"
 #include "Shooting.h"
@@ -350,19 +351,33 @@ void checkBatchPathsPerPosition(const LightSource& source, const SolverOptions& 
   }
 }
 
-std::uint64_t errorEstimateBytes(
-  std::size_t patches, std::size_t elements, std::size_t frames, const SolverOptions& options)
+std::uint64_t errorEstimateBytes(std::size_t patches, std::size_t elements, std::size_t frames,
+  const SolverOptions& options, const std::vector<std::uint8_t>* reachable)
 {
   if (!estimatesError(options))
   {
     return 0;
   }
-  const std::uint64_t sides = saturatingProduct({ frames, elements, 2 });
-  // The mean in the result's stored arrays and in single precision (BatchSpread).
+  // BatchSpread merges, and writes, only the sides a batch lit: those light reaches.
+  const bool perPatch = elements == patches * Scene::ElementsPerPatch;
+  auto elementArray = [&](std::size_t valueBytes)
+  {
+    return perPatch
+      ? writtenResultBytes(patches, Scene::ElementsPerPatch, frames, reachable, valueBytes)
+      : saturatingProduct({ frames, elements, 2, valueBytes });
+  };
+  auto patchArray = [&](std::size_t valueBytes)
+  { return writtenResultBytes(patches, 1, frames, reachable, valueBytes); };
+  // The mean in the result's stored arrays and in single precision, direct and indirect; the
+  // patches' the same; the flags of the sides a batch lit.
   const std::uint64_t mean =
-    saturatingSum(saturatingProduct(sides, 2 * (sizeof(PackedRgb) + sizeof(FloatRgb))),
-      saturatingProduct({ frames, patches, 2, sizeof(PackedRgb) + sizeof(FloatRgb) }));
-  const std::uint64_t spread = saturatingProduct(sides, sizeof(FloatRgb) + sizeof(PackedRgb));
+    saturatingSum(saturatingSum(saturatingProduct(elementArray(sizeof(PackedRgb)), 2),
+                    saturatingProduct(elementArray(sizeof(FloatRgb)), 2)),
+      saturatingSum(saturatingSum(patchArray(sizeof(PackedRgb)), patchArray(sizeof(FloatRgb))),
+        saturatingProduct({ 2, saturatingSum(elements, patches) })));
+  // The squared deviations and the standard errors.
+  const std::uint64_t spread =
+    saturatingSum(elementArray(sizeof(FloatRgb)), elementArray(sizeof(PackedRgb)));
   return saturatingSum(mean, spread);
 }
 

@@ -51,10 +51,13 @@ std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t batch);
 void checkBatchPathsPerPosition(const LightSource& source, const SolverOptions& options);
 
 /// The bytes a batched solve needs on top of one solve of a batch: the running mean of the
-/// results (direct, indirect, patches) and the batches' sum of squared deviations (double RGB)
-/// and standard errors (float RGB) of every element side and frame. 0 without batches.
-std::uint64_t errorEstimateBytes(
-  std::size_t patches, std::size_t elements, std::size_t frames, const SolverOptions& options);
+/// results (direct, indirect, patches; single precision, and stored in the result), the
+/// batches' sum of squared deviations (single precision) and the standard errors (stored) of
+/// every element side and frame. Like the results, they are written for the sides light
+/// reaches alone, in the pages of those sides' runs: `reachable` as in planSolveMemory (null
+/// counts every side). 0 without batches.
+std::uint64_t errorEstimateBytes(std::size_t patches, std::size_t elements, std::size_t frames,
+  const SolverOptions& options, const std::vector<std::uint8_t>* reachable = nullptr);
 
 /// The relative error statistics of one frame's lit elements.
 struct FrameError

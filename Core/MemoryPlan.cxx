@@ -87,10 +87,10 @@ std::uint64_t writtenShareBytes(std::size_t patches, std::size_t frames,
 }
 
 std::uint64_t writtenResultBytes(std::size_t patches, std::size_t recordsPerPatch,
-  std::size_t frames, const std::vector<std::uint8_t>* reachable)
+  std::size_t frames, const std::vector<std::uint8_t>* reachable, std::size_t valueBytes)
 {
   // One patch side's records, contiguous.
-  const std::uint64_t run = saturatingProduct({ recordsPerPatch, frames, sizeof(PackedRgb) });
+  const std::uint64_t run = saturatingProduct({ recordsPerPatch, frames, valueBytes });
   const std::uint64_t whole = saturatingProduct({ patches, 2, run });
   if (!reachable || reachable->size() != 2 * patches || run == 0 || whole == UINT64_MAX)
   {
@@ -201,9 +201,8 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
     saturatingProduct({ frames, std::max<std::uint64_t>(lights, 1), 256 });
   // A batched solve's running mean and squared deviations live through every batch; its
   // standard errors are allocated after the last batch, when no accumulators are left.
-  plan.errorEstimate = errorEstimateBytes(patches, elements, frames, options);
-  const std::uint64_t standardErrors =
-    plan.errorEstimate > 0 ? saturatingProduct({ frames, elements, 2, sizeof(PackedRgb) }) : 0;
+  plan.errorEstimate = errorEstimateBytes(patches, elements, frames, options, reachable);
+  const std::uint64_t standardErrors = plan.errorEstimate > 0 ? indirect : 0;
   const std::uint64_t base = saturatingSum(
     saturatingSum(saturatingSum(scratch, tracing), saturatingSum(perElement, lightData)),
     plan.errorEstimate - standardErrors);
@@ -231,8 +230,10 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
   const std::uint64_t gatheringRays = options.reuseGathering && blockFrames < frames
     ? std::min<std::uint64_t>(plan.gathering.hitBytes, saturatingProduct({ rays, 4 }))
     : 0;
-  const std::uint64_t gathering =
-    saturatingSum(gatheringResults, saturatingSum(readRows, gatheringRays));
+  // The standard errors are allocated once the last batch has gathered, its rows and rays
+  // freed: they take the room of those, not more.
+  const std::uint64_t gathering = saturatingSum(gatheringResults - standardErrors,
+    std::max(saturatingSum(readRows, gatheringRays), standardErrors));
   // Shooting: the direct light and the patches take memory only once written (ZeroedAllocator
   // in Solution.h), when a source's sums are turned into them, after the workers' copies were
   // collapsed into one and the others' pages given back. With one source that is the larger

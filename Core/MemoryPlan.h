@@ -66,13 +66,15 @@ MemoryPlan planSolveMemory(std::size_t patches, std::size_t elements, std::size_
 
 /**
  * The bytes of a result array that writing the frames of the reachable sides makes
- * resident: the array holds `frames` PackedRgb per (record, side), side-major, records
- * `recordsPerPatch` to a patch (Solution::elementIndex, patchIndex); it is a fresh mapping
- * aligned to 2 MiB (ZeroedAllocator) whose pages become resident whole once written. Null
- * `reachable`: every side, the whole array.
+ * resident: the array holds `frames` values of `valueBytes` (PackedRgb, or FloatRgb for the
+ * error batches' running sums) per (record, side), side-major, records `recordsPerPatch` to a
+ * patch (Solution::elementIndex, patchIndex); it is a fresh mapping aligned to 2 MiB
+ * (ZeroedAllocator) whose pages become resident whole once written. Null `reachable`: every
+ * side, the whole array.
  */
 std::uint64_t writtenResultBytes(std::size_t patches, std::size_t recordsPerPatch,
-  std::size_t frames, const std::vector<std::uint8_t>* reachable);
+  std::size_t frames, const std::vector<std::uint8_t>* reachable,
+  std::size_t valueBytes = sizeof(PackedRgb));
 
 /// planSolveMemory(...).peak: the bytes a solve will allocate at its peak.
 std::uint64_t estimateSolveMemory(
