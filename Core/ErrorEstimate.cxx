@@ -144,19 +144,18 @@ public:
     StoredArray& direct = this->Result.directData();
     StoredArray& indirect = this->Result.indirectData();
     StoredArray& patch = this->Result.patchData();
-    const std::size_t frames = this->Frames;
-    this->forEachRow(
-      [&](std::size_t row)
+    this->forEachLitRow(
+      [&](std::size_t begin, std::size_t end)
       {
-        for (std::size_t i = row * frames; this->ElementRowSeen[row] && i < (row + 1) * frames; ++i)
+        for (std::size_t i = begin; i < end; ++i)
         {
           direct[i] = PackedRgb(this->MeanDirect[i]);
           indirect[i] = PackedRgb(this->MeanIndirect[i]);
         }
       },
-      [&](std::size_t row)
+      [&](std::size_t begin, std::size_t end)
       {
-        for (std::size_t i = row * frames; this->PatchRowSeen[row] && i < (row + 1) * frames; ++i)
+        for (std::size_t i = begin; i < end; ++i)
         {
           patch[i] = PackedRgb(this->MeanPatch[i]);
         }
@@ -168,16 +167,15 @@ public:
   {
     StoredArray& stdError = this->Result.stdErrorData();
     stdError = StoredArray(this->MeanDirect.size());
-    const std::size_t frames = this->Frames;
-    this->forEachRow(
-      [&](std::size_t row)
+    this->forEachLitRow(
+      [&](std::size_t begin, std::size_t end)
       {
-        for (std::size_t i = row * frames; this->ElementRowSeen[row] && i < (row + 1) * frames; ++i)
+        for (std::size_t i = begin; i < end; ++i)
         {
           stdError[i] = PackedRgb(this->stdError(i));
         }
       },
-      [](std::size_t) {});
+      [](std::size_t, std::size_t) {});
   }
 
   /// The standard error of the mean irradiance at storage index i, in the storage unit (the
@@ -236,6 +234,28 @@ private:
         }
       },
       [](std::size_t) { return true; });
+  }
+
+  /// forEachRow over the rows some batch lit, each as its range of storage indices.
+  template <typename ElementRange, typename PatchRange>
+  void forEachLitRow(const ElementRange& elementRange, const PatchRange& patchRange)
+  {
+    const std::size_t frames = this->Frames;
+    this->forEachRow(
+      [&](std::size_t row)
+      {
+        if (this->ElementRowSeen[row])
+        {
+          elementRange(row * frames, (row + 1) * frames);
+        }
+      },
+      [&](std::size_t row)
+      {
+        if (this->PatchRowSeen[row])
+        {
+          patchRange(row * frames, (row + 1) * frames);
+        }
+      });
   }
 
   Solution& Result;
