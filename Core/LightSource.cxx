@@ -189,17 +189,21 @@ std::size_t AreaSource::kernel(const EmittedPath& path, const Vec3& y, const Vec
       kernel[j] = lit ? g : 0.0;
     }
     // From y lifted along n_y to x_j lifted along n: o_j - (y - x) + (n - n_y) offset.
+    // Every position's ray is written at the next free place and kept by counting it,
+    // without a branch, through pointers the float writes cannot make the compiler reload
+    // (count <= j, so the writes stay within the arrays).
     const Vec3 base = (n - ny) * offset - toHit;
+    float* const outX = scratch.dx.data();
+    float* const outY = scratch.dy.data();
+    float* const outZ = scratch.dz.data();
+    std::uint32_t* const outFrame = scratch.targetFrames.data();
     for (std::size_t j = 0; j < positions; ++j)
     {
-      if (kernel[j] > 0 && j != origin)
-      {
-        scratch.dx[count] = static_cast<float>(base.x + pose[9][j]);
-        scratch.dy[count] = static_cast<float>(base.y + pose[10][j]);
-        scratch.dz[count] = static_cast<float>(base.z + pose[11][j]);
-        scratch.targetFrames[count] = static_cast<std::uint32_t>(j);
-        ++count;
-      }
+      outX[count] = static_cast<float>(base.x + pose[9][j]);
+      outY[count] = static_cast<float>(base.y + pose[10][j]);
+      outZ[count] = static_cast<float>(base.z + pose[11][j]);
+      outFrame[count] = static_cast<std::uint32_t>(j);
+      count += static_cast<std::size_t>((kernel[j] > 0) & (j != origin));
     }
   }
   else
