@@ -409,7 +409,10 @@ FrameError frameError(const Solution& solution, std::size_t frame,
   double sum = 0;
   for (std::size_t e = 0; e < elements; ++e)
   {
-    totals[e] = solution.total(frame, e, solution.litSide(e)).sum();
+    // The light the element reflects, without its own emission: the emission is exact, so
+    // counting it would call an emitter lit and accurate whatever light reaches it.
+    const Side side = solution.litSide(e);
+    totals[e] = (solution.direct(frame, e, side) + solution.indirect(frame, e, side)).sum();
     sum += totals[e];
   }
   const double threshold =

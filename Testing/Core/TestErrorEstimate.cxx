@@ -366,6 +366,29 @@ TEST(ErrorEstimate, FrameErrorIsOverLitElementsByNearestRank)
   EXPECT_NEAR(fe.p95, 0.19, 0.19 * 2 * PackedRgb::RelativeRounding);
 }
 
+TEST(ErrorEstimate, FrameErrorLeavesTheEmissionOut)
+{
+  // 10 emitters that reflect little light with a 100% error, and 10 elements that reflect
+  // radiosity 1 with a 2% error. Counted with their exact emission the emitters would be the
+  // lit and accurate majority; without it they are dark, and the frame's error is the others'.
+  Solution s(1, 20, 5);
+  s.emissionData().assign(20, Rgb());
+  for (std::size_t e = 0; e < 20; ++e)
+  {
+    const bool emitter = e < 10;
+    if (emitter)
+    {
+      s.emissionData()[e] = Rgb(1000.0);
+    }
+    s.directData()[s.elementIndex(0, e, Side::Front)] = PackedRgb(Rgb(emitter ? 1e-6 : 1.0 / 3));
+  }
+  const FrameError fe =
+    frameError(s, 0, [](std::size_t e, Side) { return e < 10 ? Rgb(1e-6 / 3) : Rgb(0.02 / 3); });
+  EXPECT_EQ(fe.litElements, 10u);
+  EXPECT_NEAR(fe.median, 0.02, 0.02 * 2 * PackedRgb::RelativeRounding);
+  EXPECT_NEAR(fe.p95, 0.02, 0.02 * 2 * PackedRgb::RelativeRounding);
+}
+
 TEST(ErrorEstimate, MemoryEstimateCountsTheBatches)
 {
   const Scene scene = box();
