@@ -230,6 +230,7 @@ Scene readObj(
 
   LogicalLines lines(in);
   std::string line, keyword, rest;
+  std::size_t unnamedMaterials = 0;
   while (lines.next(line))
   {
     if (lines.number() % 65536 == 0)
@@ -291,11 +292,15 @@ Scene readObj(
     }
     else if (keyword == "usemtl")
     {
-      if (rest.empty())
+      // Some exporters (Rhino) write a bare 'usemtl' for "no material": the faces after it
+      // get the default one, as faces before any 'usemtl' do.
+      if (rest.empty() && unnamedMaterials++ == 0)
       {
-        throw FileError(where() + ": 'usemtl' without a material name");
+        warn(where() +
+          ": 'usemtl' without a material name; the faces after it (and after any "
+          "other such line) have the default material, grey 0.5");
       }
-      currentMaterial = materialId(rest);
+      currentMaterial = materialId(rest.empty() ? "none" : rest);
     }
     else if (keyword == "mtllib")
     {
@@ -459,7 +464,7 @@ Scene readObj(
     {
       warn("the " + what + " is not defined in its material libraries: it is grey 0.5");
     }
-    else if (name == "none" && !libraries.empty())
+    else if (name == "none" && !libraries.empty() && unnamedMaterials == 0)
     {
       warn("the OBJ file " + named(path) +
         " has faces before any 'usemtl': their material 'none' is grey 0.5");
