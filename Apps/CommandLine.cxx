@@ -4,9 +4,12 @@
 
 #include <vtk_cli11.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -295,6 +298,26 @@ void checkRange(const std::string& option, T value, T minimum, T maximum)
     throw UsageError(s.str());
   }
 }
+}
+
+bool Options::sceneIsYUp() const
+{
+  std::string extension = std::filesystem::path(this->scene).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".gltf" || extension == ".glb";
+}
+
+Triple Options::zenith() const
+{
+  return this->up.value_or(this->sceneIsYUp() ? Triple{ 0, 1, 0 } : Triple{ 0, 0, 1 });
+}
+
+Triple Options::northDirection() const
+{
+  // With --up given, north keeps its Z-up default, whatever the format.
+  return this->north.value_or(
+    this->sceneIsYUp() && !this->up ? Triple{ 0, 0, -1 } : Triple{ 0, 1, 0 });
 }
 
 Options parseCommandLine(int argc, const char* const* argv)
@@ -643,9 +666,10 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     filter->SetLightTypeToLuminaire();
   }
-  if (o.up && !o.lightDistribution.empty())
+  const Triple zenith = o.zenith();
+  if (!o.lightDistribution.empty())
   {
-    filter->SetUp(o.up->data());
+    filter->SetUp(zenith.data());
   }
   if (!o.lightDistribution.empty())
   {
@@ -677,10 +701,7 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     filter->SetSkyModel(skyModelIndex(*o.sky));
     filter->SetSkyDiffuseHorizontal(o.skyDiffuseHorizontal.value_or(100.0));
-    if (o.up)
-    {
-      filter->SetUp(o.up->data());
-    }
+    filter->SetUp(zenith.data());
   }
   if (o.paths)
   {
@@ -885,9 +906,11 @@ apply to --weather):
                         the sun below the horizon are kept, dark, and the series' times
                         are the clock times in hours
   --time-zone HOURS     the clock times' offset from UTC (default 0: UTC; e.g. 2 for CEST)
-  --north X,Y,Z         the scene's north (default 0,1,0)
+  --north X,Y,Z         the scene's north (default 0,1,0; 0,0,-1 for a glTF scene
+                        without --up)
   --up X,Y,Z            the scene's zenith, also the sky's and the vertical a TILT table
-                        measures the luminaire's tilt from (default 0,0,1)
+                        measures the luminaire's tilt from (default 0,0,1; 0,1,0 for a
+                        .gltf or .glb scene, which the glTF standard makes Y-up)
   --sun-irradiance W/m2 on a surface facing the sun (default 1000; 0: no direct sun, the
                         frames and the sky's sun kept)
   --weather FILE.epw    the hours of an EnergyPlus weather file as frames: the sun at the

@@ -98,6 +98,13 @@ struct Options
   std::string png;    ///< DIR, or empty for no pictures
 
   bool usesEmbeddedScene() const { return this->scene.empty(); }
+  /// A glTF scene (.gltf, .glb): Y-up, as the glTF standard has it.
+  bool sceneIsYUp() const;
+  /// The scene's zenith: --up, else +z, or +y for a glTF scene.
+  Triple zenith() const;
+  /// The scene's north: --north, else +y, or -z for a glTF scene without --up (east is +x
+  /// either way).
+  Triple northDirection() const;
   bool usesSun() const
   {
     return !this->sunDirections.empty() || this->sunPath.has_value() || !this->weather.empty();

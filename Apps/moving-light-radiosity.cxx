@@ -204,8 +204,8 @@ void tripleOf(vtkFieldData* data, const char* name, double out[3])
 vtkSmartPointer<vtkPolyData> updatedSunPath(vtkSunPathSource* source, const Options& options,
   const std::function<void(const std::string& reason)>& fail)
 {
-  const Triple north = options.north.value_or(Triple{ 0, 1, 0 });
-  const Triple up = options.up.value_or(Triple{ 0, 0, 1 });
+  const Triple north = options.northDirection();
+  const Triple up = options.zenith();
   source->SetNorth(north.data());
   source->SetUp(up.data());
   std::string error;
@@ -495,11 +495,18 @@ int run(int argc, char** argv, RankJob& job)
   }
   else if (options.workPlane)
   {
-    sensors = workPlaneSensors(scene, options.up.value_or(Triple{ 0, 0, 1 }),
-      (*options.workPlane)[0], (*options.workPlane)[1]);
+    sensors =
+      workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1]);
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);
+  if (options.sceneIsYUp() && !options.up &&
+    (options.usesSun() || options.sky || options.workPlane || !options.lightDistribution.empty()))
+  {
+    std::cout << "the glTF scene is Y-up (the glTF standard): up is 0,1,0 and north 0,0,-1; "
+                 "--up and --north change them"
+              << std::endl;
+  }
   if (sensors)
   {
     filter->SetInputData(vtkMovingLightRadiosity::SENSORS_PORT, sensors);
@@ -752,7 +759,7 @@ int run(int argc, char** argv, RankJob& job)
     const fs::path pictures = options.png;
     const PictureDisplay display; // outlives the renderer's connection to it
     // Scenes lit by the sun get an aerial view, their zenith up.
-    const Triple zenith = options.up.value_or(Triple{ 0, 0, 1 });
+    const Triple zenith = options.zenith();
     FrameRenderer renderer(scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
     for (std::size_t f = 0; f < times.size(); ++f)
     {

@@ -164,6 +164,54 @@ public:
     return value;
   }
 
+  /// A sparse accessor part: `count` (1 to the accessor's `elements`) indices of unsigned
+  /// integers and as many values of `elementBytes`, each tightly packed in its bufferView.
+  void checkSparse(
+    const Json& sparse, const std::string& where, std::int64_t elements, std::int64_t elementBytes)
+  {
+    if (!sparse.is_object())
+    {
+      this->fail(where + " is not an object");
+    }
+    const std::int64_t count = this->integer(sparse, "count", where, 0);
+    if (count < 1 || count > elements)
+    {
+      this->fail(where + ".count is " + std::to_string(count) +
+        ": give 1 to the accessor's count (" + std::to_string(elements) + ")");
+    }
+    auto part = [&](const char* key, std::int64_t bytes)
+    {
+      const std::string at = where + "." + key;
+      const auto found = sparse.find(key);
+      if (found == sparse.end() || !found->is_object() || !found->contains("bufferView"))
+      {
+        this->fail(at + " has no bufferView");
+      }
+      const Json& view = this->array("bufferViews")[static_cast<std::size_t>(
+        this->index(*found, "bufferView", "bufferViews", at))];
+      const std::int64_t offset = this->integer(*found, "byteOffset", at, 0);
+      const std::int64_t available = view["byteLength"].get<std::int64_t>();
+      if (offset < 0 || !spanFits(offset, count, bytes, bytes, available))
+      {
+        this->fail(at + " (" + std::to_string(count) + " elements of " + std::to_string(bytes) +
+          " bytes from byte " + std::to_string(offset) + ") does not fit in its bufferView (" +
+          std::to_string(available) + " bytes)");
+      }
+    };
+    const auto indices = sparse.find("indices");
+    const std::int64_t type = indices != sparse.end() && indices->is_object()
+      ? this->integer(*indices, "componentType", where, 0)
+      : 0;
+    if (type != 5121 && type != 5123 && type != 5125)
+    {
+      this->fail(where +
+        ".indices.componentType is not an unsigned byte, short or int (5121, "
+        "5123, 5125)");
+    }
+    part("indices", componentBytes(type));
+    part("values", elementBytes);
+  }
+
   const Json& object(const Json& parent, std::size_t i, const std::string& where) const
   {
     if (!parent[i].is_object())
@@ -186,12 +234,14 @@ public:
                                  : "it is glTF version " + printable(version) + ", not 2.x");
     }
     // Extensions a reader must understand: those of materials only change what is not read
-    // here (or the emission strength, which is read); geometry compression is not supported.
+    // here (or the emission strength, which is read), punctual lights are left out with a
+    // warning; geometry compression is not supported.
     for (const auto& required : this->array("extensionsRequired"))
     {
       const std::string name =
         required.is_string() ? required.get<std::string>() : std::string("?");
-      if (name.rfind("KHR_materials_", 0) != 0 && name != "KHR_texture_transform")
+      if (name.rfind("KHR_materials_", 0) != 0 && name != "KHR_texture_transform" &&
+        name != "KHR_lights_punctual")
       {
         this->fail(
           "it requires the extension " + printable(name) + ", which this reader does not support");
@@ -259,16 +309,6 @@ public:
     {
       const std::string where = "accessors[" + std::to_string(i) + "]";
       const Json& accessor = this->object(accessors, i, where);
-      if (accessor.contains("sparse"))
-      {
-        this->fail(where + " is sparse: sparse accessors are not supported");
-      }
-      if (!accessor.contains("bufferView"))
-      {
-        this->fail(where + " has no bufferView: accessors without data are not supported");
-      }
-      const Json& view =
-        views[static_cast<std::size_t>(this->index(accessor, "bufferView", "bufferViews", where))];
       const std::int64_t bytes = componentBytes(this->integer(accessor, "componentType", where, 0));
       const auto type = accessor.find("type");
       const std::int64_t components =
@@ -280,13 +320,27 @@ public:
         this->fail(where + " has a missing or invalid componentType, type, count or byteOffset");
       }
       const std::int64_t element = bytes * components;
-      const std::int64_t stride = std::max(this->integer(view, "byteStride", where, 0), element);
-      const std::int64_t available = view["byteLength"].get<std::int64_t>();
-      if (count > INT32_MAX / stride || !spanFits(offset, count, stride, element, available))
+      if (count > INT32_MAX / element)
       {
-        this->fail(where + " (" + std::to_string(count) + " elements of " +
-          std::to_string(element) + " bytes from byte " + std::to_string(offset) +
-          ") does not fit in its bufferView (" + std::to_string(available) + " bytes)");
+        this->fail(where + " has " + std::to_string(count) + " elements: too many");
+      }
+      // Without a bufferView the accessor is zeros (which a sparse part may replace).
+      if (accessor.contains("bufferView"))
+      {
+        const Json& view = views[static_cast<std::size_t>(
+          this->index(accessor, "bufferView", "bufferViews", where))];
+        const std::int64_t stride = std::max(this->integer(view, "byteStride", where, 0), element);
+        const std::int64_t available = view["byteLength"].get<std::int64_t>();
+        if (count > INT32_MAX / stride || !spanFits(offset, count, stride, element, available))
+        {
+          this->fail(where + " (" + std::to_string(count) + " elements of " +
+            std::to_string(element) + " bytes from byte " + std::to_string(offset) +
+            ") does not fit in its bufferView (" + std::to_string(available) + " bytes)");
+        }
+      }
+      if (accessor.contains("sparse"))
+      {
+        this->checkSparse(accessor["sparse"], where + ".sparse", count, element);
       }
       this->AccessorType.push_back(*type);
       this->AccessorComponent.push_back(this->integer(accessor, "componentType", where, 0));
@@ -830,21 +884,60 @@ public:
   }
 
   /// Accessor `index` as numbers, `components` per element; normalized integers in [0, 1].
+  /// Zeros where it has no bufferView, then its sparse values, if any, in their places.
   std::vector<double> accessor(std::size_t index, std::size_t& components) const
   {
     const Json& accessor = this->Root["accessors"][index];
-    const Json& view = this->Root["bufferViews"][accessor["bufferView"].get<std::size_t>()];
     const std::int64_t type = accessor["componentType"].get<std::int64_t>();
-    const std::size_t bytes = static_cast<std::size_t>(componentBytes(type));
     components = static_cast<std::size_t>(typeComponents(accessor["type"].get<std::string>()));
     const std::size_t count = accessor["count"].get<std::size_t>();
-    const std::size_t stride =
-      std::max<std::size_t>(view.value("byteStride", std::size_t(0)), bytes * components);
-    const std::string& buffer = *this->Buffers[view["buffer"].get<std::size_t>()];
-    const std::size_t start =
-      view.value("byteOffset", std::size_t(0)) + accessor.value("byteOffset", std::size_t(0));
     const bool normalized = accessor.value("normalized", false);
     std::vector<double> values(count * components);
+    if (accessor.contains("bufferView"))
+    {
+      this->read(accessor["bufferView"].get<std::size_t>(),
+        accessor.value("byteOffset", std::size_t(0)), true, type, components, normalized, count,
+        values.data());
+    }
+    if (accessor.contains("sparse"))
+    {
+      const Json& sparse = accessor["sparse"];
+      const std::size_t changed = sparse["count"].get<std::size_t>();
+      const Json& indices = sparse["indices"];
+      const Json& given = sparse["values"];
+      std::vector<double> where(changed), replacements(changed * components);
+      this->read(indices["bufferView"].get<std::size_t>(),
+        indices.value("byteOffset", std::size_t(0)), false,
+        indices["componentType"].get<std::int64_t>(), 1, false, changed, where.data());
+      this->read(given["bufferView"].get<std::size_t>(), given.value("byteOffset", std::size_t(0)),
+        false, type, components, normalized, changed, replacements.data());
+      for (std::size_t i = 0; i < changed; ++i)
+      {
+        if (!(where[i] < static_cast<double>(count)))
+        {
+          this->fail("accessors[" + std::to_string(index) + "].sparse names element " +
+            std::to_string(static_cast<std::uint64_t>(where[i])) + " but the accessor has " +
+            std::to_string(count));
+        }
+        std::copy_n(&replacements[i * components], components,
+          &values[static_cast<std::size_t>(where[i]) * components]);
+      }
+    }
+    return values;
+  }
+
+  /// `count` elements of `components` numbers of glTF component type `type` from bufferView
+  /// `viewIndex` at `offset` (checked to fit), into `out`: spaced by the view's byteStride
+  /// where `strided`, tightly packed otherwise (a sparse part's).
+  void read(std::size_t viewIndex, std::size_t offset, bool strided, std::int64_t type,
+    std::size_t components, bool normalized, std::size_t count, double* out) const
+  {
+    const Json& view = this->Root["bufferViews"][viewIndex];
+    const std::size_t bytes = static_cast<std::size_t>(componentBytes(type));
+    const std::size_t stride = std::max<std::size_t>(
+      strided ? view.value("byteStride", std::size_t(0)) : 0, bytes * components);
+    const std::string& buffer = *this->Buffers[view["buffer"].get<std::size_t>()];
+    const std::size_t start = view.value("byteOffset", std::size_t(0)) + offset;
     for (std::size_t e = 0; e < count; ++e)
     {
       for (std::size_t c = 0; c < components; ++c)
@@ -871,10 +964,9 @@ public:
           default:
             value = component<float>(at, false);
         }
-        values[e * components + c] = value;
+        out[e * components + c] = value;
       }
     }
-    return values;
   }
 
   /// The mean linear colour of texture `texture` (sRGB-encoded, as base colour and emissive
@@ -1092,6 +1184,71 @@ std::pair<std::uint64_t, std::uint64_t> drawnSize(
   return { points, triangles };
 }
 
+/// Moves `positions` (of a primitive of `mesh`, drawn by `node`) by its morph targets'
+/// POSITION displacements times their default weights: the node's, else the mesh's, else 0.
+void morph(const GltfDocument& document, const Json& node, const Json& mesh, const Json& primitive,
+  std::size_t meshIndex, std::vector<double>& positions)
+{
+  const auto targets = primitive.find("targets");
+  const Json* weights = node.contains("weights") ? &node["weights"]
+    : mesh.contains("weights")                   ? &mesh["weights"]
+                                                 : nullptr;
+  if (targets == primitive.end() || !weights)
+  {
+    return;
+  }
+  const std::string where = "meshes[" + std::to_string(meshIndex) + "]";
+  if (!weights->is_array() || weights->size() != targets->size())
+  {
+    document.fail(where + " has " + std::to_string(targets->size()) +
+      " morph targets but its (or its node's) weights are not as many numbers");
+  }
+  for (std::size_t t = 0; t < targets->size(); ++t)
+  {
+    const Json& weight = (*weights)[t];
+    if (!weight.is_number() || !std::isfinite(weight.get<double>()))
+    {
+      document.fail(
+        where + ": the weight of morph target " + std::to_string(t) + " is not a finite number");
+    }
+    const double w = weight.get<double>();
+    const Json& target = (*targets)[t];
+    if (w == 0 || !target.contains("POSITION"))
+    {
+      continue;
+    }
+    std::size_t components = 0;
+    const std::vector<double> moved =
+      document.accessor(target["POSITION"].get<std::size_t>(), components);
+    if (components != 3 || moved.size() != positions.size())
+    {
+      document.fail(where + ": morph target " + std::to_string(t) +
+        " does not move every vertex of its primitive by a VEC3");
+    }
+    for (std::size_t i = 0; i < positions.size(); ++i)
+    {
+      positions[i] += w * moved[i];
+    }
+  }
+}
+
+/// The punctual lights the file declares (KHR_lights_punctual), which are not read.
+std::size_t punctualLights(const Json& root)
+{
+  const auto extensions = root.find("extensions");
+  if (extensions == root.end() || !extensions->is_object())
+  {
+    return 0;
+  }
+  const auto lights = extensions->find("KHR_lights_punctual");
+  if (lights == extensions->end() || !lights->is_object())
+  {
+    return 0;
+  }
+  const auto list = lights->find("lights");
+  return list != lights->end() && list->is_array() ? list->size() : 0;
+}
+
 Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std::string bin,
   std::int64_t binBytes, const Warn& warn, ProgressPoll& poll, const MemoryBudget& budget)
 {
@@ -1183,6 +1340,12 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       continue;
     }
     const std::size_t meshIndex = node["mesh"].get<std::size_t>();
+    // A transform that mirrors (negative determinant) turns counter-clockwise into clockwise:
+    // glTF then takes the clockwise side as the front (a mirrored lamp still lights outward).
+    const bool mirrored = matrix[0] * (matrix[5] * matrix[10] - matrix[6] * matrix[9]) -
+        matrix[1] * (matrix[4] * matrix[10] - matrix[6] * matrix[8]) +
+        matrix[2] * (matrix[4] * matrix[9] - matrix[5] * matrix[8]) <
+      0;
     for (const Json& primitive : meshes[meshIndex]["primitives"])
     {
       const std::int64_t mode = primitive.value("mode", std::int64_t(4));
@@ -1193,9 +1356,10 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       }
       const Json& attributes = primitive["attributes"];
       std::size_t components = 0;
-      const std::vector<double> positions =
+      std::vector<double> positions =
         document.accessor(attributes["POSITION"].get<std::size_t>(), components);
       const std::size_t vertexCount = positions.size() / 3;
+      morph(document, node, meshes[meshIndex], primitive, meshIndex, positions);
       std::vector<std::size_t> indices;
       if (primitive.contains("indices"))
       {
@@ -1278,8 +1442,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       for (const auto& triangle : triangles)
       {
         const vtkIdType ids[3] = { offset + static_cast<vtkIdType>(triangle[0]),
-          offset + static_cast<vtkIdType>(triangle[1]),
-          offset + static_cast<vtkIdType>(triangle[2]) };
+          offset + static_cast<vtkIdType>(triangle[mirrored ? 2 : 1]),
+          offset + static_cast<vtkIdType>(triangle[mirrored ? 1 : 2]) };
         scene.polygons->InsertNextCell(3, ids);
         scene.materialOfCell.push_back(material);
         std::array<double, 3> mean{ { 1, 1, 1 } };
@@ -1311,14 +1475,19 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
     warn("the glTF file " + named(path) + " has " + std::to_string(skippedPrimitives) +
       " primitives of points or lines: they are skipped, only triangles are surfaces");
   }
-  if (root.contains("skins") || root.contains("animations") || root.contains("extensionsRequired"))
+  // Skins and animations move vertices; the rest pose is what is read (morph targets at
+  // their default weights).
+  if (!checks.array("skins").empty() || !checks.array("animations").empty())
   {
-    // Morph targets, skins and animations move vertices; the rest pose is what is read.
-    if (!checks.array("skins").empty() || !checks.array("animations").empty())
-    {
-      warn("the glTF file " + named(path) +
-        " has skins or animations: the meshes are read in their rest pose");
-    }
+    warn("the glTF file " + named(path) +
+      " has skins or animations: the meshes are read in their rest pose");
+  }
+  if (const std::size_t lights = punctualLights(root); lights > 0)
+  {
+    warn("the glTF file " + named(path) + " has " +
+      (lights == 1 ? std::string("a punctual light (KHR_lights_punctual): it is")
+                   : std::to_string(lights) + " punctual lights (KHR_lights_punctual): they are") +
+      " not read; the lights are the light input, an emissive material or the sun");
   }
 
   // Materials, in order of first use; names unique (glTF names are optional and may repeat).

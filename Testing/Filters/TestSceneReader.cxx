@@ -367,6 +367,25 @@ TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
   expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 0);
 }
 
+TEST(SceneReader, ObjBareUsemtlGivesTheDefaultMaterialWithAWarning)
+{
+  // Rhino writes a 'usemtl' without a name for faces without a material.
+  const TestFolder scratch("bare-usemtl");
+  const fs::path& folder = scratch.path;
+  writeFile(
+    folder / "scene.mtl", "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
+  std::string obj = twoMaterialObj("scene.mtl");
+  replaceOnce(obj, "usemtl red\n", "usemtl\n");
+  writeFile(folder / "scene.obj", obj);
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_NE(result.warnings().find("line 13: 'usemtl' without a material name"), std::string::npos)
+    << result.warnings();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.5, 0.5, 0.5, 0);
+  EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "none" }));
+}
+
 TEST(SceneReader, MaterialNamesWithControlCharactersSurviveAnXmlRoundTrip)
 {
   // VTK's XML files end each string value with a NUL byte: a name holding one came back as
@@ -776,6 +795,125 @@ TEST(SceneReader, GltfMaterialsWithoutPbrStripsAndFans)
   expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.99, 0.99, 0.99, 0);
   expectRgbNear(tuple3(result.output, "Emission", 0), Pi, Pi, Pi, 1e-12);
   expectRgbNear(tuple3(result.output, "Reflectance", 7), 0.63, 0.065, 0.05, 1e-6);
+}
+
+/// The normal (not normalised) of `cell`'s first three points, in their order.
+std::array<double, 3> windingNormal(vtkPolyData* mesh, vtkIdType cell)
+{
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  mesh->GetCellPoints(cell, count, ids);
+  double p[3][3];
+  for (int i = 0; i < 3; ++i)
+  {
+    mesh->GetPoint(ids[i], p[i]);
+  }
+  const double a[3] = { p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2] };
+  const double b[3] = { p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2] };
+  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+}
+
+TEST(SceneReader, GltfMirroredNodeKeepsItsFrontFaces)
+{
+  // A node whose transform mirrors (negative determinant) makes clockwise triangles the front
+  // ones (glTF 2.0, 3.7.4): the floor mirrored in z faces down, the wall still faces +x. Read
+  // in the file's order, a mirrored lamp would shine into itself.
+  const TestFolder scratch("gltf-mirror");
+  const fs::path& folder = scratch.path;
+  std::string json = gltfJson(dataUri(gltfBuffer()));
+  writeFile(folder / "plain.gltf", json);
+  replaceOnce(json, R"({"mesh": 0})", R"({"mesh": 0, "scale": [1, 1, -1]})");
+  writeFile(folder / "mirrored.gltf", json);
+  const ReadResult plain = readScene(folder / "plain.gltf");
+  const ReadResult mirrored = readScene(folder / "mirrored.gltf");
+  ASSERT_TRUE(plain.succeeded) << plain.errors();
+  ASSERT_TRUE(mirrored.succeeded) << mirrored.errors();
+  expectRgbNear(windingNormal(plain.output, 0), 0, 0, 1, 1e-6, "plain floor");
+  expectRgbNear(windingNormal(mirrored.output, 0), 0, 0, -1, 1e-6, "mirrored floor");
+  expectRgbNear(windingNormal(plain.output, 2), 1, 0, 0, 1e-6, "plain wall");
+  expectRgbNear(windingNormal(mirrored.output, 2), 1, 0, 0, 1e-6, "mirrored wall");
+  double bounds[6];
+  mirrored.output->GetBounds(bounds);
+  EXPECT_NEAR(bounds[4], -1, 1e-6);
+  EXPECT_NEAR(bounds[5], 0, 1e-6);
+}
+
+/// The two-material scene with its positions given sparsely over zeros (an accessor without
+/// a bufferView), a morph target that moves every vertex by (0, 0, 1) at the mesh's default
+/// weight `weight`, and one punctual light: the buffer of gltfBuffer(), then 8 uint8 sparse
+/// indices, then the target's 8 float displacements.
+std::pair<std::string, std::string> sparseMorphedGltf(const std::string& weight)
+{
+  std::string buffer = gltfBuffer();
+  for (char i = 0; i < 8; ++i)
+  {
+    buffer += i;
+  }
+  const float up[3] = { 0, 0, 1 };
+  for (int v = 0; v < 8; ++v)
+  {
+    buffer.append(reinterpret_cast<const char*>(up), sizeof(up));
+  }
+  std::string json = gltfJson(dataUri(buffer));
+  replaceOnce(json, R"("byteLength": 120})", R"("byteLength": 224})");
+  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 120, "byteLength": 8},
+    {"buffer": 0, "byteOffset": 128, "byteLength": 96}])");
+  replaceOnce(json, R"({"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",)",
+    R"({"componentType": 5126, "count": 8, "type": "VEC3",
+     "sparse": {"count": 8, "indices": {"bufferView": 2, "componentType": 5121},
+                "values": {"bufferView": 0}},)");
+  replaceOnce(json, R"("type": "SCALAR"}])", R"("type": "SCALAR"},
+    {"bufferView": 3, "componentType": 5126, "count": 8, "type": "VEC3"}])");
+  replaceOnce(json, R"("indices": 1, "material": 0, "mode": 4})",
+    R"("indices": 1, "material": 0, "mode": 4, "targets": [{"POSITION": 3}]})");
+  replaceOnce(json, R"("indices": 2, "material": 1, "mode": 4}])",
+    R"("indices": 2, "material": 1, "mode": 4, "targets": [{"POSITION": 3}]}], "weights": )" +
+      weight);
+  replaceOnce(json, R"("scene": 0,)", R"("scene": 0,
+  "extensionsRequired": ["KHR_lights_punctual"], "extensionsUsed": ["KHR_lights_punctual"],
+  "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point"}]}},)");
+  return { json, buffer };
+}
+
+TEST(SceneReader, GltfSparseAccessorsMorphTargetsAndPunctualLights)
+{
+  const TestFolder scratch("gltf-sparse");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "morphed.gltf", sparseMorphedGltf("[0.5]").first);
+  const ReadResult result = readScene(folder / "morphed.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectTwoMaterialScene(result.output, 1e-6);
+  double bounds[6];
+  result.output->GetBounds(bounds);
+  // The sparse positions are the scene's; the target moves them up by half its (0, 0, 1).
+  EXPECT_NEAR(bounds[1], 1, 1e-6);
+  EXPECT_NEAR(bounds[3], 1, 1e-6);
+  EXPECT_NEAR(bounds[4], 0.5, 1e-6);
+  EXPECT_NEAR(bounds[5], 1.5, 1e-6);
+  EXPECT_NE(result.warnings().find("a punctual light (KHR_lights_punctual): it is not read"),
+    std::string::npos)
+    << result.warnings();
+
+  // Weights that do not match the targets, and a sparse index past the accessor's end.
+  writeFile(folder / "weights.gltf", sparseMorphedGltf("[0.5, 1]").first);
+  const ReadResult weights = readScene(folder / "weights.gltf");
+  EXPECT_FALSE(weights.succeeded);
+  EXPECT_NE(
+    weights.errors().find("has 1 morph targets but its (or its node's) weights"), std::string::npos)
+    << weights.errors();
+  auto [json, buffer] = sparseMorphedGltf("[0]");
+  buffer[127] = 8;
+  replaceOnce(json,
+    json.substr(json.find("data:"), json.find('"', json.find("data:")) - json.find("data:")),
+    dataUri(buffer));
+  writeFile(folder / "index.gltf", json);
+  const ReadResult index = readScene(folder / "index.gltf");
+  EXPECT_FALSE(index.succeeded);
+  EXPECT_NE(index.errors().find("accessors[0].sparse names element 8 but the accessor has 8"),
+    std::string::npos)
+    << index.errors();
 }
 
 TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)

@@ -294,6 +294,25 @@ def gltf_seeds():
     body = (struct.pack("<I4s", len(text), b"JSON") + text +
             struct.pack("<I4s", len(data), b"BIN\0") + data)
     yield "glb_triangle", 9, struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
+    # The same triangle through the parts that shape geometry: positions given sparsely over
+    # zeros, a morph target at the mesh's weight, a mirroring node, a punctual light.
+    extra = data + bytes([0, 1, 2, 0]) + struct.pack("<9f", 0, 0, 1, 0, 0, 1, 0, 0, 1)
+    shaped = document({"byteLength": len(extra), "uri": "data:application/octet-stream;base64,"
+                       + base64.b64encode(extra).decode()})
+    shaped["bufferViews"] += [{"buffer": 0, "byteOffset": 44, "byteLength": 3},
+                              {"buffer": 0, "byteOffset": 48, "byteLength": 36}]
+    shaped["accessors"][0] = {"componentType": 5126, "count": 3, "type": "VEC3",
+                              "sparse": {"count": 3,
+                                         "indices": {"bufferView": 2, "componentType": 5121},
+                                         "values": {"bufferView": 0}}}
+    shaped["accessors"].append({"bufferView": 3, "componentType": 5126, "count": 3,
+                                "type": "VEC3"})
+    shaped["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 2}]
+    shaped["meshes"][0]["weights"] = [0.5]
+    shaped["nodes"][0]["scale"] = [1, 1, -1]
+    shaped["extensionsUsed"] = ["KHR_lights_punctual"]
+    shaped["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point"}]}}
+    yield "gltf_sparse_morph_mirrored", 8, json.dumps(shaped).encode()
 
 
 EPW_HEADER = ("LOCATION,Paris,IDF,FRA,seed,071560,48.85,2.35,1.0,35.0\n"
