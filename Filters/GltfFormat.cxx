@@ -1494,6 +1494,7 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   const Json& materials = checks.array("materials");
   std::set<std::string> names;
   auto failMaterial = [&](const std::string& problem) { document.fail(problem); };
+  std::vector<std::string> seeThrough;
   for (const std::int64_t gltfIndex : materialOrder)
   {
     Material material;
@@ -1525,9 +1526,16 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         }
       }
       material.reflectance = checkedReflectance(base, what, warn);
+      // Cut-outs (leaves, fences), glass and curtains: a radiosity surface is opaque.
+      const Json extensions = source.value("extensions", Json::object());
+      const auto alpha = source.find("alphaMode");
+      if ((alpha != source.end() && alpha->is_string() && *alpha != "OPAQUE") ||
+        extensions.contains("KHR_materials_transmission"))
+      {
+        seeThrough.push_back(named(material.name));
+      }
       double strength = 1.0;
-      const Json extension = source.value("extensions", Json::object())
-                               .value("KHR_materials_emissive_strength", Json::object());
+      const Json extension = extensions.value("KHR_materials_emissive_strength", Json::object());
       if (extension.contains("emissiveStrength"))
       {
         const Json& value = extension["emissiveStrength"];
@@ -1562,6 +1570,19 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
     }
     material.name = unique;
     scene.materials.push_back(material);
+  }
+  if (!seeThrough.empty())
+  {
+    std::string list;
+    for (std::size_t i = 0; i < std::min<std::size_t>(seeThrough.size(), 3); ++i)
+    {
+      list += (i > 0 ? ", " : "") + seeThrough[i];
+    }
+    warn("the glTF file " + named(path) + " has " + std::to_string(seeThrough.size()) +
+      " material(s) that let light through (alphaMode MASK or BLEND, or "
+      "KHR_materials_transmission): " +
+      list + (seeThrough.size() > 3 ? " ..." : "") +
+      "; they are read as opaque: they block all the light that reaches them");
   }
   if (anyColour)
   {

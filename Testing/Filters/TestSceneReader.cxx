@@ -896,6 +896,19 @@ TEST(SceneReader, GltfSparseAccessorsMorphTargetsAndPunctualLights)
     std::string::npos)
     << result.warnings();
 
+  EXPECT_EQ(result.warnings().find("let light through"), std::string::npos) << result.warnings();
+
+  // A cut-out material is read as opaque, with a warning naming it.
+  std::string cutOut = sparseMorphedGltf("[0.5]").first;
+  replaceOnce(cutOut, R"({"name": "red",)", R"({"name": "red", "alphaMode": "MASK",)");
+  writeFile(folder / "cutout.gltf", cutOut);
+  const ReadResult cut = readScene(folder / "cutout.gltf");
+  ASSERT_TRUE(cut.succeeded) << cut.errors();
+  EXPECT_NE(cut.warnings().find("1 material(s) that let light through (alphaMode MASK or BLEND, "
+                                "or KHR_materials_transmission): 'red'"),
+    std::string::npos)
+    << cut.warnings();
+
   // Weights that do not match the targets, and a sparse index past the accessor's end.
   writeFile(folder / "weights.gltf", sparseMorphedGltf("[0.5, 1]").first);
   const ReadResult weights = readScene(folder / "weights.gltf");
