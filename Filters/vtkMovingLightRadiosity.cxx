@@ -943,6 +943,17 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
       this->EmissionArrayName, materialLight.materialId);
+    // glTF is Y-up; Up's default is Z-up. Where Up sets the sky or a TILT table, say so.
+    auto* format = vtkStringArray::SafeDownCast(
+      sceneData ? sceneData->GetFieldData()->GetAbstractArray("SceneFormat") : nullptr);
+    if (format && format->GetNumberOfValues() > 0 && format->GetValue(0) == "glTF" &&
+      (this->SkyModel != NO_SKY || !this->LightDistributionFile.empty()) && this->Up[0] == 0 &&
+      this->Up[1] == 0 && this->Up[2] > 0)
+    {
+      warnings.push_back("the Scene was read from glTF, which is Y-up, but Up is +z: for a "
+                         "Y-up scene set Up to 0, 1, 0 (and on a Sun Path source Up 0, 1, 0 "
+                         "and North 0, 0, -1)");
+    }
     cache.Times = trajectory.times;
     cache.SunAzimuth = trajectory.sunAzimuth;
     cache.SunElevation = trajectory.sunElevation;

@@ -105,3 +105,31 @@ def test_a_clear_sky_without_a_sun_is_refused():
     assert not radiosity.UpdateTimeStep(0.0)
     assert any("follows the sun: set LightType to Directional" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
+
+
+def test_a_gltf_scene_under_a_z_up_sky_is_warned_of():
+    # glTF is Y-up: a scene read from it (field data SceneFormat "glTF") under a sky whose Up
+    # is still the default +z gets a warning naming Up; with Up +y it gets none.
+    from vtkmodules.vtkCommonCore import vtkStringArray
+    ground = output(vtkPlaneSource())
+    format_array = vtkStringArray()
+    format_array.SetName("SceneFormat")
+    format_array.InsertNextValue("glTF")
+    ground.GetFieldData().AddArray(format_array)
+    for up, warned in (((0.0, 0.0, 1.0), True), ((0.0, 1.0, 0.0), False)):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(ground)
+        radiosity.SetSkyModel(vtkMovingLightRadiosity.UNIFORM_SKY)
+        radiosity.SetUp(*up)
+        radiosity.SetNumberOfPaths(2000)
+        radiosity.SetNumberOfThreads(2)
+        warnings = []
+
+        @calldata_type(VTK_STRING)
+        def record(_caller, _event, message):
+            warnings.append(message)
+
+        radiosity.AddObserver("WarningEvent", record)
+        assert radiosity.UpdateTimeStep(0.0)
+        assert any("read from glTF, which is Y-up, but Up is +z" in w for w in warnings) == warned, \
+            warnings
