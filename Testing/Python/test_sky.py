@@ -90,18 +90,24 @@ def test_perez_sky_per_frame_on_open_ground(sky):
     assert len(set(efficacies)) == 3
 
 
+def recorded(algorithm, event):
+    """The messages `algorithm` sends with `event` ("ErrorEvent", "WarningEvent") from now on."""
+    messages = []
+
+    @calldata_type(VTK_STRING)
+    def record(_caller, _event, message):
+        messages.append(message)
+
+    algorithm.AddObserver(event, record)
+    return messages
+
+
 def test_a_clear_sky_without_a_sun_is_refused():
     radiosity = vtkMovingLightRadiosity()
     radiosity.SetSceneData(output(vtkPlaneSource()))
     radiosity.SetSkyModel(vtkMovingLightRadiosity.CIE_CLEAR_SKY)
     radiosity.SetNumberOfThreads(2)
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    radiosity.AddObserver("ErrorEvent", record)
+    errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
     assert any("follows the sun: set LightType to Directional" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
@@ -123,13 +129,7 @@ def test_a_gltf_scene_under_a_z_up_sky_is_warned_of():
         radiosity.SetUp(*up)
         radiosity.SetNumberOfPaths(2000)
         radiosity.SetNumberOfThreads(2)
-        warnings = []
-
-        @calldata_type(VTK_STRING)
-        def record(_caller, _event, message):
-            warnings.append(message)
-
-        radiosity.AddObserver("WarningEvent", record)
+        warnings = recorded(radiosity, "WarningEvent")
         assert radiosity.UpdateTimeStep(0.0)
         assert any("read from glTF, which is Y-up, but Up is +z" in w for w in warnings) == warned, \
             warnings
