@@ -189,23 +189,17 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
   }
   fields.number("the tilt of the luminaire during measurement");
   const std::size_t sets = fields.count("the number of standard sets of lamps n", 1, 20);
-  // Each field of the lamp sets comes for every set before the next field.
-  for (std::size_t i = 0; i < sets; ++i)
-  {
-    fields.number("the number of lamps of set " + std::to_string(i + 1));
-  }
-  for (std::size_t i = 0; i < sets; ++i)
-  {
-    fields.text("the type of lamps of set " + std::to_string(i + 1));
-  }
-  // The intensities are per 1000 lm of the first set's total flux (the luminaire's own flux
-  // for absolute photometry, where its number of lamps is negative); the flux already counts
-  // every lamp of the set.
+  // Each set's six fields come together, set after set, as files from luminaire makers and
+  // other readers have them. The intensities are per 1000 lm of the first set's total flux
+  // (the luminaire's own flux for absolute photometry, where its number of lamps is
+  // negative); the flux already counts every lamp of the set.
   double lampFlux = 0;
   for (std::size_t i = 0; i < sets; ++i)
   {
-    const double flux =
-      fields.number("the total luminous flux of lamps of set " + std::to_string(i + 1) + " (lm)");
+    const std::string set = "set " + std::to_string(i + 1);
+    fields.number("the number of lamps of " + set);
+    fields.text("the type of lamps of " + set);
+    const double flux = fields.number("the total luminous flux of lamps of " + set + " (lm)");
     if (i == 0)
     {
       lampFlux = std::abs(flux);
@@ -215,24 +209,15 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
           " lm: the cd/klm intensities need it above 0");
       }
     }
+    fields.text("the colour appearance of " + set);
+    fields.text("the colour rendering group of " + set);
+    fields.number("the wattage including ballast of " + set + " (W)");
   }
   if (sets > 1)
   {
     luminaire.warnings.push_back(name + ": " + std::to_string(sets) +
       " sets of lamps, read as alternative equipments: the intensities are scaled to the "
       "first set's flux, not to their sum");
-  }
-  for (std::size_t i = 0; i < sets; ++i)
-  {
-    fields.text("the colour appearance of set " + std::to_string(i + 1));
-  }
-  for (std::size_t i = 0; i < sets; ++i)
-  {
-    fields.text("the colour rendering group of set " + std::to_string(i + 1));
-  }
-  for (std::size_t i = 0; i < sets; ++i)
-  {
-    fields.number("the wattage including ballast of set " + std::to_string(i + 1) + " (W)");
   }
   for (int k = 0; k < 10; ++k)
   {

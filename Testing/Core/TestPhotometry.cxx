@@ -839,7 +839,9 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
 TEST(Photometry, EulumdatLampSetsAreAlternativesScaledToTheFirst)
 {
   // Two standard sets of lamps (1 x 1000 lm and 2 x 1500 lm) are alternative equipments: the
-  // cd/klm intensities scale to the first set's flux, not to the 4000 lm of both.
+  // cd/klm intensities scale to the first set's flux, not to the 4000 lm of both. Each set's
+  // six fields come together (number, type, flux, colour, rendering group, watts), as in the
+  // files of luminaire makers.
   const std::vector<double> gammas = degrees(0, 90, 15);
   auto f = [](double g, double) { return 300 * std::cos(g * Pi / 180); };
   const std::string one = ldtFile(1, 90, gammas, f, 1000);
@@ -847,7 +849,8 @@ TEST(Photometry, EulumdatLampSetsAreAlternativesScaledToTheFirst)
   const std::size_t at = one.find(block);
   ASSERT_NE(at, std::string::npos);
   std::string two = one;
-  two.replace(at, block.size(), "\n2\n1\n2\nLED\nLED\n1000\n3000\n3000\n3000\n1B\n1B\n40\n80\n");
+  two.replace(at, block.size(),
+    "\n2\n1\nLED Module\n1000\n3000\n1B\n40\n2\nLED Module\n3000\nnw\n1A/>90\n80\n");
   const Luminaire single = parseEulumdat(one, "one.ldt");
   const Luminaire sets = parseEulumdat(two, "two.ldt");
   EXPECT_NEAR(sets.lumens, single.lumens, 1e-12 * single.lumens);
