@@ -3,6 +3,7 @@
 #include "Error.h"
 
 #include <libnova/julian_day.h>
+#include <libnova/precession.h>
 #include <libnova/solar.h>
 #include <libnova/transform.h>
 
@@ -16,8 +17,14 @@ namespace mlr
 void sunAzimuthElevation(double latitude, double longitude, double julianDay,
   double& azimuthDegrees, double& elevationDegrees)
 {
-  ln_equ_posn equatorial{};
-  ln_get_solar_equ_coords(julianDay, &equatorial);
+  // libnova's solar coordinates are referred to the equinox of J2000 (its VSOP87 series),
+  // while the horizontal transform uses the sidereal time of the day: precessed to the day,
+  // or the sun drifts by 50 arcseconds of right ascension a year from 2000 (0.3 degrees, more
+  // than a minute of time, by 2021).
+  constexpr double J2000 = 2451545.0;
+  ln_equ_posn mean{}, equatorial{};
+  ln_get_solar_equ_coords(julianDay, &mean);
+  ln_get_equ_prec2(&mean, J2000, julianDay, &equatorial);
   ln_lnlat_posn observer{ longitude, latitude };
   ln_hrz_posn horizontal{};
   ln_get_hrz_from_equ(&equatorial, &observer, julianDay, &horizontal);

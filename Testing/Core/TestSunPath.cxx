@@ -46,6 +46,37 @@ TEST(SunPath, MatchesTheAlmanacAtJ2000)
   EXPECT_NEAR(azimuth, 179.1, 0.3);
 }
 
+TEST(SunPath, TheJuneSolsticeSunIsOnTheMeridianOfRightAscension90InAnyYear)
+{
+  // At a June solstice the Sun's apparent right ascension is 90 degrees and its declination
+  // the obliquity of the day. So at that instant, on the meridian whose local sidereal time is
+  // 90 degrees (the Greenwich mean sidereal time of IAU 1982; the equation of the equinoxes,
+  // under 0.005 degrees, left out), the Sun transits: due south of 50 N, at 40 degrees plus
+  // the obliquity. Solstices (UTC): 2000-06-21 01:48, 2021-06-21 03:32, 2024-06-20 20:51.
+  // Coordinates referred to J2000 instead would miss by 0.014 degrees of right ascension a
+  // year, twice that of azimuth here: 0.6 degrees in 2021.
+  struct Solstice
+  {
+    int year, day;
+    double hours;
+  };
+  for (const Solstice s : { Solstice{ 2000, 21, 1.8 }, Solstice{ 2021, 21, 3 + 32.0 / 60 },
+         Solstice{ 2024, 20, 20 + 51.0 / 60 } })
+  {
+    SCOPED_TRACE(s.year);
+    const double jd = julianDay(s.year, 6, s.day, s.hours);
+    const double d = jd - 2451545.0, t = d / 36525;
+    const double gmst =
+      280.46061837 + 360.98564736629 * d + 0.000387933 * t * t - t * t * t / 38710000;
+    const double longitude = std::remainder(90 - gmst, 360.0);
+    const double obliquity = 23.439291 - 0.0130042 * t;
+    double azimuth = 0, elevation = 0;
+    sunAzimuthElevation(50, longitude, jd, azimuth, elevation);
+    EXPECT_NEAR(azimuth, 180, 0.03);
+    EXPECT_NEAR(elevation, 40 + obliquity, 0.01);
+  }
+}
+
 TEST(SunPath, DirectionsFollowNorthAndUp)
 {
   // Equator at an equinox, local noon at longitude 0: the sun is nearly overhead. With north
