@@ -94,9 +94,11 @@ public:
   }
 
 private:
+  /// Blanks, commas, and DOS's end-of-file mark (^Z), which old files end with, even right
+  /// after their last value.
   static bool separator(char c)
   {
-    return c == ' ' || c == '\t' || c == ',' || c == '\f' || c == '\v';
+    return c == ' ' || c == '\t' || c == ',' || c == '\f' || c == '\v' || c == '\x1a';
   }
 
   /// Moves to the start of the next token; false at the end of the text.

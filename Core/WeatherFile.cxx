@@ -380,6 +380,7 @@ std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSe
   const bool wraps = last < first;
   const std::size_t n = file.hours.size();
   std::vector<WeatherFrame> frames;
+  std::size_t inRange = 0; // the chosen dates and hours, night included
   // With a wrap, the days from the first date to December 31 come first, then January's.
   for (int part = 0; part < (wraps ? 2 : 1); ++part)
   {
@@ -394,6 +395,7 @@ std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSe
       {
         continue;
       }
+      ++inRange;
       WeatherFrame f;
       f.seriesHour = static_cast<double>(k + (part == 1 ? n : 0));
       f.dayOfYear = static_cast<int>(k / 24) + 1;
@@ -423,9 +425,19 @@ std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSe
     std::ostringstream m;
     m << "no hour of the weather file " << file.name << " is chosen: the dates " << s.firstMonth
       << "-" << s.firstDay << " to " << s.lastMonth << "-" << s.lastDay << " and clock hours "
-      << s.firstHour << " to " << s.lastHour << " hold "
-      << (s.includeNight ? "no hour of the file" : "only night (the sun below the horizon)")
-      << ": widen them" << (s.includeNight ? "" : " or include the night");
+      << s.firstHour << " to " << s.lastHour << " hold ";
+    const bool february29 =
+      (s.firstMonth == 2 && s.firstDay == 29) || (s.lastMonth == 2 && s.lastDay == 29);
+    if (inRange == 0 && n == Year && february29)
+    {
+      m << "no hour of the file, which has no February 29 (its year is not a leap year): "
+           "choose other dates";
+    }
+    else
+    {
+      m << (inRange == 0 ? "no hour of the file" : "only night (the sun below the horizon)")
+        << ": widen them" << (inRange == 0 ? "" : " or include the night");
+    }
     throw Error(m.str());
   }
   return frames;

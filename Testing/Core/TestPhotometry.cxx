@@ -633,6 +633,12 @@ TEST(Photometry, IesCosinePowerGivesTheAnalyticFlux)
     crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
   }
   EXPECT_NEAR(parseIes(crlf, "crlf.ies").lumens, exact / 2, 2e-4 * exact);
+  // DOS's end-of-file mark (^Z) right after the last value, as old files have it.
+  std::string text = iesFile(vertical, { 0 }, f);
+  text.erase(text.find_last_not_of("\n") + 1);
+  const Luminaire dos = parseIes(text + "\x1a", "dos.ies");
+  EXPECT_NEAR(dos.lumens, exact / 2, 2e-4 * exact);
+  EXPECT_TRUE(dos.warnings.empty());
 
   // An uplight (90-180): 10 cd over the upper hemisphere, nothing below.
   const Luminaire up =

@@ -301,6 +301,12 @@ TEST(WeatherFile, HoursAreChosenByDateHourAndDaylight)
   s.firstHour = 0;
   s.lastHour = 5;
   expectError([&] { weatherFrames(file, s); }, "only night");
+  // February 29 of a file that is not of a leap year: no hour at all, said so.
+  WeatherSelection leapDay;
+  leapDay.firstMonth = leapDay.lastMonth = 2;
+  leapDay.firstDay = leapDay.lastDay = 29;
+  leapDay.firstHour = leapDay.lastHour = 12;
+  expectError([&] { weatherFrames(file, leapDay); }, "which has no February 29");
   s.lastHour = 24;
   expectError([&] { weatherFrames(file, s); }, "clock hours from 0 to 23");
   s.lastHour = 5;
