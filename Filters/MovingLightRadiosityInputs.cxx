@@ -4,11 +4,17 @@
 #include "MemoryBudget.h"
 #include "PolygonTriangulation.h"
 
+#include "vtkAppendPolyData.h"
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
 #include "vtkCellData.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDataArray.h"
+#include "vtkDataSet.h"
 #include "vtkFieldData.h"
+#include "vtkGeometryFilter.h"
+#include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPoints.h"
@@ -19,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <sstream>
 
 namespace mlr::vtkinputs
@@ -224,6 +231,75 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
   values.erase(std::unique(values.begin(), values.end()), values.end());
   return values;
 }
+}
+
+vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std::string>& warnings)
+{
+  if (!scene)
+  {
+    return nullptr;
+  }
+  if (auto* polygons = vtkPolyData::SafeDownCast(scene))
+  {
+    return polygons;
+  }
+  auto surfaceOf = [](vtkDataSet* data)
+  {
+    vtkNew<vtkGeometryFilter> surface;
+    surface->SetInputData(data);
+    surface->Update();
+    return vtkSmartPointer<vtkPolyData>(surface->GetOutput());
+  };
+  if (auto* data = vtkDataSet::SafeDownCast(scene))
+  {
+    return surfaceOf(data);
+  }
+  auto* composite = vtkCompositeDataSet::SafeDownCast(scene);
+  if (!composite)
+  {
+    throw Error(std::string("the Scene is a ") + scene->GetClassName() +
+      ", which has no surfaces: give a data set (polygons, or cells whose boundary is the "
+      "surface to light) or a multiblock of them");
+  }
+  vtkNew<vtkAppendPolyData> append;
+  std::map<std::string, int> arrayLeaves;
+  int leaves = 0;
+  vtkSmartPointer<vtkCompositeDataIterator> leaf;
+  leaf.TakeReference(composite->NewIterator());
+  for (leaf->InitTraversal(); !leaf->IsDoneWithTraversal(); leaf->GoToNextItem())
+  {
+    auto* data = vtkDataSet::SafeDownCast(leaf->GetCurrentDataObject());
+    if (!data || data->GetNumberOfCells() == 0)
+    {
+      continue;
+    }
+    const vtkSmartPointer<vtkPolyData> surface = surfaceOf(data);
+    vtkCellData* cells = surface->GetCellData();
+    for (int a = 0; a < cells->GetNumberOfArrays(); ++a)
+    {
+      if (const char* name = cells->GetArrayName(a))
+      {
+        ++arrayLeaves[name];
+      }
+    }
+    append->AddInputData(surface);
+    ++leaves;
+  }
+  if (leaves == 0)
+  {
+    return vtkSmartPointer<vtkPolyData>::New();
+  }
+  for (const auto& [name, count] : arrayLeaves)
+  {
+    if (count < leaves)
+    {
+      warnings.push_back("the Scene's cell array '" + name + "' is on " + std::to_string(count) +
+        " of its " + std::to_string(leaves) +
+        " blocks with cells, so it is dropped: give it to every block");
+    }
+  }
+  append->Update();
+  return append->GetOutput();
 }
 
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,

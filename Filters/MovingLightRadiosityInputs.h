@@ -10,11 +10,21 @@
 #include <string>
 #include <vector>
 
+#include "vtkSmartPointer.h"
+
+class vtkDataObject;
 class vtkPointSet;
 class vtkPolyData;
 
 namespace mlr::vtkinputs
 {
+
+/// The Scene as a vtkPolyData: a vtkPolyData as it is; the surface of another data set (its
+/// polygons and the boundary faces of its volume cells, with their cell and field data); the
+/// surfaces of a composite data set's leaves, appended, where a cell array that not every leaf
+/// has is dropped with a warning in `warnings`. Null for no input. Throws mlr::Error for data
+/// that has no cells to light (a table, an image of no cells).
+vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std::string>& warnings);
 
 /// The Scene's polygons (strips split into triangles) with one material each: reflectance
 /// from the cell array named `reflectanceName` (1 or 3 components, each in [0, 1)) and

@@ -241,12 +241,15 @@ int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* 
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
     return 1;
   }
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  if (port == LIGHT_PORT)
+  if (port == SCENE_PORT)
   {
-    // A directional light, or a scene whose surfaces emit, needs no Light.
-    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+    // Any data set or composite of them, whole: its surface is taken (sceneSurface).
+    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObject");
+    return 1;
   }
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  // A directional light, or a scene whose surfaces emit, needs no Light.
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   return 1;
 }
 
@@ -898,8 +901,19 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   double secondsGatheringInputs = 0;
   std::string failure;
   bool cancelled = false, elsewhere = false;
+  std::vector<std::string> warnings;
+  vtkNew<vtkInformationVector> sceneSurface;
   try
   {
+    // The Scene as polygons, whatever data it is, before its pieces travel between ranks.
+    if (inputVector[SCENE_PORT]->GetNumberOfInformationObjects() > 0)
+    {
+      vtkNew<vtkInformation> info;
+      info->Set(vtkDataObject::DATA_OBJECT(),
+        mlr::vtkinputs::sceneSurface(vtkDataObject::GetData(inputVector[SCENE_PORT], 0), warnings));
+      sceneSurface->Append(info);
+      inputs[SCENE_PORT] = sceneSurface;
+    }
     if (controller)
     {
       // The solve's first collective would wait in silence for a rank that never comes.
@@ -917,7 +931,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           continue; // an optional input not connected, on every rank alike
         }
         wholeInputs[port] =
-          mlr::vtkparallel::gatherPieces(controller, vtkDataObject::GetData(inputVector[port], 0),
+          mlr::vtkparallel::gatherPieces(controller, vtkDataObject::GetData(inputs[port], 0),
             names[port], port == SCENE_PORT ? &cellRanks : nullptr);
         vtkNew<vtkInformation> info;
         info->Set(vtkDataObject::DATA_OBJECT(), wholeInputs[port]);
@@ -927,7 +941,6 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       secondsGatheringInputs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    std::vector<std::string> warnings;
     vtkPolyData* lightData = vtkPolyData::GetData(inputs[LIGHT_PORT], 0);
     const bool directional = this->LightType == DIRECTIONAL_LIGHT;
     const mlr::vtkinputs::Trajectory trajectory =

@@ -9,7 +9,9 @@
  *
  * Inputs:
  * - port 0, Scene (required): polygons and triangle strips; vertices and lines are ignored
- *   with a warning. The cell array named by ReflectanceArrayName (default `Reflectance`)
+ *   with a warning. Any other data set gives its surface (its polygons and the boundary faces
+ *   of its volume cells, with their cell arrays), a composite data set the surfaces of all
+ *   its leaves together (a cell array some leaf lacks is dropped, with a warning). The cell array named by ReflectanceArrayName (default `Reflectance`)
  *   gives each cell's reflectance (3 components, RGB, or 1 component, grey; every value >= 0
  *   and < 1). Without it the scene is grey 0.5 and a warning says so. The cell array named by
  *   EmissionArrayName (default `Emission`; 3 or 1 components, W/m^2, >= 0) makes those cells

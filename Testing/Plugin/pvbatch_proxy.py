@@ -50,12 +50,14 @@ def domains(prop):
 
 
 # What each port accepts, asked the way the GUI's input dialog asks: polygons (Box), a
-# tetrahedral unstructured grid (a point set, not polygons) and an image (neither).
+# tetrahedral unstructured grid (a point set, not polygons), an image (neither) and a
+# multiblock. The Scene takes the surface of any of them.
 candidates = {"polydata": Box(), "tetrahedra": Tetrahedralize(Input=Wavelet(WholeExtent=[0, 2] * 3)),
-              "image": Wavelet(WholeExtent=[0, 2] * 3)}
+              "image": Wavelet(WholeExtent=[0, 2] * 3),
+              "multiblock": GroupDatasets(Input=[Box(), Sphere()])}
 for candidate in candidates.values():
     candidate.UpdatePipeline()
-for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False),
+for port, (name, accepted, optional) in enumerate((("Scene", set(candidates), False),
                                                    ("Light", {"polydata"}, True),
                                                    ("Trajectory", {"polydata", "tetrahedra"}, True),
                                                    ("Sensors", {"polydata", "tetrahedra"}, True))):
@@ -65,6 +67,8 @@ for port, (name, accepted, optional) in enumerate((("Scene", {"polydata"}, False
     check(prop.GetPortIndex() == port, f"input {name} on port {prop.GetPortIndex()}, expected {port}")
     check(prop.GetXMLLabel() == name, f"input {name} labelled {prop.GetXMLLabel()!r}")
     for kind, candidate in candidates.items():
+        if kind == "multiblock" and name != "Scene":
+            continue  # ParaView offers a composite of accepted leaves to any port
         prop.RemoveAllUncheckedProxies()
         prop.AddUncheckedInputConnection(candidate.SMProxy, 0)
         takes = bool(prop.IsInDomains())

@@ -166,3 +166,91 @@ def test_frames_per_chunk_solves_in_chunks_and_keeps_every_frame(pipeline):
     for whole, chunked in zip(*means):
         assert chunked == pytest.approx(whole, rel=0.05)
     radiosity.SetFramesPerChunk(0)
+
+
+def surface_area(data):
+    """The summed area of the polygons (and 2D cells) of a data set."""
+    return sum(data.GetCell(c).ComputeArea() for c in range(data.GetNumberOfCells())
+               if data.GetCell(c).GetCellDimension() == 2)
+
+
+def grey_plane(origin, point1, point2, reflectance=None):
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    plane = vtkPlaneSource()
+    plane.SetOrigin(*origin)
+    plane.SetPoint1(*point1)
+    plane.SetPoint2(*point2)
+    plane.Update()
+    data = plane.GetOutput()
+    if reflectance is not None:
+        array = vtkDoubleArray()
+        array.SetName("Reflectance")
+        array.InsertNextValue(reflectance)
+        data.GetCellData().AddArray(array)
+    return data
+
+
+def lit(scene, paths=4000):
+    """The Elements output of the scene under the sun straight above, and the warnings."""
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.util.vtkConstants import VTK_STRING
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(scene)
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetPathStart(0, 0, 1)
+    radiosity.SetPathEnd(0, 0, 1)
+    radiosity.SetNumberOfPositions(1)
+    radiosity.SetNumberOfPaths(paths)
+    radiosity.SetPatchSize(0.25)
+    radiosity.SetNumberOfThreads(2)
+    radiosity.SetErrorBatches(1)
+    messages = {"ErrorEvent": [], "WarningEvent": []}
+    for event, into in messages.items():
+        @calldata_type(VTK_STRING)
+        def record(_caller, _event, message, into=into):
+            into.append(message)
+        radiosity.AddObserver(event, record)
+    radiosity.Update()
+    return radiosity.GetOutput(0), messages
+
+
+def test_any_data_set_or_multiblock_gives_its_surface():
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    from vtkmodules.vtkCommonDataModel import vtkImageData, vtkMultiBlockDataSet, vtkTable
+    # A unit voxel (an image of 2 x 2 x 2 points): its surface is the six faces of its cell.
+    voxel = vtkImageData()
+    voxel.SetDimensions(2, 2, 2)
+    elements, messages = lit(voxel)
+    assert not messages["ErrorEvent"], messages
+    assert surface_area(elements) == pytest.approx(6.0, rel=1e-9)
+
+    # Two blocks of different reflectances, one of them an unstructured grid, keep them.
+    floor = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.2)
+    wall = vtkAppendFilter()
+    wall.AddInputData(grey_plane((0, 0, 0), (0, 1, 0), (0, 0, 2), 0.7))
+    wall.Update()
+    blocks = vtkMultiBlockDataSet()
+    blocks.SetBlock(0, floor)
+    blocks.SetBlock(1, wall.GetOutput())
+    elements, messages = lit(blocks)
+    assert not messages["ErrorEvent"], messages
+    reflectance = elements.GetCellData().GetArray("Reflectance")
+    areas = {}
+    for c in range(elements.GetNumberOfCells()):
+        rho = round(reflectance.GetTuple(c)[0], 6)
+        areas[rho] = areas.get(rho, 0.0) + elements.GetCell(c).ComputeArea()
+    assert sorted(areas) == [0.2, 0.7]
+    assert areas[0.2] == pytest.approx(1.0, rel=1e-9)
+    assert areas[0.7] == pytest.approx(2.0, rel=1e-9)
+
+    # A block without the Reflectance array: it is dropped, with a warning naming it.
+    blocks.SetBlock(1, grey_plane((0, 0, 0), (0, 1, 0), (0, 0, 2)))
+    elements, messages = lit(blocks)
+    assert any("cell array 'Reflectance' is on 1 of its 2 blocks" in w
+               for w in messages["WarningEvent"]), messages
+
+    # A table has no surface: the error says what to give.
+    elements, messages = lit(vtkTable())
+    assert any("the Scene is a vtkTable, which has no surfaces" in e
+               for e in messages["ErrorEvent"]), messages
+    assert elements.GetNumberOfCells() == 0
