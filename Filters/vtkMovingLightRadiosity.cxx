@@ -655,12 +655,13 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
   if (!cache.RankFrames.empty())
   {
     held = false;
+    // Nothing moves: the one frame solved serves every time step. (A rank may also hold frame
+    // 0 alone of an animation whose other frames other ranks hold.)
+    const bool oneFrame = mlr::frameCount(cache.Rig, true) == 1;
     for (mlr::vtkparallel::FrameBlock& block : cache.RankFrames)
     {
       const std::size_t n = block.frames.frameCount();
-      // One frame solved serves every time step (a scene lit by things that do not move).
-      if ((n == 1 && block.first == 0 && cache.RankFrames.size() == 1 && !cache.ChunkScene) ||
-        (frame >= block.first && frame < block.first + n))
+      if ((oneFrame && block.first == 0) || (frame >= block.first && frame < block.first + n))
       {
         frames = &block.frames;
         solved = n == 1 ? 0 : frame - block.first;

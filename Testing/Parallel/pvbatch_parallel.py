@@ -22,7 +22,9 @@ run_parallel.py compares. Cases:
 - bad: rank 1's Scene piece lacks the Reflectance array (the ranks' pieces disagree), then,
   with consistent pieces, rank 1 alone has a memory limit the solve does not fit in;
 - chunks: FramesPerChunk 8 (4 chunks of the 30 frames), every time step in turn: each rank
-  holds the frames of the chunks it solved and outputs them whole, nothing at the others'.
+  holds the frames of the chunks it solved and outputs them whole, nothing at the others';
+- fewchunks: 4 positions in chunks of 2, so that the first chunk finishes frame 0 alone: its
+  rank still outputs nothing at the other time steps.
 """
 import argparse
 import os
@@ -34,7 +36,7 @@ import numpy as np
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--plugin", required=True)
 parser.add_argument("--case", required=True, choices=["whole", "split", "time", "abort", "abortalone", "waitlimit", "bad",
-                             "chunks"])
+                             "chunks", "fewchunks"])
 parser.add_argument("--out", required=True, help="prefix of the .rank<r>.npz files written")
 parser.add_argument("--paths", type=int, default=20000)
 args = parser.parse_args()
@@ -152,6 +154,13 @@ if args.case in ("whole", "split"):
 elif args.case == "chunks":
     radiosity.FramesPerChunk = 8
     for f in range(30):
+        record(f"f{f}_", float(f))
+elif args.case == "fewchunks":
+    from paraview.simple import Line
+    radiosity.Trajectory = Line(Point1=[0.12, 0.5478, 0.0995], Point2=[0.436, 0.5478, 0.4595],
+                                Resolution=3)
+    radiosity.FramesPerChunk = 2
+    for f in range(4):
         record(f"f{f}_", float(f))
 elif args.case == "time":
     for step, f in enumerate((0.0, 29.0, 14.0, 29.0, 0.0)):

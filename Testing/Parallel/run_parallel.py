@@ -26,6 +26,8 @@ bad:   rank 1's piece lacks Reflectance: every rank reports an error naming it; 
 chunks: 30 frames in 4 chunks of 8 (overlap 1): rank k mod R holds chunk k's frames (0-6,
        7-14, 15-22, 23-29) and outputs them whole, the other ranks nothing, and the union of
        the ranks' outputs is the serial output bit for bit in every frame.
+fewchunks: the same with 4 frames in 2 chunks of 2: the first rank holds frame 0 alone,
+       which it must not show at the other frames' time steps.
 """
 import argparse
 import glob
@@ -219,11 +221,13 @@ def main():
                       f"rank {r}: an element lies {float(data['own_excess']):.3g} m farther from this "
                       "rank's own piece of the scene than from the whole scene: it comes from "
                       "another rank's cells")
-    elif args.case == "chunks":
-        run(pvbatch + ["--case", "chunks", "--out", os.path.join(args.work, "serial")], "serial")
+    elif args.case in ("chunks", "fewchunks"):
+        run(pvbatch + ["--case", args.case, "--out", os.path.join(args.work, "serial")], "serial")
         reference = load(os.path.join(args.work, "serial"))[0]
-        finished = [(0, 7), (7, 15), (15, 23), (23, 30)]
-        for f in range(30):
+        # The frames each chunk finishes: up to the overlap before its end (1 frame here).
+        finished = ([(0, 7), (7, 15), (15, 23), (23, 30)] if args.case == "chunks"
+                    else [(0, 1), (1, 4)])
+        for f in range(finished[-1][1]):
             prefix = f"f{f}_"
             owner = next(k for k, (b, e) in enumerate(finished) if b <= f < e) % args.ranks
             cells = [int(r[prefix + "e_cells"]) for r in ranks]
