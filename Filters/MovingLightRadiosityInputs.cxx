@@ -264,6 +264,11 @@ vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std:
   vtkNew<vtkAppendPolyData> append;
   std::map<std::string, int> arrayLeaves;
   int leaves = 0;
+  // Materials (cell array MaterialId into field data MaterialNames, as the scene reader gives
+  // them) are matched by name over the blocks: each block's ids are renumbered into one list.
+  vtkNew<vtkStringArray> materialNames;
+  materialNames->SetName("MaterialNames");
+  std::map<std::string, int> materialIndex;
   vtkSmartPointer<vtkCompositeDataIterator> leaf;
   leaf.TakeReference(composite->NewIterator());
   for (leaf->InitTraversal(); !leaf->IsDoneWithTraversal(); leaf->GoToNextItem())
@@ -273,7 +278,36 @@ vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std:
     {
       continue;
     }
-    const vtkSmartPointer<vtkPolyData> surface = surfaceOf(data);
+    vtkSmartPointer<vtkPolyData> surface = surfaceOf(data);
+    auto* names =
+      vtkStringArray::SafeDownCast(surface->GetFieldData()->GetAbstractArray("MaterialNames"));
+    auto* ids = vtkDataArray::SafeDownCast(surface->GetCellData()->GetAbstractArray("MaterialId"));
+    if (names && ids)
+    {
+      // A copy, so that the block's own arrays stay as they are.
+      auto renumbered = vtkSmartPointer<vtkPolyData>::New();
+      renumbered->ShallowCopy(surface);
+      vtkSmartPointer<vtkDataArray> merged;
+      merged.TakeReference(ids->NewInstance());
+      merged->SetName("MaterialId");
+      merged->SetNumberOfTuples(ids->GetNumberOfTuples());
+      for (vtkIdType c = 0; c < ids->GetNumberOfTuples(); ++c)
+      {
+        const auto id = static_cast<vtkIdType>(ids->GetComponent(c, 0));
+        const std::string name = id >= 0 && id < names->GetNumberOfValues()
+          ? names->GetValue(id)
+          : "material " + std::to_string(id);
+        auto found = materialIndex.find(name);
+        if (found == materialIndex.end())
+        {
+          found = materialIndex.emplace(name, static_cast<int>(materialIndex.size())).first;
+          materialNames->InsertNextValue(name);
+        }
+        merged->SetComponent(c, 0, found->second);
+      }
+      renumbered->GetCellData()->AddArray(merged);
+      surface = renumbered;
+    }
     vtkCellData* cells = surface->GetCellData();
     for (int a = 0; a < cells->GetNumberOfArrays(); ++a)
     {
@@ -299,7 +333,13 @@ vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std:
     }
   }
   append->Update();
-  return append->GetOutput();
+  vtkSmartPointer<vtkPolyData> whole = append->GetOutput();
+  if (materialNames->GetNumberOfValues() > 0)
+  {
+    whole->GetFieldData()->RemoveArray("MaterialNames");
+    whole->GetFieldData()->AddArray(materialNames);
+  }
+  return whole;
 }
 
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,

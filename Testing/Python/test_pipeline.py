@@ -254,3 +254,53 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     assert any("the Scene is a vtkTable, which has no surfaces" in e
                for e in messages["ErrorEvent"]), messages
     assert elements.GetNumberOfCells() == 0
+
+
+def material_block(quads, names):
+    """Quads [(origin, point1, point2, material id)] with MaterialId and MaterialNames, as the
+    scene reader gives a file's materials."""
+    from vtkmodules.vtkCommonCore import vtkIntArray, vtkStringArray
+    from vtkmodules.vtkFiltersCore import vtkAppendPolyData
+    append = vtkAppendPolyData()
+    for origin, point1, point2, _ in quads:
+        append.AddInputData(grey_plane(origin, point1, point2, 0.5))
+    append.Update()
+    data = append.GetOutput()
+    ids = vtkIntArray()
+    ids.SetName("MaterialId")
+    for *_, material in quads:
+        ids.InsertNextValue(material)
+    data.GetCellData().AddArray(ids)
+    table = vtkStringArray()
+    table.SetName("MaterialNames")
+    for name in names:
+        table.InsertNextValue(name)
+    data.GetFieldData().AddArray(table)
+    return data
+
+
+def test_a_multiblock_matches_materials_by_name():
+    # Two files' materials in one multiblock: each block numbers its own from 0, so a Light
+    # Material is found by name in any block, and only there.
+    from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet
+    first = material_block([((0, 0, 0), (2, 0, 0), (0, 2, 0), 0),
+                            ((0.8, 1.2, 1.5), (1.2, 1.2, 1.5), (0.8, 0.8, 1.5), 1)],
+                           ["floor", "lamp"])
+    second = material_block([((0, 0, 0), (0, 2, 0), (0, 0, 2), 0),
+                             ((2, 0, 0), (2, 0, 2), (2, 2, 0), 1)],
+                            ["wall", "other"])
+    blocks = vtkMultiBlockDataSet()
+    blocks.SetBlock(0, first)
+    blocks.SetBlock(1, second)
+    for material, polygons in (("lamp", 1), ("other", 1)):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(blocks)
+        radiosity.SetLightMaterial(material)
+        radiosity.SetLightPowerFromMaterial(False)
+        radiosity.SetNumberOfPositions(1)
+        radiosity.SetNumberOfPaths(2000)
+        radiosity.SetPatchSize(0.5)
+        radiosity.SetNumberOfThreads(2)
+        radiosity.SetErrorBatches(1)
+        assert radiosity.UpdateTimeStep(0.0), material
+        assert radiosity.GetOutput(2).GetNumberOfCells() == polygons, material
