@@ -304,3 +304,24 @@ def test_a_multiblock_matches_materials_by_name():
         radiosity.SetErrorBatches(1)
         assert radiosity.UpdateTimeStep(0.0), material
         assert radiosity.GetOutput(2).GetNumberOfCells() == polygons, material
+
+
+def test_an_empty_light_is_named_before_nothing_emits():
+    from vtkmodules.util.misc import calldata_type
+    from vtkmodules.util.vtkConstants import VTK_STRING
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5))
+    radiosity.SetLightData(vtkPolyData())
+    radiosity.SetNumberOfThreads(2)
+    messages = []
+
+    @calldata_type(VTK_STRING)
+    def record(_caller, _event, message):
+        messages.append(message)
+
+    radiosity.AddObserver("WarningEvent", record)
+    radiosity.AddObserver("ErrorEvent", record)
+    assert not radiosity.UpdateTimeStep(0.0)
+    assert any("the Light input is connected but empty" in m for m in messages), messages
+    assert any("nothing emits light" in m for m in messages), messages
