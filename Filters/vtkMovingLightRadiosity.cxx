@@ -576,6 +576,19 @@ int vtkMovingLightRadiosity::RequestData(
   {
     vtkPolyData::GetData(outputVector, port)->Initialize();
   }
+  // Enumerations are kept as given (not clamped), so that the error names the value given.
+  if (this->LightType < AREA_LIGHT || this->LightType > LUMINAIRE_LIGHT)
+  {
+    vtkErrorMacro(<< "LightType is " << this->LightType
+                  << ": give 0 (Area), 1 (Directional), 2 (Point) or 3 (Luminaire)");
+    return 0;
+  }
+  if (this->SkyModel < NO_SKY || this->SkyModel > PEREZ_SKY)
+  {
+    vtkErrorMacro(<< "SkyModel is " << this->SkyModel
+                  << ": give 0 (none), 1 (uniform), 2 (CIE overcast), 3 (CIE clear) or 4 (Perez)");
+    return 0;
+  }
   if (!(this->LuminousEfficacy > 0 && this->LuminousEfficacy <= 683))
   {
     vtkErrorMacro(<< "LuminousEfficacy is " << this->LuminousEfficacy
@@ -1554,12 +1567,13 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ErrorBatches: " << this->ErrorBatches << "\n";
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
   os << indent << "TimeLimit: " << this->TimeLimit << " s\n";
-  os << indent << "LightType: "
-     << (this->LightType == DIRECTIONAL_LIGHT    ? "Directional"
-            : this->LightType == POINT_LIGHT     ? "Point"
-            : this->LightType == LUMINAIRE_LIGHT ? "Luminaire"
-                                                 : "Area")
-     << "\n";
+  static const char* const lightTypes[] = { "Area", "Directional", "Point", "Luminaire" };
+  os << indent << "LightType: " << this->LightType;
+  if (this->LightType >= AREA_LIGHT && this->LightType <= LUMINAIRE_LIGHT)
+  {
+    os << " (" << lightTypes[this->LightType] << ")";
+  }
+  os << "\n";
   os << indent << "SunIrradiance: " << this->SunIrradiance << " W/m^2\n";
   os << indent << "SkyModel: " << this->SkyModel << "\n";
   os << indent << "SkyDiffuseHorizontal: " << this->SkyDiffuseHorizontal << " W/m^2\n";

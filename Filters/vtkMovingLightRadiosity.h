@@ -11,12 +11,12 @@
  * - port 0, Scene (required): polygons and triangle strips; vertices and lines are ignored
  *   with a warning. Any other data set gives its surface (its polygons and the boundary faces
  *   of its volume cells, with their cell arrays), a composite data set the surfaces of all
- *   its leaves together (a cell array some leaf lacks is dropped, with a warning). The cell array named by ReflectanceArrayName (default `Reflectance`)
- *   gives each cell's reflectance (3 components, RGB, or 1 component, grey; every value >= 0
- *   and < 1). Without it the scene is grey 0.5 and a warning says so. The cell array named by
- *   EmissionArrayName (default `Emission`; 3 or 1 components, W/m^2, >= 0) makes those cells
- *   static emitters that also reflect: they emit from their front side in every frame. The
- *   scene is remeshed into patches of about PatchSize.
+ *   its leaves together (a cell array some leaf lacks is dropped, with a warning). The cell array
+ * named by ReflectanceArrayName (default `Reflectance`) gives each cell's reflectance (3
+ * components, RGB, or 1 component, grey; every value >= 0 and < 1). Without it the scene is grey
+ * 0.5 and a warning says so. The cell array named by EmissionArrayName (default `Emission`; 3 or 1
+ * components, W/m^2, >= 0) makes those cells static emitters that also reflect: they emit from
+ * their front side in every frame. The scene is remeshed into patches of about PatchSize.
  * - port 1, Light (required when LightType is Area and nothing in the Scene emits): one or
  *   more planar polygons emitting diffusely along their normals (right-hand rule). The
  *   integer cell array `LightId` groups them into several lights (one light without it); the
@@ -322,9 +322,10 @@ public:
    * luminaire as an area light of its luminous opening (a rectangle, or a polygon of an
    * ellipse's or a circle's area: the opening seen from below), centred on the Trajectory's
    * points and posed as the point light is (nadir -z, C = 0 along +x); a file that gives no
-   * opening makes it a point light, with a warning. Default Area.
+   * opening makes it a point light, with a warning. Default Area. Kept as given: another
+   * value fails the update with an error naming LightType.
    */
-  vtkSetClampMacro(LightType, int, AREA_LIGHT, LUMINAIRE_LIGHT);
+  vtkSetMacro(LightType, int);
   vtkGetMacro(LightType, int);
   void SetLightTypeToArea() { this->SetLightType(AREA_LIGHT); }
   void SetLightTypeToDirectional() { this->SetLightType(DIRECTIONAL_LIGHT); }
@@ -365,7 +366,7 @@ public:
    * Illuminance arrays use the Perez luminous efficacy of each frame's daylight (field data
    * LuminousEfficacy and LuminousEfficacyModel). Default none.
    */
-  vtkSetClampMacro(SkyModel, int, NO_SKY, PEREZ_SKY);
+  vtkSetMacro(SkyModel, int);
   vtkGetMacro(SkyModel, int);
   ///@}
 

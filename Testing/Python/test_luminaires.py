@@ -127,7 +127,7 @@ def test_contradictory_or_missing_luminaires_are_refused_naming_them(tmp_path):
 def test_print_self_lists_the_luminaire():
     text = str(radiosity_filter(LightType=vtkMovingLightRadiosity.POINT_LIGHT,
                                 SpotHalfAngle=30.0, LightFluxLumens=800.0))
-    for line in ("LightType: Point", "SpotHalfAngle: 30 degrees", "SpotSoftEdge: 0 degrees",
+    for line in ("LightType: 2 (Point)", "SpotHalfAngle: 30 degrees", "SpotSoftEdge: 0 degrees",
                  "LightFluxLumens: 800 lm", "LightDistributionFile: "):
         assert line in text, text
 

@@ -133,3 +133,15 @@ def test_a_gltf_scene_under_a_z_up_sky_is_warned_of():
         assert radiosity.UpdateTimeStep(0.0)
         assert any("read from glTF, which is Y-up, but Up is +z" in w for w in warnings) == warned, \
             warnings
+
+
+def test_an_unknown_light_type_or_sky_model_is_named():
+    # Kept as given, not clamped to the nearest kind, so that the error names what was given.
+    for setter, value, message in (("SetLightType", 7, "LightType is 7: give 0 (Area)"),
+                                   ("SetSkyModel", 9, "SkyModel is 9: give 0 (none)")):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(output(vtkPlaneSource()))
+        getattr(radiosity, setter)(value)
+        errors = recorded(radiosity, "ErrorEvent")
+        assert not radiosity.UpdateTimeStep(0.0)
+        assert any(message in e for e in errors), errors
