@@ -984,6 +984,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.Times = trajectory.times;
     cache.SunAzimuth = trajectory.sunAzimuth;
     cache.SunElevation = trajectory.sunElevation;
+    if (soup.polygons.empty() && fromMaterial && !materialLight.light.polygons.empty())
+    {
+      throw mlr::Error("LightMaterial '" + this->LightMaterial +
+        "' takes every polygon of the Scene: nothing is left to light; give the Scene "
+        "surfaces of other materials, or choose another LightMaterial");
+    }
     if (soup.polygons.empty())
     {
       for (const std::string& warning : warnings)

@@ -6,16 +6,19 @@ Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.tx
     PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
 """
 import math
+import os
+import sys
 
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData, vtkPolyLine
 from vtkmodules.vtkFiltersCore import vtkCellCenters
 from vtkmodules.vtkFiltersSources import vtkPlaneSource
-from vtkmodules.util.misc import calldata_type
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.util.vtkConstants import VTK_STRING
 
 from movinglightradiosity import vtkMovingLightRadiosity
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 from test_rigs_and_sun import field, output, square_light
 
@@ -101,13 +104,7 @@ def test_lumens_scale_the_power_by_the_efficacy():
 
 
 def failure(radiosity):
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    radiosity.AddObserver("ErrorEvent", record)
+    errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
     return " ".join(errors)
@@ -141,13 +138,7 @@ def ies_file(path, opening="0.4 0.8 0", tilt="TILT=NONE"):
 
 
 def warnings_of(radiosity):
-    warnings = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        warnings.append(message)
-
-    radiosity.AddObserver("WarningEvent", record)
+    warnings = recorded(radiosity, "WarningEvent")
     return warnings
 
 

@@ -5,6 +5,7 @@ Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.tx
     PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
 """
 import os
+import sys
 import xml.etree.ElementTree as ElementTree
 
 import pytest
@@ -16,6 +17,9 @@ from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridRead
 from paraview.modules.vtkPVVTKExtensionsIOCore import vtkPVDReader, vtkXMLPVDWriter
 
 from movinglightradiosity import vtkMovingLightRadiosity
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 DATA = os.environ.get("MLR_DATA_DIR",
                       os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "Data"))
@@ -192,8 +196,6 @@ def grey_plane(origin, point1, point2, reflectance=None):
 
 def lit(scene, paths=4000):
     """The Elements output of the scene under the sun straight above, and the warnings."""
-    from vtkmodules.util.misc import calldata_type
-    from vtkmodules.util.vtkConstants import VTK_STRING
     radiosity = vtkMovingLightRadiosity()
     radiosity.SetSceneData(scene)
     radiosity.SetLightTypeToDirectional()
@@ -204,18 +206,12 @@ def lit(scene, paths=4000):
     radiosity.SetPatchSize(0.25)
     radiosity.SetNumberOfThreads(2)
     radiosity.SetErrorBatches(1)
-    messages = {"ErrorEvent": [], "WarningEvent": []}
-    for event, into in messages.items():
-        @calldata_type(VTK_STRING)
-        def record(_caller, _event, message, into=into):
-            into.append(message)
-        radiosity.AddObserver(event, record)
+    messages = {event: recorded(radiosity, event) for event in ("ErrorEvent", "WarningEvent")}
     radiosity.Update()
     return radiosity.GetOutput(0), messages
 
 
 def test_any_data_set_or_multiblock_gives_its_surface():
-    from vtkmodules.vtkCommonCore import vtkDoubleArray
     from vtkmodules.vtkCommonDataModel import vtkImageData, vtkMultiBlockDataSet, vtkTable
     # A unit voxel (an image of 2 x 2 x 2 points): its surface is the six faces of its cell.
     voxel = vtkImageData()
@@ -307,21 +303,23 @@ def test_a_multiblock_matches_materials_by_name():
 
 
 def test_an_empty_light_is_named_before_nothing_emits():
-    from vtkmodules.util.misc import calldata_type
-    from vtkmodules.util.vtkConstants import VTK_STRING
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     radiosity = vtkMovingLightRadiosity()
     radiosity.SetSceneData(grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5))
     radiosity.SetLightData(vtkPolyData())
     radiosity.SetNumberOfThreads(2)
-    messages = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        messages.append(message)
-
-    radiosity.AddObserver("WarningEvent", record)
-    radiosity.AddObserver("ErrorEvent", record)
+    messages = recorded(radiosity, "WarningEvent", "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
     assert any("the Light input is connected but empty" in m for m in messages), messages
     assert any("nothing emits light" in m for m in messages), messages
+
+
+def test_a_light_material_that_takes_the_whole_scene_is_an_error():
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(material_block([((0, 0, 0), (1, 0, 0), (0, 1, 0), 0)], ["lamp"]))
+    radiosity.SetLightMaterial("lamp")
+    radiosity.SetLightPowerFromMaterial(False)
+    radiosity.SetNumberOfThreads(2)
+    errors = recorded(radiosity, "ErrorEvent")
+    assert not radiosity.UpdateTimeStep(0.0)
+    assert any("LightMaterial 'lamp' takes every polygon of the Scene" in e for e in errors), errors

@@ -5,6 +5,8 @@ Run by ctest with PYTHONPATH set to the build's Python folder (see CMakeLists.tx
     PYTHONPATH=build/lib/python3/dist-packages /usr/bin/python3 -m pytest Testing/Python
 """
 import math
+import os
+import sys
 
 import pytest
 
@@ -12,10 +14,11 @@ from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkFiltersCore import vtkAppendPolyData
 from vtkmodules.vtkFiltersSources import vtkCubeSource, vtkLineSource, vtkPlaneSource
-from vtkmodules.util.misc import calldata_type
-from vtkmodules.util.vtkConstants import VTK_STRING
 
 from movinglightradiosity import vtkMovingLightRadiosity
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 FRAMES = 3
 ELEMENT_ARRAYS = ("Radiosity", "DirectRadiosity", "IndirectRadiosity", "EmittedRadiosity",
@@ -129,13 +132,7 @@ def test_rig_without_its_polyline_is_an_error(rig):
     line = vtkLineSource()
     line.SetResolution(FRAMES - 1)
     radiosity.SetTrajectoryData(output(line))  # one polyline for two lights
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    radiosity.AddObserver("ErrorEvent", record)
+    errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
     assert any("2 lights (LightId) but the Trajectory has 1 polylines" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0

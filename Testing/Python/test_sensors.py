@@ -7,17 +7,20 @@ A uniform sky's estimator pi L is the same for every direction, so an up-facing 
 open ground reads E_dh exactly (to single precision); the sun adds DNI sin(elevation).
 """
 import math
+import os
+import sys
 
 import pytest
 
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkFloatArray, vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkPolyData
-from vtkmodules.util.misc import calldata_type
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.util.vtkConstants import VTK_STRING
 from vtkmodules.vtkFiltersSources import vtkPlaneSource
 
 from movinglightradiosity import vtkMovingLightRadiosity
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 EDH = 10.0
 DNI = 500.0
@@ -180,13 +183,7 @@ def test_thread_count_changes_no_sensor_bit():
 )
 def test_bad_sensors_are_refused_by_name(data, words):
     radiosity = make_filter(data)
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    radiosity.AddObserver("ErrorEvent", record)
+    errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(HOURS[0])
     assert any(words in e and "Sensors" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0

@@ -8,15 +8,18 @@ paths give a relative standard deviation below 0.7 %; reuse spreads the weights 
 mixture of the frames' skies, and the tolerance is six such deviations.
 """
 import math
+import os
+import sys
 
 import pytest
 
 from vtkmodules.vtkCommonCore import vtkDoubleArray
-from vtkmodules.util.misc import calldata_type
-from vtkmodules.util.vtkConstants import VTK_STRING
 from vtkmodules.vtkFiltersSources import vtkLineSource, vtkPlaneSource
 
 from movinglightradiosity import vtkMovingLightRadiosity
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 PATHS = 50000
 EDH = (50.0, 100.0, 150.0)
@@ -88,18 +91,6 @@ def test_perez_sky_per_frame_on_open_ground(sky):
         efficacies.append(efficacy)
     # The efficacy follows each frame's sky (clearness and brightness differ).
     assert len(set(efficacies)) == 3
-
-
-def recorded(algorithm, event):
-    """The messages `algorithm` sends with `event` ("ErrorEvent", "WarningEvent") from now on."""
-    messages = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        messages.append(message)
-
-    algorithm.AddObserver(event, record)
-    return messages
 
 
 def test_a_clear_sky_without_a_sun_is_refused():

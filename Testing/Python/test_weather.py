@@ -9,16 +9,18 @@ spreads the weights over the frames, and the tolerance is six such deviations.
 """
 import math
 import os
+import sys
 
 import pytest
 
-from vtkmodules.util.misc import calldata_type
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.util.vtkConstants import VTK_STRING
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkFiltersSources import vtkPlaneSource
 
 from movinglightradiosity import vtkMovingLightRadiosity, vtkSunPathSource
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
+from vtk_messages import recorded  # noqa: E402
 
 DATA = os.environ.get("MLR_DATA_DIR", os.path.join(os.path.dirname(__file__), os.pardir,
                                                    os.pardir, "Data"))
@@ -99,13 +101,7 @@ def test_a_malformed_weather_file_is_refused_with_its_line(tmp_path):
     bad.write_text("\n".join(lines))
     source = vtkSunPathSource()
     source.SetWeatherFile(str(bad))
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    source.AddObserver("ErrorEvent", record)
+    errors = recorded(source, "ErrorEvent")
     source.Update()
     assert any("line 21: gives January 2 hour 13 where January 1 hour 13 belongs" in e
                for e in errors), errors
@@ -171,13 +167,7 @@ def test_the_filter_takes_the_sun_and_sky_of_each_hour_and_its_date():
     days.SetValue(0, 400)
     january.Modified()
     refused = solve(january)
-    errors = []
-
-    @calldata_type(VTK_STRING)
-    def record(_caller, _event, message):
-        errors.append(message)
-
-    refused.AddObserver("ErrorEvent", record)
+    errors = recorded(refused, "ErrorEvent")
     assert not refused.UpdateTimeStep(0.0)
     assert any("DayOfYear has 400" in e for e in errors), errors
 
