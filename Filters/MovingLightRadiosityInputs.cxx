@@ -233,7 +233,8 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
 }
 }
 
-vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std::string>& warnings)
+vtkSmartPointer<vtkPolyData> surfaceOf(
+  vtkDataObject* scene, const std::string& port, std::vector<std::string>& warnings)
 {
   if (!scene)
   {
@@ -257,7 +258,7 @@ vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std:
   auto* composite = vtkCompositeDataSet::SafeDownCast(scene);
   if (!composite)
   {
-    throw Error(std::string("the Scene is a ") + scene->GetClassName() +
+    throw Error("the " + port + " is a " + scene->GetClassName() +
       ", which has no surfaces: give a data set (polygons, or cells whose boundary is the "
       "surface to light) or a multiblock of them");
   }
@@ -327,8 +328,8 @@ vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std:
   {
     if (count < leaves)
     {
-      warnings.push_back("the Scene's cell array '" + name + "' is on " + std::to_string(count) +
-        " of its " + std::to_string(leaves) +
+      warnings.push_back("the " + port + "'s cell array '" + name + "' is on " +
+        std::to_string(count) + " of its " + std::to_string(leaves) +
         " blocks with cells, so it is dropped: give it to every block");
     }
   }

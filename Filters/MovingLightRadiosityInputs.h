@@ -19,12 +19,14 @@ class vtkPolyData;
 namespace mlr::vtkinputs
 {
 
-/// The Scene as a vtkPolyData: a vtkPolyData as it is; the surface of another data set (its
-/// polygons and the boundary faces of its volume cells, with their cell and field data); the
-/// surfaces of a composite data set's leaves, appended, where a cell array that not every leaf
-/// has is dropped with a warning in `warnings`. Null for no input. Throws mlr::Error for data
-/// that has no cells to light (a table, an image of no cells).
-vtkSmartPointer<vtkPolyData> sceneSurface(vtkDataObject* scene, std::vector<std::string>& warnings);
+/// The input `port` (the Scene, the Light) as a vtkPolyData: a vtkPolyData as it is; the
+/// surface of another data set (its polygons and the boundary faces of its volume cells, with
+/// their cell and field data); the surfaces of a composite data set's leaves, appended, their
+/// materials (MaterialId, MaterialNames) matched by name, and a cell array that not every leaf
+/// has dropped with a warning in `warnings`. Null for no input. Throws mlr::Error, naming the
+/// port, for data that has no surface (a table).
+vtkSmartPointer<vtkPolyData> surfaceOf(
+  vtkDataObject* data, const std::string& port, std::vector<std::string>& warnings);
 
 /// The Scene's polygons (strips split into triangles) with one material each: reflectance
 /// from the cell array named `reflectanceName` (1 or 3 components, each in [0, 1)) and

@@ -241,15 +241,13 @@ int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* 
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
     return 1;
   }
-  if (port == SCENE_PORT)
+  // Any data set or composite of them, whole: its surface is taken (vtkinputs::surfaceOf).
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObject");
+  if (port == LIGHT_PORT)
   {
-    // Any data set or composite of them, whole: its surface is taken (sceneSurface).
-    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObject");
-    return 1;
+    // A directional light, or a scene whose surfaces emit, needs no Light.
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  // A directional light, or a scene whose surfaces emit, needs no Light.
-  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   return 1;
 }
 
@@ -263,7 +261,9 @@ std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightI
   {
     return 1;
   }
-  return mlr::vtkinputs::lightCount(vtkPolyData::GetData(lightInput, 0));
+  std::vector<std::string> ignored; // the solve reports them
+  return mlr::vtkinputs::lightCount(
+    mlr::vtkinputs::surfaceOf(vtkDataObject::GetData(lightInput, 0), "Light", ignored));
 }
 
 /// The sky of SkyModel in `rig`: one frame per sun direction of a directional light (or one
@@ -916,17 +916,22 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   std::string failure;
   bool cancelled = false, elsewhere = false;
   std::vector<std::string> warnings;
-  vtkNew<vtkInformationVector> sceneSurface;
+  vtkNew<vtkInformationVector> surfaces[2];
   try
   {
-    // The Scene as polygons, whatever data it is, before its pieces travel between ranks.
-    if (inputVector[SCENE_PORT]->GetNumberOfInformationObjects() > 0)
+    // The Scene and the Light as polygons, whatever data they are, before their pieces travel
+    // between ranks.
+    for (const int port : { SCENE_PORT, LIGHT_PORT })
     {
-      vtkNew<vtkInformation> info;
-      info->Set(vtkDataObject::DATA_OBJECT(),
-        mlr::vtkinputs::sceneSurface(vtkDataObject::GetData(inputVector[SCENE_PORT], 0), warnings));
-      sceneSurface->Append(info);
-      inputs[SCENE_PORT] = sceneSurface;
+      if (inputVector[port]->GetNumberOfInformationObjects() > 0)
+      {
+        vtkNew<vtkInformation> info;
+        info->Set(vtkDataObject::DATA_OBJECT(),
+          mlr::vtkinputs::surfaceOf(vtkDataObject::GetData(inputVector[port], 0),
+            port == SCENE_PORT ? "Scene" : "Light", warnings));
+        surfaces[port]->Append(info);
+        inputs[port] = surfaces[port];
+      }
     }
     if (controller)
     {

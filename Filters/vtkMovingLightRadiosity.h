@@ -18,7 +18,8 @@
  * components, W/m^2, >= 0) makes those cells static emitters that also reflect: they emit from
  * their front side in every frame. The scene is remeshed into patches of about PatchSize.
  * - port 1, Light (required when LightType is Area and nothing in the Scene emits): one or
- *   more planar polygons emitting diffusely along their normals (right-hand rule). The
+ *   more planar polygons emitting diffusely along their normals (right-hand rule); of any
+ *   other data set or a composite, its surface, as for the Scene. The
  *   integer cell array `LightId` groups them into several lights (one light without it); the
  *   cell array `LightPower` (3 components, W) gives each light its power, else each gets the
  *   LightPower property. A light's area centroid is its reference point. Lights do not cast

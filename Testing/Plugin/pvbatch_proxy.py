@@ -51,14 +51,14 @@ def domains(prop):
 
 # What each port accepts, asked the way the GUI's input dialog asks: polygons (Box), a
 # tetrahedral unstructured grid (a point set, not polygons), an image (neither) and a
-# multiblock. The Scene takes the surface of any of them.
+# multiblock. The Scene and the Light take the surface of any of them.
 candidates = {"polydata": Box(), "tetrahedra": Tetrahedralize(Input=Wavelet(WholeExtent=[0, 2] * 3)),
               "image": Wavelet(WholeExtent=[0, 2] * 3),
               "multiblock": GroupDatasets(Input=[Box(), Sphere()])}
 for candidate in candidates.values():
     candidate.UpdatePipeline()
 for port, (name, accepted, optional) in enumerate((("Scene", set(candidates), False),
-                                                   ("Light", {"polydata"}, True),
+                                                   ("Light", set(candidates), True),
                                                    ("Trajectory", {"polydata", "tetrahedra"}, True),
                                                    ("Sensors", {"polydata", "tetrahedra"}, True))):
     prop = proxy.GetProperty(name)
@@ -67,7 +67,7 @@ for port, (name, accepted, optional) in enumerate((("Scene", set(candidates), Fa
     check(prop.GetPortIndex() == port, f"input {name} on port {prop.GetPortIndex()}, expected {port}")
     check(prop.GetXMLLabel() == name, f"input {name} labelled {prop.GetXMLLabel()!r}")
     for kind, candidate in candidates.items():
-        if kind == "multiblock" and name != "Scene":
+        if kind == "multiblock" and name not in ("Scene", "Light"):
             continue  # ParaView offers a composite of accepted leaves to any port
         prop.RemoveAllUncheckedProxies()
         prop.AddUncheckedInputConnection(candidate.SMProxy, 0)

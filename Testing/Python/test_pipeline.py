@@ -323,3 +323,29 @@ def test_a_light_material_that_takes_the_whole_scene_is_an_error():
     errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
     assert any("LightMaterial 'lamp' takes every polygon of the Scene" in e for e in errors), errors
+
+
+def test_a_light_of_any_data_set_lights_as_its_polygons():
+    # A Plane made an unstructured grid (as Clip or Threshold give it) is the same light.
+    from vtkmodules.vtkFiltersCore import vtkAppendFilter as Append
+    results = []
+    for make_grid in (False, True):
+        lamp = grey_plane((0.4, 0.6, 1), (0.6, 0.6, 1), (0.4, 0.4, 1))  # facing down
+        if make_grid:
+            grid = Append()
+            grid.AddInputData(lamp)
+            grid.Update()
+            lamp = grid.GetOutput()
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5))
+        radiosity.SetLightData(lamp)
+        radiosity.SetNumberOfPositions(1)
+        radiosity.SetNumberOfPaths(2000)
+        radiosity.SetNumberOfThreads(2)
+        radiosity.SetErrorBatches(1)
+        errors = recorded(radiosity, "ErrorEvent")
+        assert radiosity.UpdateTimeStep(0.0), errors
+        assert radiosity.GetOutput(2).GetNumberOfCells() == 1
+        radiance = radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")
+        results.append([radiance.GetTuple(c) for c in range(radiance.GetNumberOfTuples())])
+    assert results[0] == results[1]
