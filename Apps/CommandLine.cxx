@@ -763,6 +763,12 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
       "--frames-per-chunk", *o.framesPerChunk, 0, filter->GetFramesPerChunkMaxValue());
     filter->SetFramesPerChunk(static_cast<int>(*o.framesPerChunk));
   }
+  if (o.paths && *o.paths < o.errorBatches.value_or(filter->GetErrorBatches()))
+  {
+    throw UsageError("--paths " + std::to_string(*o.paths) + " cannot make " +
+      std::to_string(o.errorBatches.value_or(filter->GetErrorBatches())) +
+      " error batches: give at least as many paths as --error-batches, or fewer batches");
+  }
   if (o.errorBatches)
   {
     checkRange<long long>("--error-batches", *o.errorBatches, 1, 4096);

@@ -311,9 +311,11 @@ void validateErrorOptions(const SolverOptions& options)
   }
   if (options.errorBatches > options.pathsPerFrame)
   {
-    throw Error("the paths per frame, " + std::to_string(options.pathsPerFrame) + ", cannot make " +
+    throw Error("the paths per frame (NumberOfPaths, --paths), " +
+      std::to_string(options.pathsPerFrame) + ", cannot make " +
       std::to_string(options.errorBatches) +
-      " error batches: give at least as many paths as batches, or fewer batches");
+      " error batches (ErrorBatches, --error-batches): give at least as many paths as batches, "
+      "or fewer batches");
   }
   if (!(options.targetRelativeError >= 0) || !std::isfinite(options.targetRelativeError))
   {

@@ -104,8 +104,11 @@ def test_bad_error_options_fail_with_a_message_and_write_nothing(tmp_path, args,
 
 
 def test_more_batches_than_paths_fail_before_writing(tmp_path):
-    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
-                 ["--paths", "10", "--error-batches", "16", "--output", "out/x.pvd"], tmp_path)
-    assert result.returncode == 1
-    assert "cannot make 16 error batches" in result.stderr, result.stderr
-    assert not (tmp_path / "out" / "x.pvd").exists()
+    # A bad command line (exit 2) naming both options, given or by default.
+    for batches in (["--error-batches", "16"], []):
+        result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                     ["--paths", "10"] + batches + ["--output", "out/x.pvd"], tmp_path)
+        assert result.returncode == 2
+        assert "--paths 10 cannot make 16 error batches" in result.stderr, result.stderr
+        assert "--error-batches" in result.stderr, result.stderr
+        assert not (tmp_path / "out" / "x.pvd").exists()
