@@ -4,12 +4,10 @@
 
 #include <vtk_cli11.h>
 
-#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -302,10 +300,7 @@ void checkRange(const std::string& option, T value, T minimum, T maximum)
 
 bool Options::sceneIsYUp() const
 {
-  std::string extension = std::filesystem::path(this->scene).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension == ".gltf" || extension == ".glb";
+  return endsWith(this->scene, ".gltf") || endsWith(this->scene, ".glb");
 }
 
 Triple Options::zenith() const

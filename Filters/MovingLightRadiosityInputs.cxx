@@ -234,31 +234,31 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
 }
 
 vtkSmartPointer<vtkPolyData> surfaceOf(
-  vtkDataObject* scene, const std::string& port, std::vector<std::string>& warnings)
+  vtkDataObject* input, const std::string& port, std::vector<std::string>& warnings)
 {
-  if (!scene)
+  if (!input)
   {
     return nullptr;
   }
-  if (auto* polygons = vtkPolyData::SafeDownCast(scene))
+  if (auto* polygons = vtkPolyData::SafeDownCast(input))
   {
     return polygons;
   }
-  auto surfaceOf = [](vtkDataSet* data)
+  auto boundaryOf = [](vtkDataSet* data)
   {
     vtkNew<vtkGeometryFilter> surface;
     surface->SetInputData(data);
     surface->Update();
     return vtkSmartPointer<vtkPolyData>(surface->GetOutput());
   };
-  if (auto* data = vtkDataSet::SafeDownCast(scene))
+  if (auto* data = vtkDataSet::SafeDownCast(input))
   {
-    return surfaceOf(data);
+    return boundaryOf(data);
   }
-  auto* composite = vtkCompositeDataSet::SafeDownCast(scene);
+  auto* composite = vtkCompositeDataSet::SafeDownCast(input);
   if (!composite)
   {
-    throw Error("the " + port + " is a " + scene->GetClassName() +
+    throw Error("the " + port + " is a " + input->GetClassName() +
       ", which has no surfaces: give a data set (polygons, or cells whose boundary is the "
       "surface to light) or a multiblock of them");
   }
@@ -279,7 +279,7 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
     {
       continue;
     }
-    vtkSmartPointer<vtkPolyData> surface = surfaceOf(data);
+    vtkSmartPointer<vtkPolyData> surface = boundaryOf(data);
     auto* names =
       vtkStringArray::SafeDownCast(surface->GetFieldData()->GetAbstractArray("MaterialNames"));
     auto* ids = vtkDataArray::SafeDownCast(surface->GetCellData()->GetAbstractArray("MaterialId"));

@@ -1105,14 +1105,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         }
       }
     }
-    else if (!fromMaterial && lightData && lightData->GetNumberOfCells() == 0)
-    {
-      // Connected, so meant to light: say so before "nothing emits light" would follow.
-      warnings.push_back("the Light input is connected but empty (no cells; an upstream filter "
-                         "gave nothing?): it lights nothing");
-    }
-    if (this->LightType == AREA_LIGHT &&
-      (fromMaterial || (lightData && lightData->GetNumberOfCells() > 0)))
+    else if (fromMaterial || (lightData && lightData->GetNumberOfCells() > 0))
     {
       std::vector<mlr::vtkinputs::LightInput> lights;
       if (fromMaterial)
@@ -1163,6 +1156,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           }
         }
       }
+    }
+    else if (lightData)
+    {
+      // Connected, so meant to light: say so before "nothing emits light" would follow.
+      warnings.push_back("the Light input is connected but empty (no cells; an upstream filter "
+                         "gave nothing?): it lights nothing");
     }
     for (const std::string& warning : warnings)
     {
