@@ -296,6 +296,15 @@ void checkRange(const std::string& option, T value, T minimum, T maximum)
     throw UsageError(s.str());
   }
 }
+
+/// `value` of `option` within the range the filter accepts for `property`.
+template <typename T>
+void checkPropertyRange(const std::string& option, T value, const char* property)
+{
+  double range[2] = { 0, 0 };
+  vtkMovingLightRadiosity::GetPropertyRange(property, range);
+  checkRange<T>(option, value, static_cast<T>(range[0]), static_cast<T>(range[1]));
+}
 }
 
 bool Options::sceneIsYUp() const
@@ -700,20 +709,17 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.paths)
   {
-    checkRange<long long>(
-      "--paths", *o.paths, filter->GetNumberOfPathsMinValue(), filter->GetNumberOfPathsMaxValue());
+    checkPropertyRange<long long>("--paths", *o.paths, "NumberOfPaths");
     filter->SetNumberOfPaths(static_cast<vtkIdType>(*o.paths));
   }
   if (o.gatherRatio)
   {
-    checkRange("--gather-ratio", *o.gatherRatio, filter->GetGatheringRatioMinValue(),
-      filter->GetGatheringRatioMaxValue());
+    checkPropertyRange("--gather-ratio", *o.gatherRatio, "GatheringRatio");
     filter->SetGatheringRatio(*o.gatherRatio);
   }
   if (o.survival)
   {
-    checkRange("--survival", *o.survival, filter->GetFirstBounceSurvivalMinValue(),
-      filter->GetFirstBounceSurvivalMaxValue());
+    checkPropertyRange("--survival", *o.survival, "FirstBounceSurvival");
     filter->SetFirstBounceSurvival(*o.survival);
   }
   if (o.reuse)
@@ -727,24 +733,22 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.patchSize)
   {
-    checkRange(
-      "--patch-size", *o.patchSize, filter->GetPatchSizeMinValue(), filter->GetPatchSizeMaxValue());
+    checkPropertyRange("--patch-size", *o.patchSize, "PatchSize");
     filter->SetPatchSize(*o.patchSize);
   }
   if (o.seed)
   {
-    checkRange<long long>("--seed", *o.seed, filter->GetSeedMinValue(), filter->GetSeedMaxValue());
+    checkPropertyRange<long long>("--seed", *o.seed, "Seed");
     filter->SetSeed(static_cast<int>(*o.seed));
   }
   if (o.threads)
   {
-    checkRange<long long>("--threads", *o.threads, filter->GetNumberOfThreadsMinValue(),
-      filter->GetNumberOfThreadsMaxValue());
+    checkPropertyRange<long long>("--threads", *o.threads, "NumberOfThreads");
     filter->SetNumberOfThreads(static_cast<int>(*o.threads));
   }
   if (o.memoryLimit)
   {
-    checkRange<long long>("--memory-limit", *o.memoryLimit, 1, filter->GetMemoryLimitMaxValue());
+    checkRange<long long>("--memory-limit", *o.memoryLimit, 1, VTK_INT_MAX);
     filter->SetMemoryLimit(static_cast<int>(*o.memoryLimit));
   }
   if (o.framesPerChunk)
@@ -754,8 +758,7 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
       throw UsageError("--frames-per-chunk is 1: give 0 (the memory limit chooses) or at least "
                        "2, so that the blends at a chunk's two seams do not overlap");
     }
-    checkRange<long long>(
-      "--frames-per-chunk", *o.framesPerChunk, 0, filter->GetFramesPerChunkMaxValue());
+    checkPropertyRange<long long>("--frames-per-chunk", *o.framesPerChunk, "FramesPerChunk");
     filter->SetFramesPerChunk(static_cast<int>(*o.framesPerChunk));
   }
   if (o.paths && *o.paths < o.errorBatches.value_or(filter->GetErrorBatches()))
@@ -766,7 +769,7 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.errorBatches)
   {
-    checkRange<long long>("--error-batches", *o.errorBatches, 1, 4096);
+    checkPropertyRange<long long>("--error-batches", *o.errorBatches, "ErrorBatches");
     filter->SetErrorBatches(static_cast<int>(*o.errorBatches));
   }
   if (o.targetError)
@@ -819,8 +822,7 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.from)
   {
-    checkRange<long long>("--frames", *o.frames, filter->GetNumberOfPositionsMinValue(),
-      filter->GetNumberOfPositionsMaxValue());
+    checkPropertyRange<long long>("--frames", *o.frames, "NumberOfPositions");
     filter->SetPathStart(o.from->data());
     filter->SetPathEnd(o.to->data());
     filter->SetNumberOfPositions(static_cast<int>(*o.frames));

@@ -40,6 +40,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <new>
@@ -193,10 +194,83 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
 //------------------------------------------------------------------------------
 vtkMovingLightRadiosity::~vtkMovingLightRadiosity() = default;
 
+namespace
+{
+/// A numeric property's range, bounds included, and what to give when a value is outside.
+struct PropertyRange
+{
+  const char* name;
+  double low, high;
+  const char* give;
+  double (*value)(vtkMovingLightRadiosity*);
+};
+
+using Self = vtkMovingLightRadiosity;
+constexpr double Most = std::numeric_limits<double>::max();
+const PropertyRange PropertyRanges[] = {
+  { "NumberOfPaths", 1, static_cast<double>(mlr::MaximumPathsPerFrame),
+    "paths per frame from 1 to 100000000000 (600000 is typical)",
+    [](Self* f) { return static_cast<double>(f->GetNumberOfPaths()); } },
+  { "GatheringRatio", 0, 1000, "0 (no final gathering) up to 1000 (1 is typical)",
+    [](Self* f) { return f->GetGatheringRatio(); } },
+  { "FirstBounceSurvival", mlr::MinimumFirstBounceSurvival, 1,
+    "a probability from 0.001 to 1 (0.25 is typical)",
+    [](Self* f) { return f->GetFirstBounceSurvival(); } },
+  { "PatchSize", 0, Most, "0 (about 3000 patches) or a positive length, in scene units",
+    [](Self* f) { return f->GetPatchSize(); } },
+  { "Seed", 0, VTK_INT_MAX, "0 or a positive integer",
+    [](Self* f) { return static_cast<double>(f->GetSeed()); } },
+  { "NumberOfThreads", 0, 1024, "0 (every core) or 1 to 1024",
+    [](Self* f) { return static_cast<double>(f->GetNumberOfThreads()); } },
+  { "NumberOfPositions", 1, 100000, "1 to 100000 light positions",
+    [](Self* f) { return static_cast<double>(f->GetNumberOfPositions()); } },
+  { "SunIrradiance", 0, Most,
+    "0 (no direct sun) or an irradiance in W/m^2 (1000 at noon on a clear day)",
+    [](Self* f) { return f->GetSunIrradiance(); } },
+  { "SkyDiffuseHorizontal", 0, Most, "0 or an irradiance in W/m^2 (100 is typical)",
+    [](Self* f) { return f->GetSkyDiffuseHorizontal(); } },
+  { "SpotHalfAngle", 0, 180, "0 (no spot) up to 180 degrees",
+    [](Self* f) { return f->GetSpotHalfAngle(); } },
+  { "SpotSoftEdge", 0, 180, "0 (a hard edge) up to 180 degrees",
+    [](Self* f) { return f->GetSpotSoftEdge(); } },
+  { "LightFluxLumens", 0, Most, "0 (LightPower's watts) or a luminous flux in lm",
+    [](Self* f) { return f->GetLightFluxLumens(); } },
+  { "MemoryLimit", 0, VTK_INT_MAX, "0 (half of the physical memory) or a limit in MiB",
+    [](Self* f) { return static_cast<double>(f->GetMemoryLimit()); } },
+  { "FramesPerChunk", 0, VTK_INT_MAX, "0 (MemoryLimit chooses) or at least 2",
+    [](Self* f) { return static_cast<double>(f->GetFramesPerChunk()); } },
+  { "CachedChunks", 0, VTK_INT_MAX, "0 (every frame kept) or a count of chunks",
+    [](Self* f) { return static_cast<double>(f->GetCachedChunks()); } },
+  { "ErrorBatches", 1, static_cast<double>(mlr::MaximumErrorBatches),
+    "1 (no error estimate) up to 4096 (16 is typical)",
+    [](Self* f) { return static_cast<double>(f->GetErrorBatches()); } },
+  { "Exposure", -20, 20, "-20 to 20 EV (0 is the automatic exposure)",
+    [](Self* f) { return f->GetExposure(); } },
+  { "SensorRays", 1, 1000000, "1 to 1000000 rays per sensor (512 is typical)",
+    [](Self* f) { return static_cast<double>(f->GetSensorRays()); } },
+  { "DaylightAutonomyThreshold", 0, Most, "0 or an illuminance in lx (300 is typical)",
+    [](Self* f) { return f->GetDaylightAutonomyThreshold(); } },
+};
+} // namespace
+
+//------------------------------------------------------------------------------
+bool vtkMovingLightRadiosity::GetPropertyRange(const char* name, double range[2])
+{
+  for (const PropertyRange& known : PropertyRanges)
+  {
+    if (name && std::string(name) == known.name)
+    {
+      range[0] = known.low;
+      range[1] = known.high;
+      return true;
+    }
+  }
+  return false;
+}
+
 //------------------------------------------------------------------------------
 void vtkMovingLightRadiosity::SetExposure(double exposure)
 {
-  exposure = std::clamp(exposure, -20.0, 20.0);
   if (exposure == this->Exposure)
   {
     return;
@@ -216,7 +290,6 @@ void vtkMovingLightRadiosity::SetExposure(double exposure)
 //------------------------------------------------------------------------------
 void vtkMovingLightRadiosity::SetDaylightAutonomyThreshold(double threshold)
 {
-  threshold = threshold > 0 ? threshold : 0.0;
   if (threshold == this->DaylightAutonomyThreshold)
   {
     return;
@@ -253,6 +326,61 @@ int vtkMovingLightRadiosity::FillInputPortInformation(int port, vtkInformation* 
 
 namespace
 {
+/**
+ * The first numeric property outside its range, as an error naming it, the value given and
+ * what to give; empty when every one is in range. The properties are kept as given rather
+ * than clamped as VTK's set-macros do, so that a mistake (0 paths, a negative seed, NaN) is
+ * named instead of solving something else.
+ */
+std::string propertyOutOfRange(vtkMovingLightRadiosity* self)
+{
+  // Whole numbers (counts) with every digit, so that a value just over a bound shows it.
+  const auto format = [](double value)
+  {
+    std::ostringstream s;
+    if (std::abs(value) < 9e18 && value == std::floor(value))
+    {
+      s << static_cast<long long>(value);
+    }
+    else
+    {
+      s << std::setprecision(15) << value;
+    }
+    return s.str();
+  };
+  if (self->GetLightType() < Self::AREA_LIGHT || self->GetLightType() > Self::LUMINAIRE_LIGHT)
+  {
+    return "LightType is " + std::to_string(self->GetLightType()) +
+      ": give 0 (Area), 1 (Directional), 2 (Point) or 3 (Luminaire)";
+  }
+  if (self->GetSkyModel() < Self::NO_SKY || self->GetSkyModel() > Self::PEREZ_SKY)
+  {
+    return "SkyModel is " + std::to_string(self->GetSkyModel()) +
+      ": give 0 (none), 1 (uniform), 2 (CIE overcast), 3 (CIE clear) or 4 (Perez)";
+  }
+  const double efficacy = self->GetLuminousEfficacy();
+  if (!(efficacy > 0 && efficacy <= 683))
+  {
+    return "LuminousEfficacy is " + format(efficacy) +
+      " lm/W: give the light's luminous efficacy, above 0 and at most 683 lm/W (179 for white "
+      "light)";
+  }
+  for (const PropertyRange& range : PropertyRanges)
+  {
+    const double value = range.value(self);
+    if (!(value >= range.low && value <= range.high))
+    {
+      return std::string(range.name) + " is " + format(value) + ": give " + range.give;
+    }
+  }
+  if (self->GetFramesPerChunk() == 1)
+  {
+    return "FramesPerChunk is 1: give 0 (MemoryLimit chooses) or at least 2, so that the "
+           "blends at a chunk's two seams do not overlap";
+  }
+  return {};
+}
+
 /// The number of lights whose poses the Trajectory holds: the Light's LightId groups for
 /// area lights, one for a directional or point light.
 std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightInput)
@@ -576,24 +704,10 @@ int vtkMovingLightRadiosity::RequestData(
   {
     vtkPolyData::GetData(outputVector, port)->Initialize();
   }
-  // Enumerations are kept as given (not clamped), so that the error names the value given.
-  if (this->LightType < AREA_LIGHT || this->LightType > LUMINAIRE_LIGHT)
+  const std::string outOfRange = propertyOutOfRange(this);
+  if (!outOfRange.empty())
   {
-    vtkErrorMacro(<< "LightType is " << this->LightType
-                  << ": give 0 (Area), 1 (Directional), 2 (Point) or 3 (Luminaire)");
-    return 0;
-  }
-  if (this->SkyModel < NO_SKY || this->SkyModel > PEREZ_SKY)
-  {
-    vtkErrorMacro(<< "SkyModel is " << this->SkyModel
-                  << ": give 0 (none), 1 (uniform), 2 (CIE overcast), 3 (CIE clear) or 4 (Perez)");
-    return 0;
-  }
-  if (!(this->LuminousEfficacy > 0 && this->LuminousEfficacy <= 683))
-  {
-    vtkErrorMacro(<< "LuminousEfficacy is " << this->LuminousEfficacy
-                  << " lm/W: give the light's luminous efficacy, above 0 and at most 683 lm/W "
-                     "(179 for white light)");
+    vtkErrorMacro(<< outOfRange);
     return 0;
   }
   vtkInternals& cache = *this->Internals;
@@ -1180,19 +1294,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.seed = static_cast<std::uint64_t>(this->Seed);
     solverOptions.threads = this->NumberOfThreads;
     solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
-    if (this->FramesPerChunk == 1)
-    {
-      throw mlr::Error("FramesPerChunk is 1: give 0 (MemoryLimit chooses) or at least 2, so "
-                       "that the blends at a chunk's two seams do not overlap");
-    }
     solverOptions.framesPerChunk = static_cast<std::uint64_t>(this->FramesPerChunk);
     // Core refuses the other bad values (NaN targets included) naming the property to fix.
-    if (this->ErrorBatches < 0)
-    {
-      throw mlr::Error("the error batch count (ErrorBatches) is " +
-        std::to_string(this->ErrorBatches) + ": give 1 (no error estimate) up to " +
-        std::to_string(mlr::MaximumErrorBatches) + " (16 is typical)");
-    }
     solverOptions.errorBatches = static_cast<std::uint64_t>(this->ErrorBatches);
     solverOptions.targetRelativeError = this->TargetRelativeError;
     solverOptions.timeLimitSeconds = this->TimeLimit;

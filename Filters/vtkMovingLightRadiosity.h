@@ -107,7 +107,9 @@
  * again until a property or an input changes (or Modified() is called): a request for another
  * time step or output port meanwhile repeats the error without solving. Bad input (NaN
  * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to
- * fix and empty outputs. An empty scene gives empty outputs and no error.
+ * fix and empty outputs. An empty scene gives empty outputs and no error. Numeric properties
+ * are kept as given, not clamped: a value outside the range its description gives (NaN
+ * included) fails the update with an error naming the property, the value and what to give.
  *
  * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
  * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
@@ -189,26 +191,27 @@ public:
 
   ///@{
   /**
-   * Effective shooting paths per frame, N. Default 600000.
+   * Effective shooting paths per frame, N, from 1 to 10^11. Default 600000.
    */
-  vtkSetClampMacro(NumberOfPaths, vtkIdType, 1, 100000000000LL);
+  vtkSetMacro(NumberOfPaths, vtkIdType);
   vtkGetMacro(NumberOfPaths, vtkIdType);
   ///@}
 
   ///@{
   /**
    * Gathering rays per frame as a multiple k of NumberOfPaths; 0 skips final gathering and
-   * the elements show their patch's shooting solution. Default 1.
+   * the elements show their patch's shooting solution. At most 1000. Default 1.
    */
-  vtkSetClampMacro(GatheringRatio, double, 0.0, 1000.0);
+  vtkSetMacro(GatheringRatio, double);
   vtkGetMacro(GatheringRatio, double);
   ///@}
 
   ///@{
   /**
-   * Probability lambda that a shooting path continues after its first hit. Default 0.25.
+   * Probability lambda that a shooting path continues after its first hit, from 0.001 to 1.
+   * Default 0.25.
    */
-  vtkSetClampMacro(FirstBounceSurvival, double, 0.001, 1.0);
+  vtkSetMacro(FirstBounceSurvival, double);
   vtkGetMacro(FirstBounceSurvival, double);
   ///@}
 
@@ -246,26 +249,27 @@ public:
 
   ///@{
   /**
-   * Target patch edge length, in scene units; 0 picks one that gives about 3000 patches.
-   * Default 0.
+   * Target patch edge length, in scene units, 0 or more; 0 picks one that gives about 3000
+   * patches. Default 0.
    */
-  vtkSetClampMacro(PatchSize, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(PatchSize, double);
   vtkGetMacro(PatchSize, double);
   ///@}
 
   ///@{
   /**
-   * Seed of the random numbers: the same seed gives the same result. Default 0.
+   * Seed of the random numbers, 0 or positive: the same seed gives the same result. Default 0.
    */
-  vtkSetClampMacro(Seed, int, 0, VTK_INT_MAX);
+  vtkSetMacro(Seed, int);
   vtkGetMacro(Seed, int);
   ///@}
 
   ///@{
   /**
-   * Threads of the solve; 0 uses every core. The result does not depend on it. Default 0.
+   * Threads of the solve, up to 1024; 0 uses every core. The result does not depend on it.
+   * Default 0.
    */
-  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkSetMacro(NumberOfThreads, int);
   vtkGetMacro(NumberOfThreads, int);
   ///@}
 
@@ -297,9 +301,10 @@ public:
   ///@{
   /**
    * Light positions (frames) from PathStart to PathEnd when no Trajectory is connected
-   * (one frame when there is no light at all, only emissive scene surfaces). Default 10.
+   * (one frame when there is no light at all, only emissive scene surfaces), from 1 to 100000.
+   * Default 10.
    */
-  vtkSetClampMacro(NumberOfPositions, int, 1, 100000);
+  vtkSetMacro(NumberOfPositions, int);
   vtkGetMacro(NumberOfPositions, int);
   ///@}
 
@@ -339,9 +344,9 @@ public:
    * Irradiance of the directional light on a surface facing it, W/m^2 (before the
    * Trajectory's Power factor). A Trajectory with the point array DirectNormalIrradiance (a
    * weather file's, from vtkSunPathSource) gives it per frame instead, and SunIrradiance 0
-   * still turns the direct sun off. Default 1000 (the sun at noon on a clear day).
+   * still turns the direct sun off; 0 or more. Default 1000 (the sun at noon on a clear day).
    */
-  vtkSetClampMacro(SunIrradiance, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(SunIrradiance, double);
   vtkGetMacro(SunIrradiance, double);
   ///@}
 
@@ -373,8 +378,8 @@ public:
 
   ///@{
   /// The sky's diffuse horizontal irradiance E_dh, W/m^2, when the Trajectory has no
-  /// SkyDiffuseHorizontal array. Default 100.
-  vtkSetClampMacro(SkyDiffuseHorizontal, double, 0.0, VTK_DOUBLE_MAX);
+  /// SkyDiffuseHorizontal array; 0 or more. Default 100.
+  vtkSetMacro(SkyDiffuseHorizontal, double);
   vtkGetMacro(SkyDiffuseHorizontal, double);
   ///@}
 
@@ -427,9 +432,9 @@ public:
    * falling linearly to zero over SpotSoftEdge degrees beyond it. A half angle of 0 is no
    * spot; a spot and a LightDistributionFile exclude each other. Defaults 0 and 0.
    */
-  vtkSetClampMacro(SpotHalfAngle, double, 0.0, 180.0);
+  vtkSetMacro(SpotHalfAngle, double);
   vtkGetMacro(SpotHalfAngle, double);
-  vtkSetClampMacro(SpotSoftEdge, double, 0.0, 180.0);
+  vtkSetMacro(SpotSoftEdge, double);
   vtkGetMacro(SpotSoftEdge, double);
   ///@}
 
@@ -438,9 +443,10 @@ public:
    * A luminaire's luminous flux (lm), for every area and point light, instead of LightPower:
    * the power is LightFluxLumens / LuminousEfficacy watts of luminance, with the light's
    * colour (LightPower, or the Light's LightPower cell array) as the RGB ratio, scaled so
-   * that 0.2126 R + 0.7152 G + 0.0722 B of it equals that. 0 keeps LightPower. Default 0.
+   * that 0.2126 R + 0.7152 G + 0.0722 B of it equals that. 0 keeps LightPower; no negative
+   * flux. Default 0.
    */
-  vtkSetClampMacro(LightFluxLumens, double, 0.0, VTK_DOUBLE_MAX);
+  vtkSetMacro(LightFluxLumens, double);
   vtkGetMacro(LightFluxLumens, double);
   ///@}
 
@@ -495,9 +501,9 @@ public:
    * Refuse work estimated to need more memory than this (MiB), before allocating it: taking
    * the scene for remeshing, remeshing it, and the solve with its outputs (a solve that
    * cannot fit is refused before remeshing runs, from the patch count expected); 0 means
-   * half of the physical memory. Default 0.
+   * half of the physical memory; no negative limit. Default 0.
    */
-  vtkSetClampMacro(MemoryLimit, int, 0, VTK_INT_MAX);
+  vtkSetMacro(MemoryLimit, int);
   vtkGetMacro(MemoryLimit, int);
   ///@}
 
@@ -511,9 +517,9 @@ public:
    * kept for the time steps; every chunk solves with Seed, a position casting the same paths
    * in every chunk that solves it. On several MPI ranks with at least as many chunks as ranks
    * (and no Sensors), each rank solves whole chunks and keeps their frames: the rank holding a
-   * time step outputs it whole, the others an empty piece. Default 0.
+   * time step outputs it whole, the others an empty piece. No negative count. Default 0.
    */
-  vtkSetClampMacro(FramesPerChunk, int, 0, VTK_INT_MAX);
+  vtkSetMacro(FramesPerChunk, int);
   vtkGetMacro(FramesPerChunk, int);
   ///@}
 
@@ -525,9 +531,9 @@ public:
    * solve), the same bits as the first solve; the field data `ChunksSolvedAgain` counts
    * them. The memory limit counts the chunks kept. The display's exposure and lit sides are
    * then those of the first chunk, as when streaming. 0 keeps every frame. One process only:
-   * on several MPI ranks, and with Sensors, every frame is kept. Default 0.
+   * on several MPI ranks, and with Sensors, every frame is kept. No negative count. Default 0.
    */
-  vtkSetClampMacro(CachedChunks, int, 0, VTK_INT_MAX);
+  vtkSetMacro(CachedChunks, int);
   vtkGetMacro(CachedChunks, int);
   ///@}
 
@@ -605,7 +611,7 @@ public:
   /**
    * The illuminance (lx) a sensor's DaylightAutonomy counts the time steps at or above.
    * Changing it only recomputes the metrics from the cached solve: it never solves again.
-   * From 0 (NaN is taken as 0); default 300.
+   * From 0; default 300.
    */
   void SetDaylightAutonomyThreshold(double threshold);
   vtkGetMacro(DaylightAutonomyThreshold, double);
@@ -617,9 +623,17 @@ public:
    * sky through those that escape, the surfaces' radiosity through those that hit. Their
    * noise falls as one over the square root. From 1 to 1000000; default 512.
    */
-  vtkSetClampMacro(SensorRays, int, 1, 1000000);
+  vtkSetMacro(SensorRays, int);
   vtkGetMacro(SensorRays, int);
   ///@}
+
+  /**
+   * The range of the numeric property `name` ("NumberOfPaths", "Seed", "Exposure", ...) that an
+   * update accepts, bounds included, into `range`; false, leaving `range` as it is, for a name
+   * without one. The properties keep what they are given: a value outside fails the update
+   * with an error naming the property.
+   */
+  static bool GetPropertyRange(const char* name, double range[2]);
 
   /**
    * Number of solves performed so far by this filter (new times do not solve again).

@@ -93,6 +93,12 @@ int vtkRadiositySceneReader::RequestData(
     vtkErrorMacro(<< "no FileName: give an .obj, .gltf, .glb or .ply scene file");
     return 0;
   }
+  if (this->MemoryLimit < 0)
+  {
+    vtkErrorMacro(<< "MemoryLimit is " << this->MemoryLimit
+                  << ": give 0 (half of the physical memory) or a limit in MiB");
+    return 0;
+  }
   const std::string path = this->FileName;
   const std::string extension = lowerExtension(this->FileName);
 

@@ -88,9 +88,10 @@ public:
    * the file's declared counts (glTF: every mesh instance the node hierarchy draws; PLY: the
    * header's vertex and face counts; OBJ: the file's size) before anything proportional to
    * them is allocated, and a file over the limit is an error naming the estimate. The same
-   * policy as vtkMovingLightRadiosity's MemoryLimit. Default: 0, half of the physical memory.
+   * policy as vtkMovingLightRadiosity's MemoryLimit; a negative limit is an error naming it.
+   * Default: 0, half of the physical memory.
    */
-  vtkSetClampMacro(MemoryLimit, int, 0, VTK_INT_MAX);
+  vtkSetMacro(MemoryLimit, int);
   vtkGetMacro(MemoryLimit, int);
   ///@}
 

@@ -137,7 +137,7 @@ TEST(FilterErrorEstimate, BadErrorPropertiesAreRefusedByName)
   filter->SetErrorBatches(0);
   EXPECT_NE(failure(filter).find("ErrorBatches"), std::string::npos);
   filter->SetErrorBatches(-3);
-  EXPECT_NE(failure(filter).find("ErrorBatches) is -3"), std::string::npos);
+  EXPECT_NE(failure(filter).find("ErrorBatches is -3: give 1"), std::string::npos);
   filter->SetErrorBatches(100000);
   EXPECT_NE(failure(filter).find("ErrorBatches"), std::string::npos);
   filter->SetErrorBatches(16);

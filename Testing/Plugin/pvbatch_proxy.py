@@ -3,7 +3,7 @@
 - the menu hint (Filters > Radiosity), the input ports (Scene, Light, optional Trajectory and Sensors)
   and the data types they accept, the output port names (Elements, Patches, Light, Sensors);
 - every property: a label that is also its paraview.simple name, documentation, a domain,
-  the VTK filter's default, the filter's clamping range, advanced or not;
+  the VTK filter's default, the filter's range (refused by name just outside), advanced or not;
 - every property's documentation names its unit (or says it has none) and its effect on
   the cost of a solve;
 - what the first Apply shows: TimestepValues and the time keeper with one step per light
@@ -12,7 +12,7 @@
 
     pvbatch --force-offscreen-rendering pvbatch_proxy.py --plugin MovingLightRadiosity.so
 
-The VTK defaults and clamps come from the Python package (PYTHONPATH=<build>/lib/python3/
+The VTK defaults and ranges come from the Python package (PYTHONPATH=<build>/lib/python3/
 dist-packages), so that the XML cannot drift from vtkMovingLightRadiosity."""
 import plugin_test_support as support
 
@@ -25,7 +25,30 @@ support.load_plugin(args.plugin, globals())
 checks = support.Checks("Plugin.Proxy")
 check = checks.check
 
+import os  # noqa: E402
+import sys  # noqa: E402
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
 from movinglightradiosity import vtkMovingLightRadiosity  # noqa: E402
+from vtk_messages import recorded  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkDoubleArray  # noqa: E402
+from vtkmodules.vtkFiltersSources import vtkCubeSource  # noqa: E402
+
+
+def glowing_box_filter():
+    """The filter on a box that lights itself: every property in range would solve."""
+    cube = vtkCubeSource()
+    cube.Update()
+    box = cube.GetOutput()
+    emission = vtkDoubleArray()
+    emission.SetName("Emission")
+    emission.SetNumberOfComponents(3)
+    for _ in range(box.GetNumberOfCells()):
+        emission.InsertNextTuple3(1, 1, 1)
+    box.GetCellData().AddArray(emission)
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetInputData(vtkMovingLightRadiosity.SCENE_PORT, box)
+    return radiosity
 
 radiosity, sources = support.box_pipeline()
 proxy = radiosity.SMProxy
@@ -87,8 +110,6 @@ ADVANCED = {"Seed", "NumberOfThreads", "FirstBounceSurvival", "GatheringRatio", 
 BOOLEANS = {"TwoSided", "ReuseShooting", "ReuseGathering", "AimAtPoint", "LightPowerFromMaterial"}
 # Free text (names of arrays and materials): no domain to check against.
 STRINGS = {"LightMaterial", "ReflectanceArrayName", "EmissionArrayName"}
-# Kept as given outside the domain, and refused by name at the update, never changed.
-REFUSED = {"LuminousEfficacy", "ErrorBatches", "TargetRelativeError", "TimeLimit"}
 EXPECTED = {"LightPower", "NumberOfPaths", "GatheringRatio", "FirstBounceSurvival",
             "ReuseShooting", "ReuseGathering", "PatchSize", "Seed", "NumberOfThreads",
             "TwoSided", "PathStart", "PathEnd", "NumberOfPositions", "MemoryLimit", "Exposure",
@@ -161,27 +182,27 @@ while not iterator.IsAtEnd():
         check([float(v) for v in xml_value] == [float(v) for v in vtk_value],
               f"{where}: XML default {xml_value}, VTK default {vtk_value}")
 
-    # Where the filter clamps a scalar, the domain must give the same range, else the panel
-    # would accept values the filter silently changes.
+    # A value just outside the domain is kept as given, and the update refuses it by name:
+    # the panel's range is the filter's, and nothing is silently changed.
     for domain in own_domains:
         if prop.GetNumberOfElements() != 1 or not (domain.IsA("vtkSMIntRangeDomain") or
                                                    domain.IsA("vtkSMDoubleRangeDomain")):
             continue
-        probe = vtkMovingLightRadiosity()
-        setter = getattr(probe, "Set" + name)
+        outside = []
         if domain.GetMinimumExists(0):
             low = domain.GetMinimum(0)
-            below = low - 1 if domain.IsA("vtkSMIntRangeDomain") else low - 1e-6 - abs(low)
-            setter(below)
-            got = getattr(probe, "Get" + name)()
-            kept = below if name in REFUSED else low
-            check(got == kept, f"{where}: domain minimum {low}, but the filter turns {below} into {got}")
+            outside.append(low - 1 if domain.IsA("vtkSMIntRangeDomain") else low - 1e-6 - abs(low))
         if domain.GetMaximumExists(0):
-            high = domain.GetMaximum(0)
-            setter(high + 1)
+            outside.append(domain.GetMaximum(0) + 1)
+        for value in outside:
+            probe = glowing_box_filter()
+            getattr(probe, "Set" + name)(value)
             got = getattr(probe, "Get" + name)()
-            kept = high + 1 if name in REFUSED else high
-            check(got == kept, f"{where}: domain maximum {high}, but the filter turns {high + 1} into {got}")
+            check(got == value, f"{where}: the filter turns {value} into {got}")
+            errors = recorded(probe, "ErrorEvent")
+            probe.Update()
+            check(any(name in e for e in errors),
+                  f"{where}: {value}, outside the domain, is not refused by name: {errors}")
 check(found == EXPECTED, f"properties {sorted(found)}, expected {sorted(EXPECTED)}")
 
 # --- The first Apply ----------------------------------------------------------------------

@@ -239,17 +239,38 @@ std::vector<Row> rows()
       Outcome::Error,
       "the Scene has 200000 cells on 100002 points: taking them for remeshing needs an estimated",
       2 },
-    // Clamped to one path, fewer than the light positions: reuse refuses it.
-    { "PathsZeroIsClampedToOne", [](Case& c) { c.filter->SetNumberOfPaths(0); }, Outcome::Error,
-      "give at least", 10, [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 1); } },
-    { "PathsTwoToThe62IsClampedAndAbortable",
+    // Out-of-range numbers are kept as given and refused by name before anything is solved.
+    { "PathsZeroIsRefusedByName", [](Case& c) { c.filter->SetNumberOfPaths(0); }, Outcome::Error,
+      "NumberOfPaths is 0: give paths per frame from 1", 10,
+      [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 0); } },
+    { "PathsTwoToThe62AreRefusedByName",
+      [](Case& c) { c.filter->SetNumberOfPaths(vtkIdType(1) << 62); }, Outcome::Error,
+      "NumberOfPaths is 4611686018427387904: give" },
+    { "PathsAtTheMaximumAreAbortable",
       [](Case& c)
       {
-        c.filter->SetNumberOfPaths(vtkIdType(1) << 62);
-        c.abortAfter = 0.3; // the clamped 10^11 paths would take days
+        c.filter->SetNumberOfPaths(100000000000LL);
+        c.abortAfter = 0.3; // 10^11 paths would take days
       },
-      Outcome::Error, "aborted", 10,
-      [](Case& c) { EXPECT_EQ(c.filter->GetNumberOfPaths(), 100000000000LL); } },
+      Outcome::Error, "aborted", 10 },
+    { "NegativeSeedIsRefusedByName", [](Case& c) { c.filter->SetSeed(-1); }, Outcome::Error,
+      "Seed is -1: give 0 or a positive integer" },
+    { "NoPositionIsRefusedByName",
+      [](Case& c)
+      {
+        c.setup.trajectory = nullptr;
+        c.filter->SetNumberOfPositions(0);
+      },
+      Outcome::Error, "NumberOfPositions is 0: give 1 to 100000" },
+    { "NaNPatchSizeIsRefusedByName",
+      [](Case& c) { c.filter->SetPatchSize(std::numeric_limits<double>::quiet_NaN()); },
+      Outcome::Error, "PatchSize is nan: give 0" },
+    { "WideSpotIsRefusedByName", [](Case& c) { c.filter->SetSpotHalfAngle(200); }, Outcome::Error,
+      "SpotHalfAngle is 200: give 0 (no spot) up to 180 degrees" },
+    { "NegativeExposureBeyondTheRangeIsRefusedByName", [](Case& c) { c.filter->SetExposure(-21); },
+      Outcome::Error, "Exposure is -21: give -20 to 20 EV" },
+    { "NegativeFluxIsRefusedByName", [](Case& c) { c.filter->SetLightFluxLumens(-800); },
+      Outcome::Error, "LightFluxLumens is -800: give 0" },
     { "AbortMidSolve",
       [](Case& c)
       {
