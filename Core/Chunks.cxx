@@ -529,6 +529,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   const std::size_t ranks = overRanks ? static_cast<std::size_t>(options.ranks) : 1;
   const std::size_t rank = overRanks ? static_cast<std::size_t>(options.rank) : 0;
   SolverOptions chunkOptions = options;
+  // The chunks' results are blended and handed on as stored: in the whole rig's unit.
+  chunkOptions.storageScale = storageScaleFor(scene, rig);
   if (overRanks)
   {
     chunkOptions.ranks = 1;
@@ -768,7 +770,10 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
     throw Error("chunk " + std::to_string(chunk) + " of an animation in " +
       std::to_string(plan.chunks.size()) + " chunks");
   }
-  // The chunk before, for its estimate of the seam between them; then this chunk.
+  // The chunk before, for its estimate of the seam between them; then this chunk, in the unit
+  // of the first solve (solveInChunks).
+  SolverOptions chunkOptions = options;
+  chunkOptions.storageScale = storageScaleFor(scene, rig);
   const std::size_t first = chunk > 0 ? chunk - 1 : chunk;
   std::optional<Solution> seam;
   for (std::size_t k = first; k <= chunk; ++k)
@@ -782,7 +787,7 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
       part = [&progress, base, share](double f) { return progress(base + share * f); };
     }
     Solution current =
-      solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin), options, part);
+      solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin), chunkOptions, part);
     if (k < chunk)
     {
       const std::size_t seamFirst = plan.finishedEnd(k);

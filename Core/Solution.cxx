@@ -20,13 +20,14 @@ Solution::Solution(std::size_t frames, std::size_t elements, std::size_t patches
 {
 }
 
-double Solution::storageScaleFor(double totalArea)
+double Solution::storageScaleFor(double totalArea, double power)
 {
   if (!(totalArea > 0) || !std::isfinite(totalArea))
   {
     return 1;
   }
-  return std::ldexp(1.0, -static_cast<int>(std::lround(std::log2(totalArea))));
+  const double watts = power > 0 && std::isfinite(power) ? power : 1.0;
+  return std::ldexp(1.0, static_cast<int>(std::lround(std::log2(watts) - std::log2(totalArea))));
 }
 
 void Solution::clearRadiosity()

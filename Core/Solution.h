@@ -229,15 +229,17 @@ public:
   // per RGB; see MemoryPlan), divided by storageScale().
   /**
    * The unit of the stored values, a power of two (so that scaling is exact): a value is
-   * stored as load() / storageScale(). The solver sets it to the inverse of the scene's area
-   * (storageScaleFor), so that any scene in any unit stores its irradiance as about its
-   * lights' power, in the middle of PackedRgb's range of 2^-62 to 2^64. Results of one scene
-   * share it, so blends and sums of stored values need no scaling.
+   * stored as load() / storageScale(). The solver sets it to about the scene's mean
+   * irradiance, its lights' power over its area (storageScaleFor), so that any scene in any
+   * unit and of any power stores its irradiance as about 1, in the middle of PackedRgb's
+   * range of 2^-62 to 2^64. Results of one scene share it, so blends and sums of stored
+   * values need no scaling.
    */
   double storageScale() const { return this->Scale; }
   void setStorageScale(double scale) { this->Scale = scale; }
-  /// 2^-round(log2(area)), or 1 for an area that is not positive and finite.
-  static double storageScaleFor(double totalArea);
+  /// 2^round(log2(power / area)); the area alone for a power that is not positive and
+  /// finite (lights all off), and 1 for an area that is not.
+  static double storageScaleFor(double totalArea, double power);
   Rgb load(const PackedRgb& stored) const { return Rgb(stored) * this->Scale; }
   PackedRgb store(const Rgb& value) const { return PackedRgb(value / this->Scale); }
   /// Adds `value` (W/m^2) to a stored value, rounded once.

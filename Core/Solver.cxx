@@ -99,6 +99,29 @@ double predictedSpeedup(
   return (n * (1.0 + walk) + gatheringRatio * n) / (n + walk + gatheringRatio);
 }
 
+namespace
+{
+double storageScaleOf(const Scene& scene, const std::vector<LightSource>& sources)
+{
+  double power = 0;
+  for (const LightSource& source : sources)
+  {
+    double brightest = 0;
+    for (std::size_t k = 0; k < source.positions(); ++k)
+    {
+      brightest = std::max(brightest, (source.power() * source.factor(k)).maxComponent());
+    }
+    power += brightest;
+  }
+  return Solution::storageScaleFor(scene.totalArea(), power);
+}
+} // namespace
+
+double storageScaleFor(const Scene& scene, const LightRig& rig)
+{
+  return storageScaleOf(scene, lightSources(scene, rig, sceneEmitters(scene)));
+}
+
 void validateOptions(const SolverOptions& options)
 {
   if (options.pathsPerFrame == 0)
@@ -130,6 +153,10 @@ void validateOptions(const SolverOptions& options)
   {
     throw Error("the gathering ratio k times the paths per frame is over the maximum of " +
       std::to_string(MaximumPathsPerFrame) + " rays per frame");
+  }
+  if (!(options.storageScale >= 0) || !std::isfinite(options.storageScale))
+  {
+    throw Error("the storage scale must be 0 (from the scene and its lights) or positive");
   }
   if (options.framesPerChunk == 1)
   {
@@ -201,7 +228,8 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       }
       tracerStorage.emplace(scene);
       solution = Solution(frames, scene.elementCount(), scene.patchCount());
-      solution.setStorageScale(Solution::storageScaleFor(scene.totalArea()));
+      solution.setStorageScale(
+        options.storageScale > 0 ? options.storageScale : storageScaleOf(scene, sources));
       for (std::size_t e = 0; e < scene.elementCount(); ++e)
       {
         solution.reflectanceData()[e] = scene.elementReflectance(e);

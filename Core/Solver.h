@@ -39,6 +39,13 @@ using ProgressCallback = std::function<bool(double fraction)>;
 Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   const ProgressCallback& progress = {});
 
+/**
+ * The unit a solve of `rig` stores its results in (Solution::storageScale): the scene's mean
+ * irradiance were its lights all at their brightest (every light's largest power over its
+ * positions, the scene's emitters included, over the scene's area), as a power of two.
+ */
+double storageScaleFor(const Scene& scene, const LightRig& rig);
+
 /// The same for one area light (and the scene's emitters).
 Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions& options,
   const ProgressCallback& progress = {});

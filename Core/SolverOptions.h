@@ -53,6 +53,10 @@ struct SolverOptions
   /// The round count then depends on the machine's speed: the result is no longer
   /// reproducible.
   double timeLimitSeconds = 0;
+  /// The unit the results are stored in (Solution::storageScale), a power of two; 0 takes
+  /// it from the scene and the rig solved (storageScaleFor). Solves whose results are
+  /// blended, as the chunks of one animation, set the one of the whole rig.
+  double storageScale = 0;
 
   /// A solve shared by `ranks` processes (MPI ranks of pvbatch or pvserver), this one being
   /// `rank`. Every rank gives the same scene, rig and options; each traces a disjoint share
@@ -102,8 +106,8 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
     reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, errorBatches,
-    targetRelativeError, timeLimitSeconds, rank, ranks, sumAcrossRanks, sumDoublesAcrossRanks,
-    log] = options;
+    targetRelativeError, timeLimitSeconds, storageScale, rank, ranks, sumAcrossRanks,
+    sumDoublesAcrossRanks, log] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -123,6 +127,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   // The ranks stop together (the first to run out of time stops all), so they must agree on
   // the limit.
   visit("timeLimitSeconds", timeLimitSeconds, OptionRole::Result);
+  visit("storageScale", storageScale, OptionRole::Result);
   visit("rank", rank, OptionRole::PerRank);
   visit("ranks", ranks, OptionRole::Result);
   visit("sumAcrossRanks", sumAcrossRanks, OptionRole::Hook);

@@ -130,8 +130,10 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
   if (!(r.stepMinutes > 0) || !std::isfinite(r.stepMinutes) ||
     (r.endHour - r.startHour) * 60 / r.stepMinutes > 100000)
   {
-    throw Error("the step is " + std::to_string(r.stepMinutes) +
-      " minutes: give a positive step that makes at most 100000 frames");
+    std::ostringstream s;
+    s << "the step is " << r.stepMinutes
+      << " minutes: give a positive step that makes at most 100000 frames";
+    throw Error(s.str());
   }
   if (!(std::abs(r.timeZoneHours) <= 14))
   {

@@ -181,6 +181,27 @@ vtkDataArray* pointArray(vtkPointSet* data, const char* name, int components, in
   return numbers;
 }
 
+/// Refuses a MaterialId array of floating-point values that are not whole numbers, rather than
+/// rounding them to some material.
+void checkWholeMaterialIds(vtkDataArray* ids)
+{
+  if (ids->GetDataType() != VTK_FLOAT && ids->GetDataType() != VTK_DOUBLE)
+  {
+    return;
+  }
+  for (vtkIdType cell = 0; cell < ids->GetNumberOfTuples(); ++cell)
+  {
+    const double id = ids->GetComponent(cell, 0);
+    if (id != std::floor(id))
+    {
+      std::ostringstream s;
+      s << "the Scene's cell array MaterialId holds " << id << " (cell " << cell
+        << "): give whole numbers, each an index into the field data MaterialNames";
+      throw Error(s.str());
+    }
+  }
+}
+
 /// The Scene's cell array MaterialId (one integer per cell), or nullptr.
 vtkDataArray* materialIdArray(vtkPolyData* scene)
 {
@@ -190,6 +211,7 @@ vtkDataArray* materialIdArray(vtkPolyData* scene)
   {
     return nullptr;
   }
+  checkWholeMaterialIds(ids);
   return ids;
 }
 
@@ -285,6 +307,7 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
     auto* ids = vtkDataArray::SafeDownCast(surface->GetCellData()->GetAbstractArray("MaterialId"));
     if (names && ids)
     {
+      checkWholeMaterialIds(ids);
       // A copy, so that the block's own arrays stay as they are.
       auto renumbered = vtkSmartPointer<vtkPolyData>::New();
       renumbered->ShallowCopy(surface);
@@ -733,19 +756,22 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
 
   Trajectory result;
   std::size_t frames = 0;
+  std::size_t firstMoving = 0;
   for (std::size_t l = 0; l < perLight.size(); ++l)
   {
     const std::size_t count = perLight[l].size();
     if (count > 1 && frames == 0)
     {
       frames = count;
+      firstMoving = l;
       result.times = timesOf(trajectory, perLight[l]);
       perFrameArrays(trajectory, perLight[l], result);
     }
     else if (count > 1 && count != frames)
     {
       throw Error("polyline " + std::to_string(l) + " of the Trajectory has " +
-        std::to_string(count) + " points but polyline 0 has " + std::to_string(frames) +
+        std::to_string(count) + " points but polyline " + std::to_string(firstMoving) + " has " +
+        std::to_string(frames) +
         ": every moving light needs one point per frame (one point: a light that does not move)");
     }
     result.lights.push_back(poseInputsOf(trajectory, perLight[l]));
@@ -780,11 +806,24 @@ std::size_t frameAtOrBelow(const std::vector<double>& times, double time)
   {
     return 0;
   }
-  // Requests that differ from a step only by rounding (e.g. a time keeper's arithmetic) still
-  // land on that step.
-  const double tolerance = 1e-9 * std::max(1.0, std::abs(times.back() - times.front()));
-  const auto above = std::upper_bound(times.begin(), times.end(), time + tolerance);
-  return above == times.begin() ? 0 : static_cast<std::size_t>(above - times.begin()) - 1;
+  const auto above = std::upper_bound(times.begin(), times.end(), time);
+  const std::size_t next = static_cast<std::size_t>(above - times.begin());
+  if (next < times.size())
+  {
+    // A request a rounding below a step lands on it: a time keeper's arithmetic, or a step
+    // given in single precision (a float Time array's 0.2 is 0.2000000030) asked for as
+    // written. The rounding is a few float steps of the time, or of the range near 0, and
+    // never a quarter of the way to the step before.
+    const double range = std::max(1.0, std::abs(times.back() - times.front()));
+    const double rounding =
+      0x1.0p-20 * std::max(std::abs(times[next]), std::abs(time)) + 1e-9 * range;
+    const double gap = next > 0 ? times[next] - times[next - 1] : rounding;
+    if (times[next] - time <= std::min(rounding, 0.25 * gap))
+    {
+      return next;
+    }
+  }
+  return next == 0 ? 0 : next - 1;
 }
 
 } // namespace mlr::vtkinputs

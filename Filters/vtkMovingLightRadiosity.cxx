@@ -481,8 +481,25 @@ mlr::vtkinputs::Trajectory trajectoryOf(
       return mlr::vtkinputs::straightTrajectory(
         { start[0], start[1], start[2] }, { start[0], start[1], start[2] }, 1);
     }
-    return mlr::vtkinputs::straightTrajectory(
+    mlr::vtkinputs::Trajectory line = mlr::vtkinputs::straightTrajectory(
       { start[0], start[1], start[2] }, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
+    if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
+    {
+      for (std::size_t k = 0; k < line.lights[0].size(); ++k)
+      {
+        if (!(mlr::length(line.lights[0][k].position) > 0))
+        {
+          throw mlr::Error("LightType Directional without a Trajectory takes its directions "
+                           "towards the sun from PathStart to PathEnd, and frame " +
+            std::to_string(k) +
+            "'s is zero or not a number: give PathStart and PathEnd as directions (e.g. 1, 0, 1 "
+            "and -1, 0, 1: "
+            "the sun from +x to -x at 45 degrees), or connect a Trajectory of directions, as "
+            "the Sun Path source gives");
+        }
+      }
+    }
+    return line;
   }
   return mlr::vtkinputs::trajectoryFromPoints(vtkPointSet::GetData(trajectoryInput, 0), lights);
 }

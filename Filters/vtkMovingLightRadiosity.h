@@ -59,7 +59,8 @@
  *   along creases (lit-side normals more than 30 degrees apart), between materials and
  *   between the lit sides of thin walls, and carry `Radiosity` (area-weighted mean of the
  *   cells around the point), `Color` (its display colour) and `ScenePointId` (the remeshed
- *   scene's point it was split from, the numbering of the Patches output). Cells and
+ *   scene's point it was split from: below the Patches output's point count, that point of
+ *   the Patches; above, the midpoint of a patch edge, which only elements have). Cells and
  *   points also carry `Irradiance` (3 components, W/m^2: the light arriving on the lit
  *   side, direct and indirect, the surface's own emission excluded, so that black surfaces
  *   have it too; at points averaged as `Radiosity`) and `Illuminance` (1 component, lx:
@@ -99,7 +100,9 @@
  * are served from it without solving again, until an input or a property other than
  * Exposure changes. A time between two steps shows the step at or below it. All the outputs
  * show the time requested on the port being updated. The filter's time is not passed
- * upstream: the inputs are used as they are.
+ * upstream: the inputs are used as they are. The outputs share their unchanging arrays
+ * (points, cells, `Reflectance`, ...) with the kept result: edit a DeepCopy of an output,
+ * not the output itself, or the other time steps show the edit.
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with

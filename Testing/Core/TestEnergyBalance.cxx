@@ -100,3 +100,36 @@ TEST(EnergyBalance, WithoutGatheringPatchSolutionStillBalances)
     EXPECT_NEAR(balanceOfFrame(scene, solution, f).radiantPower.g, 1.0, 0.01);
   }
 }
+
+TEST(EnergyBalance, AnyPowerBalancesInAnyUnit)
+{
+  // The results are stored in 16-bit floats of range 2^-62 to 2^64 (PackedRgb), in a unit
+  // taken from the lights' power over the scene's area: a light of 10^24 W in a box of
+  // 10^-6 units (irradiance 10^36) or of 10^-24 W in a box of 10^6 units (10^-36) stays in
+  // range, and with batches too, whose single batches have the noisiest elements.
+  for (const auto& [watts, size] : { std::pair{ 1e24, 1e-6 }, std::pair{ 1e-24, 1e6 } })
+  {
+    PatchMesh box = scenes::closedBox(5, true, { Rgb(0.5) });
+    for (Vec3& p : box.points)
+    {
+      p = p * size;
+    }
+    const Scene scene = Scene::fromPatchMesh(box);
+    std::vector<Vec3> path = boxTrajectory(2);
+    for (Vec3& p : path)
+    {
+      p = p * size;
+    }
+    const MovingLight light(
+      scenes::squareLightFacingDown(Vec3{ 0.5, 0.5, 0.9 } * size, 0.2 * size), Rgb(watts), path);
+    SolverOptions options;
+    options.pathsPerFrame = 300000;
+    options.errorBatches = 16;
+    const Solution solution = solve(scene, light, options);
+    for (std::size_t f = 0; f < 2; ++f)
+    {
+      EXPECT_NEAR(balanceOfFrame(scene, solution, f).absorbed.g / watts, 1.0, 0.01)
+        << watts << " W, frame " << f;
+    }
+  }
+}

@@ -42,6 +42,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.framesPerChunk = 8;
   else if (name == "timeLimitSeconds")
     options.timeLimitSeconds = 60;
+  else if (name == "storageScale")
+    options.storageScale = 0.25;
   else if (name == "log")
     options.log = [](const std::string&) {};
   else if (name == "rank")
@@ -73,7 +75,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 19u);
+  EXPECT_EQ(names.size(), 20u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

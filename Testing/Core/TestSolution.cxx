@@ -105,28 +105,35 @@ TEST(Solution, LitSidesDoNotDependOnTheWorkers)
 
 TEST(Solution, StoredResultsKeepTheirPrecisionInAnyUnit)
 {
-  // A room of 100 m^2 in metres, in micrometres and at the coordinate bound's scale: its
-  // irradiance ranges over 40 decades, beyond PackedRgb's 37, and is stored as irradiance
-  // times the area, the lights' power.
+  // A room of 100 m^2 in metres, in micrometres and at the coordinate bound's scale, lit by
+  // lights of 10^-20 W to 10^20 W: its irradiance ranges over 80 decades, beyond PackedRgb's
+  // 37, and is stored as a multiple of the mean irradiance, lights' power over area, with
+  // room for peaks of 10^15 times it and dim corners of 10^-15.
   for (const double metre : { 1.0, 1e6, 1e13 })
   {
-    const double area = 100 * metre * metre;
-    const double scale = Solution::storageScaleFor(area);
-    int exponent = 0;
-    EXPECT_EQ(std::frexp(scale, &exponent), 0.5) << "a power of two";
-    EXPECT_GT(scale * area, 0.7);
-    EXPECT_LT(scale * area, 1.5);
-    Solution solution(1, 4, 1);
-    solution.setStorageScale(scale);
-    for (const double watts : { 1e-3, 1.0, 1e5 })
+    for (const double power : { 1e-20, 1.0, 1e20 })
     {
-      const double irradiance = watts / area;
-      const Rgb back = solution.load(solution.store(Rgb(irradiance, 0.5 * irradiance, 0)));
-      EXPECT_NEAR(back.r, irradiance, PackedRgb::RelativeRounding * irradiance) << area;
-      EXPECT_NEAR(back.g, 0.5 * irradiance, PackedRgb::RelativeRounding * irradiance) << area;
-      EXPECT_EQ(back.b, 0.0);
+      const double area = 100 * metre * metre;
+      const double scale = Solution::storageScaleFor(area, power);
+      int exponent = 0;
+      EXPECT_EQ(std::frexp(scale, &exponent), 0.5) << "a power of two";
+      const double mean = power / area;
+      EXPECT_GT(mean / scale, 0.7);
+      EXPECT_LT(mean / scale, 1.5);
+      Solution solution(1, 4, 1);
+      solution.setStorageScale(scale);
+      for (const double share : { 1e-15, 1.0, 1e15 })
+      {
+        const double irradiance = share * mean;
+        const Rgb back = solution.load(solution.store(Rgb(irradiance, 0.5 * irradiance, 0)));
+        EXPECT_NEAR(back.r, irradiance, PackedRgb::RelativeRounding * irradiance) << area;
+        EXPECT_NEAR(back.g, 0.5 * irradiance, PackedRgb::RelativeRounding * irradiance) << area;
+        EXPECT_EQ(back.b, 0.0);
+      }
     }
   }
-  EXPECT_EQ(Solution::storageScaleFor(0), 1.0);
-  EXPECT_EQ(Solution::storageScaleFor(std::nan("")), 1.0);
+  // Lights all off: the area alone; no area: 1.
+  EXPECT_EQ(Solution::storageScaleFor(4, 0), 0.25);
+  EXPECT_EQ(Solution::storageScaleFor(0, 1), 1.0);
+  EXPECT_EQ(Solution::storageScaleFor(std::nan(""), 1), 1.0);
 }

@@ -154,6 +154,9 @@ TEST(SunPath, BadRequestsSayWhatToFix)
   r = SunPathRequest();
   r.stepMinutes = 0;
   expectError([&] { sunPath(r); }, "step");
+  // A positive step too small for the frame limit is shown as given, not as 0.000000.
+  r.stepMinutes = 1e-9;
+  expectError([&] { sunPath(r); }, "the step is 1e-09 minutes");
   r = SunPathRequest();
   r.north = { 0, 0, 1 };
   expectError([&] { sunPath(r); }, "north");

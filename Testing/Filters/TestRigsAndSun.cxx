@@ -532,6 +532,24 @@ TEST(FilterRigs, MovingLightsWithDifferentPointCountsAreAnError)
   setup.trajectory = polylines({ { { 0.25, 0.3, 0.9 }, { 0.5, 0.5, 0.9 }, { 0.75, 0.7, 0.9 } },
     { { 0.7, 0.3, 0.7 }, { 0.3, 0.3, 0.7 } } });
   expectError(boxFilter(setup), "polyline 1 of the Trajectory has 2 points but polyline 0 has 3");
+  // The count compared with is the first moving light's: light 0 here does not move.
+  std::vector<std::vector<Vec3>> polygons;
+  vtkNew<vtkIntArray> ids;
+  ids->SetName("LightId");
+  for (int l = 0; l < 3; ++l)
+  {
+    for (const auto& polygon : scenes::squareLightFacingDown({ 0.5, 0.5, 0.9 - 0.2 * l }, 0.2))
+    {
+      polygons.push_back(polygon);
+      ids->InsertNextValue(l);
+    }
+  }
+  setup.light = lightPolyData(polygons);
+  setup.light->GetCellData()->AddArray(ids);
+  setup.trajectory = polylines(
+    { { { 0.5, 0.5, 0.9 } }, { { 0.25, 0.3, 0.7 }, { 0.5, 0.5, 0.7 }, { 0.75, 0.7, 0.7 } },
+      { { 0.2, 0.3, 0.5 }, { 0.4, 0.3, 0.5 }, { 0.6, 0.3, 0.5 }, { 0.8, 0.3, 0.5 } } });
+  expectError(boxFilter(setup), "polyline 2 of the Trajectory has 4 points but polyline 1 has 3");
 }
 
 // ------------------------------------------------------------------------ Scene emission
@@ -1016,9 +1034,13 @@ TEST(FilterSun, WithoutTrajectoryTheDirectionGoesFromPathStartToPathEnd)
   ASSERT_TRUE(filter->UpdateTimeStep(2));
   EXPECT_NEAR(filter->GetOutput()->GetFieldData()->GetArray("SunDirection")->GetComponent(0, 0),
     std::sqrt(0.5), 1e-12);
-  // The defaults start at the origin, which is no direction: an error, not a crash.
+  // The defaults start at the origin, which is no direction: an error naming PathStart and
+  // PathEnd, not a crash; opposite directions pass through zero half-way.
   filter->SetPathStart(0, 0, 0);
-  expectError(filter, "direction 0 towards the light is (0, 0, 0)");
+  expectError(filter, "from PathStart to PathEnd, and frame 0's is zero or not a number");
+  filter->SetPathStart(1, 0, 1);
+  filter->SetPathEnd(-1, 0, -1);
+  expectError(filter, "frame 1's is zero");
 }
 
 TEST(FilterSun, NoSurfaceFacingTheSunIsDarkWithAWarning)

@@ -4,10 +4,12 @@
 #include "vtkCallbackCommand.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkFloatArray.h"
 #include "vtkInformation.h"
 #include "vtkMovingLightRadiosity.h"
 #include "vtkNew.h"
 #include "vtkPlaneSource.h"
+#include "vtkPointData.h"
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
@@ -154,6 +156,39 @@ TEST(FilterTime, TimesBetweenStepsShowTheStepAtOrBelow)
     vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectoryPolyData(setup.positions, { 1, 2, 4 }));
   const std::vector<std::pair<double, double>> cases = { { 3.9, 2 }, { 4.5, 4 }, { 0.0, 1 },
     { 2.0, 2 }, { 2.0 - 1e-12, 2 } };
+  for (const auto& [requested, shown] : cases)
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(requested));
+    EXPECT_EQ(dataTime(filter->GetOutput()), shown) << "requested " << requested;
+  }
+}
+
+TEST(FilterTime, StepsAskedForAsWrittenShowThatStep)
+{
+  // A Time array in single precision holds 0.1 as 0.10000000149: asked for 0.1, 0.2 and 0.3
+  // as written, the steps show, not the steps before them.
+  BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  vtkSmartPointer<vtkPolyData> trajectory = trajectoryPolyData(setup.positions);
+  vtkNew<vtkFloatArray> time;
+  time->SetName("Time");
+  for (const float t : { 0.1f, 0.2f, 0.3f })
+  {
+    time->InsertNextValue(t);
+  }
+  trajectory->GetPointData()->AddArray(time);
+  filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT, trajectory);
+  for (const double written : { 0.1, 0.2, 0.3 })
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(written));
+    EXPECT_EQ(dataTime(filter->GetOutput()), static_cast<float>(written)) << written;
+  }
+  // Steps closer than any rounding: each shows itself, and a request between them the one
+  // at or below.
+  filter->SetInputData(vtkMovingLightRadiosity::TRAJECTORY_PORT,
+    trajectoryPolyData(setup.positions, { 10.0, 10.0000001, 1000.0 }));
+  const std::vector<std::pair<double, double>> cases = { { 10.0, 10.0 }, { 10.0000001, 10.0000001 },
+    { 10.00000005, 10.0 }, { 999.9999999, 1000.0 } };
   for (const auto& [requested, shown] : cases)
   {
     ASSERT_TRUE(filter->UpdateTimeStep(requested));

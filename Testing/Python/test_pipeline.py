@@ -325,6 +325,31 @@ def test_a_light_material_that_takes_the_whole_scene_is_an_error():
     assert any("LightMaterial 'lamp' takes every polygon of the Scene" in e for e in errors), errors
 
 
+def test_material_ids_that_are_not_whole_numbers_are_named():
+    # A float MaterialId of 0.5 is no material: refused, not rounded to one, alone or in a
+    # multiblock (whose blocks' materials are renumbered by name).
+    from vtkmodules.vtkCommonCore import vtkFloatArray
+    from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet
+    scene = material_block([((0, 0, 0), (2, 0, 0), (0, 2, 0), 0),
+                            ((0.8, 1.2, 1.5), (1.2, 1.2, 1.5), (0.8, 0.8, 1.5), 1)],
+                           ["floor", "lamp"])
+    ids = vtkFloatArray()
+    ids.SetName("MaterialId")
+    for value in (0, 0.5):
+        ids.InsertNextValue(value)
+    scene.GetCellData().AddArray(ids)
+    blocks = vtkMultiBlockDataSet()
+    blocks.SetBlock(0, scene)
+    for data in (scene, blocks):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(data)
+        radiosity.SetLightMaterial("lamp")
+        radiosity.SetNumberOfThreads(2)
+        errors = recorded(radiosity, "ErrorEvent")
+        assert not radiosity.UpdateTimeStep(0.0)
+        assert any("MaterialId holds 0.5 (cell 1): give whole numbers" in e for e in errors), errors
+
+
 def test_a_light_of_any_data_set_lights_as_its_polygons():
     # A Plane made an unstructured grid (as Clip or Threshold give it) is the same light.
     from vtkmodules.vtkFiltersCore import vtkAppendFilter as Append
