@@ -328,7 +328,7 @@ void summariseErrors(Solution& s, const ErrorEstimateSummary& like)
   for (std::size_t f = 0; f < s.frameCount(); ++f)
   {
     const FrameError e = frameError(
-      s, f, [&](std::size_t element, Side side) { return s.radiosityStdError(f, element, side); });
+      s, f, [&](std::size_t element, Side side) { return s.irradianceStdError(f, element, side); });
     summary.relativeErrorMedian.push_back(e.median);
     summary.relativeErrorP95.push_back(e.p95);
     summary.litElements.push_back(e.litElements);

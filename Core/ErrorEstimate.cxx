@@ -194,11 +194,11 @@ public:
       std::sqrt(std::max(0.0, m2.b * scale)));
   }
 
-  /// The radiosity's standard error of an element side in a frame.
-  Rgb radiosityStdError(std::size_t frame, std::size_t element, Side side) const
+  /// The irradiance's standard error of an element side in a frame.
+  Rgb irradianceStdError(std::size_t frame, std::size_t element, Side side) const
   {
-    return this->Result.reflectanceData()[element] *
-      this->stdError(this->Result.elementIndex(frame, element, side)) * this->Result.storageScale();
+    return this->stdError(this->Result.elementIndex(frame, element, side)) *
+      this->Result.storageScale();
   }
 
 private:
@@ -291,7 +291,7 @@ std::pair<double, std::size_t> worstFrame(const Solution& result, const BatchSpr
   for (std::size_t f = 0; f < result.frameCount(); ++f)
   {
     const FrameError e = frameError(result, f,
-      [&](std::size_t element, Side side) { return spread.radiosityStdError(f, element, side); });
+      [&](std::size_t element, Side side) { return spread.irradianceStdError(f, element, side); });
     if (e.p95 > worst.first)
     {
       worst = { e.p95, f };
@@ -411,10 +411,10 @@ FrameError frameError(const Solution& solution, std::size_t frame,
   double sum = 0;
   for (std::size_t e = 0; e < elements; ++e)
   {
-    // The light the element reflects, without its own emission: the emission is exact, so
-    // counting it would call an emitter lit and accurate whatever light reaches it.
-    const Side side = solution.litSide(e);
-    totals[e] = (solution.direct(frame, e, side) + solution.indirect(frame, e, side)).sum();
+    // The light arriving, not the radiosity: black surfaces have illuminance to judge too, and
+    // an emitter's own emission, which is exact, would call it lit and accurate whatever light
+    // reaches it. Where rho_e > 0 the relative error is the reflected radiosity's.
+    totals[e] = solution.irradiance(frame, e, solution.litSide(e)).sum();
     sum += totals[e];
   }
   const double threshold =
@@ -590,7 +590,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
   for (std::size_t f = 0; f < result.frameCount(); ++f)
   {
     const FrameError e = frameError(result, f,
-      [&](std::size_t element, Side side) { return result.radiosityStdError(f, element, side); });
+      [&](std::size_t element, Side side) { return result.irradianceStdError(f, element, side); });
     summary.relativeErrorMedian.push_back(e.median);
     summary.relativeErrorP95.push_back(e.p95);
     summary.litElements.push_back(e.litElements);

@@ -15,9 +15,9 @@
 namespace mlr
 {
 
-/// An element is lit in a frame when the radiosity it reflects there (lit side, sum over
-/// channels, its own emission left out) is above this fraction of the frame's mean over all
-/// elements: the relative error statistics and the target are over the lit elements only.
+/// An element is lit in a frame when its irradiance there (lit side, sum over channels) is
+/// above this fraction of the frame's mean over all elements: the relative error statistics
+/// and the target are over the lit elements only.
 constexpr double LitFractionOfMean = 0.01;
 
 /// The factor by which a round multiplies the batch count, from (p95 / target)^2, is kept in
@@ -68,10 +68,11 @@ struct FrameError
 };
 
 /**
- * The relative error of frame `frame` over its lit elements. An element's relative error is
- * the sum over channels of its radiosity's standard error (`stdError`, on its lit side) over
- * the sum over channels of the radiosity it reflects (its radiosity less its emission, which
- * has no error).
+ * The relative error of frame `frame` over its lit elements, those whose irradiance is over
+ * LitFractionOfMean of the frame's mean. An element's relative error is the sum over
+ * channels of its irradiance's standard error (`stdError`, on its lit side) over the sum over
+ * channels of its irradiance: where the element reflects, that of the radiosity it reflects
+ * (its radiosity less its emission, which has no error), and black elements count too.
  */
 FrameError frameError(const Solution& solution, std::size_t frame,
   const std::function<Rgb(std::size_t element, Side side)>& stdError);

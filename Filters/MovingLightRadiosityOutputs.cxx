@@ -71,13 +71,15 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
   // coordinates, a ScenePointId and an inverse area, and 3 corner ids per element. Per
   // frame: Radiosity, Direct, Indirect, Front, Back and Irradiance (3 floats each),
   // Illuminance (a float) and Color (3 bytes) per element, point Radiosity, Irradiance,
-  // Illuminance and Color, and the patches' Radiosity; RadiosityStdError (3 floats) on cells
-  // and points, counted whether or not the solve estimates its error.
+  // Illuminance and Color, and the patches' Radiosity; RadiosityStdError and
+  // IrradianceStdError (3 floats) and IlluminanceStdError (a float) on cells and points,
+  // counted whether or not the solve estimates its error.
   const std::uint64_t e = elements, p = points;
   const std::uint64_t split = p + e / 4;
   const std::uint64_t meshes =
     p * 24 + split * (24 + 4 + 8) + e * (32 + 12 + 8 + 24) + e / 4 * (32 + 12);
-  const std::uint64_t frame = e * (7 * 12 + 4 + 3) + split * (12 + 12 + 12 + 4 + 3) + e / 4 * 12;
+  const std::uint64_t frame =
+    e * (8 * 12 + 4 + 4 + 3) + split * (12 + 12 + 12 + 12 + 4 + 4 + 3) + e / 4 * 12;
   return meshes + frame;
 }
 
@@ -132,28 +134,45 @@ void addElementRadiosity(
 }
 
 void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  vtkPointData* pointData, vtkCellData* cellData)
+  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData)
 {
   if (!solution.hasErrorEstimate())
   {
     return;
   }
   const std::size_t n = solution.elementCount();
-  std::vector<Rgb> stdError(n);
-  auto cells = rgbArray("RadiosityStdError", n);
+  std::vector<Rgb> radiosity(n), irradiance(n);
   for (std::size_t e = 0; e < n; ++e)
   {
-    stdError[e] = solution.radiosityStdError(frame, e, solution.litSide(e));
-    setRgb(cells, e, stdError[e]);
+    const Side lit = solution.litSide(e);
+    radiosity[e] = solution.radiosityStdError(frame, e, lit);
+    irradiance[e] = solution.irradianceStdError(frame, e, lit);
   }
-  const std::vector<Rgb> atPoints = pointMeans(shading, stdError);
-  auto points = rgbArray("RadiosityStdError", atPoints.size());
-  for (std::size_t p = 0; p < atPoints.size(); ++p)
+  auto add = [&](const std::vector<Rgb>& radiosityValues, const std::vector<Rgb>& irradianceValues,
+               vtkDataSetAttributes* data)
   {
-    setRgb(points, p, atPoints[p]);
-  }
-  cellData->AddArray(cells);
-  pointData->AddArray(points);
+    const std::size_t count = radiosityValues.size();
+    auto radiosityArray = rgbArray("RadiosityStdError", count);
+    auto irradianceArray = rgbArray("IrradianceStdError", count);
+    vtkNew<vtkFloatArray> lux;
+    lux->SetName("IlluminanceStdError");
+    lux->SetNumberOfValues(static_cast<vtkIdType>(count));
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      setRgb(radiosityArray, i, radiosityValues[i]);
+      setRgb(irradianceArray, i, irradianceValues[i]);
+      // The channels' errors come from the same paths, so they move together: the luminance
+      // of the channels' errors is the error of the luminance when they are fully correlated,
+      // and bounds it otherwise.
+      lux->SetValue(static_cast<vtkIdType>(i),
+        static_cast<float>(luminousEfficacy * luminance(irradianceValues[i])));
+    }
+    data->AddArray(radiosityArray);
+    data->AddArray(irradianceArray);
+    data->AddArray(lux);
+  };
+  add(radiosity, irradiance, cellData);
+  add(pointMeans(shading, radiosity), pointMeans(shading, irradiance), pointData);
 }
 
 void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution)

@@ -67,12 +67,13 @@ void addElementRadiosity(
 
 struct SmoothShading;
 
-/// With an error estimate (Solution::hasErrorEstimate), adds `RadiosityStdError` (RGB,
-/// W/(scene unit)^2, the standard error of each element's lit-side Radiosity in `frame`) to the
-/// cells, and to the points as their area-weighted mean over the cells around each point (as
-/// point `Radiosity` is made); nothing without one.
+/// With an error estimate (Solution::hasErrorEstimate), adds the standard errors of each
+/// element's lit side in `frame`: `RadiosityStdError` and `IrradianceStdError` (RGB,
+/// W/(scene unit)^2) and `IlluminanceStdError` (`luminousEfficacy` times the luminance of
+/// `IrradianceStdError`) to the cells, and to the points as their area-weighted means over the
+/// cells around each point (as point `Radiosity` is made); nothing without one.
 void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  vtkPointData* pointData, vtkCellData* cellData);
+  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData);
 
 /// With an error estimate, adds to `fieldData` the per-frame arrays (one value per solved frame)
 /// `RelativeErrorMedian`, `RelativeErrorP95` and `LitElements`, and `ErrorBatches`,

@@ -564,7 +564,7 @@ RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t
       for (std::size_t f = 0; f < s.frameCount(); ++f)
       {
         const FrameError e = frameError(s, f,
-          [&](std::size_t element, Side side) { return s.radiosityStdError(f, element, side); });
+          [&](std::size_t element, Side side) { return s.irradianceStdError(f, element, side); });
         const std::size_t i = 3 * (b.first + f);
         figures[i] = e.median;
         figures[i + 1] = e.p95;

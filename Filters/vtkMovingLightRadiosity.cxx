@@ -896,8 +896,8 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
         output->GetCellData());
       mlr::vtkoutputs::addIrradianceArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
         output->GetPointData(), output->GetCellData());
-      mlr::vtkoutputs::addStdErrorArrays(
-        *frames, cache.Shading, solved, output->GetPointData(), output->GetCellData());
+      mlr::vtkoutputs::addStdErrorArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
+        output->GetPointData(), output->GetCellData());
       if (cut)
       {
         // Cut from the whole frame, so that the point arrays at the cut average over the

@@ -65,8 +65,10 @@
  *   side, direct and indirect, the surface's own emission excluded, so that black surfaces
  *   have it too; at points averaged as `Radiosity`) and `Illuminance` (1 component, lx:
  *   LuminousEfficacy times the luminance of `Irradiance`). With ErrorBatches above 1, cells
- *   and points carry `RadiosityStdError` (3 components, W/m^2: the standard error of
- *   `Radiosity`, at points averaged as `Radiosity`). `Color` is the active scalars of
+ *   and points carry the standard errors `RadiosityStdError` and `IrradianceStdError` (3
+ *   components, W/m^2, of `Radiosity` and `Irradiance`) and `IlluminanceStdError` (lx,
+ *   LuminousEfficacy times the luminance of `IrradianceStdError`), at points averaged as
+ *   `Radiosity`. `Color` is the active scalars of
  *   points and cells. Its field data holds the solver statistics (paths, rays by kind,
  *   seconds by phase, patches, elements, frames, reuse modes, predicted speed-up), the frame
  *   shown (`FrameIndex`), where the light is in it (`LightPosition`, its centroid, and

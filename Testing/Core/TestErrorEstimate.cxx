@@ -389,6 +389,23 @@ TEST(ErrorEstimate, FrameErrorLeavesTheEmissionOut)
   EXPECT_NEAR(fe.p95, 0.02, 0.02 * 2 * PackedRgb::RelativeRounding);
 }
 
+TEST(ErrorEstimate, BlackElementsAreJudgedByTheLightArrivingOnThem)
+{
+  // A black floor reflects nothing, but its illuminance is read as any other's: 10 black
+  // elements with a 10% error on their irradiance and 10 grey ones with 1%. Judged by the
+  // radiosity they reflect, the black ones would be dark and the frame's p95 1%.
+  Solution s(1, 20, 5);
+  for (std::size_t e = 0; e < 20; ++e)
+  {
+    s.reflectanceData()[e] = e < 10 ? Rgb(0.0) : Rgb(0.5);
+    s.directData()[s.elementIndex(0, e, Side::Front)] = PackedRgb(Rgb(1.0 / 3));
+  }
+  const FrameError fe =
+    frameError(s, 0, [](std::size_t e, Side) { return e < 10 ? Rgb(0.1 / 3) : Rgb(0.01 / 3); });
+  EXPECT_EQ(fe.litElements, 20u);
+  EXPECT_NEAR(fe.p95, 0.1, 0.1 * 2 * PackedRgb::RelativeRounding);
+}
+
 TEST(ErrorEstimate, MemoryEstimateCountsTheBatches)
 {
   const Scene scene = box();

@@ -74,6 +74,34 @@ TEST(FilterErrorEstimate, StandardErrorArraysOnCellsAndPointsAndPerFrameFieldDat
     pointMax = std::max(pointMax, points->GetComponent(p, 0));
   }
   EXPECT_LE(pointMax, cellMax * (1 + 1e-6));
+  // The same error in the light arriving: the radiosity's is rho times the irradiance's, and
+  // the illuminance's is K times the irradiance's luminance.
+  for (vtkDataSetAttributes* data : { static_cast<vtkDataSetAttributes*>(out->GetCellData()),
+         static_cast<vtkDataSetAttributes*>(out->GetPointData()) })
+  {
+    vtkDataArray* irradiance = data->GetArray("IrradianceStdError");
+    vtkDataArray* lux = data->GetArray("IlluminanceStdError");
+    ASSERT_NE(irradiance, nullptr);
+    ASSERT_NE(lux, nullptr);
+    EXPECT_EQ(irradiance->GetNumberOfComponents(), 3);
+    EXPECT_EQ(lux->GetNumberOfComponents(), 1);
+    EXPECT_EQ(lux->GetNumberOfTuples(), data->GetArray("RadiosityStdError")->GetNumberOfTuples());
+    for (vtkIdType i = 0; i < lux->GetNumberOfTuples(); ++i)
+    {
+      const double* e = irradiance->GetTuple3(i);
+      EXPECT_NEAR(lux->GetComponent(i, 0),
+        filter->GetLuminousEfficacy() * (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]),
+        1e-5 * lux->GetComponent(i, 0));
+    }
+  }
+  vtkDataArray* reflectance = out->GetCellData()->GetArray("Reflectance");
+  vtkDataArray* irradianceCells = out->GetCellData()->GetArray("IrradianceStdError");
+  for (vtkIdType c = 0; c < out->GetNumberOfCells(); ++c)
+  {
+    EXPECT_NEAR(cells->GetComponent(c, 1),
+      reflectance->GetComponent(c, 1) * irradianceCells->GetComponent(c, 1),
+      1e-5 * cells->GetComponent(c, 1));
+  }
 
   vtkFieldData* field = out->GetFieldData();
   vtkDataArray* median = field->GetArray("RelativeErrorMedian");
@@ -101,6 +129,7 @@ TEST(FilterErrorEstimate, OneBatchHasNoErrorArrays)
   vtkPolyData* out = filter->GetOutput(0);
   EXPECT_EQ(out->GetCellData()->GetArray("RadiosityStdError"), nullptr);
   EXPECT_EQ(out->GetPointData()->GetArray("RadiosityStdError"), nullptr);
+  EXPECT_EQ(out->GetCellData()->GetArray("IlluminanceStdError"), nullptr);
   EXPECT_EQ(out->GetFieldData()->GetArray("RelativeErrorP95"), nullptr);
 }
 
