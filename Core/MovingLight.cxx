@@ -197,6 +197,20 @@ void MovingLight::samplePoint(double u0, double u1, double u2, Vec3& point, Vec3
   normal = t.normal;
 }
 
+void MovingLight::samplePoint(double u, double v, Vec3& point, Vec3& normal) const
+{
+  const double target = u * this->Area;
+  auto it = std::upper_bound(this->CumulativeArea.begin(), this->CumulativeArea.end(), target);
+  const std::size_t i = std::min<std::size_t>(
+    static_cast<std::size_t>(it - this->CumulativeArea.begin()), this->Triangles.size() - 1);
+  const double before = i > 0 ? this->CumulativeArea[i - 1] : 0.0;
+  const double area = this->CumulativeArea[i] - before;
+  const double rest = area > 0 ? std::clamp((target - before) / area, 0.0, 1.0) : 0.0;
+  const LightTriangle& t = this->Triangles[i];
+  point = sampleTriangle(t.a, t.b, t.c, rest, v);
+  normal = t.normal;
+}
+
 Vec3 meanNormal(const std::vector<std::vector<Vec3>>& polygons)
 {
   Vec3 sum;

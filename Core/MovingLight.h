@@ -88,6 +88,10 @@ public:
 
   /// A uniformly distributed point on the light (own frame) and the normal there.
   void samplePoint(double u0, double u1, double u2, Vec3& point, Vec3& normal) const;
+  /// The same from two numbers, by a map that keeps areas: `u` picks the triangle by area and
+  /// what is left of it places the point with `v`, so that equal cells of the unit square are
+  /// equal areas of the light and stratified (u, v) are stratified points.
+  void samplePoint(double u, double v, Vec3& point, Vec3& normal) const;
 
   /// How every point of the light spreads its power over directions (Lambertian unless set).
   const IntensityDistribution& distribution() const { return this->Distribution; }

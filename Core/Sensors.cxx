@@ -8,8 +8,10 @@
 #include "RayTracer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <string>
 
 namespace mlr
@@ -297,13 +299,22 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
       i < rig.areaLights.size() ? rig.areaLights[i] : emitters[i - rig.areaLights.size()];
     const IntensityDistribution& f = light.distribution();
     RandomStream lightRandom(options.seed, StreamPurpose::Sensors, s, 1 + i);
+    // A jittered grid: the largest m x m grid that the samples fill, one point in each cell
+    // of the unit square, which samplePoint maps to equal areas of the light; the rest
+    // independent. Each point is uniform on the light, so the estimate is unbiased, and the
+    // light's smooth variation over its extent averages out instead of staying as noise.
+    const auto side = static_cast<std::uint32_t>(std::sqrt(static_cast<double>(samples)));
     scratch.clearRays();
     for (std::uint32_t q = 0; q < samples; ++q)
     {
-      const double u0 = lightRandom.uniform(), u1 = lightRandom.uniform(),
-                   u2 = lightRandom.uniform();
+      double u = lightRandom.uniform(), v = lightRandom.uniform();
+      if (q < side * side)
+      {
+        u = (q % side + u) / side;
+        v = (q / side + v) / side;
+      }
       Vec3 own, ownNormal;
-      light.samplePoint(u0, u1, u2, own, ownNormal);
+      light.samplePoint(u, v, own, ownNormal);
       for (std::size_t frame = 0; frame < frames; ++frame)
       {
         const std::size_t k = poseOf(light.frameCount(), frame);

@@ -36,7 +36,7 @@ struct SensorOptions
   /// escape see the sky, those that hit a surface gather its radiosity.
   std::uint32_t hemisphereRays = 512;
   /// Points sampled on every area light (scene emitters included), in every frame.
-  std::uint32_t areaLightSamples = 16;
+  std::uint32_t areaLightSamples = 64;
 };
 
 /// The most sensors and rays per sensor accepted: beyond them a run would not finish.

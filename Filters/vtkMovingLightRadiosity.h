@@ -604,8 +604,10 @@ public:
    * Luminous efficacy K of the light, lm/W: the `Illuminance` arrays (lx) are K times the
    * luminance (0.2126 R + 0.7152 G + 0.0722 B) of `Irradiance` (W/m^2). It must be > 0 and
    * at most 683 (the efficacy of monochromatic 555 nm light); other values, NaN included, are
-   * kept as given and make the update fail with an error naming LuminousEfficacy.
-   * Default 179 (Radiance's value for white light).
+   * kept as given and make the update fail with an error naming LuminousEfficacy. Daylight
+   * is not white light: with a sky, or LightType Directional (the sun) alone, the arrays use
+   * Perez's efficacy of each frame's daylight instead (field data `LuminousEfficacy` and
+   * `LuminousEfficacyModel`). Default 179 (Radiance's value for white light).
    */
   vtkSetMacro(LuminousEfficacy, double);
   vtkGetMacro(LuminousEfficacy, double);
@@ -625,8 +627,10 @@ public:
   ///@{
   /**
    * Cosine-distributed rays each sensor casts over its hemisphere, once for all frames: the
-   * sky through those that escape, the surfaces' radiosity through those that hit. Their
-   * noise falls as one over the square root. From 1 to 1000000; default 512.
+   * sky through those that escape, the surfaces' radiosity through those that hit; and an
+   * eighth as many points (at least 1) each sensor samples on every area light, each with a
+   * shadow ray per frame. Their noise falls as one over the square root or faster. From 1 to
+   * 1000000; default 512.
    */
   vtkSetMacro(SensorRays, int);
   vtkGetMacro(SensorRays, int);

@@ -279,6 +279,54 @@ TEST(Sensors, AnAreaLightGivesLambertsFormFactor)
   }
 }
 
+TEST(Sensors, AreaLightPointsAreStratified)
+{
+  // 64 points on a 0.3 m panel 0.3 m above sensors 0.2 to 0.8 m off its axis, over 8 seeds:
+  // independent points would leave each reading off by about the deviation of one point
+  // over 8 (sigma); the jittered grid leaves a small part of it.
+  const Scene scene = ground(2, Rgb(0.0));
+  const std::vector<std::vector<Vec3>> light = scenes::squareLightFacingDown({ 0, 0, 0.3 }, 0.3);
+  const Rgb power(10);
+  LightRig rig;
+  rig.areaLights.emplace_back(light, power, std::vector<Vec3>{ { 0, 0, 0 } });
+  const Solution solution = solve(scene, rig, quick());
+  SensorOptions counts;
+  counts.areaLightSamples = 64;
+  const Vec3 up(0, 0, 1);
+  for (const double x : { 0.2, 0.4, 0.8 })
+  {
+    const Vec3 point(x, 0.05, 0);
+    const double exact = power.r / 0.09 * pointToPolygonFormFactor(point, up, light[0]);
+    double m1 = 0, m2 = 0;
+    const int n = 64;
+    for (int i = 0; i < n; ++i)
+    {
+      for (int j = 0; j < n; ++j)
+      {
+        const Vec3 d = Vec3(-0.15 + 0.3 * (i + 0.5) / n, -0.15 + 0.3 * (j + 0.5) / n, 0.3) - point;
+        const double r2 = dot(d, d);
+        const double v = power.r * (d.z / std::sqrt(r2)) * (d.z / std::sqrt(r2)) / (M_PI * r2);
+        m1 += v / (n * n);
+        m2 += v * v / (n * n);
+      }
+    }
+    const double sigma = std::sqrt(m2 - m1 * m1) / std::sqrt(64.0);
+    double squares = 0;
+    for (std::uint64_t seed = 1; seed <= 8; ++seed)
+    {
+      SolverOptions options = quick();
+      options.seed = seed;
+      const SensorSolution result =
+        solveSensors(scene, rig, solution, oneSensor(point, up), options, counts);
+      const double error = result.irradiance(0, 0).r - exact;
+      squares += error * error / 8;
+    }
+    EXPECT_LT(std::sqrt(squares), 0.3 * sigma)
+      << "x = " << x << ", sigma " << sigma / exact << ", rms " << std::sqrt(squares) / exact;
+    EXPECT_GT(sigma, 0.02 * exact) << "independent points would be visibly noisy";
+  }
+}
+
 TEST(Sensors, TheStatisticsCountEveryRayCast)
 {
   // One sensor faces up under every kind of light, one faces down and sees none of them: the

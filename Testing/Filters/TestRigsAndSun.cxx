@@ -4,6 +4,7 @@
 #include "FilterTestSupport.h"
 
 #include "GeneratedScenes.h"
+#include "Sky.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -17,6 +18,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkStringArray.h"
 
 #include <gtest/gtest.h>
 
@@ -1041,6 +1043,37 @@ TEST(FilterSun, WithoutTrajectoryTheDirectionGoesFromPathStartToPathEnd)
   filter->SetPathStart(1, 0, 1);
   filter->SetPathEnd(-1, 0, -1);
   expectError(filter, "frame 1's is zero");
+}
+
+TEST(FilterSun, TheSunAloneHasPerezsDirectEfficacy)
+{
+  // Sunlight is not white light: without a sky its lux are Perez's direct efficacy (about 100
+  // lm/W for a high clear sun), not LuminousEfficacy's 179, in every frame.
+  const std::vector<mlr::Vec3> suns = { normalize(mlr::Vec3(0.2, 0.1, 1)),
+    normalize(mlr::Vec3(1, 0, 0.3)) };
+  auto filter = sunFilter(ground(), trajectoryPolyData(suns), 20000);
+  for (std::size_t f = 0; f < suns.size(); ++f)
+  {
+    ASSERT_TRUE(filter->UpdateTimeStep(static_cast<double>(f)));
+    mlr::SkyFrame frame;
+    frame.sun = suns[f];
+    frame.directNormal = 1000;
+    frame.diffuseHorizontal = 100;
+    const double expected = mlr::perezEfficacy(frame, { 0, 0, 1 }).direct;
+    EXPECT_GT(expected, 60) << "frame " << f;
+    EXPECT_LT(expected, 130) << "frame " << f;
+    vtkPolyData* out = filter->GetOutput();
+    EXPECT_DOUBLE_EQ(fieldValue(out, "LuminousEfficacy"), expected) << "frame " << f;
+    auto* model =
+      vtkStringArray::SafeDownCast(out->GetFieldData()->GetAbstractArray("LuminousEfficacyModel"));
+    ASSERT_NE(model, nullptr);
+    EXPECT_EQ(model->GetValue(0), "Perez (1990) efficacy of the direct sun");
+    vtkDataArray* irradiance = out->GetCellData()->GetArray("Irradiance");
+    vtkDataArray* lux = out->GetCellData()->GetArray("Illuminance");
+    const double* e = irradiance->GetTuple3(0);
+    EXPECT_NEAR(lux->GetComponent(0, 0), expected * (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]),
+      1e-5 * lux->GetComponent(0, 0));
+  }
 }
 
 TEST(FilterSun, NoSurfaceFacingTheSunIsDarkWithAWarning)
