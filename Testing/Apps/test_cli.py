@@ -193,6 +193,23 @@ def test_equals_syntax(tmp_path):
     assert all_files(tmp_path) == ["s.json", "s.pvd", "s_0000.vtu", "s_0001.vtu"]
 
 
+def test_unknown_scene_extension_names_every_format_read(tmp_path):
+    """The scene's formats are VTK's readers' and the scene reader's (glTF too); a light file
+    is read by VTK's alone."""
+    (tmp_path / "lamp.ies").write_text("IESNA:LM-63-2002\n")
+    result = run(["--scene", "lamp.ies", "--light", LIGHT, "--output", "out/x.pvd"] + PATH + FAST,
+                 tmp_path)
+    assert result.returncode == 1
+    assert "the scene file 'lamp.ies' has an unknown extension: give a .vtp .vtu .vtk .obj .ply " \
+        ".stl .gltf or .glb file" in result.stderr, result.stderr
+    result = run(["--scene", SCENE, "--light", "lamp.ies", "--output", "out/x.pvd"] + PATH + FAST,
+                 tmp_path)
+    assert result.returncode == 1
+    assert "the light file 'lamp.ies' has an unknown extension: give a .vtp .vtu .vtk .obj .ply " \
+        "or .stl file" in result.stderr, result.stderr
+    assert all_files(tmp_path) == ["lamp.ies"]
+
+
 def test_unreadable_files_fail_with_a_message_and_write_nothing(tmp_path):
     (tmp_path / "inputs").mkdir()
     garbage = tmp_path / "inputs" / "garbage.vtp"
