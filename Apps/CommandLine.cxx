@@ -966,7 +966,10 @@ Sensors (measuring points that receive light but neither block nor reflect it):
   --work-plane HEIGHT,SPACING
                         a grid of sensors facing up over every upward-facing face (within
                         5 degrees of --up: floors, and roofs), HEIGHT above it, SPACING
-                        apart on a lattice at (i + 1/2) SPACING, inside the polygons
+                        apart on a lattice at (i + 1/2) SPACING, inside the polygons; with
+                        lights (not the sun or a sky) also over the faces facing down that
+                        see a light from above (a room modelled with outward normals),
+                        without that room's roof
   --da-threshold LX     the illuminance DaylightAutonomy counts the frames at or above
                         (default 300). The sensors' series is PATH_sensors.pvd with
                         PATH_sensors_0000.vtp ... (point arrays Irradiance, Illuminance per

@@ -16,6 +16,7 @@
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
+#include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationDoubleVectorKey.h"
 #include "vtkMovingLightRadiosity.h"
@@ -164,6 +165,66 @@ bool emits(vtkPolyData* scene, const char* arrayName)
     }
   }
   return false;
+}
+
+/**
+ * Where the lights are, for the work plane to find the floors they light: the trajectory's
+ * points (each light's centroid in a frame), the ends and middle of --from/--to, or the
+ * centroids of the scene's emitting cells. None under the sun or a sky, which light from
+ * above.
+ */
+std::vector<Triple> lightPositions(const Options& options, vtkPolyData* trajectory,
+  vtkPolyData* scene, const char* emissionArrayName)
+{
+  std::vector<Triple> positions;
+  if (options.usesSun() || options.sky)
+  {
+    return positions;
+  }
+  if (options.from)
+  {
+    const Triple& a = *options.from;
+    const Triple& b = *options.to;
+    positions = { a, { (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2 }, b };
+  }
+  else if (trajectory)
+  {
+    for (vtkIdType i = 0; i < trajectory->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      trajectory->GetPoint(i, p);
+      positions.push_back({ p[0], p[1], p[2] });
+    }
+  }
+  else if (vtkDataArray* emission = scene->GetCellData()->GetArray(emissionArrayName))
+  {
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType c = 0; c < scene->GetNumberOfCells(); ++c)
+    {
+      double most = 0;
+      for (int k = 0; k < emission->GetNumberOfComponents(); ++k)
+      {
+        most = std::max(most, emission->GetComponent(c, k));
+      }
+      scene->GetCellPoints(c, ids);
+      if (!(most > 0) || ids->GetNumberOfIds() == 0)
+      {
+        continue;
+      }
+      Triple centroid{ 0, 0, 0 };
+      for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
+      {
+        double p[3];
+        scene->GetPoint(ids->GetId(i), p);
+        for (int k = 0; k < 3; ++k)
+        {
+          centroid[k] += p[k] / static_cast<double>(ids->GetNumberOfIds());
+        }
+      }
+      positions.push_back(centroid);
+    }
+  }
+  return positions;
 }
 
 std::vector<double> timeSteps(vtkMovingLightRadiosity* filter)
@@ -496,7 +557,8 @@ int run(int argc, char** argv, RankJob& job)
   else if (options.workPlane)
   {
     sensors =
-      workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1]);
+      workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1],
+        lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()));
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);
