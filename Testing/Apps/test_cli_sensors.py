@@ -173,6 +173,28 @@ def test_bad_sensor_inputs(tmp_path):
     assert result.returncode == 1 and "no polygon facing up" in result.stderr, result.stderr
 
 
+def test_a_run_without_sensors_removes_the_earlier_sensors_series(tmp_path):
+    """Its frames and pictures were replaced, not its sensors' series: a run without
+    sensors left the earlier one beside the new frames. A file of that name that is no
+    sensors' series of the command line's stays."""
+    base = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
+            "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--output", "out/room.pvd"] + FAST
+    result = run(base + ["--frames", "3", "--work-plane", f"{HEIGHT},{SPACING}"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert len(read_sensor_series(tmp_path)) == 3
+    result = run(base + ["--frames", "2"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert sorted(os.listdir(tmp_path / "out")) == ["room.pvd", "room_0000.vtu", "room_0001.vtu"]
+
+    # Not the command line's: another series' frames, or no collection at all.
+    mine = '<VTKFile type="Collection"><Collection><DataSet file="mine_0000.vtu"/></Collection>' \
+        '</VTKFile>\n'
+    (tmp_path / "out" / "room_sensors.pvd").write_text(mine)
+    result = run(base + ["--frames", "2"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "out" / "room_sensors.pvd").read_text() == mine
+
+
 def write_outward_box(directory):
     """The room of write_room with a ceiling, modelled as a closed box with its normals
     outward: its floor faces down, its roof up."""
