@@ -1,5 +1,8 @@
 #include "CommandLine.h"
 
+#include "OutputTransaction.h"
+#include "SeriesWriter.h"
+
 #include "vtkMovingLightRadiosity.h"
 
 #include <vtk_cli11.h>
@@ -8,6 +11,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -286,6 +290,66 @@ std::string stem(const std::string& path)
   return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
 }
 
+/// `path` made absolute, with its symbolic links resolved as far as it exists.
+std::filesystem::path resolved(const std::filesystem::path& path)
+{
+  std::error_code error;
+  const std::filesystem::path absolute =
+    std::filesystem::absolute(path.empty() ? std::filesystem::path(".") : path, error);
+  std::filesystem::path real = std::filesystem::weakly_canonical(absolute, error);
+  return error ? absolute.lexically_normal() : real;
+}
+
+/**
+ * Refuses a --stats file that is one of the files the run writes or replaces: the series,
+ * its frames, the sensors' series (which a run without sensors removes) or the pictures. The
+ * statistics would be staged under the same name as one of them, and the commit would fail
+ * halfway, after the earlier series was replaced.
+ */
+void checkStatsHasItsOwnName(const Options& o)
+{
+  namespace fs = std::filesystem;
+  if (o.stats.empty())
+  {
+    return;
+  }
+  const fs::path stats = resolved(o.stats);
+  const std::string name = stats.filename().string();
+  const fs::path collection = o.output;
+  const SeriesNaming naming(collection, 1);
+  const fs::path sensors = sensorsCollectionOf(collection);
+  const SeriesNaming sensorNaming(sensors, 1);
+  const bool besideSeries = stats.parent_path() == resolved(naming.directory);
+  std::string what;
+  if (stats == resolved(collection))
+  {
+    what = "the series of --output '" + o.output + "'";
+  }
+  else if (besideSeries && isSeriesFile(name, naming.framePrefix(), ".vtu"))
+  {
+    what =
+      "a frame of the series of --output '" + o.output + "' (" + naming.framePrefix() + "NNNN.vtu)";
+  }
+  else if (stats == resolved(sensors) ||
+    (besideSeries && isSeriesFile(name, sensorNaming.framePrefix(), ".vtp")))
+  {
+    what = "a file of the sensors' series of --output '" + o.output + "' (" +
+      sensors.filename().string() + ", " + sensorNaming.framePrefix() + "NNNN.vtp)";
+  }
+  else if (!o.png.empty() &&
+    (stats == resolved(o.png) ||
+      (stats.parent_path() == resolved(o.png) && isSeriesFile(name, naming.framePrefix(), ".png"))))
+  {
+    what = "the folder of --png '" + o.png + "' or one of its pictures";
+  }
+  if (!what.empty())
+  {
+    throw UsageError("--stats '" + o.stats + "' is " + what +
+      ": give the statistics a file of their own, e.g. --stats " +
+      (naming.directory / (naming.stem + ".json")).string());
+  }
+}
+
 template <typename T>
 void checkRange(const std::string& option, T value, T minimum, T maximum)
 {
@@ -354,11 +418,21 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     app
       .add_option_function<std::string>(name,
-        [name, &into, read, &needsValue](const std::string& text)
+        [name, value, &into, read, &needsValue](const std::string& text)
         {
           if (text.empty())
           {
             throw needsValue(name);
+          }
+          // CLI11 takes the word after an option as its value whatever it is: `--stats --help`
+          // would solve and write a file named --help.
+          if (text.rfind("--", 0) == 0)
+          {
+            const std::string type = value;
+            const bool path = type.find("FILE") != std::string::npos ||
+              type.find("DIR") != std::string::npos || type.find("PATH") != std::string::npos;
+            throw UsageError(std::string(needsValue(name).what()) + ", not the option '" + text +
+              "'" + (path ? " (a file whose name starts with -- is ./" + text + ")" : ""));
           }
           into = read(name, text);
         })
@@ -589,6 +663,26 @@ Options parseCommandLine(int argc, const char* const* argv)
     {
       throw UsageError("the sky needs --scene FILE: the built-in Cornell box is closed");
     }
+    // The filter solves a sky with the sun and the scene's emission, without its area and
+    // point lights: they would be dropped without a word.
+    const char* light = !o.light.empty() ? "--light"
+      : o.lightMaterial                  ? "--light-material"
+      : o.pointLight                     ? "--point-light"
+      : o.luminaire                      ? "--luminaire"
+                                         : nullptr;
+    if (light)
+    {
+      throw UsageError(std::string(light) +
+        " with --sky: a sky lights the scene beside the sun or alone, and the solve would leave "
+        "the light out; give one or the other");
+    }
+    if (o.luminousEfficacy)
+    {
+      throw UsageError(std::string("--luminous-efficacy with ") +
+        (o.weather.empty() ? "--sky" : "--weather (and its Perez sky)") +
+        ": under a sky the Illuminance takes each frame's Perez daylight efficacy (field data "
+        "LuminousEfficacy), not this one; leave --luminous-efficacy out");
+    }
   }
   else if (o.skyDiffuseHorizontal)
   {
@@ -618,12 +712,25 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   if (o.sceneLightsItself())
   {
-    // Whether the scene emits is known once it is read (main checks it then).
-    if (!o.trajectory.empty() || o.from || o.aim || o.lightPower)
+    // Whether the scene emits is known once it is read (main checks it then). The filter has
+    // no light to give these to: they would be ignored.
+    const char* given = !o.trajectory.empty() ? "--trajectory"
+      : o.from                                ? "--from"
+      : o.aim                                 ? "--aim"
+      : o.lightPower                          ? "--light-power"
+      : o.lightLumens                         ? "--light-lumens"
+      : o.spot                                ? "--spot"
+      : !o.lightDistribution.empty()          ? "--light-distribution"
+                                              : nullptr;
+    if (given)
     {
-      throw UsageError("--trajectory, --from, --to, --aim and --light-power are for a light: give "
-                       "--light FILE or --light-material NAME (without either, the scene's own "
-                       "emissive surfaces light it, in one frame)");
+      throw UsageError(std::string(given) +
+        " is for a light, and the scene has none (--trajectory, --from, --to, --aim, "
+        "--light-power, --light-lumens, --spot and --light-distribution are for a light): " +
+        (o.sky ? "leave it out (the sky alone lights the scene, in one frame; --sky drops "
+                 "lights)"
+               : "give --light FILE, --light-material NAME or --point-light, or leave it out "
+                 "(without a light the scene's own emissive surfaces light it, in one frame)"));
     }
   }
   else if (!o.usesEmbeddedScene() && !o.usesSun())
@@ -643,6 +750,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     o.png = "output/png";
   }
+  checkStatsHasItsOwnName(o);
   return o;
 }
 
@@ -928,7 +1036,8 @@ apply to --weather):
                         8-16 is 08:00 to 17:00 (default 0-23)
   --night               also the hours whose sun is below the horizon at their middle
                         (left out by default), dark but for the sky
-The sky (beside the sun or alone; needs --scene; nothing lights from below the horizon):
+The sky (beside the sun or alone, not with a light; needs --scene; nothing lights from
+below the horizon):
   --sky MODEL           uniform, cie-overcast, cie-clear or perez; cie-clear (CIE type 12)
                         and perez (Perez all-weather) follow each frame's sun, perez from
                         its direct normal irradiance (--sun-irradiance times Power)
@@ -966,7 +1075,10 @@ Sensors (measuring points that receive light but neither block nor reflect it):
   --work-plane HEIGHT,SPACING
                         a grid of sensors facing up over every upward-facing face (within
                         5 degrees of --up: floors, and roofs), HEIGHT above it, SPACING
-                        apart on a lattice at (i + 1/2) SPACING, inside the polygons
+                        apart on a lattice at (i + 1/2) SPACING, inside the polygons; with
+                        lights (not the sun or a sky) also over the faces facing down that
+                        see a light from above (a room modelled with outward normals),
+                        without that room's roof
   --da-threshold LX     the illuminance DaylightAutonomy counts the frames at or above
                         (default 300). The sensors' series is PATH_sensors.pvd with
                         PATH_sensors_0000.vtp ... (point arrays Irradiance, Illuminance per
@@ -976,10 +1088,13 @@ Output:
   --luminous-efficacy LM_PER_W
                         lumens per watt of the light, which turn the Irradiance arrays
                         (W/m^2) into Illuminance (lx for a scene in metres); above 0 and at
-                        most 683 (default 179, white light)
+                        most 683 (default 179, white light); not with a sky, whose
+                        Illuminance takes each frame's Perez daylight efficacy
   --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)
-  --stats FILE.json     also write the options, times and solver statistics as JSON
+  --stats FILE.json     also write the options, the light as solved, times and solver
+                        statistics as JSON (a name of its own: not the series, its frames,
+                        its sensors' series or its pictures)
   --png DIR             also render one picture per frame into DIR, as ParaView shows the
                         frame: the point array Color, unlit, and the light where it is in
                         that frame (needs an X display; without DISPLAY the program starts

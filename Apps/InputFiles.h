@@ -28,9 +28,10 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(
   const std::string& path, const std::string& role, std::uint64_t memoryLimitBytes = 0);
 
 /**
- * The scene file: as readSurfaceFile, but .obj (with its .mtl), .gltf, .glb and .ply files are
- * read with their materials by vtkRadiositySceneReader (cell arrays Reflectance, Emission,
- * MaterialId, field data MaterialNames), in the same guarded reading process.
+ * The scene file: as readSurfaceFile, but the files vtkRadiositySceneReader reads (.obj with
+ * its .mtl, .gltf, .glb, .ply: its GetFileExtensions()) are read with their materials by it
+ * (cell arrays Reflectance, Emission, MaterialId, field data MaterialNames), in the same
+ * guarded reading process.
  */
 vtkSmartPointer<vtkPolyData> readSceneFile(
   const std::string& path, std::uint64_t memoryLimitBytes = 0);

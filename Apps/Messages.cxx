@@ -115,4 +115,13 @@ void printError(const std::string& message)
   std::cerr << Program << ": error: " << message << std::endl;
 }
 
+void printWarning(const std::string& message)
+{
+  if (Quiet)
+  {
+    return;
+  }
+  std::cerr << Program << ": warning: " << message << std::endl;
+}
+
 } // namespace mlr::cli

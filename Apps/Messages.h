@@ -23,4 +23,7 @@ void quietMessages();
 /// Prints "program: error: message" on stderr.
 void printError(const std::string& message);
 
+/// Prints "program: warning: message" on stderr.
+void printWarning(const std::string& message);
+
 } // namespace mlr::cli

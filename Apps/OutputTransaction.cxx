@@ -10,6 +10,16 @@ namespace fs = std::filesystem;
 namespace mlr::cli
 {
 
+bool isSeriesFile(const std::string& name, const std::string& prefix, const std::string& suffix)
+{
+  return name.size() > prefix.size() + suffix.size() &&
+    name.compare(0, prefix.size(), prefix) == 0 &&
+    name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+    std::all_of(name.begin() + static_cast<long>(prefix.size()),
+      name.end() - static_cast<long>(suffix.size()),
+      [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
 OutputTransaction::~OutputTransaction()
 {
   if (!this->Committed)
@@ -46,6 +56,13 @@ void OutputTransaction::createDirectories(const fs::path& directory)
 
 fs::path OutputTransaction::stage(const fs::path& finalPath)
 {
+  // Two files staged under one name would share a temporary file, and the second rename
+  // would fail after the first had replaced the earlier file.
+  if (!this->StagedNames.insert(fs::absolute(finalPath).lexically_normal()).second)
+  {
+    throw std::runtime_error(
+      "'" + finalPath.string() + "' would be written twice in one run: nothing was written");
+  }
   fs::path temporary = finalPath.parent_path() / ("." + finalPath.filename().string() + ".partial");
   this->StagedFiles.push_back({ temporary, finalPath });
   return temporary;
@@ -55,6 +72,12 @@ void OutputTransaction::replaceSeries(
   const fs::path& directory, const std::string& prefix, const std::string& suffix)
 {
   this->ReplacedSeries.push_back({ directory, prefix, suffix });
+}
+
+void OutputTransaction::removeAtCommit(
+  const fs::path& file, std::function<bool(const fs::path&)> isStale)
+{
+  this->RemovedFiles.push_back({ file, std::move(isStale) });
 }
 
 void OutputTransaction::keep(const fs::path& finalPath)
@@ -92,20 +115,22 @@ void OutputTransaction::commit()
     for (const fs::directory_entry& entry : fs::directory_iterator(directory, error))
     {
       const std::string name = entry.path().filename().string();
-      const std::size_t digits =
-        name.size() - std::min(name.size(), series.prefix.size() + series.suffix.size());
-      const bool matches = digits > 0 &&
-        name.compare(0, series.prefix.size(), series.prefix) == 0 &&
-        name.compare(name.size() - series.suffix.size(), series.suffix.size(), series.suffix) ==
-          0 &&
-        std::all_of(name.begin() + static_cast<long>(series.prefix.size()),
-          name.end() - static_cast<long>(series.suffix.size()),
-          [](unsigned char c) { return std::isdigit(c) != 0; });
       const fs::path path = (series.directory / name).lexically_normal();
-      if (matches && entry.is_regular_file() && kept.count(path) == 0)
+      if (isSeriesFile(name, series.prefix, series.suffix) && entry.is_regular_file() &&
+        kept.count(path) == 0)
       {
         fs::remove(entry.path(), error);
       }
+    }
+  }
+  for (const Removal& removal : this->RemovedFiles)
+  {
+    std::error_code error;
+    if (kept.count(removal.file.lexically_normal()) == 0 &&
+      fs::is_regular_file(removal.file, error) &&
+      (!removal.isStale || removal.isStale(removal.file)))
+    {
+      fs::remove(removal.file, error);
     }
   }
 }

@@ -2,11 +2,17 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace mlr::cli
 {
+
+/// Whether the file name `name` is `prefix`, one or more digits and `suffix`: a file of a
+/// series (OutputTransaction::replaceSeries deletes those it did not write).
+bool isSeriesFile(const std::string& name, const std::string& prefix, const std::string& suffix);
 
 /**
  * Files are written under hidden temporary names next to their final ones and renamed when
@@ -34,6 +40,12 @@ public:
   void replaceSeries(
     const std::filesystem::path& directory, const std::string& prefix, const std::string& suffix);
 
+  /// At commit, also delete `file` if it is a regular file that was not staged: the index of
+  /// a series this run no longer writes. `isStale`, if given, must say yes first (it is given
+  /// the file's path).
+  void removeAtCommit(const std::filesystem::path& file,
+    std::function<bool(const std::filesystem::path&)> isStale = {});
+
   /// A file of a replaced series that another process writes and commits before this one:
   /// kept, though not staged here.
   void keep(const std::filesystem::path& finalPath);
@@ -54,7 +66,14 @@ private:
   void rollback() noexcept;
 
   std::vector<Staged> StagedFiles;
+  std::set<std::filesystem::path> StagedNames; ///< absolute, normalised
+  struct Removal
+  {
+    std::filesystem::path file;
+    std::function<bool(const std::filesystem::path&)> isStale;
+  };
   std::vector<Series> ReplacedSeries;
+  std::vector<Removal> RemovedFiles;
   std::vector<std::filesystem::path> KeptFiles;
   std::vector<std::filesystem::path> CreatedDirectories;
   bool Committed = false;

@@ -2,9 +2,13 @@
 
 #include "CommandLine.h"
 
+#include "Photometry.h"
+
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkMovingLightRadiosity.h"
+#include "vtkPolyData.h"
 #include "vtkStringArray.h"
 #include "vtkType.h"
 
@@ -13,6 +17,7 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <set>
@@ -64,6 +69,188 @@ nlohmann::ordered_json jsonTriple(const double* v)
 }
 }
 
+namespace
+{
+double luminance(const double rgb[3])
+{
+  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+/// The light as solved: its kind, files and settings, and its power. The filter's Light output
+/// gives the area lights' (each polygon's Power); it has no point lights, whose power is the
+/// filter's rule: --light-lumens, else --light-power's watts, else the file's own flux.
+nlohmann::ordered_json lightingJson(
+  const Options& o, vtkMovingLightRadiosity* filter, const PosedLight& posed)
+{
+  nlohmann::ordered_json j;
+  const bool sky = o.sky.has_value();
+  const bool areaKinds = !o.usesSun() && !o.sceneLightsItself() && !o.pointLight;
+  vtkDataArray* powers = posed.light ? posed.light->GetCellData()->GetArray("Power") : nullptr;
+  const bool fromOutput =
+    areaKinds && powers && powers->GetNumberOfComponents() == 3 && powers->GetNumberOfTuples() > 0;
+  j["kind"] = o.usesSun()   ? "sun"
+    : sky                   ? "sky"
+    : o.sceneLightsItself() ? "scene emission"
+    : o.pointLight          ? "point light"
+    : o.luminaire           ? "luminaire"
+    : o.lightMaterial       ? "material"
+                            : "area light";
+  if (o.luminaire)
+  {
+    j["emitsFrom"] =
+      fromOutput ? "the file's luminous opening" : "a point (no opening in the file)";
+  }
+  if (!o.light.empty())
+  {
+    j["file"] = o.light;
+  }
+  else if (o.lightMaterial)
+  {
+    j["material"] = *o.lightMaterial;
+  }
+  else if (areaKinds && !o.luminaire && o.usesEmbeddedScene())
+  {
+    j["file"] = "built-in Cornell box light";
+  }
+  if (!o.lightDistribution.empty())
+  {
+    j["distributionFile"] = o.lightDistribution;
+  }
+  if (o.spot)
+  {
+    j["spot"] = { { "halfAngleDegrees", jsonNumber((*o.spot)[0]) },
+      { "softEdgeDegrees", jsonNumber((*o.spot)[1]) } };
+  }
+  if (o.aim)
+  {
+    j["aim"] = jsonTriple(o.aim->data());
+  }
+
+  if (!o.usesSun() && !sky && !o.sceneLightsItself())
+  {
+    double power[3] = { 0, 0, 0 };
+    double lumens = 0;
+    if (fromOutput)
+    {
+      for (vtkIdType c = 0; c < powers->GetNumberOfTuples(); ++c)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          power[k] += powers->GetComponent(c, k);
+        }
+      }
+      lumens = filter->GetLuminousEfficacy() * luminance(power);
+    }
+    else
+    {
+      const double* colour = filter->GetLightPower();
+      std::copy(colour, colour + 3, power);
+      lumens = o.lightLumens.value_or(0.0);
+      if (!(lumens > 0) && filter->GetLightFluxFromFile())
+      {
+        try
+        {
+          lumens = mlr::readPhotometricFile(o.lightDistribution).lumens;
+        }
+        catch (const std::exception&)
+        {
+          lumens = 0; // the filter read it: it has not changed since
+        }
+      }
+      if (lumens > 0 && luminance(colour) > 0)
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          power[k] = colour[k] * lumens / filter->GetLuminousEfficacy() / luminance(colour);
+        }
+      }
+      else
+      {
+        lumens = filter->GetLuminousEfficacy() * luminance(power);
+      }
+    }
+    j["powerW"] = jsonTriple(power);
+    if (fromOutput)
+    {
+      // The Light output poses the lights in one frame, with that frame's Power factor and
+      // TILT factor.
+      j["powerFrame"] = posed.frame;
+    }
+    j["lumens"] = jsonNumber(lumens);
+    j["powerFrom"] = o.lightLumens     ? "--light-lumens"
+      : filter->GetLightFluxFromFile() ? "the distribution file's flux"
+      : o.lightPower                   ? "--light-power"
+      : o.lightMaterial                ? "the material's emission (pi Ke area)"
+                                       : "the Light's LightPower cells, else 100 W per channel";
+    j["luminousEfficacy"] = jsonNumber(filter->GetLuminousEfficacy());
+  }
+  else if (!sky)
+  {
+    j["luminousEfficacy"] = jsonNumber(filter->GetLuminousEfficacy());
+  }
+  else
+  {
+    j["luminousEfficacy"] = "per frame (frames[].luminousEfficacy): Perez daylight efficacy";
+  }
+
+  if (o.usesSun())
+  {
+    nlohmann::ordered_json sun;
+    if (!o.weather.empty())
+    {
+      const std::array<int, 4> d = o.dates.value_or(std::array<int, 4>{ 1, 1, 12, 31 });
+      const std::array<int, 2> h = o.hours.value_or(std::array<int, 2>{ 0, 23 });
+      char dates[16];
+      std::snprintf(dates, sizeof dates, "%02d-%02d,%02d-%02d", d[0], d[1], d[2], d[3]);
+      sun["weather"] = { { "file", o.weather }, { "dates", dates }, { "hours", { h[0], h[1] } },
+        { "night", o.night } };
+      sun["irradianceWPerM2"] = "per hour: the file's direct normal irradiance";
+    }
+    else
+    {
+      if (o.sunPath)
+      {
+        const SunPathSpec& p = *o.sunPath;
+        char date[16];
+        std::snprintf(date, sizeof date, "%04d-%02d-%02d", p.year, p.month, p.day);
+        sun["path"] = { { "latitude", jsonNumber(p.latitude) },
+          { "longitude", jsonNumber(p.longitude) }, { "date", date },
+          { "startHour", jsonNumber(p.startHour) }, { "endHour", jsonNumber(p.endHour) },
+          { "stepMinutes", jsonNumber(p.stepMinutes) },
+          { "timeZone", jsonNumber(o.timeZone.value_or(0.0)) } };
+      }
+      else
+      {
+        sun["directionsFile"] = o.sunDirections;
+      }
+      sun["irradianceWPerM2"] = jsonNumber(filter->GetSunIrradiance());
+    }
+    const Triple north = o.northDirection();
+    sun["north"] = jsonTriple(north.data());
+    j["sun"] = sun;
+  }
+  if (sky)
+  {
+    nlohmann::ordered_json skyJson = { { "model", *o.sky } };
+    if (o.weather.empty())
+    {
+      skyJson["diffuseHorizontalWPerM2"] = jsonNumber(filter->GetSkyDiffuseHorizontal());
+    }
+    else
+    {
+      skyJson["diffuseHorizontalWPerM2"] = "per hour: the file's diffuse horizontal irradiance";
+    }
+    j["sky"] = skyJson;
+  }
+  if (o.usesSun() || sky || !o.lightDistribution.empty() || o.workPlane)
+  {
+    const Triple up = o.zenith();
+    j["up"] = jsonTriple(up.data());
+  }
+  return j;
+}
+}
+
 std::string summaryLine(vtkFieldData* statistics)
 {
   const double rays = value(statistics, "ShootingRays") + value(statistics, "ShadowRays") +
@@ -74,7 +261,7 @@ std::string summaryLine(vtkFieldData* statistics)
     << " paths/frame, " << millions(rays) << " rays ("
     << millions(value(statistics, "ShootingRays")) << " shooting, "
     << millions(value(statistics, "ShadowRays")) << " shadow, "
-    << millions(value(statistics, "GatheringRays")) << " gathering), "
+    << millions(value(statistics, "GatheringRays")) << " gathering), solve "
     << seconds(value(statistics, "SecondsTotal")) << " (remeshing "
     << seconds(value(statistics, "SecondsRemeshing")) << ", shooting "
     << seconds(value(statistics, "SecondsShooting")) << ", gathering "
@@ -85,6 +272,19 @@ std::string summaryLine(vtkFieldData* statistics)
     s << "; sensors " << millions(value(statistics, "SensorShadowRays")) << " shadow, "
       << millions(value(statistics, "SensorGatheringRays")) << " gathering rays, "
       << seconds(value(statistics, "SecondsSensors"));
+  }
+  return s.str();
+}
+
+std::string timeLine(const StageTimes& stages)
+{
+  std::ostringstream s;
+  s << seconds(stages.total) << " in all: reading " << seconds(stages.reading) << ", remeshing "
+    << seconds(stages.remeshing) << ", solving " << seconds(stages.solving) << ", writing "
+    << seconds(stages.writing);
+  if (stages.rendering > 0)
+  {
+    s << ", pictures " << seconds(stages.rendering);
   }
   return s.str();
 }
@@ -122,18 +322,19 @@ std::string errorLine(vtkFieldData* statistics)
 
 void writeStatisticsJson(const std::filesystem::path& path, const Options& options,
   vtkMovingLightRadiosity* filter, vtkFieldData* statistics, const std::vector<FrameRecord>& frames,
-  const StageTimes& stages)
+  const StageTimes& stages, const PosedLight& posedLight, vtkIdType sensorCount)
 {
   const std::string builtIn = "built-in Cornell box";
   nlohmann::ordered_json json;
   json["scene"] = options.scene.empty() ? builtIn : options.scene;
-  // What lit the scene: a light file, a material of the scene, the sun, or the scene's own
-  // emissive surfaces.
+  const nlohmann::ordered_json lighting = lightingJson(options, filter, posedLight);
+  // What lit the scene: a light file, a material of the scene, a luminaire, the sun, the sky,
+  // or the scene's own emissive surfaces ("lighting" says more).
+  const std::string kind = lighting["kind"].get<std::string>();
   json["light"] = !options.light.empty() ? options.light
     : options.lightMaterial              ? "material " + *options.lightMaterial
-    : options.usesSun()                  ? std::string("sun")
-    : options.sceneLightsItself()        ? std::string("scene emission")
-                                         : builtIn;
+    : kind == "area light"               ? builtIn
+                                         : kind;
   json["trajectory"] = !options.trajectory.empty()
     ? options.trajectory
     : (options.from                        ? "straight line"
@@ -146,8 +347,24 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     json["sky"] = *options.sky;
   }
   json["output"] = options.output;
+  json["lighting"] = lighting;
+  if (options.usesSensors())
+  {
+    nlohmann::ordered_json sensors;
+    if (!options.sensors.empty())
+    {
+      sensors["file"] = options.sensors;
+    }
+    else
+    {
+      sensors["workPlane"] = { { "height", jsonNumber((*options.workPlane)[0]) },
+        { "spacing", jsonNumber((*options.workPlane)[1]) } };
+    }
+    sensors["count"] = sensorCount;
+    sensors["daylightAutonomyThresholdLx"] = jsonNumber(filter->GetDaylightAutonomyThreshold());
+    json["sensors"] = sensors;
+  }
   json["settings"] = {
-    { "lightPower", jsonTriple(filter->GetLightPower()) },
     { "paths", filter->GetNumberOfPaths() },
     { "gatherRatio", jsonNumber(filter->GetGatheringRatio()) },
     { "survival", jsonNumber(filter->GetFirstBounceSurvival()) },
@@ -163,6 +380,12 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "timeLimit", jsonNumber(filter->GetTimeLimit()) },
     { "framesPerChunk", filter->GetFramesPerChunk() },
   };
+  if (lighting.contains("powerW"))
+  {
+    // The power solved, not the LightPower property, which lumens, a material or a file's
+    // flux replace.
+    json["settings"]["lightPower"] = lighting["powerW"];
+  }
 
   // Every statistic the filter reports, except those that describe one frame.
   static const std::set<std::string> perFrame = { "FrameIndex", "LightPosition", "LightTranslation",
@@ -223,7 +446,20 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     {
       record["picture"] = frame.picture;
     }
-    record["lightPosition"] = jsonTriple(frame.lightPosition.data());
+    // The sun's and the sky's frames have no light position, and a scene's own emission
+    // does not move.
+    if (options.usesSun())
+    {
+      record["sunDirection"] = jsonTriple(frame.sunDirection.data());
+    }
+    else if (!options.sky && !options.sceneLightsItself())
+    {
+      record["lightPosition"] = jsonTriple(frame.lightPosition.data());
+    }
+    if (options.sky)
+    {
+      record["luminousEfficacy"] = jsonNumber(frame.luminousEfficacy);
+    }
     records.push_back(record);
   }
   json["frames"] = records;

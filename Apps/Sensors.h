@@ -7,6 +7,7 @@
 #include "vtkSmartPointer.h"
 
 #include <filesystem>
+#include <vector>
 
 class vtkPolyData;
 
@@ -17,14 +18,25 @@ namespace mlr::cli
 constexpr double WorkPlaneToleranceDegrees = 5;
 
 /**
- * Sensors facing `up` at `height` above every polygon of `scene` whose normal is within
- * WorkPlaneToleranceDegrees of `up`, on the lattice (i + 1/2) `spacing`, (j + 1/2) `spacing`
- * of two axes across `up` (x and y for a z up), at the lattice points inside the polygon seen
- * along `up`. Point array Normals. Throws InputError when no face faces up, and UsageError
- * when the grid would have more sensors than a solve accepts.
+ * Sensors facing `up` at `height` above the scene's floors, on the lattice (i + 1/2)
+ * `spacing`, (j + 1/2) `spacing` of two axes across `up` (x and y for a z up), at the lattice
+ * points inside each floor polygon seen along `up`. Point array Normals.
+ *
+ * The floors are the polygons whose normal is within WorkPlaneToleranceDegrees of `up`. With
+ * `lights` (where the lights are, for a scene not lit by the sun or a sky) the floors are
+ * also found by geometry, as the solve is two-sided: the polygons within that angle of down
+ * whose upper side sees a light and that have nothing lit straight below them (a room
+ * modelled with outward normals), with every polygon facing down at their height; the
+ * lattice then loses its points over the polygons facing up that have nothing above them,
+ * see no light and stand over such a floor (that room's roof). A correctly oriented room's
+ * polygons facing down (ceilings, undersides, a shelf over a lit floor) find no floor, and
+ * its work plane is the one of the polygons facing up alone, as without `lights`. Warns when
+ * every sensor lies above the scene while some polygon faces down. Throws InputError when no
+ * polygon is a floor, and UsageError when the grid would have more sensors than a solve
+ * accepts.
  */
-vtkSmartPointer<vtkPolyData> workPlaneSensors(
-  vtkPolyData* scene, const Triple& up, double height, double spacing);
+vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& up, double height,
+  double spacing, const std::vector<Triple>& lights = {});
 
 /// Writes the Sensors output of one frame (points as vertices and their arrays) to `path`,
 /// a .vtp file. Throws std::runtime_error when it cannot be written.

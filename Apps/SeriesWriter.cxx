@@ -38,6 +38,11 @@ SeriesNaming::SeriesNaming(const std::filesystem::path& collection, std::size_t 
   }
 }
 
+std::filesystem::path sensorsCollectionOf(const std::filesystem::path& collection)
+{
+  return collection.parent_path() / (collection.stem().string() + "_sensors.pvd");
+}
+
 std::string SeriesNaming::frameName(std::size_t frame, const std::string& extension) const
 {
   std::ostringstream name;

@@ -38,6 +38,10 @@ struct SeriesNaming
   std::string frameName(std::size_t frame, const std::string& extension) const;
 };
 
+/// The sensors' series beside the series `collection` (PATH.pvd): PATH_sensors.pvd, whose
+/// frames are PATH_sensors_0000.vtp ...
+std::filesystem::path sensorsCollectionOf(const std::filesystem::path& collection);
+
 /**
  * Writes the frames of a series, each the filter's Elements output as an unstructured grid of
  * triangles with its cell, point and field data and a field array TimeValue, LZ4-compressed

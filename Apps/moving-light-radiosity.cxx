@@ -16,6 +16,7 @@
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
+#include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationDoubleVectorKey.h"
 #include "vtkMovingLightRadiosity.h"
@@ -38,6 +39,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -146,6 +148,38 @@ void prepareDirectory(OutputTransaction& output, const fs::path& directory)
   fs::remove(probe, error);
 }
 
+/// True when `index` is a .pvd collection whose every data set is a file `prefix`NNNN`suffix`
+/// beside it: a series the command line wrote, not a file of the user's that happens to bear
+/// its name.
+bool indexesOnly(const fs::path& index, const std::string& prefix, const std::string& suffix)
+{
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(index, error);
+  if (error || size > (std::uintmax_t(64) << 20))
+  {
+    return false;
+  }
+  std::ifstream in(index);
+  const std::string text{ std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>() };
+  if (text.find("type=\"Collection\"") == std::string::npos)
+  {
+    return false;
+  }
+  std::size_t files = 0;
+  for (std::size_t at = text.find(" file=\""); at != std::string::npos;
+       at = text.find(" file=\"", at + 1))
+  {
+    const std::size_t begin = at + 7;
+    const std::size_t end = text.find('"', begin);
+    if (end == std::string::npos || !isSeriesFile(text.substr(begin, end - begin), prefix, suffix))
+    {
+      return false;
+    }
+    ++files;
+  }
+  return files > 0;
+}
+
 /// True when the scene's emission array (the filter's EmissionArrayName) has a value above 0.
 bool emits(vtkPolyData* scene, const char* arrayName)
 {
@@ -164,6 +198,66 @@ bool emits(vtkPolyData* scene, const char* arrayName)
     }
   }
   return false;
+}
+
+/**
+ * Where the lights are, for the work plane to find the floors they light: the trajectory's
+ * points (each light's centroid in a frame), the ends and middle of --from/--to, or the
+ * centroids of the scene's emitting cells. None under the sun or a sky, which light from
+ * above.
+ */
+std::vector<Triple> lightPositions(const Options& options, vtkPolyData* trajectory,
+  vtkPolyData* scene, const char* emissionArrayName)
+{
+  std::vector<Triple> positions;
+  if (options.usesSun() || options.sky)
+  {
+    return positions;
+  }
+  if (options.from)
+  {
+    const Triple& a = *options.from;
+    const Triple& b = *options.to;
+    positions = { a, { (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2 }, b };
+  }
+  else if (trajectory)
+  {
+    for (vtkIdType i = 0; i < trajectory->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      trajectory->GetPoint(i, p);
+      positions.push_back({ p[0], p[1], p[2] });
+    }
+  }
+  else if (vtkDataArray* emission = scene->GetCellData()->GetArray(emissionArrayName))
+  {
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType c = 0; c < scene->GetNumberOfCells(); ++c)
+    {
+      double most = 0;
+      for (int k = 0; k < emission->GetNumberOfComponents(); ++k)
+      {
+        most = std::max(most, emission->GetComponent(c, k));
+      }
+      scene->GetCellPoints(c, ids);
+      if (!(most > 0) || ids->GetNumberOfIds() == 0)
+      {
+        continue;
+      }
+      Triple centroid{ 0, 0, 0 };
+      for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
+      {
+        double p[3];
+        scene->GetPoint(ids->GetId(i), p);
+        for (int k = 0; k < 3; ++k)
+        {
+          centroid[k] += p[k] / static_cast<double>(ids->GetNumberOfIds());
+        }
+      }
+      positions.push_back(centroid);
+    }
+  }
+  return positions;
 }
 
 std::vector<double> timeSteps(vtkMovingLightRadiosity* filter)
@@ -197,6 +291,17 @@ void tripleOf(vtkFieldData* data, const char* name, double out[3])
   {
     array->GetTuple(0, out);
   }
+}
+
+/// What a frame's field data says of its lights: where the first light is, where the sun is,
+/// and the luminous efficacy of its Illuminance.
+void recordLights(FrameRecord& record, vtkFieldData* data)
+{
+  tripleOf(data, "LightPosition", record.lightPosition.data());
+  tripleOf(data, "SunDirection", record.sunDirection.data());
+  vtkDataArray* efficacy = data->GetArray("LuminousEfficacy");
+  record.luminousEfficacy =
+    efficacy && efficacy->GetNumberOfTuples() > 0 ? efficacy->GetComponent(0, 0) : 0.0;
 }
 
 /// Runs the Sun Path source with the scene's north and up; its error, without VTK's location
@@ -367,7 +472,7 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
           if (writes)
           {
             vtkPolyData* elements = frameAt(filter, times[f]);
-            tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+            recordLights(record, elements->GetFieldData());
             if (elements->GetNumberOfCells() > 0)
             {
               writer.write(elements, times[f], output.stage(naming.directory / record.file));
@@ -394,7 +499,7 @@ std::vector<FrameRecord> writeRankFrames(RankJob& job, vtkMovingLightRadiosity* 
 /**
  * Under mpiexec, after a streamed solve: each rank wrote the frames of its chunks as they
  * came (`mine`, of the frames `mineFrames`); the ranks agree that every frame was written once, and
- * every rank gets the records of all, the light's positions summed over the ranks.
+ * every rank gets the records of all, what they say of the lights summed over the ranks.
  */
 std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double>& times,
   const SeriesNaming& naming, std::optional<FrameWriter>& writer,
@@ -406,19 +511,26 @@ std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double
     failure = failureOf([&] { writer->finish(); });
   }
   agreeOnFramesWritten(job, failure, static_cast<long long>(mine.size()), times.size());
-  std::vector<double> positions(3 * times.size(), 0.0);
+  // Per frame: the light's position, the sun's direction and the luminous efficacy.
+  constexpr std::size_t Values = 7;
+  std::vector<double> lights(Values * times.size(), 0.0);
   for (std::size_t i = 0; i < mine.size(); ++i)
   {
-    std::copy(
-      mine[i].lightPosition.begin(), mine[i].lightPosition.end(), &positions[3 * mineFrames[i]]);
+    double* at = &lights[Values * mineFrames[i]];
+    std::copy(mine[i].lightPosition.begin(), mine[i].lightPosition.end(), at);
+    std::copy(mine[i].sunDirection.begin(), mine[i].sunDirection.end(), at + 3);
+    at[6] = mine[i].luminousEfficacy;
   }
-  job.sum(positions);
+  job.sum(lights);
   std::vector<FrameRecord> records(times.size());
   for (std::size_t f = 0; f < times.size(); ++f)
   {
     records[f].time = times[f];
     records[f].file = naming.frameName(f, ".vtu");
-    std::copy(&positions[3 * f], &positions[3 * f + 3], records[f].lightPosition.begin());
+    const double* at = &lights[Values * f];
+    std::copy(at, at + 3, records[f].lightPosition.begin());
+    std::copy(at + 3, at + 6, records[f].sunDirection.begin());
+    records[f].luminousEfficacy = at[6];
   }
   return records;
 }
@@ -496,7 +608,8 @@ int run(int argc, char** argv, RankJob& job)
   else if (options.workPlane)
   {
     sensors =
-      workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1]);
+      workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1],
+        lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()));
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);
@@ -572,8 +685,7 @@ int run(int argc, char** argv, RankJob& job)
   OutputTransaction output;
   const fs::path collection = options.output;
   const SeriesNaming naming(collection, times.size());
-  const fs::path sensorCollection =
-    collection.parent_path() / (collection.stem().string() + "_sensors.pvd");
+  const fs::path sensorCollection = sensorsCollectionOf(collection);
   const SeriesNaming sensorNaming(sensorCollection, times.size());
   checkNotADirectory(collection, "output");
   prepareDirectory(output, naming.directory);
@@ -620,7 +732,7 @@ int run(int argc, char** argv, RankJob& job)
           FrameRecord record;
           record.time = times[f];
           record.file = naming.frameName(f, ".vtu");
-          tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+          recordLights(record, elements->GetFieldData());
           streamWriter->write(elements, times[f], output.stage(naming.directory / record.file));
           records.push_back(record);
           streamedFrames.push_back(f);
@@ -675,6 +787,11 @@ int run(int argc, char** argv, RankJob& job)
   // A copy: the next update clears the output's field data in place.
   vtkNew<vtkFieldData> statistics;
   statistics->ShallowCopy(first->GetFieldData());
+  // The update of the Elements serves the Light output too: the area lights as solved.
+  PosedLight posedLight;
+  posedLight.light = vtkSmartPointer<vtkPolyData>::New();
+  posedLight.light->DeepCopy(filter->GetOutput(vtkMovingLightRadiosity::LIGHT_OUTPUT_PORT));
+  posedLight.frame = streaming ? times.size() - 1 : 0;
   vtkDataArray* remeshing = statistics->GetArray("SecondsRemeshing");
   stages.remeshing = remeshing ? std::min(remeshing->GetComponent(0, 0), update) : 0.0;
   stages.solving = update - stages.remeshing;
@@ -724,7 +841,7 @@ int run(int argc, char** argv, RankJob& job)
       FrameRecord record;
       record.time = times[f];
       record.file = naming.frameName(f, ".vtu");
-      tripleOf(elements->GetFieldData(), "LightPosition", record.lightPosition.data());
+      recordLights(record, elements->GetFieldData());
       writer.write(elements, times[f], output.stage(naming.directory / record.file));
       records.push_back(record);
       if (sensors)
@@ -746,10 +863,21 @@ int run(int argc, char** argv, RankJob& job)
   {
     output.replaceSeries(naming.directory, naming.framePrefix(), ".vtu");
   }
-  if (sensors)
+  if (job.rank() == 0)
   {
+    // An earlier run's sensors are part of the series this one replaces, with or without
+    // sensors of its own.
     output.replaceSeries(naming.directory, sensorNaming.framePrefix(), ".vtp");
-    writeCollection(output.stage(sensorCollection), sensorEntries);
+    if (sensors)
+    {
+      writeCollection(output.stage(sensorCollection), sensorEntries);
+    }
+    else
+    {
+      output.removeAtCommit(sensorCollection,
+        [&sensorNaming](const fs::path& index)
+        { return indexesOnly(index, sensorNaming.framePrefix(), ".vtp"); });
+    }
   }
   stages.writing = secondsSince(writingStarted);
 
@@ -790,7 +918,8 @@ int run(int argc, char** argv, RankJob& job)
     if (!options.stats.empty())
     {
       const fs::path statsPath = options.stats;
-      writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records, stages);
+      writeStatisticsJson(output.stage(statsPath), options, filter, statistics, records, stages,
+        posedLight, sensors ? sensors->GetNumberOfPoints() : 0);
     }
   };
   if (!job.parallel())
@@ -837,7 +966,7 @@ int run(int argc, char** argv, RankJob& job)
     std::cout << ", " << sensors->GetNumberOfPoints() << " sensors in "
               << sensorCollection.string();
   }
-  std::cout << std::endl;
+  std::cout << "\n" << timeLine(stages) << std::endl;
   return 0;
 }
 }

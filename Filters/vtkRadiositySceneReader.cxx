@@ -23,6 +23,7 @@
 #include <cmath>
 #include <filesystem>
 #include <new>
+#include <sstream>
 #include <string>
 
 vtkStandardNewMacro(vtkRadiositySceneReader);
@@ -72,7 +73,21 @@ vtkRadiositySceneReader::~vtkRadiositySceneReader()
 int vtkRadiositySceneReader::CanReadFile(const char* fileName)
 {
   const std::string extension = lowerExtension(fileName);
-  return extension == ".obj" || extension == ".gltf" || extension == ".glb" || extension == ".ply";
+  std::istringstream extensions(GetFileExtensions());
+  for (std::string known; extensions >> known;)
+  {
+    if (extension == known)
+    {
+      return 1;
+    }
+  }
+  return 0;
+}
+
+//------------------------------------------------------------------------------
+const char* vtkRadiositySceneReader::GetFileExtensions()
+{
+  return ".obj .gltf .glb .ply";
 }
 
 //------------------------------------------------------------------------------

@@ -96,10 +96,16 @@ public:
   ///@}
 
   /**
-   * Whether the extension of `fileName` is one this reader reads (.obj, .gltf, .glb, .ply).
+   * Whether the extension of `fileName` is one this reader reads (GetFileExtensions()).
    * The file itself is not opened.
    */
   static int CanReadFile(const char* fileName);
+
+  /**
+   * The extensions this reader reads, lowercase, separated by spaces: ".obj .gltf .glb .ply"
+   * (any case in a file name).
+   */
+  static const char* GetFileExtensions();
 
 protected:
   vtkRadiositySceneReader();

@@ -151,53 +151,65 @@ std::string extensionOf(const std::string& path)
   return extension;
 }
 
-/// The reader for `extension` on `path`; InputError for an extension we do not read.
-vtkSmartPointer<vtkAlgorithm> makeReader(
-  const std::string& path, const std::string& extension, const std::string& what)
+template <typename Reader>
+vtkSmartPointer<vtkAlgorithm> fileReader(const std::string& path)
 {
-  vtkSmartPointer<vtkAlgorithm> reader;
-  if (extension == ".vtp")
-  {
-    auto xml = vtkSmartPointer<vtkXMLPolyDataReader>::New();
-    xml->SetFileName(path.c_str());
-    reader = xml;
-  }
-  else if (extension == ".vtu")
-  {
-    auto xml = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
-    xml->SetFileName(path.c_str());
-    reader = xml;
-  }
-  else if (extension == ".vtk")
-  {
-    auto legacy = vtkSmartPointer<vtkGenericDataObjectReader>::New();
-    legacy->SetFileName(path.c_str());
-    reader = legacy;
-  }
-  else if (extension == ".obj")
-  {
-    auto obj = vtkSmartPointer<vtkOBJReader>::New();
-    obj->SetFileName(path.c_str());
-    reader = obj;
-  }
-  else if (extension == ".ply")
-  {
-    auto ply = vtkSmartPointer<vtkPLYReader>::New();
-    ply->SetFileName(path.c_str());
-    reader = ply;
-  }
-  else if (extension == ".stl")
-  {
-    auto stl = vtkSmartPointer<vtkSTLReader>::New();
-    stl->SetFileName(path.c_str());
-    reader = stl;
-  }
-  else
-  {
-    throw InputError(
-      what + " has an unknown extension: give a .vtp .vtu .vtk .obj .ply or .stl file");
-  }
+  auto reader = vtkSmartPointer<Reader>::New();
+  reader->SetFileName(path.c_str());
   return reader;
+}
+
+/// VTK's readers by extension: what readSurfaceFile() reads, and names when it cannot.
+struct VtkReader
+{
+  const char* extension;
+  vtkSmartPointer<vtkAlgorithm> (*make)(const std::string& path);
+};
+const VtkReader VtkReaders[] = {
+  { ".vtp", fileReader<vtkXMLPolyDataReader> },
+  { ".vtu", fileReader<vtkXMLUnstructuredGridReader> },
+  { ".vtk", fileReader<vtkGenericDataObjectReader> },
+  { ".obj", fileReader<vtkOBJReader> },
+  { ".ply", fileReader<vtkPLYReader> },
+  { ".stl", fileReader<vtkSTLReader> },
+};
+
+/// "a .vtp .vtu ... or .stl file": VTK's extensions, then those of `more` not among them.
+std::string extensionsText(const std::vector<std::string>& more)
+{
+  std::vector<std::string> all;
+  for (const VtkReader& reader : VtkReaders)
+  {
+    all.emplace_back(reader.extension);
+  }
+  for (const std::string& extension : more)
+  {
+    if (std::find(all.begin(), all.end(), extension) == all.end())
+    {
+      all.push_back(extension);
+    }
+  }
+  std::string text = "a";
+  for (std::size_t i = 0; i < all.size(); ++i)
+  {
+    text += (i + 1 == all.size() && i > 0 ? " or " : " ") + all[i];
+  }
+  return text + " file";
+}
+
+/// The reader for `extension` on `path`; InputError for an extension we do not read (nor
+/// the caller's reader, which reads `ownExtensions`).
+vtkSmartPointer<vtkAlgorithm> makeReader(const std::string& path, const std::string& extension,
+  const std::string& what, const std::vector<std::string>& ownExtensions = {})
+{
+  for (const VtkReader& reader : VtkReaders)
+  {
+    if (extension == reader.extension)
+    {
+      return reader.make(path);
+    }
+  }
+  throw InputError(what + " has an unknown extension: give " + extensionsText(ownExtensions));
 }
 
 std::string secondsText(double seconds)
@@ -536,7 +548,8 @@ vtkSmartPointer<vtkPolyData> polygonsOf(vtkAlgorithm* reader)
 }
 
 vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std::string& role,
-  const ReadLimits& limits, const ReaderFactory& ownReader)
+  const ReadLimits& limits, const ReaderFactory& ownReader,
+  const std::vector<std::string>& ownExtensions)
 {
   const std::string what = "the " + role + " file '" + path + "'";
   std::error_code error;
@@ -556,7 +569,8 @@ vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std:
 
   const std::string extension = extensionOf(path);
   const vtkSmartPointer<vtkAlgorithm> own = ownReader ? ownReader(path, extension) : nullptr;
-  const vtkSmartPointer<vtkAlgorithm> probe = own ? own : makeReader(path, extension, what);
+  const vtkSmartPointer<vtkAlgorithm> probe =
+    own ? own : makeReader(path, extension, what, ownExtensions);
   if (auto* xml = vtkXMLReader::SafeDownCast(probe))
   {
     if (!xml->CanReadFile(path.c_str()))

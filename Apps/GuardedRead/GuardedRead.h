@@ -14,6 +14,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 class vtkAlgorithm;
 class vtkPolyData;
@@ -66,10 +67,11 @@ struct ReadLimits
 
 /**
  * Reads a .vtp .vtu .vtk .obj .ply or .stl file as polygons (the surface of volumetric data),
- * keeping its cell arrays. `role` ("scene", "light", ...) names it in messages ("the scene file
- * 'x.obj'"). Throws InputError when the file is missing, empty, of an unknown extension,
- * refused by the checks, reported as bad by VTK, when the reader crashes, runs out of memory or
- * time, or when the file has no points.
+ * keeping its cell arrays, or with `ownReader` a file of its own. `ownExtensions` are the
+ * extensions `ownReader` reads, named beside VTK's readers' when a file has none of them. `role`
+ * ("scene", "light", ...) names it in messages ("the scene file 'x.obj'"). Throws InputError when
+ * the file is missing, empty, of an unknown extension, refused by the checks, reported as bad by
+ * VTK, when the reader crashes, runs out of memory or time, or when the file has no points.
  *
  * VTK's messages from the reading process are passed on to stderr unless it crashed or was
  * stopped. SIGINT and SIGTERM reaching the calling thread while it waits stop the reading
@@ -84,7 +86,8 @@ using ReaderFactory = std::function<vtkSmartPointer<vtkAlgorithm>(
   const std::string& path, const std::string& extension)>;
 
 vtkSmartPointer<vtkPolyData> readSurfaceFile(const std::string& path, const std::string& role,
-  const ReadLimits& limits = {}, const ReaderFactory& ownReader = {});
+  const ReadLimits& limits = {}, const ReaderFactory& ownReader = {},
+  const std::vector<std::string>& ownExtensions = {});
 
 /**
  * Runs `reader` in this process and returns its output as polygons (the surface of other

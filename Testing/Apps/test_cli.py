@@ -162,6 +162,11 @@ def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, mess
     (["--gather-ratio", "1e999"], "--gather-ratio needs a number, not '1e999'"),
     (["--from", "1,2"], "--from needs three numbers X,Y,Z, not '1,2'"),
     (["--aim", "1,2,3,"], "--aim needs three numbers X,Y,Z, not '1,2,3,'"),
+    # CLI11 takes the next word as the value: these solved and wrote a file named --help.
+    (["--stats", "--help"], "--stats needs a value: --stats FILE.json, not the option '--help'"),
+    (["--png", "--help"], "--png needs a value: --png DIR, not the option '--help'"),
+    (["--output", "--help"], "--output needs a value: --output PATH.pvd, not the option"),
+    (["--scene", "--help"], "--scene needs a value: --scene FILE, not the option '--help'"),
 ])
 def test_bad_syntax_fails_with_a_message_and_writes_nothing(tmp_path, args, message):
     result = run(args, tmp_path)
@@ -191,6 +196,48 @@ def test_equals_syntax(tmp_path):
     settings = json.loads((tmp_path / "s.json").read_text())["settings"]
     assert settings["paths"] == 20000 and settings["seed"] == 3
     assert all_files(tmp_path) == ["s.json", "s.pvd", "s_0000.vtu", "s_0001.vtu"]
+
+
+@pytest.mark.parametrize("stats, words", [
+    ("out/s.pvd", "is the series of --output 'out/s.pvd'"),
+    ("out/s_0001.vtu", "is a frame of the series of --output 'out/s.pvd'"),
+    ("out/s_0012.vtu", "is a frame of the series of --output 'out/s.pvd'"),  # no such frame yet
+    ("out/../out/s_sensors.pvd", "is a file of the sensors' series of --output 'out/s.pvd'"),
+    ("out/s_sensors_0000.vtp", "is a file of the sensors' series of --output 'out/s.pvd'"),
+    ("pictures", "is the folder of --png 'pictures'"),
+    ("pictures/s_0001.png", "is the folder of --png 'pictures' or one of its pictures"),
+])
+def test_stats_on_a_file_of_the_run_is_refused_and_keeps_the_earlier_series(tmp_path, stats,
+                                                                            words):
+    """The statistics were staged under the name of a file of the series: the commit renamed
+    half of the files, then failed, leaving JSON in the .pvd (or a frame)."""
+    base = ["--scene", SCENE, "--light", LIGHT, "--output", "out/s.pvd", "--frames", "2"] + \
+        PATH + FAST
+    assert run(base, tmp_path).returncode == 0
+    before = {name: (tmp_path / name).read_bytes() for name in all_files(tmp_path)}
+    pictures = ["--png", "pictures"] if stats.startswith("pictures") else []
+    result = run(base + ["--light-power", "5", "--stats", stats] + pictures, tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert f"--stats '{stats}' {words}" in result.stderr, result.stderr
+    assert "give the statistics a file of their own, e.g. --stats out/s.json" in result.stderr
+    assert {name: (tmp_path / name).read_bytes() for name in all_files(tmp_path)} == before
+
+
+def test_unknown_scene_extension_names_every_format_read(tmp_path):
+    """The scene's formats are VTK's readers' and the scene reader's (glTF too); a light file
+    is read by VTK's alone."""
+    (tmp_path / "lamp.ies").write_text("IESNA:LM-63-2002\n")
+    result = run(["--scene", "lamp.ies", "--light", LIGHT, "--output", "out/x.pvd"] + PATH + FAST,
+                 tmp_path)
+    assert result.returncode == 1
+    assert "the scene file 'lamp.ies' has an unknown extension: give a .vtp .vtu .vtk .obj .ply " \
+        ".stl .gltf or .glb file" in result.stderr, result.stderr
+    result = run(["--scene", SCENE, "--light", "lamp.ies", "--output", "out/x.pvd"] + PATH + FAST,
+                 tmp_path)
+    assert result.returncode == 1
+    assert "the light file 'lamp.ies' has an unknown extension: give a .vtp .vtu .vtk .obj .ply " \
+        "or .stl file" in result.stderr, result.stderr
+    assert all_files(tmp_path) == ["lamp.ies"]
 
 
 def test_unreadable_files_fail_with_a_message_and_write_nothing(tmp_path):

@@ -11,6 +11,7 @@ are compared within 4.5 standard deviations of the number of paths that land the
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
 """
+import json
 import math
 import os
 import sys
@@ -128,6 +129,53 @@ def test_light_distribution_file_gives_its_own_flux(tmp_path):
         2000 * math.pi / 179 / 100, rel=STORED_RATIO)
     # --light-lumens wins over the file's flux: 8950 lm is 50 W.
     assert lumens.cells("DirectRadiosity")[lit] / direct[lit] == pytest.approx(0.5, rel=1e-6)
+
+
+def test_stats_record_the_point_light_as_solved(tmp_path):
+    """--stats said "built-in Cornell box" and LightPower's 100 W for an IES point light: it
+    records the light's kind, file, flux and the power solved."""
+    ies = write_uniform_hemisphere(tmp_path / "own.ies")
+    result = run(["--scene", write_floor(tmp_path), "--point-light", "--from", f"0,0,{HEIGHT}",
+                  "--to", f"0,0,{HEIGHT}", "--frames", "1", "--light-distribution", ies,
+                  "--paths", "2000", "--output", "out/s.pvd", "--stats", "out/s.json"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "out" / "s.json").read_text())
+    assert stats["light"] == "point light"
+    lighting = stats["lighting"]
+    assert lighting["kind"] == "point light" and lighting["distributionFile"] == ies
+    assert lighting["powerFrom"] == "the distribution file's flux"
+    assert lighting["lumens"] == pytest.approx(2000 * math.pi, rel=1e-9)
+    assert lighting["luminousEfficacy"] == 179
+    assert lighting["powerW"] == pytest.approx([2000 * math.pi / 179] * 3, rel=1e-9)
+    assert stats["settings"]["lightPower"] == lighting["powerW"]
+    assert stats["frames"][0]["lightPosition"] == [0, 0, HEIGHT]
+
+    # --light-lumens with a colour: the colour scaled to those lumens.
+    result = run(["--scene", write_floor(tmp_path), "--point-light", "--from", f"0,0,{HEIGHT}",
+                  "--to", f"0,0,{HEIGHT}", "--frames", "1", "--spot", "40",
+                  "--light-lumens", "8950", "--light-power", "2,1,0", "--paths", "2000",
+                  "--output", "out/c.pvd", "--stats", "out/c.json"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    lighting = json.loads((tmp_path / "out" / "c.json").read_text())["lighting"]
+    scale = 50 / (0.2126 * 2 + 0.7152 * 1)
+    assert lighting["powerW"] == pytest.approx([2 * scale, scale, 0], rel=1e-9)
+    assert lighting["lumens"] == 8950 and lighting["powerFrom"] == "--light-lumens"
+    assert lighting["spot"] == {"halfAngleDegrees": 40, "softEdgeDegrees": 0}
+
+    # A luminaire of an opening: its power is the Light output's, the file's flux.
+    (tmp_path / "opening.ies").write_text(
+        "IESNA:LM-63-2002\n[TEST] uniform downlight\nTILT=NONE\n1 -1 1 3 1 1 2 0.2 0.2 0\n"
+        "1 1 0\n0 45 90\n0\n1000 1000 1000\n")
+    result = run(["--scene", write_floor(tmp_path), "--luminaire", "--light-distribution",
+                  "opening.ies", "--from", f"0,0,{HEIGHT}", "--to", f"0,0,{HEIGHT}", "--frames",
+                  "1", "--paths", "2000", "--output", "out/l.pvd", "--stats", "out/l.json"],
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "out" / "l.json").read_text())
+    lighting = stats["lighting"]
+    assert stats["light"] == "luminaire" and lighting["emitsFrom"] == "the file's luminous opening"
+    assert lighting["powerW"] == pytest.approx([2000 * math.pi / 179] * 3, rel=1e-6)
+    assert lighting["powerFrame"] == 0
 
 
 def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):

@@ -10,6 +10,9 @@ import os
 import shutil
 import sys
 
+import numpy
+import pytest
+
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
 from cli_support import DATA, all_files, run  # noqa: E402
 
@@ -42,7 +45,21 @@ def test_light_material_is_the_moving_lamp_with_its_own_power(tmp_path):
     result = run(["--scene", OBJ, "--light-material", "light", "--output", "out/cornell.pvd",
                   "--stats", "out/stats.json"] + PATH + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
-    assert json.loads((tmp_path / "out" / "stats.json").read_text())["light"] == "material light"
+    stats = json.loads((tmp_path / "out" / "stats.json").read_text())
+    assert stats["light"] == "material light"
+    # The power solved is the material's, pi Ke area (the Light output's Power), not
+    # LightPower's 100 W, which --stats used to state.
+    lighting = stats["lighting"]
+    assert lighting["kind"] == "material" and lighting["material"] == "light"
+    assert lighting["powerFrom"] == "the material's emission (pi Ke area)"
+    power = lighting["powerW"]
+    assert power == pytest.approx([9.432, 6.658, 2.219], abs=0.002)
+    assert numpy.array(power) / (math.pi * numpy.array([17, 12, 4])) == pytest.approx(
+        power[0] / (math.pi * 17), rel=1e-6)
+    assert stats["settings"]["lightPower"] == power
+    assert lighting["lumens"] == pytest.approx(
+        179 * (0.2126 * power[0] + 0.7152 * power[1] + 0.0722 * power[2]))
+    assert [f["lightPosition"][0] for f in stats["frames"]] == pytest.approx([-0.15, 0, 0.15])
     data = frame(tmp_path, 1)
     # The materials' Kd, not grey: the left wall red, the right wall green.
     rho = vtk_to_numpy(data.GetCellData().GetArray("Reflectance"))

@@ -12,6 +12,7 @@ mixture: N times the mean over active frames of the probability of reaching the 
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
 """
+import json
 import math
 import os
 import sys
@@ -293,6 +294,25 @@ def test_sun_path_is_dark_at_night_and_rho_e_sin_elevation_by_day(tmp_path):
         assert frame.mean("DirectRadiosity", region) == pytest.approx(
             [expected] * 3, rel=sun_tolerance(frame, region, active))
         assert not frame.cells("EmittedRadiosity").any()
+
+
+def test_stats_record_the_sun_and_its_direction_in_each_frame(tmp_path):
+    """The sun's frames have no light position ([0, 0, 0] was recorded): --stats gives each
+    frame's direction towards the sun, and the sun's settings."""
+    frames = solve(tmp_path, ["--scene", write_town(tmp_path), "--sun-path",
+                              PARIS + ",10:00,14:00,120", "--time-zone", "2", "--sun-irradiance",
+                              "800", "--stats", "s.json"], paths=2000)
+    stats = json.loads((tmp_path / "s.json").read_text())
+    assert stats["light"] == "sun" and "lightPower" not in stats["settings"]
+    sun = stats["lighting"]["sun"]
+    assert sun["irradianceWPerM2"] == 800
+    assert sun["path"] == {"latitude": 48.85, "longitude": 2.35, "date": "2024-06-21",
+                           "startHour": 10, "endHour": 14, "stepMinutes": 120, "timeZone": 2}
+    assert sun["north"] == [0, 1, 0] and stats["lighting"]["up"] == [0, 0, 1]
+    assert len(stats["frames"]) == len(frames) == 3
+    for record, (_, frame) in zip(stats["frames"], frames):
+        assert "lightPosition" not in record
+        assert record["sunDirection"] == pytest.approx(frame.field("SunDirection"), abs=1e-12)
 
 
 def test_sun_path_through_the_night_is_dark_with_a_warning(tmp_path):

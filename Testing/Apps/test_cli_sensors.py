@@ -173,6 +173,64 @@ def test_bad_sensor_inputs(tmp_path):
     assert result.returncode == 1 and "no polygon facing up" in result.stderr, result.stderr
 
 
+def test_a_run_without_sensors_removes_the_earlier_sensors_series(tmp_path):
+    """Its frames and pictures were replaced, not its sensors' series: a run without
+    sensors left the earlier one beside the new frames. A file of that name that is no
+    sensors' series of the command line's stays."""
+    base = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
+            "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--output", "out/room.pvd"] + FAST
+    result = run(base + ["--frames", "3", "--work-plane", f"{HEIGHT},{SPACING}"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert len(read_sensor_series(tmp_path)) == 3
+    result = run(base + ["--frames", "2"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert sorted(os.listdir(tmp_path / "out")) == ["room.pvd", "room_0000.vtu", "room_0001.vtu"]
+
+    # Not the command line's: another series' frames, or no collection at all.
+    mine = '<VTKFile type="Collection"><Collection><DataSet file="mine_0000.vtu"/></Collection>' \
+        '</VTKFile>\n'
+    (tmp_path / "out" / "room_sensors.pvd").write_text(mine)
+    result = run(base + ["--frames", "2"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "out" / "room_sensors.pvd").read_text() == mine
+
+
+def write_outward_box(directory):
+    """The room of write_room with a ceiling, modelled as a closed box with its normals
+    outward: its floor faces down, its roof up."""
+    room = Polygons()
+    room.add([(0, 0, 0), (0, D, 0), (W, D, 0), (W, 0, 0)])          # floor, facing down
+    room.add([(0, 0, H), (W, 0, H), (W, D, H), (0, D, H)])          # roof, facing up
+    room.add([(0, 0, 0), (0, 0, H), (0, D, H), (0, D, 0)])          # x = 0, facing -x
+    room.add([(W, 0, 0), (W, D, 0), (W, D, H), (W, 0, H)])          # x = W, facing +x
+    room.add([(0, 0, 0), (W, 0, 0), (W, 0, H), (0, 0, H)])          # y = 0, facing -y
+    room.add([(0, D, 0), (0, D, H), (W, D, H), (W, D, 0)])          # y = D, facing +y
+    return room.write(directory / "outward.vtp")
+
+
+def test_work_plane_finds_the_floor_of_a_room_with_outward_normals(tmp_path):
+    """The solve is two-sided: a room modelled with outward normals is lit as the same room
+    with inward ones. Its work plane was 0.8 above its roof, outside, at 0 lx: it is the same
+    grid over its floor, which sees the lamp."""
+    lamp = ["--point-light", "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--frames", "2",
+            "--work-plane", f"{HEIGHT},{SPACING}"] + FAST
+    result = run(["--scene", write_outward_box(tmp_path), "--output", "out/room.pvd"] + lamp,
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "--work-plane" not in result.stderr, result.stderr
+    outward = read_sensor_series(tmp_path)
+    result = run(["--scene", write_room(tmp_path, ceiling=True), "--output", "in/room.pvd"] + lamp,
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    inward = read_sensor_series(tmp_path, "in/room_sensors.pvd")
+    for (_, a), (_, b) in zip(outward, inward):
+        assert a.GetNumberOfPoints() == b.GetNumberOfPoints() == 24
+        assert vtk_to_numpy(a.GetPoints().GetData()) == pytest.approx(
+            vtk_to_numpy(b.GetPoints().GetData()), abs=1e-12)
+        assert numpy.allclose(array(a, "Normals"), [0, 0, 1])
+        assert numpy.all(array(a, "Illuminance") > 0)
+
+
 def test_work_plane_follows_up(tmp_path):
     # The same 3 x 2 floor in the x-z plane, facing +y, with --up 0,1,0: 24 sensors 0.8 above
     # it along y, facing +y; a ceiling-like face (facing -y) gets none.

@@ -121,6 +121,28 @@ def test_header_ranges_are_those_of_the_data(series):
     assert checked >= 14  # with the point data's Radiosity, Color and ScenePointId
 
 
+def test_printed_time_is_the_whole_run_with_its_stages_as_in_stats(tmp_path):
+    """The summary's time was the solve's alone: a long series printed a third of the wall
+    time. The run's time, from its start to its statistics, is printed with its stages, the
+    same figures as --stats (rounded as printed)."""
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", str(FRAMES), "--output", "out/s.pvd", "--stats", "out/s.json"] +
+                 FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    timing = json.loads((tmp_path / "out" / "s.json").read_text())["timing"]
+    line = re.search(r"^(\S+) s in all: reading (\S+) s, remeshing (\S+) s, solving (\S+) s, "
+                     r"writing (\S+) s$", result.stdout, re.MULTILINE)
+    assert line, result.stdout
+    printed = [float(value) for value in line.groups()]
+    for value, key in zip(printed, ("secondsTotal", "secondsReading", "secondsRemeshing",
+                                    "secondsSolving", "secondsWriting")):
+        assert value == pytest.approx(timing[key], abs=0.006), key
+    assert printed[4] > 0
+    assert sum(printed[1:]) <= printed[0] + 0.02
+    # The solver's own time is labelled as the solve's.
+    assert re.search(r"gathering\), solve \S+ s \(remeshing", result.stdout), result.stdout
+
+
 def test_stats_time_the_stages(series):
     stats = json.loads((series / "s.json").read_text())
     timing = stats["timing"]

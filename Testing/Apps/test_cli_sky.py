@@ -84,11 +84,34 @@ def test_up_turns_the_sky(tmp_path):
     (["--sky-diffuse-horizontal", "10"], "--sky-diffuse-horizontal needs --sky"),
     (["--sky", "uniform", "--sky-diffuse-horizontal", "-1"], "0 or above"),
     (["--up", "0,0,1"], "--up needs --sun-path"),
+    # Given and ignored before: the sky's Perez efficacy, no light to take them, the lights
+    # left out of a solve with a sky.
+    (["--sky", "uniform", "--luminous-efficacy", "90"],
+     "--luminous-efficacy with --sky: under a sky the Illuminance takes each frame's Perez"),
+    (["--sky", "uniform", "--light-lumens", "1000"], "--light-lumens is for a light, and the "
+                                                      "scene has none"),
+    (["--sky", "uniform", "--spot", "30"], "--spot is for a light, and the scene has none"),
+    (["--sky", "uniform", "--light-distribution", "a.ies"],
+     "--light-distribution is for a light, and the scene has none"),
+    (["--sky", "uniform", "--point-light", "--from", "0,0,1", "--to", "1,0,1"],
+     "--point-light with --sky: a sky lights the scene beside the sun or alone"),
+    (["--sky", "uniform", "--light-material", "m", "--from", "0,0,1", "--to", "1,0,1"],
+     "--light-material with --sky"),
+    (["--sky", "uniform", "--light", "lamp.vtp", "--from", "0,0,1", "--to", "1,0,1"],
+     "--light with --sky"),
 ])
 def test_bad_sky_options_are_refused_by_name(tmp_path, args, words):
     result = run(["--scene", write_ground(tmp_path)] + args + ["--output", "o/s.pvd"], tmp_path)
     assert result.returncode != 0
     assert words in result.stderr
+    assert not (tmp_path / "o").exists()
+
+
+def test_weather_refuses_a_luminous_efficacy_it_would_ignore(tmp_path):
+    result = run(["--scene", write_ground(tmp_path), "--weather", "w.epw",
+                  "--luminous-efficacy", "90", "--output", "o/s.pvd"], tmp_path)
+    assert result.returncode == 2
+    assert "--luminous-efficacy with --weather (and its Perez sky)" in result.stderr
     assert not (tmp_path / "o").exists()
 
 
