@@ -477,6 +477,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--sensors", "FILE.vtp", o.sensors, asGiven);
   option("--work-plane", "HEIGHT,SPACING", o.workPlane, parseWorkPlane);
   option("--da-threshold", "LX", o.daThreshold, parseNumber);
+  option("--sensor-rays", "N", o.sensorRays, parseInteger);
   option("--output", "PATH.pvd", o.output, parseOutput);
   option("--stats", "FILE.json", o.stats, asGiven);
   option("--png", "DIR", o.png, asGiven);
@@ -616,6 +617,11 @@ Options parseCommandLine(int argc, const char* const* argv)
     throw UsageError("--da-threshold is for the sensors' DaylightAutonomy: give --sensors "
                      "FILE.vtp or --work-plane HEIGHT,SPACING too");
   }
+  if (o.sensorRays && !o.usesSensors())
+  {
+    throw UsageError("--sensor-rays is for the sensors: give --sensors FILE.vtp or "
+                     "--work-plane HEIGHT,SPACING too");
+  }
   if (o.usesSun())
   {
     if (!o.light.empty() || !o.trajectory.empty() || o.from || o.to || o.aim || o.lightPower)
@@ -676,17 +682,19 @@ Options parseCommandLine(int argc, const char* const* argv)
         " with --sky: a sky lights the scene beside the sun or alone, and the solve would leave "
         "the light out; give one or the other");
     }
-    if (o.luminousEfficacy)
-    {
-      throw UsageError(std::string("--luminous-efficacy with ") +
-        (o.weather.empty() ? "--sky" : "--weather (and its Perez sky)") +
-        ": under a sky the Illuminance takes each frame's Perez daylight efficacy (field data "
-        "LuminousEfficacy), not this one; leave --luminous-efficacy out");
-    }
   }
   else if (o.skyDiffuseHorizontal)
   {
     throw UsageError("--sky-diffuse-horizontal needs --sky MODEL");
+  }
+  if (o.luminousEfficacy && (o.sky || o.usesSun()))
+  {
+    throw UsageError(std::string("--luminous-efficacy with ") +
+      (!o.weather.empty() ? "--weather"
+          : o.sky         ? "--sky"
+                          : "the sun") +
+      ": daylight's Illuminance takes each frame's Perez daylight efficacy (field data "
+      "LuminousEfficacy), not this one; leave --luminous-efficacy out");
   }
   if (o.skyDiffuseHorizontal &&
     !(*o.skyDiffuseHorizontal >= 0 && std::isfinite(*o.skyDiffuseHorizontal)))
@@ -928,6 +936,11 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkRange("--da-threshold", *o.daThreshold, 0.0, 1e9);
     filter->SetDaylightAutonomyThreshold(*o.daThreshold);
   }
+  if (o.sensorRays)
+  {
+    checkPropertyRange<long long>("--sensor-rays", *o.sensorRays, "SensorRays");
+    filter->SetSensorRays(static_cast<int>(*o.sensorRays));
+  }
   if (o.from)
   {
     checkPropertyRange<long long>("--frames", *o.frames, "NumberOfPositions");
@@ -1079,6 +1092,9 @@ Sensors (measuring points that receive light but neither block nor reflect it):
                         lights (not the sun or a sky) also over the faces facing down that
                         see a light from above (a room modelled with outward normals),
                         without that room's roof
+  --sensor-rays N       rays each sensor casts over its hemisphere (default 512), and an
+                        eighth as many points it samples on each area light: raise it
+                        for less noise on the sensors
   --da-threshold LX     the illuminance DaylightAutonomy counts the frames at or above
                         (default 300). The sensors' series is PATH_sensors.pvd with
                         PATH_sensors_0000.vtp ... (point arrays Irradiance, Illuminance per
@@ -1088,8 +1104,8 @@ Output:
   --luminous-efficacy LM_PER_W
                         lumens per watt of the light, which turn the Irradiance arrays
                         (W/m^2) into Illuminance (lx for a scene in metres); above 0 and at
-                        most 683 (default 179, white light); not with a sky, whose
-                        Illuminance takes each frame's Perez daylight efficacy
+                        most 683 (default 179, white light); not with the sun or a sky,
+                        whose Illuminance takes each frame's Perez daylight efficacy
   --output PATH.pvd     the series; frames go next to it as PATH_0000.vtu ...
                         (default output/cornell.pvd, or output/SCENE.pvd with --scene)
   --stats FILE.json     also write the options, the light as solved, times and solver

@@ -91,6 +91,8 @@ struct Options
   std::string sensors;
   std::optional<std::array<double, 2>> workPlane;
   std::optional<double> daThreshold;
+  /// Hemisphere rays per sensor (the filter's SensorRays).
+  std::optional<long long> sensorRays;
   bool usesSensors() const { return !this->sensors.empty() || this->workPlane.has_value(); }
 
   std::string output; ///< PATH.pvd

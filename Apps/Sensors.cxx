@@ -88,6 +88,22 @@ void checkSensorCount(double area, double spacing)
  * the lights (at most 16 of their positions, spread over the frames), and whether it is a roof
  * in the dark (nothing above it and no light in sight).
  */
+/// Faces sorted by level, grouped where consecutive levels are within `tolerance`: one floor
+/// each.
+std::vector<std::vector<Face>> levelsOf(const std::vector<Face>& sorted, double tolerance)
+{
+  std::vector<std::vector<Face>> levels;
+  for (std::size_t i = 0; i < sorted.size(); ++i)
+  {
+    if (i == 0 || sorted[i].level - sorted[i - 1].level > tolerance)
+    {
+      levels.emplace_back();
+    }
+    levels.back().push_back(sorted[i]);
+  }
+  return levels;
+}
+
 class FloorFinder
 {
 public:
@@ -334,16 +350,8 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     std::sort(facingDown.begin(), facingDown.end(),
       [](const Face& f, const Face& g) { return f.level < g.level; });
     std::vector<Face> floors;
-    for (std::size_t first = 0, last = 0; first < facingDown.size(); first = last)
+    for (const std::vector<Face>& level : levelsOf(facingDown, finder.levelTolerance()))
     {
-      last = first + 1;
-      while (last < facingDown.size() &&
-        facingDown[last].level - facingDown[last - 1].level <= finder.levelTolerance())
-      {
-        ++last;
-      }
-      const std::vector<Face> level(facingDown.begin() + static_cast<long>(first),
-        facingDown.begin() + static_cast<long>(last));
       double levelArea = 0;
       for (const Face& face : level)
       {
@@ -380,20 +388,11 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
           !(finder.isDarkRoof(sensor.point) && finder.standsOver(sensor.point, floorCells));
       }
       std::vector<Sensor> more;
-      for (std::size_t first = 0, last = 0; first < floors.size(); first = last)
+      for (const std::vector<Face>& level : levelsOf(floors, finder.levelTolerance()))
       {
-        last = first + 1;
-        while (last < floors.size() &&
-          floors[last].level - floors[last - 1].level <= finder.levelTolerance())
-        {
-          ++last;
-        }
         // An object's underside on the floor adds nothing to the floor's lattice.
-        const std::vector<Sensor> level =
-          lattice(std::vector<Face>(floors.begin() + static_cast<long>(first),
-                    floors.begin() + static_cast<long>(last)),
-            spacing, true);
-        more.insert(more.end(), level.begin(), level.end());
+        const std::vector<Sensor> onLevel = lattice(level, spacing, true);
+        more.insert(more.end(), onLevel.begin(), onLevel.end());
       }
       sensors.insert(sensors.end(), more.begin(), more.end());
     }

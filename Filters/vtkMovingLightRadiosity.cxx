@@ -1111,6 +1111,17 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     }
     vtkPolyData* lightData = vtkPolyData::GetData(inputs[LIGHT_PORT], 0);
     const bool directional = this->LightType == DIRECTIONAL_LIGHT;
+    if (this->SkyModel != NO_SKY && !directional &&
+      (this->LightType != AREA_LIGHT || !this->LightMaterial.empty() ||
+        (lightData && lightData->GetNumberOfCells() > 0)))
+    {
+      // A frame's Illuminance takes one efficacy, the daylight's: a lamp's lux would be
+      // wrong, so the lamp is refused rather than solved in daylight's lumens or left out.
+      throw mlr::Error("a sky lights the scene alone or with the sun (LightType Directional), "
+                       "not with a lamp: the Light, LightMaterial or point light would be left "
+                       "out. Solve the lamp and the sky apart (their Irradiance arrays add up), "
+                       "or set SkyModel to none");
+    }
     const mlr::vtkinputs::Trajectory trajectory =
       trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]));
     vtkPolyData* sceneData = vtkPolyData::GetData(inputs[SCENE_PORT], 0);

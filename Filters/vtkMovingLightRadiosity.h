@@ -367,8 +367,9 @@ public:
 
   ///@{
   /**
-   * A sky beside the other lights: none, uniform, CIE overcast, CIE clear (type 12) or Perez
-   * all-weather. The clear and Perez skies need LightType Directional: they follow its sun in
+   * A sky, alone or with the sun (LightType Directional): none, uniform, CIE overcast, CIE
+   * clear (type 12) or Perez all-weather; with a lamp (a Light, a LightMaterial or a point
+   * light) it is an error, since one frame's Illuminance takes one efficacy, the daylight's. The clear and Perez skies need LightType Directional: they follow its sun in
    * every frame (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is
    * scaled so that an unobstructed horizontal surface receives SkyDiffuseHorizontal, or the
    * Trajectory's point array SkyDiffuseHorizontal per frame; the Perez sky also reads the

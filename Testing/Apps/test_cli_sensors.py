@@ -122,6 +122,13 @@ def test_work_plane_under_the_sky_gives_the_grid_and_its_illuminance(tmp_path):
     shares = array(sensors, "UDILow") + array(sensors, "UDIUseful") + array(sensors, "UDIHigh")
     assert numpy.allclose(shares, 1)
     assert numpy.all(array(sensors, "DirectSunHours") == 0)
+    # --sensor-rays sets the rays per sensor.
+    result = run(["--scene", write_room(tmp_path), "--sky", "uniform", "--work-plane",
+                  f"{HEIGHT},{SPACING}", "--sensor-rays", "64", "--output", "out/room.pvd"]
+                 + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    sensors = read_sensor_series(tmp_path)[0][1]
+    assert sensors.GetFieldData().GetArray("SensorGatheringRays").GetValue(0) == 24 * 64
 
 
 def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
@@ -153,6 +160,9 @@ def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
     (["--work-plane", "0.8,0.5", "--sensors", "s.vtp"], 2, "give one of them"),
     (["--da-threshold", "300"], 2, "--da-threshold is for the sensors"),
     (["--work-plane", "0.8,1e-7"], 2, "over the maximum"),
+    (["--sensor-rays", "64"], 2, "--sensor-rays is for the sensors"),
+    (["--work-plane", "0.8,0.5", "--sensor-rays", "0"], 2,
+     "--sensor-rays is 0: give a value from 1 to 1000000"),
 ])
 def test_bad_sensor_options(tmp_path, extra, status, words):
     result = run(["--scene", write_room(tmp_path), "--sky", "uniform"] + extra + FAST, tmp_path)

@@ -87,7 +87,9 @@ def test_up_turns_the_sky(tmp_path):
     # Given and ignored before: the sky's Perez efficacy, no light to take them, the lights
     # left out of a solve with a sky.
     (["--sky", "uniform", "--luminous-efficacy", "90"],
-     "--luminous-efficacy with --sky: under a sky the Illuminance takes each frame's Perez"),
+     "--luminous-efficacy with --sky: daylight's Illuminance takes each frame's Perez"),
+    (["--sun-path", "48.85,2.35,2026-06-21,08:00,18:00,60", "--luminous-efficacy", "90"],
+     "--luminous-efficacy with the sun: daylight's Illuminance takes each frame's Perez"),
     (["--sky", "uniform", "--light-lumens", "1000"], "--light-lumens is for a light, and the "
                                                       "scene has none"),
     (["--sky", "uniform", "--spot", "30"], "--spot is for a light, and the scene has none"),
@@ -111,7 +113,7 @@ def test_weather_refuses_a_luminous_efficacy_it_would_ignore(tmp_path):
     result = run(["--scene", write_ground(tmp_path), "--weather", "w.epw",
                   "--luminous-efficacy", "90", "--output", "o/s.pvd"], tmp_path)
     assert result.returncode == 2
-    assert "--luminous-efficacy with --weather (and its Perez sky)" in result.stderr
+    assert "--luminous-efficacy with --weather: daylight's Illuminance" in result.stderr
     assert not (tmp_path / "o").exists()
 
 

@@ -104,6 +104,27 @@ def test_a_clear_sky_without_a_sun_is_refused():
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
 
 
+def test_a_sky_with_a_lamp_is_refused_not_dropped():
+    # The lamp used to be left out of the solve without a word; the sky alone and the sun
+    # with a sky solve.
+    lamp = vtkPlaneSource()
+    lamp.SetOrigin(-0.1, -0.1, 1)
+    lamp.SetPoint1(-0.1, 0.1, 1)
+    lamp.SetPoint2(0.1, -0.1, 1)
+    for light_type, with_lamp in ((vtkMovingLightRadiosity.AREA_LIGHT, True),
+                                  (vtkMovingLightRadiosity.POINT_LIGHT, False)):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(output(vtkPlaneSource()))
+        if with_lamp:
+            radiosity.SetLightData(output(lamp))
+        radiosity.SetLightType(light_type)
+        radiosity.SetSkyModel(vtkMovingLightRadiosity.UNIFORM_SKY)
+        radiosity.SetNumberOfThreads(2)
+        errors = recorded(radiosity, "ErrorEvent")
+        assert not radiosity.UpdateTimeStep(0.0)
+        assert any("a sky lights the scene alone or with the sun" in e for e in errors), errors
+
+
 def test_a_gltf_scene_under_a_z_up_sky_is_warned_of():
     # glTF is Y-up: a scene read from it (field data SceneFormat "glTF") under a sky whose Up
     # is still the default +z gets a warning naming Up; with Up +y it gets none.
