@@ -1157,7 +1157,8 @@ std::pair<std::uint64_t, std::uint64_t> drawnSize(
       const std::uint64_t points = count(primitive, "POSITION");
       const std::uint64_t corners =
         primitive.contains("indices") ? count(primitive, nullptr) : points;
-      perMesh[m].first = saturatingSum(perMesh[m].first, points);
+      // A primitive keeps only the vertices its triangles use.
+      perMesh[m].first = saturatingSum(perMesh[m].first, std::min(points, corners));
       perMesh[m].second = saturatingSum(perMesh[m].second, mode == 4 ? corners / 3 : corners);
     }
   }
@@ -1423,9 +1424,23 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
             "] has a COLOR_0 that is not one RGB or RGBA colour per vertex");
         }
       }
-      const vtkIdType offset = scene.points->GetNumberOfPoints();
+      // Only the vertices the triangles use, each once: primitives often share one POSITION
+      // accessor of the whole mesh (an exporter's single vertex buffer), which copied whole
+      // per primitive made 86 primitives of a 560,569-vertex buffer 48 million points.
+      std::vector<vtkIdType> pointOf(vertexCount, -1);
+      for (const auto& triangle : triangles)
+      {
+        for (const std::size_t v : triangle)
+        {
+          pointOf[v] = 0;
+        }
+      }
       for (std::size_t v = 0; v < vertexCount; ++v)
       {
+        if (pointOf[v] < 0)
+        {
+          continue;
+        }
         double p[3];
         for (std::size_t r = 0; r < 3; ++r)
         {
@@ -1437,13 +1452,12 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
           document.fail(
             "meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
         }
-        scene.points->InsertNextPoint(p);
+        pointOf[v] = scene.points->InsertNextPoint(p);
       }
       for (const auto& triangle : triangles)
       {
-        const vtkIdType ids[3] = { offset + static_cast<vtkIdType>(triangle[0]),
-          offset + static_cast<vtkIdType>(triangle[mirrored ? 2 : 1]),
-          offset + static_cast<vtkIdType>(triangle[mirrored ? 1 : 2]) };
+        const vtkIdType ids[3] = { pointOf[triangle[0]], pointOf[triangle[mirrored ? 2 : 1]],
+          pointOf[triangle[mirrored ? 1 : 2]] };
         scene.polygons->InsertNextCell(3, ids);
         scene.materialOfCell.push_back(material);
         std::array<double, 3> mean{ { 1, 1, 1 } };

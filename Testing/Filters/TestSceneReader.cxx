@@ -516,6 +516,9 @@ TEST(SceneReader, GltfNodeTransformsAndEmission)
   EXPECT_EQ(result.warnings(), "");
   vtkPolyData* mesh = result.output;
   ASSERT_EQ(mesh->GetNumberOfCells(), 4);
+  // The two primitives share one POSITION accessor of 8 vertices, 4 used by each: each keeps
+  // the vertices it uses, not a copy of the whole accessor (8 points, not 16).
+  EXPECT_EQ(mesh->GetNumberOfPoints(), 8);
   expectRgbNear(tuple3(mesh, "Emission", 0), 0, 0, 0, 0);
   expectRgbNear(tuple3(mesh, "Emission", 2), 4 * Pi, 2 * Pi, 1 * Pi, 1e-6);
   double bounds[6];
