@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <numeric>
 #include <sstream>
 
@@ -580,6 +581,22 @@ RemeshResult remesh(
   }
   stats.patches = result.mesh.triangles.size();
   stats.outputArea = totalArea(result.mesh);
+  // Patches far finer than asked for share the paths: most elements get no hit and the
+  // result is speckle, with no error of the input's to see why.
+  const double aimed = std::max(1.0, remeshedPatchCount(stats.inputArea, h));
+  if (static_cast<double>(stats.patches) > ManyMorePatchesThanAimed * aimed)
+  {
+    std::ostringstream s;
+    s << "the scene keeps " << stats.patches << " patches, " << std::setprecision(2)
+      << static_cast<double>(stats.patches) / aimed << " times the about " << std::setprecision(6)
+      << static_cast<std::size_t>(aimed) << " its patch size " << h
+      << " aims at: its triangles are finer than that and are kept where they cannot be "
+         "merged (regions only refined, small separate pieces). The paths are shared by that "
+         "many more patches, so most elements get none (speckle, large errors): give about as "
+         "many times the paths, or simplify the mesh first (ParaView's Decimate or Quadric "
+         "Clustering)";
+    result.warnings.push_back(s.str());
+  }
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   checkProgress(progress, 1.0);
   return result;

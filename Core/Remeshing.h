@@ -59,6 +59,9 @@ struct RemeshStatistics
   double secondsContacts = 0;  ///< of which finding contacts, splitting and dropping covered pieces
 };
 
+/// remesh() warns when it keeps more than this many times the patches its patch size aims at.
+constexpr double ManyMorePatchesThanAimed = 4;
+
 struct RemeshResult
 {
   PatchMesh mesh;

@@ -203,7 +203,7 @@ Scene readObj(
   const std::uintmax_t size = std::max<std::uintmax_t>(1, fileSize(path));
   // OBJ declares no counts: its lines, about 16 bytes each in files written by modellers, are
   // the estimate, each taken as a vertex and a triangle.
-  checkOutputSize(path, "OBJ", size / 16, size / 16, budget);
+  checkOutputSize(path, "OBJ", size / 16, size / 16, budget, true);
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   ProgressPoll poll(progress, 0.0, 0.9);
 

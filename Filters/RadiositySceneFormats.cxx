@@ -43,7 +43,7 @@ std::array<double, 3> checkedReflectance(
 }
 
 void checkOutputSize(const std::string& path, const std::string& format, std::uint64_t points,
-  std::uint64_t triangles, const MemoryBudget& budget)
+  std::uint64_t triangles, const MemoryBudget& budget, bool fromFileSize)
 {
   // A point is three doubles; a triangle three ids, an offset, a material id, a reflectance
   // and an emission (doubles), with a margin for the cell array's growth.
@@ -53,8 +53,11 @@ void checkOutputSize(const std::string& path, const std::string& format, std::ui
   if (!budget.fits(bytes))
   {
     throw FileError(budget.overLimitMessage(bytes, "the " + format + " file " + named(path),
-      std::to_string(points) + " points, " + std::to_string(triangles) + " triangles",
-      "simplify the model, or raise the reader's MemoryLimit"));
+      (fromFileSize ? "up to " : "") + std::to_string(points) + " points and " +
+        (fromFileSize ? "up to " : "") + std::to_string(triangles) + " triangles" +
+        (fromFileSize ? " (bounds from the file's size)" : ""),
+      "simplify the model, or raise the memory limit (the reader's MemoryLimit, the command "
+      "line's --memory-limit)"));
   }
 }
 

@@ -103,8 +103,9 @@ Scene readPly(
 
 /// The output's estimated bytes for `points` points and `triangles` triangles (coordinates,
 /// connectivity and the per-cell arrays), checked against `budget` before reading them:
-/// FileError naming `path` and the estimate when it does not fit.
+/// FileError naming `path` and the estimate when it does not fit. `fromFileSize`: the counts
+/// are bounds from the file's size, and the message says so.
 void checkOutputSize(const std::string& path, const std::string& format, std::uint64_t points,
-  std::uint64_t triangles, const MemoryBudget& budget);
+  std::uint64_t triangles, const MemoryBudget& budget, bool fromFileSize = false);
 
 } // namespace mlr::scenefile

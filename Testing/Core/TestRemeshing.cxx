@@ -489,6 +489,28 @@ TEST(RemeshingMessyInput, NanOrInfinitePointsAreRefusedWithTheirCount)
   expectError([&] { remesh(soup, RemeshOptions{}); }, "2 points with NaN or infinite coordinates");
 }
 
+TEST(RemeshingMessyInput, FarMorePatchesThanThePatchSizeAimsAtAreWarnedOf)
+{
+  // A 5 cm ball of 18,000 triangles alone, at 10 cm: about 9 patches aimed at, its 18,000
+  // kept. The warning names the count and what to do; a ball in the box of the test below
+  // (2.2 times) gets none.
+  const PolygonSoup ball = icosphere(30, 0.05);
+  const RemeshResult result = remesh(ball, withEdgeLength(0.1));
+  EXPECT_EQ(result.statistics.patches, 18000u);
+  EXPECT_TRUE(contains(result.warnings, "the scene keeps 18000 patches, "))
+    << joined(result.warnings);
+  EXPECT_TRUE(contains(result.warnings, "give about as many times the paths"))
+    << joined(result.warnings);
+  PolygonSoup soup = boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) });
+  PolygonSoup small = icosphere(10, 0.05);
+  for (Vec3& p : small.points)
+  {
+    p += Vec3(0.5, 0.5, 0.5);
+  }
+  append(soup, small);
+  EXPECT_FALSE(contains(remesh(soup, withEdgeLength(0.1)).warnings, "the scene keeps"));
+}
+
 TEST(RemeshingMessyInput, RegionTooCurvedForThePatchSizeIsOnlyRefined)
 {
   // A 5 cm ball of 2,000 triangles in a unit box remeshed at 10 cm would shrink to a few

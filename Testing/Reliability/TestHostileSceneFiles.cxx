@@ -178,6 +178,28 @@ TEST(HostileSceneFiles, InstancesBeyondTheMemoryLimitAreRefusedBeforeDrawing)
   EXPECT_TRUE(readScene(gltf).read);
 }
 
+TEST(HostileSceneFiles, AnObjOverTheLimitIsRefusedWithBoundsFromItsSize)
+{
+  // An OBJ's counts are not known before reading it: the refusal gives them as bounds from
+  // the file's size, not as counts, and names both ways to raise the limit.
+  TestFolder folder("obj-limit");
+  const fs::path obj = folder.path / "big.obj";
+  {
+    std::ofstream out(obj);
+    for (int i = 0; i < 160000; ++i)
+    {
+      out << "v 0 0 0\n";
+    }
+  }
+  const Outcome limited = readScene(obj, 8);
+  EXPECT_FALSE(limited.read);
+  EXPECT_NE(limited.errors.find("up to 80000 points and up to 80000 triangles (bounds from the "
+                                "file's size)"),
+    std::string::npos)
+    << limited.errors;
+  EXPECT_NE(limited.errors.find("--memory-limit"), std::string::npos) << limited.errors;
+}
+
 TEST(HostileSceneFiles, ALongNodeChainIsCheckedInLinearTime)
 {
   // 200,000 nodes, each the parent of the next, the mesh at the end: climbing the chain once
