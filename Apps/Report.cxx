@@ -184,7 +184,7 @@ nlohmann::ordered_json lightingJson(
                                        : "the Light's LightPower cells, else 100 W per channel";
     j["luminousEfficacy"] = jsonNumber(filter->GetLuminousEfficacy());
   }
-  else if (!sky)
+  else if (!sky && !o.usesSun())
   {
     j["luminousEfficacy"] = jsonNumber(filter->GetLuminousEfficacy());
   }
@@ -456,7 +456,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     {
       record["lightPosition"] = jsonTriple(frame.lightPosition.data());
     }
-    if (options.sky)
+    if (options.sky || options.usesSun())
     {
       record["luminousEfficacy"] = jsonNumber(frame.luminousEfficacy);
     }

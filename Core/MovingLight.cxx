@@ -186,13 +186,16 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
   this->setPoses(poses);
 }
 
+std::size_t MovingLight::triangleAt(double area) const
+{
+  auto it = std::upper_bound(this->CumulativeArea.begin(), this->CumulativeArea.end(), area);
+  return std::min<std::size_t>(
+    static_cast<std::size_t>(it - this->CumulativeArea.begin()), this->Triangles.size() - 1);
+}
+
 void MovingLight::samplePoint(double u0, double u1, double u2, Vec3& point, Vec3& normal) const
 {
-  const double target = u0 * this->Area;
-  auto it = std::upper_bound(this->CumulativeArea.begin(), this->CumulativeArea.end(), target);
-  const std::size_t i = std::min<std::size_t>(
-    static_cast<std::size_t>(it - this->CumulativeArea.begin()), this->Triangles.size() - 1);
-  const LightTriangle& t = this->Triangles[i];
+  const LightTriangle& t = this->Triangles[this->triangleAt(u0 * this->Area)];
   point = sampleTriangle(t.a, t.b, t.c, u1, u2);
   normal = t.normal;
 }
@@ -200,9 +203,7 @@ void MovingLight::samplePoint(double u0, double u1, double u2, Vec3& point, Vec3
 void MovingLight::samplePoint(double u, double v, Vec3& point, Vec3& normal) const
 {
   const double target = u * this->Area;
-  auto it = std::upper_bound(this->CumulativeArea.begin(), this->CumulativeArea.end(), target);
-  const std::size_t i = std::min<std::size_t>(
-    static_cast<std::size_t>(it - this->CumulativeArea.begin()), this->Triangles.size() - 1);
+  const std::size_t i = this->triangleAt(target);
   const double before = i > 0 ? this->CumulativeArea[i - 1] : 0.0;
   const double area = this->CumulativeArea[i] - before;
   const double rest = area > 0 ? std::clamp((target - before) / area, 0.0, 1.0) : 0.0;

@@ -110,6 +110,8 @@ public:
   }
 
 private:
+  /// The triangle in which the cumulative area `area` falls (the last one past the end).
+  std::size_t triangleAt(double area) const;
   Rgb Power;
   double Area = 0;
   Vec3 Centroid;

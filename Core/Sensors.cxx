@@ -8,10 +8,8 @@
 #include "RayTracer.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 #include <string>
 
 namespace mlr

@@ -313,6 +313,10 @@ def test_stats_record_the_sun_and_its_direction_in_each_frame(tmp_path):
     for record, (_, frame) in zip(stats["frames"], frames):
         assert "lightPosition" not in record
         assert record["sunDirection"] == pytest.approx(frame.field("SunDirection"), abs=1e-12)
+        # The sun's lux take Perez's direct efficacy of the frame, not white light's 179.
+        assert record["luminousEfficacy"] == pytest.approx(frame.field("LuminousEfficacy"))
+        assert 60 < record["luminousEfficacy"] < 130
+    assert "per frame" in stats["lighting"]["luminousEfficacy"]
 
 
 def test_sun_path_through_the_night_is_dark_with_a_warning(tmp_path):
