@@ -27,6 +27,25 @@ std::uint64_t outputBytes(const AnimationOptions& options, const LightRig& light
       saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
 }
 
+/// The bytes `soup` holds, which the solve's memory check counts: the caller keeps it
+/// through the solve. Each polygon's indices are a heap block of their own (glibc: 16-byte
+/// granules, 8 bytes of header, 32 at least).
+std::uint64_t soupBytes(const PolygonSoup& soup)
+{
+  std::uint64_t bytes = soup.points.capacity() * sizeof(Vec3) +
+    soup.polygons.capacity() * sizeof(soup.polygons[0]) +
+    soup.materials.capacity() * sizeof(Material);
+  for (const auto& polygon : soup.polygons)
+  {
+    if (polygon.capacity() > 0)
+    {
+      bytes += std::max<std::uint64_t>(
+        32, (polygon.capacity() * sizeof(std::uint32_t) + 8 + 15) / 16 * 16);
+    }
+  }
+  return bytes;
+}
+
 /// Ranks whose memory limits chose different chunks would add up different solves: every
 /// rank's C is compared (the sums of C and C^2 agree with R C and R C^2 only when all are C).
 void agreeOnChunks(const SolverOptions& options, std::size_t framesPerChunk)
@@ -71,12 +90,17 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
                 "streaming the frames chunk by chunk");
   }
   // The chunks' length, from the memory limit unless set, and the one memory check of the
-  // solve in those chunks.
+  // solve in those chunks, with what lives beside it: the caller's outputs and input, the
+  // scene and its patches.
   std::size_t framesPerChunk = frames;
+  const std::uint64_t input = soupBytes(soup);
   auto checkChunkedMemory =
     [&](std::size_t patches, std::size_t elements, std::size_t points, bool approximate)
   {
-    const std::uint64_t outputs = outputBytes(options, lights, soupEmits, elements, points, frames);
+    const std::uint64_t outputs =
+      saturatingSum(saturatingSum(outputBytes(options, lights, soupEmits, elements, points, frames),
+                      Scene::estimateMemory(patches, elements, points, soupEmits)),
+        input);
     const std::size_t kept = streamed ? options.keptStreamedChunks : 0;
     framesPerChunk = chooseFramesPerChunk(
       patches, elements, points, frames, options.solver, lightCount, outputs, streamed, kept);

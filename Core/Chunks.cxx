@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -537,12 +538,22 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     chunkOptions.rank = 0;
   }
 
-  // Progress: each chunk's share is its positions' share of the positions this rank solves.
-  double positionsSolved = 0;
+  // Progress: the setup, then each chunk, by their expected rays.
+  const double setupCost = SolveSetup::cost(scene, options);
+  double chunksCost = 0;
   for (std::size_t k = rank; k < chunkCount; k += ranks)
   {
-    positionsSolved += static_cast<double>(plan.chunks[k].solveEnd - plan.chunks[k].solveBegin);
+    chunksCost +=
+      solveCost(scene, rig, options, plan.chunks[k].solveEnd - plan.chunks[k].solveBegin);
   }
+  const double totalCost = setupCost + chunksCost;
+  std::optional<SolveSetup> setup;
+  agreeAcrossRanks(options,
+    [&]
+    {
+      setup.emplace(scene, rig, options,
+        [&](double f) { return !progress || progress(f * setupCost / totalCost); });
+    });
   Solution whole; // every frame, without onFrames
   Solution result;
   SolverStatistics& stats = result.statistics;
@@ -555,7 +566,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   std::optional<Solution> tail;
   std::size_t tailFirst = 0;
   Solution shape;
-  double progressBase = 0;
+  double progressBase = setupCost / totalCost;
   double secondsExchanging = 0;
   double firstFigure = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -568,7 +579,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     {
       const ChunkPlan::Chunk& c = plan.chunks[k];
       const std::size_t positions = c.solveEnd - c.solveBegin;
-      const double share = static_cast<double>(positions) / positionsSolved;
+      const double share = solveCost(scene, rig, options, positions) / totalCost;
       ProgressCallback chunkProgress;
       if (progress)
       {
@@ -585,8 +596,10 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       }
       // Over ranks a chunk is solved alone; a failure or cancel on any rank stops every rank
       // here, before the exchange.
-      auto solveChunk = [&] {
-        current = solve(scene, sliceRig(rig, c.solveBegin, positions), chunkOptions, chunkProgress);
+      auto solveChunk = [&]
+      {
+        current =
+          solve(scene, sliceRig(rig, c.solveBegin, positions), chunkOptions, chunkProgress, *setup);
       };
       if (overRanks)
       {
@@ -727,6 +740,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     }
   }
   stats.secondsReducing += secondsExchanging;
+  stats.reachabilityRays += setup->reachabilityRays();
+  stats.secondsSetup += setup->seconds();
   // A chunk where every light is off (a night) warns that no light arrived; the animation
   // only when none arrived anywhere.
   if (stats.firstHits > 0)
@@ -775,19 +790,33 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   SolverOptions chunkOptions = options;
   chunkOptions.storageScale = storageScaleFor(scene, rig);
   const std::size_t first = chunk > 0 ? chunk - 1 : chunk;
+  // The setup of the whole animation, as solveInChunks has it, then the chunks, by their
+  // expected rays.
+  std::vector<double> costs{ SolveSetup::cost(scene, options) };
+  for (std::size_t k = first; k <= chunk; ++k)
+  {
+    costs.push_back(
+      solveCost(scene, rig, options, plan.chunks[k].solveEnd - plan.chunks[k].solveBegin));
+  }
+  const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
+  double base = 0;
+  auto part = [&](double cost) -> ProgressCallback
+  {
+    const double from = base, share = cost / total;
+    base += share;
+    if (!progress)
+    {
+      return {};
+    }
+    return [&progress, from, share](double f) { return progress(from + share * f); };
+  };
+  const SolveSetup setup(scene, rig, options, part(costs[0]));
   std::optional<Solution> seam;
   for (std::size_t k = first; k <= chunk; ++k)
   {
     const ChunkPlan::Chunk& c = plan.chunks[k];
-    ProgressCallback part;
-    if (progress)
-    {
-      const double base = static_cast<double>(k - first) / static_cast<double>(chunk - first + 1);
-      const double share = 1.0 / static_cast<double>(chunk - first + 1);
-      part = [&progress, base, share](double f) { return progress(base + share * f); };
-    }
-    Solution current =
-      solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin), chunkOptions, part);
+    Solution current = solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin),
+      chunkOptions, part(costs[1 + k - first]), setup);
     if (k < chunk)
     {
       const std::size_t seamFirst = plan.finishedEnd(k);

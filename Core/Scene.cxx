@@ -1,9 +1,11 @@
 #include "Scene.h"
 
 #include "Error.h"
+#include "MemoryBudget.h"
 
 #include <limits>
 #include <sstream>
+#include <type_traits>
 #include <unordered_map>
 
 namespace mlr
@@ -43,6 +45,29 @@ void checkScenePoints(const std::vector<Vec3>& points)
       throw Error(s.str());
     }
   }
+}
+
+std::uint64_t Scene::estimateMemory(
+  std::size_t patches, std::size_t elements, std::size_t points, bool emits)
+{
+  const std::uint64_t emission = emits ? sizeof(Rgb) : 0;
+  const std::uint64_t perPatch = sizeof(Triangle) + sizeof(Vec3) + sizeof(double) + sizeof(Rgb) +
+    sizeof(LinearStencil) + emission;
+  const std::uint64_t perElement = sizeof(Triangle) + sizeof(double);
+  // The patch mesh: its corners (fewer than the scene's points), triangles and materials.
+  const std::uint64_t mesh = sizeof(Triangle) + sizeof(Rgb) + emission;
+  return saturatingSum(saturatingSum(saturatingProduct(patches, perPatch + mesh),
+                         saturatingProduct(elements, perElement)),
+    saturatingProduct({ points, 2, sizeof(Vec3) }));
+}
+
+std::uint64_t Scene::memoryBytes() const
+{
+  auto bytes = [](const auto& v) -> std::uint64_t
+  { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
+  return bytes(this->Points) + bytes(this->PatchTriangles) + bytes(this->ElementTriangles) +
+    bytes(this->PatchNormals) + bytes(this->PatchAreas) + bytes(this->ElementAreas) +
+    bytes(this->Reflectance) + bytes(this->PatchStencils) + bytes(this->Emission);
 }
 
 Scene Scene::fromPatchMesh(const PatchMesh& mesh)

@@ -66,6 +66,13 @@ public:
 
   static Scene fromPatchMesh(const PatchMesh& mesh);
 
+  /// The bytes a scene of these counts holds, and with it the patch mesh it was built from
+  /// (which an animation keeps): what the solve's memory check adds to the solve's own.
+  static std::uint64_t estimateMemory(
+    std::size_t patches, std::size_t elements, std::size_t points, bool emits);
+  /// The bytes this scene holds.
+  std::uint64_t memoryBytes() const;
+
   std::size_t patchCount() const { return this->PatchTriangles.size(); }
   std::size_t elementCount() const { return this->ElementTriangles.size(); }
   static std::size_t patchOfElement(std::size_t element) { return element / ElementsPerPatch; }

@@ -705,10 +705,15 @@ void checkPathsPerPosition(const LightSource& source, const SolverOptions& optio
 
 double shootingCost(const LightSource& source, const SolverOptions& options)
 {
+  return shootingCost(source.positions(), options);
+}
+
+double shootingCost(std::size_t positions, const SolverOptions& options)
+{
   const double N = static_cast<double>(options.pathsPerFrame);
   const double lambda = options.firstBounceSurvival;
-  const double n = static_cast<double>(source.positions());
-  const bool reuse = options.reuseShooting && source.positions() > 1;
+  const double n = static_cast<double>(positions);
+  const bool reuse = options.reuseShooting && positions > 1;
   return reuse ? N * (1 + 1.5 * lambda + 0.2 * (n - 1)) : n * N * (1 + 1.5 * lambda);
 }
 

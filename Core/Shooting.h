@@ -7,6 +7,7 @@
 #include "SolverOptions.h"
 #include "WorkerCounters.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -21,6 +22,9 @@ void checkPathsPerPosition(const LightSource& source, const SolverOptions& optio
 
 /// The expected ray casts of shooting `source`, which weigh the progress of its phase.
 double shootingCost(const LightSource& source, const SolverOptions& options);
+
+/// The same for a source of `positions` positions.
+double shootingCost(std::size_t positions, const SolverOptions& options);
 
 /// What shooting one source traced: its paths and this rank's rays.
 struct ShootingResult

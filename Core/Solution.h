@@ -55,7 +55,9 @@ struct SolverStatistics
   double secondsRemeshing = 0; ///< set by callers that remesh before solving
   /// The patch edge length the scene was remeshed to (scene units), by callers that remesh.
   double patchEdgeLength = 0;
-  double secondsSetup = 0; ///< validation, allocation and building the BVH
+  /// Validation, allocation, building the BVH, the pilot and the reachability probes (once
+  /// for every chunk: SolveSetup).
+  double secondsSetup = 0;
   double secondsShooting = 0;
   double secondsGathering = 0;
   /// Of shooting and gathering, the time spent in sums over ranks and the agreements

@@ -25,14 +25,17 @@ double secondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The fractions of the progress its phases take, weighted by their expected ray counts:
-/// shooting each source, then gathering (reachability, before them, is cheap).
+/// The fractions of the progress its phases take, weighted by their expected ray counts: the
+/// reachability probes (none when a SolveSetup brings them), then the passes, each shooting
+/// every source, then gathering.
 struct ProgressPlan
 {
+  double probing = 0;
+  /// Of a pass's progress.
   std::vector<double> shooting;
 
-  ProgressPlan(
-    const std::vector<LightSource>& sources, std::size_t frames, const SolverOptions& options)
+  ProgressPlan(const std::vector<LightSource>& sources, std::size_t frames,
+    const SolverOptions& options, double probeRays)
   {
     double total = 0;
     for (const LightSource& source : sources)
@@ -40,13 +43,18 @@ struct ProgressPlan
       this->shooting.push_back(shootingCost(source, options));
       total += this->shooting.back();
     }
-    const double gathering = options.gatheringRatio * static_cast<double>(options.pathsPerFrame) *
-      (options.reuseGathering ? 1.0 : static_cast<double>(frames));
-    total += gathering;
+    total += gatheringCost(frames, options);
     for (double& share : this->shooting)
     {
       share /= total;
     }
+    this->probing = probeRays / (probeRays + total);
+  }
+
+  static double gatheringCost(std::size_t frames, const SolverOptions& options)
+  {
+    return options.gatheringRatio * static_cast<double>(options.pathsPerFrame) *
+      (options.reuseGathering ? 1.0 : static_cast<double>(frames));
   }
 };
 
@@ -189,8 +197,10 @@ Solution solve(const Scene& scene, const MovingLight& light, const SolverOptions
   return solve(scene, rig, options, progress);
 }
 
-Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
-  const ProgressCallback& progress)
+namespace
+{
+Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress, const SolveSetup* setup)
 {
   const auto start = Clock::now();
   // Setup, up to the allocations, is one phase the ranks agree on: a rank over its memory
@@ -221,12 +231,15 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       {
         checkBatchPathsPerPosition(source, options);
       }
-      shares.emplace(sources, frames, options);
+      shares.emplace(sources, frames, options, setup ? 0.0 : SolveSetup::cost(scene, options));
       if (progress && !progress(0.0))
       {
         throw Cancelled();
       }
-      tracerStorage.emplace(scene);
+      if (!setup)
+      {
+        tracerStorage.emplace(scene);
+      }
       solution = Solution(frames, scene.elementCount(), scene.patchCount());
       solution.setStorageScale(
         options.storageScale > 0 ? options.storageScale : storageScaleOf(scene, sources));
@@ -244,9 +257,15 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       }
     },
     &secondsReducing);
-  const RayTracer& tracer = *tracerStorage;
+  const RayTracer& tracer = setup ? setup->tracer() : *tracerStorage;
   SolverStatistics& stats = solution.statistics;
-  stats.secondsSetup = secondsSince(start);
+  // What follows the probes: the passes, a batched solve's too.
+  ProgressCallback passesProgress;
+  if (progress)
+  {
+    passesProgress = [&progress, probing = shares->probing](double f)
+    { return progress(probing + (1.0 - probing) * f); };
+  }
 
   // How each moving light's reused paths are shared over its positions: chosen once, from
   // the whole solve's N and seed, for every batch and round.
@@ -267,16 +286,27 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   // The patch sides light can reach, from geometry alone (deterministic and cheap: every rank
   // probes every side): only they get shooting accumulators and gather. With them known, the
   // plan counts the accumulators they take, and may give each worker a copy after all.
+  // A chunk takes those of the whole animation's setup instead.
   std::vector<std::uint8_t> reachable, firstHits;
-  agreeAcrossRanks(
-    options,
-    [&]
-    {
-      reachable = reachableSides(
-        scene, tracer, sources, options, workers,
-        [&](double) { return !progress || progress(0.0); }, stats.reachabilityRays, &firstHits);
-    },
-    &secondsReducing);
+  if (setup)
+  {
+    reachable = setup->reachable();
+    firstHits = setup->firstHits();
+  }
+  else
+  {
+    agreeAcrossRanks(
+      options,
+      [&]
+      {
+        reachable = reachableSides(
+          scene, tracer, sources, options, workers,
+          [&](double f) { return !progress || progress(shares->probing * f); },
+          stats.reachabilityRays, &firstHits);
+      },
+      &secondsReducing);
+  }
+  stats.secondsSetup = secondsSince(start);
   stats.reachableSides =
     static_cast<std::uint64_t>(std::count(reachable.begin(), reachable.end(), 1));
   plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), frames,
@@ -351,11 +381,11 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
         pass(batchOptions, batch, fraction);
         return batch;
       },
-      progress, plan.peak, secondsReducing, solution);
+      passesProgress, plan.peak, secondsReducing, solution);
   }
   else
   {
-    pass(options, solution, progress);
+    pass(options, solution, passesProgress);
   }
   stats.sources = sources.size();
   // The counters of the rays each rank traced (reachability's are every rank's own).
@@ -375,6 +405,77 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
   finish(scene, options, frames, plan, workers, counts[4], counts[5], solution);
   stats.secondsTotal = secondsSince(start);
   return solution;
+}
+} // namespace
+
+Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress)
+{
+  return solveWith(scene, rig, options, progress, nullptr);
+}
+
+Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress, const SolveSetup& setup)
+{
+  return solveWith(scene, rig, options, progress, &setup);
+}
+
+SolveSetup::SolveSetup(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress)
+{
+  const auto start = Clock::now();
+  validateOptions(options);
+  frameCount(rig, scene.hasEmission());
+  const int workers = resolveThreadCount(options.threads);
+  const std::vector<MovingLight> emitters = sceneEmitters(scene);
+  const std::vector<LightSource> sources = lightSources(scene, rig, emitters);
+  if (progress && !progress(0.0))
+  {
+    throw Cancelled();
+  }
+  this->Tracer = std::make_unique<RayTracer>(scene);
+  this->Reachable = reachableSides(
+    scene, *this->Tracer, sources, options, workers,
+    [&](double f) { return !progress || progress(f); }, this->ReachabilityRays, &this->FirstHits);
+  this->Seconds = secondsSince(start);
+}
+
+SolveSetup::~SolveSetup() = default;
+
+double SolveSetup::cost(const Scene& scene, const SolverOptions& options)
+{
+  return static_cast<double>(scene.patchCount()) * (options.twoSided ? 2.0 : 1.0) *
+    ReachabilityProbesPerSide;
+}
+
+double solveCost(
+  const Scene& scene, const LightRig& rig, const SolverOptions& options, std::size_t positions)
+{
+  const std::size_t frames = positions > 0 ? positions : frameCount(rig, scene.hasEmission());
+  double shooting = 0;
+  auto add = [&](std::size_t lightFrames)
+  { shooting += shootingCost(lightFrames > 1 ? frames : 1, options); };
+  for (const MovingLight& light : rig.areaLights)
+  {
+    add(light.frameCount());
+  }
+  for (const PointLight& light : rig.pointLights)
+  {
+    add(light.frameCount());
+  }
+  for (const DirectionalLight& light : rig.directionalLights)
+  {
+    add(light.frameCount());
+  }
+  for (const Sky& sky : rig.skies)
+  {
+    add(sky.frameCount());
+  }
+  if (scene.hasEmission())
+  {
+    add(1);
+  }
+  return shooting + ProgressPlan::gatheringCost(frames, options);
 }
 
 } // namespace mlr

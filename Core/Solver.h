@@ -18,10 +18,15 @@
 #include "SolverOptions.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
+#include <memory>
+#include <vector>
 
 namespace mlr
 {
+
+class RayTracer;
 
 /// Paper eq. (4): predicted speed-up of full reuse over classic, in ray casts.
 double predictedSpeedup(
@@ -38,6 +43,54 @@ using ProgressCallback = std::function<bool(double fraction)>;
  */
 Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   const ProgressCallback& progress = {});
+
+/**
+ * What the solves of one animation's chunks share (Chunks.h), built once instead of per
+ * chunk: the ray-tracing scene, and the patch sides light can reach from any position of the
+ * whole rig. The probes cost a fixed number of rays per patch side (64 million on a million
+ * patches, as much as gathering there), the same in every chunk; from every position at
+ * once they reach every side a chunk's own would (light in a chunk reaches only sides it
+ * would reach from the whole rig), so a chunk solved with it gives the same result as alone
+ * wherever its own probes would have found the same sides, and gathers a side they missed.
+ */
+class SolveSetup
+{
+public:
+  /// Validates the options, builds the tracer and probes from every frame of `rig`.
+  /// `progress` gets the fraction of the probes done; throws mlr::Cancelled when it asks to
+  /// stop, and as solve() does on bad options.
+  SolveSetup(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+    const ProgressCallback& progress = {});
+  ~SolveSetup();
+  SolveSetup(const SolveSetup&) = delete;
+  SolveSetup& operator=(const SolveSetup&) = delete;
+
+  const RayTracer& tracer() const { return *this->Tracer; }
+  /// reachableSides() from every light's positions, and the sides they hit first.
+  const std::vector<std::uint8_t>& reachable() const { return this->Reachable; }
+  const std::vector<std::uint8_t>& firstHits() const { return this->FirstHits; }
+  std::uint64_t reachabilityRays() const { return this->ReachabilityRays; }
+  double seconds() const { return this->Seconds; }
+
+  /// The probe rays a setup of `scene` lit by `rig` casts, to weigh its share of progress.
+  static double cost(const Scene& scene, const SolverOptions& options);
+
+private:
+  std::unique_ptr<RayTracer> Tracer;
+  std::vector<std::uint8_t> Reachable, FirstHits;
+  std::uint64_t ReachabilityRays = 0;
+  double Seconds = 0;
+};
+
+/// solve() with the tracer and the reachable sides of `setup`, built for `scene` and a rig
+/// `rig` is a slice of (sliceRig): the chunks' solve.
+Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ProgressCallback& progress, const SolveSetup& setup);
+
+/// The ray casts a solve of `rig` (or, with `positions`, of a slice of that many positions
+/// of it) is expected to take, past its setup: shooting every source and gathering.
+double solveCost(
+  const Scene& scene, const LightRig& rig, const SolverOptions& options, std::size_t positions = 0);
 
 /**
  * The unit a solve of `rig` stores its results in (Solution::storageScale): the scene's mean

@@ -252,6 +252,7 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("MissedRays", statistics.missedRays);
   count("GatheringSides", statistics.gatheringSides);
   count("PilotRays", statistics.pilotRays);
+  count("ReachabilityRays", statistics.reachabilityRays);
   real("SmallestPositionShare", statistics.smallestPositionShare);
   real("LargestPositionShare", statistics.largestPositionShare);
   count("Threads", static_cast<std::uint64_t>(statistics.threads));

@@ -156,6 +156,20 @@ TEST(Chunks, ThreadCountDoesNotChangeABit)
   EXPECT_FALSE(checks::sameBits(one.directData(), plain.directData()));
 }
 
+TEST(Chunks, TheSidesLightCanReachAreProbedOnceForEveryChunk)
+{
+  // The probes cost a fixed number of rays per patch side: per chunk, they would cost as
+  // much as gathering on a fine mesh, chunk after chunk.
+  const Scene scene = box();
+  const SolverOptions o = options(20000, 42);
+  const Solution plain = solve(scene, rig(), o);
+  const Solution chunked = solveInChunks(scene, rig(), o, 4);
+  EXPECT_EQ(chunked.statistics.chunks, 3u);
+  EXPECT_GT(plain.statistics.reachabilityRays, 0u);
+  EXPECT_EQ(chunked.statistics.reachabilityRays, plain.statistics.reachabilityRays);
+  EXPECT_EQ(chunked.statistics.reachableSides, plain.statistics.reachableSides);
+}
+
 TEST(Chunks, StreamedFramesAreTheAssembledOnes)
 {
   const Scene scene = box();
@@ -545,4 +559,33 @@ TEST(Chunks, ACancelOnOneRankStopsEveryRankBetweenChunks)
   }
   EXPECT_EQ(outcome[0], "cancelled");
   EXPECT_EQ(outcome[1], "cancelled");
+}
+
+TEST(Chunks, TheSceneAndTheInputCountAgainstTheMemoryLimit)
+{
+  // A fine box over few frames: the scene, its patches and the polygons given live through
+  // the solve, beside its own peak. A limit over the solve's estimate but short of the scene
+  // on top of it must refuse, naming the solve; a limit that holds both solves.
+  const PolygonSoup soup = scenes::boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }, true);
+  AnimationOptions options;
+  options.solver.pathsPerFrame = 10000;
+  options.solver.threads = 1;
+  options.solver.framesPerChunk = Frames;
+  options.remeshing.targetEdgeLength = 0.02;
+  const Animation a = solveAnimation(soup, rig(), options);
+  const Scene& scene = a.scene;
+  const std::uint64_t sceneBytes =
+    Scene::estimateMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), false);
+  const std::uint64_t held = scene.memoryBytes() + a.patches.points.capacity() * sizeof(Vec3) +
+    a.patches.triangles.capacity() * sizeof(Triangle) +
+    a.patches.reflectance.capacity() * sizeof(Rgb);
+  EXPECT_LE(held, sceneBytes);
+  EXPECT_GE(1.25 * static_cast<double>(held), static_cast<double>(sceneBytes));
+  const std::uint64_t solveOnly = estimateChunkedMemory(scene.patchCount(), scene.elementCount(),
+    scene.points().size(), Frames, Frames, options.solver, 1, 0, false);
+  std::printf("solve %.2f MB, scene %.2f MB\n", solveOnly / 1e6, sceneBytes / 1e6);
+  options.solver.memoryLimitBytes = solveOnly + sceneBytes / 2;
+  checks::expectError([&] { solveAnimation(soup, rig(), options); }, "the solve needs");
+  options.solver.memoryLimitBytes = solveOnly + 2 * sceneBytes + (std::uint64_t(1) << 20);
+  EXPECT_NO_THROW(solveAnimation(soup, rig(), options));
 }
