@@ -38,6 +38,7 @@
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <optional>
@@ -889,6 +890,28 @@ int run(int argc, char** argv, RankJob& job)
     // Scenes lit by the sun get an aerial view, their zenith up.
     const Triple zenith = options.zenith();
     FrameRenderer renderer(scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
+    if (!options.usesSun())
+    {
+      // The lit sides of the first, middle and last frames choose between the outside camera
+      // and one inside a closed room.
+      std::vector<std::size_t> samples = { 0, times.size() / 2, times.size() - 1 };
+      samples.erase(std::unique(samples.begin(), samples.end()), samples.end());
+      for (std::size_t f : samples)
+      {
+        renderer.sampleLighting(frameAt(filter, times[f]));
+      }
+      const FrameRenderer::View& view = renderer.chooseView();
+      if (view.inside)
+      {
+        std::ostringstream line;
+        line << std::setprecision(3) << "pictures from inside the scene, at (" << view.position[0]
+             << ", " << view.position[1] << ", " << view.position[2]
+             << ") looking along +z: lit sides fill " << 100 * view.litInside
+             << "% of the view there, " << 100 * view.litOutside << "% from outside";
+        bar.finish();
+        std::cout << line.str() << std::endl;
+      }
+    }
     for (std::size_t f = 0; f < times.size(); ++f)
     {
       throwIfInterrupted();
