@@ -795,7 +795,11 @@ int run(int argc, char** argv, RankJob& job)
   posedLight.frame = streaming ? times.size() - 1 : 0;
   vtkDataArray* remeshing = statistics->GetArray("SecondsRemeshing");
   stages.remeshing = remeshing ? std::min(remeshing->GetComponent(0, 0), update) : 0.0;
-  stages.solving = update - stages.remeshing;
+  // Streamed frames were converted and handed to the writers during the solve: writing.
+  vtkDataArray* handedOn = streamed ? statistics->GetArray("SecondsStreaming") : nullptr;
+  stages.writing =
+    handedOn ? std::clamp(handedOn->GetComponent(0, 0), 0.0, update - stages.remeshing) : 0.0;
+  stages.solving = update - stages.remeshing - stages.writing;
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<std::pair<double, std::string>> sensorEntries;
@@ -880,7 +884,7 @@ int run(int argc, char** argv, RankJob& job)
         { return indexesOnly(index, sensorNaming.framePrefix(), ".vtp"); });
     }
   }
-  stages.writing = secondsSince(writingStarted);
+  stages.writing += secondsSince(writingStarted);
 
   if (!options.png.empty())
   {
