@@ -1580,6 +1580,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           std::chrono::duration<double>(std::chrono::steady_clock::now() - handing).count();
       };
     }
+    // Remeshing's warnings as soon as the scene is built, so that a run refused by its memory
+    // limit, cancelled or stopped during the solve still shows them.
+    options.sceneWarning = [this](const std::string& warning) { vtkWarningMacro(<< warning); };
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
       [this, reportsProgress](double fraction)
       {
