@@ -1529,7 +1529,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       options.chunkFrames =
         [&](const mlr::Animation& solving, std::size_t first, mlr::Solution& frames)
       {
-        if (first == 0 && (frames.frameCount() == cache.Times.size() || frames.frameCount() == 1))
+        // Every solved frame at once (one chunk, or lights that do not move). Not a first
+        // chunk's single finished frame, which chunks of 2 hand on before their seam.
+        if (first == 0 && frames.frameCount() == mlr::frameCount(rig, true))
         {
           whole = std::move(frames);
           return;

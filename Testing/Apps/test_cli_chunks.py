@@ -118,3 +118,13 @@ def test_streamed_chunks_print_the_error_line_and_time_their_writing(tmp_path):
     stages = ("secondsReading", "secondsRemeshing", "secondsSolving", "secondsWriting")
     assert sum(timing[key] for key in stages) <= timing["secondsTotal"] + 1e-6
 
+
+def test_chunks_of_two_frames_stream_every_frame(tmp_path):
+    """With chunks of 2 the first chunk hands on its frame 0 alone, before its seam: a
+    streamed frame, not a solve of one frame."""
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", "5", "--frames-per-chunk", "2", "--error-batches", "1",
+                  "--output", "out/s.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "chunk 3 of 3: frames 4 to 4" in result.stdout
+    assert all_files(tmp_path / "out") == ["s.pvd"] + [f"s_{f:04d}.vtu" for f in range(5)]
