@@ -18,6 +18,17 @@ namespace mlr::cli
  * exposure, tone curve and smooth-shading points), unlit, and the Light output's polygons
  * where the filter posed them, in the plugin's unlit yellow. Needs an X display (ParaView's VTK
  * renders with GLX).
+ *
+ * A closed room seen from outside shows only walls whose outer side no light reaches (the
+ * colours are each element's lit side, so the near wall shows its inner side's light as if
+ * it were the view into the room). With frames given to sampleLighting(), the camera looks
+ * from inside instead when that shows much more of the lit sides: rays cast from the outside
+ * camera and from points just past each surface the view's axis crosses (up to 4, each
+ * looking along +z with a wider angle) count the surfaces whose side facing the camera is
+ * lit in the sampled frames. The outside camera stays unless it sees under a fifth of the
+ * picture lit and an inside one at least twice as much; then the inside camera nearest the
+ * outside that sees at least 80% of the best one's share is taken (usually just inside the
+ * near wall: the widest view of the room).
  */
 class FrameRenderer
 {
@@ -29,6 +40,24 @@ public:
   ~FrameRenderer();
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;
+
+  /// Before the first render(), without `up`: one frame's Elements (cell arrays
+  /// RadiosityFront and RadiosityBack, or Radiosity for one-sided surfaces, less
+  /// EmittedRadiosity), whose lit sides count in the choice of the camera. Call it for a few
+  /// frames of the animation.
+  void sampleLighting(vtkPolyData* elements);
+
+  /// Where the camera looks from, chosen at the first render(): "outside" (the default) or
+  /// "inside", with its position.
+  struct View
+  {
+    bool inside = false;
+    double position[3] = { 0, 0, 0 };
+    double viewAngle = 0;                 ///< degrees
+    double litOutside = 0, litInside = 0; ///< fractions of the rays that met a lit side
+  };
+  /// Chooses the camera from the samples now, if it was not yet chosen, and returns it.
+  const View& chooseView();
 
   /// Renders one frame, the filter's Elements and Light outputs of that frame, into a PNG
   /// file. Throws std::runtime_error when the picture cannot be written.

@@ -38,6 +38,7 @@
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <optional>
@@ -794,7 +795,11 @@ int run(int argc, char** argv, RankJob& job)
   posedLight.frame = streaming ? times.size() - 1 : 0;
   vtkDataArray* remeshing = statistics->GetArray("SecondsRemeshing");
   stages.remeshing = remeshing ? std::min(remeshing->GetComponent(0, 0), update) : 0.0;
-  stages.solving = update - stages.remeshing;
+  // Streamed frames were converted and handed to the writers during the solve: writing.
+  vtkDataArray* handedOn = streamed ? statistics->GetArray("SecondsStreaming") : nullptr;
+  stages.writing =
+    handedOn ? std::clamp(handedOn->GetComponent(0, 0), 0.0, update - stages.remeshing) : 0.0;
+  stages.solving = update - stages.remeshing - stages.writing;
 
   const Clock::time_point writingStarted = Clock::now();
   std::vector<std::pair<double, std::string>> sensorEntries;
@@ -879,7 +884,7 @@ int run(int argc, char** argv, RankJob& job)
         { return indexesOnly(index, sensorNaming.framePrefix(), ".vtp"); });
     }
   }
-  stages.writing = secondsSince(writingStarted);
+  stages.writing += secondsSince(writingStarted);
 
   if (!options.png.empty())
   {
@@ -889,6 +894,28 @@ int run(int argc, char** argv, RankJob& job)
     // Scenes lit by the sun get an aerial view, their zenith up.
     const Triple zenith = options.zenith();
     FrameRenderer renderer(scene->GetBounds(), options.usesSun() ? zenith.data() : nullptr);
+    if (!options.usesSun())
+    {
+      // The lit sides of the first, middle and last frames choose between the outside camera
+      // and one inside a closed room.
+      std::vector<std::size_t> samples = { 0, times.size() / 2, times.size() - 1 };
+      samples.erase(std::unique(samples.begin(), samples.end()), samples.end());
+      for (std::size_t f : samples)
+      {
+        renderer.sampleLighting(frameAt(filter, times[f]));
+      }
+      const FrameRenderer::View& view = renderer.chooseView();
+      if (view.inside)
+      {
+        std::ostringstream line;
+        line << std::setprecision(3) << "pictures from inside the scene, at (" << view.position[0]
+             << ", " << view.position[1] << ", " << view.position[2]
+             << ") looking along +z: lit sides fill " << 100 * view.litInside
+             << "% of the view there, " << 100 * view.litOutside << "% from outside";
+        bar.finish();
+        std::cout << line.str() << std::endl;
+      }
+    }
     for (std::size_t f = 0; f < times.size(); ++f)
     {
       throwIfInterrupted();

@@ -133,8 +133,19 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     [&]
     {
       RemeshResult remeshed = remesh(soup, remeshing, remeshProgress);
-
-      animation.warnings = std::move(remeshed.warnings);
+      if (options.sceneWarning)
+      {
+        // Shown now: they often explain why the memory check below refuses the solve, or why
+        // a run stopped before its end gave no result worth waiting for.
+        for (const std::string& warning : remeshed.warnings)
+        {
+          options.sceneWarning(warning);
+        }
+      }
+      else
+      {
+        animation.warnings = std::move(remeshed.warnings);
+      }
       animation.remeshing = remeshed.statistics;
       animation.scene = Scene::fromPatchMesh(remeshed.mesh);
       animation.patches = std::move(remeshed.mesh);

@@ -46,6 +46,10 @@ struct AnimationOptions
   std::size_t keptStreamedChunks = 0;
   /// With chunkFrames: a figure of the first chunk's frames for every rank (Chunks.h).
   FirstChunkFigure firstChunkFigure;
+  /// When set, remeshing's warnings go here one by one as soon as the scene is built, before
+  /// the memory check and the solve (which may fail, run for hours or be stopped), instead of
+  /// into Animation::warnings.
+  std::function<void(const std::string& warning)> sceneWarning;
 };
 
 /// A solved animation: the patches, the scene built from them and every frame's radiosity.
@@ -57,7 +61,8 @@ struct Animation
   /// The irradiance of options.sensors in every frame of the solution.
   SensorSolution sensors;
   RemeshStatistics remeshing;
-  /// Recoverable oddities from remeshing and solving, for the caller to show.
+  /// Recoverable oddities from remeshing (unless options.sceneWarning took them) and
+  /// solving, for the caller to show.
   std::vector<std::string> warnings;
 };
 

@@ -276,26 +276,46 @@ Scene readPly(
 
   const PlyElement* vertex = nullptr;
   const PlyElement* face = nullptr;
+  // Scanned models (Stanford's igea, bunny2, the trimesh2 tools) store triangle strips
+  // instead of faces: one list of indices, each -1 ending a strip.
+  const PlyElement* strips = nullptr;
   for (const auto& element : elements)
   {
     vertex = element.name == "vertex" ? &element : vertex;
     face = element.name == "face" ? &element : face;
+    strips = element.name == "tristrips" ? &element : strips;
   }
   if (!vertex || vertex->find("x") < 0 || vertex->find("y") < 0 || vertex->find("z") < 0)
   {
     fail("has no element 'vertex' with properties x, y and z");
   }
   checkOutputSize(path, "PLY", vertex->count, face ? face->count : 0, budget);
-  int indexProperty = face ? face->find("vertex_indices") : -1;
-  if (face && indexProperty < 0)
+  auto indexListOf = [](const PlyElement* element)
   {
-    indexProperty = face->find("vertex_index");
+    if (!element)
+    {
+      return -1;
+    }
+    int index = element->find("vertex_indices");
+    index = index < 0 ? element->find("vertex_index") : index;
+    return index >= 0 && element->properties[static_cast<std::size_t>(index)].list ? index : -1;
+  };
+  const int indexProperty = indexListOf(face);
+  const int stripIndexProperty = indexListOf(strips);
+  const bool hasFaces = face && face->count > 0 && indexProperty >= 0;
+  const bool hasStrips = strips && strips->count > 0 && stripIndexProperty >= 0;
+  if (!hasFaces && !hasStrips)
+  {
+    fail("has no faces (an element 'face' or 'tristrips' with a list property vertex_indices): "
+         "there is no surface to light");
   }
-  if (!face || face->count == 0 || indexProperty < 0 ||
-    !face->properties[static_cast<std::size_t>(indexProperty)].list)
+  if (!hasFaces)
   {
-    fail("has no faces (an element 'face' with a list property vertex_indices): there is no "
-         "surface to light");
+    face = nullptr;
+  }
+  if (!hasStrips)
+  {
+    strips = nullptr;
   }
   auto colourOf = [](const PlyElement& element, std::array<int, 3>& rgb)
   {
@@ -317,9 +337,10 @@ Scene readPly(
     }
     return false;
   };
-  std::array<int, 3> vertexRgb{}, faceRgb{};
+  std::array<int, 3> vertexRgb{}, faceRgb{}, stripRgb{};
   const bool vertexColours = colourOf(*vertex, vertexRgb);
-  const bool faceColours = colourOf(*face, faceRgb);
+  const bool faceColours = face && colourOf(*face, faceRgb);
+  const bool stripColours = strips && colourOf(*strips, stripRgb);
   for (int axis : { vertex->find("x"), vertex->find("y"), vertex->find("z") })
   {
     if (vertex->properties[static_cast<std::size_t>(axis)].list)
@@ -339,23 +360,58 @@ Scene readPly(
   std::vector<std::array<double, 3>> vertexColour;
   std::vector<double> row;
   std::vector<vtkIdType> ids;
-  std::uint64_t rowsRead = 0;
+  std::uint64_t rowsRead = 0, valuesRead = 0;
+  // Triangles the strips read so far can hold at most, for the memory check of each list.
+  std::uint64_t stripTriangles = 0;
   std::size_t unlistedFaces = 0;
   bool verticesRead = false;
+  auto pollProgress = [&]
+  {
+    poll(size > 0
+        ? static_cast<double>(std::max<std::streamoff>(0, in.tellg())) / static_cast<double>(size)
+        : 0.0);
+  };
+  // The cell's reflectance: the row's colour, else the mean of its vertices', else grey.
+  auto addCell = [&](const vtkIdType* cell, vtkIdType count, const PlyElement& element,
+                   bool rowColours, const std::array<int, 3>& rowRgb)
+  {
+    scene.polygons->InsertNextCell(count, cell);
+    std::array<double, 3> rgb{ { FallbackReflectance, FallbackReflectance, FallbackReflectance } };
+    if (rowColours)
+    {
+      for (std::size_t c = 0; c < 3; ++c)
+      {
+        const auto& property = element.properties[static_cast<std::size_t>(rowRgb[c])];
+        rgb[c] = plyColour(row[static_cast<std::size_t>(rowRgb[c])], property.type);
+      }
+    }
+    else if (vertexColours)
+    {
+      rgb = { { 0, 0, 0 } };
+      for (vtkIdType i = 0; i < count; ++i)
+      {
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+          rgb[c] += vertexColour[static_cast<std::size_t>(cell[i])][c] / static_cast<double>(count);
+        }
+      }
+    }
+    scene.cellReflectance.push_back(rgb);
+  };
   for (const auto& element : elements)
   {
-    const bool isVertex = &element == vertex, isFace = &element == face;
-    if (isFace && !verticesRead)
+    const bool isVertex = &element == vertex, isFace = &element == face,
+               isStrips = &element == strips;
+    if ((isFace || isStrips) && !verticesRead)
     {
-      fail("lists its faces before its vertices: this reader needs the vertices first");
+      fail("lists its " + std::string(isFace ? "faces" : "triangle strips") +
+        " before its vertices: this reader needs the vertices first");
     }
     for (std::uint64_t e = 0; e < element.count; ++e)
     {
       if (++rowsRead % 65536 == 0)
       {
-        poll(size > 0 ? static_cast<double>(std::max<std::streamoff>(0, in.tellg())) /
-              static_cast<double>(size)
-                      : 0.0);
+        pollProgress();
       }
       const std::string what = element.name + " " + std::to_string(e);
       row.assign(element.properties.size(), 0.0);
@@ -368,30 +424,63 @@ Scene readPly(
           continue;
         }
         const double count = values.read(property.countType, what + " " + property.name + " count");
-        if (count < 0 || count > 1e6)
+        const bool stripIndices = isStrips && static_cast<int>(p) == stripIndexProperty;
+        // A face has a few corners; a strip list may hold a whole model's strips, so its
+        // bound is what the file can hold: a binary value's bytes, an ASCII digit and a space.
+        const double most = stripIndices ? static_cast<double>(fileBytes) /
+            (format == PlyFormat::Ascii ? 2.0 : static_cast<double>(plyBytes(property.type)))
+                                         : 1e6;
+        if (!(count >= 0) || count > most || count != std::floor(count))
         {
-          fail("has a list of " + std::to_string(count) + " values in " + what);
+          std::ostringstream text;
+          text << count;
+          fail("has a list of " + text.str() + " values in " + what +
+            (stripIndices ? ", more than the file's " + std::to_string(fileBytes) +
+                  " bytes can hold: the count is wrong or the file is truncated"
+                          : ""));
         }
-        const bool indices = isFace && static_cast<int>(p) == indexProperty;
+        if (stripIndices)
+        {
+          // Each index after a strip's first two makes at most one triangle.
+          stripTriangles += static_cast<std::uint64_t>(count);
+          checkOutputSize(
+            path, "PLY", vertex->count, (face ? face->count : 0) + stripTriangles, budget);
+        }
+        const bool indices = (isFace && static_cast<int>(p) == indexProperty) || stripIndices;
+        // -1 ends a strip; written as an unsigned type, it is the type's largest value.
+        const double restart = stripIndices && !plyIsSigned(property.type)
+          ? std::ldexp(1.0, 8 * plyBytes(property.type)) - 1
+          : -1;
         if (indices)
         {
           ids.clear();
         }
-        for (int k = 0; k < static_cast<int>(count); ++k)
+        for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(count); ++k)
         {
-          const double value = values.read(property.type, what + " " + property.name);
-          if (indices)
+          if (++valuesRead % 1048576 == 0)
           {
-            if (value < 0 || value >= static_cast<double>(scene.points->GetNumberOfPoints()) ||
-              value != std::floor(value))
-            {
-              std::ostringstream text;
-              text << value;
-              fail("names vertex " + text.str() + " in " + what + " but has " +
-                std::to_string(scene.points->GetNumberOfPoints()) + " vertices");
-            }
-            ids.push_back(static_cast<vtkIdType>(value));
+            pollProgress();
           }
+          const double value = values.read(property.type, what + " " + property.name);
+          if (!indices)
+          {
+            continue;
+          }
+          if (stripIndices && (value == -1 || value == restart))
+          {
+            ids.push_back(-1);
+            continue;
+          }
+          if (value < 0 || value >= static_cast<double>(scene.points->GetNumberOfPoints()) ||
+            value != std::floor(value))
+          {
+            std::ostringstream text;
+            text << value;
+            fail("names vertex " + text.str() + " in " + what + " but has " +
+              std::to_string(scene.points->GetNumberOfPoints()) + " vertices" +
+              (stripIndices ? " (-1 ends a strip)" : ""));
+          }
+          ids.push_back(static_cast<vtkIdType>(value));
         }
       }
       if (isVertex)
@@ -417,37 +506,43 @@ Scene readPly(
           ++unlistedFaces;
           continue;
         }
-        scene.polygons->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-        std::array<double, 3> rgb{ { FallbackReflectance, FallbackReflectance,
-          FallbackReflectance } };
-        if (faceColours)
+        addCell(ids.data(), static_cast<vtkIdType>(ids.size()), *face, faceColours, faceRgb);
+      }
+      else if (isStrips)
+      {
+        // Triangle i of a strip is (v[i], v[i+1], v[i+2]), every other one turned
+        // (v[i+1], v[i], v[i+2]) so that all face the same way. Strips join with
+        // repeated indices: those triangles have no area and are dropped, but they count
+        // for the turning, as for the tools that wrote them.
+        std::size_t begin = 0;
+        for (std::size_t i = 0; i <= ids.size(); ++i)
         {
-          for (std::size_t c = 0; c < 3; ++c)
+          if (i < ids.size() && ids[i] >= 0)
           {
-            const auto& property = face->properties[static_cast<std::size_t>(faceRgb[c])];
-            rgb[c] = plyColour(row[static_cast<std::size_t>(faceRgb[c])], property.type);
+            continue;
           }
-        }
-        else if (vertexColours)
-        {
-          rgb = { { 0, 0, 0 } };
-          for (vtkIdType id : ids)
+          for (std::size_t j = begin; j + 2 < i; ++j)
           {
-            for (std::size_t c = 0; c < 3; ++c)
+            const bool turned = (j - begin) % 2 == 1;
+            const vtkIdType triangle[3] = { ids[turned ? j + 1 : j], ids[turned ? j : j + 1],
+              ids[j + 2] };
+            if (triangle[0] != triangle[1] && triangle[1] != triangle[2] &&
+              triangle[0] != triangle[2])
             {
-              rgb[c] +=
-                vertexColour[static_cast<std::size_t>(id)][c] / static_cast<double>(ids.size());
+              addCell(triangle, 3, *strips, stripColours, stripRgb);
             }
           }
+          begin = i + 1;
         }
-        scene.cellReflectance.push_back(rgb);
       }
     }
     verticesRead = verticesRead || isVertex;
   }
   if (scene.polygons->GetNumberOfCells() == 0)
   {
-    fail("has no faces with 3 or more vertices: there is no surface to light");
+    fail(strips ? "has no faces with 3 or more vertices and no triangle in its strips: there is "
+                  "no surface to light"
+                : "has no faces with 3 or more vertices: there is no surface to light");
   }
   if (unlistedFaces > 0)
   {
@@ -455,7 +550,7 @@ Scene readPly(
       " faces with fewer than 3 vertices: they are skipped");
   }
   const std::string stem = std::filesystem::path(path).stem().string();
-  if (!faceColours && !vertexColours)
+  if (((face && !faceColours) || (strips && !stripColours)) && !vertexColours)
   {
     warn(
       "the PLY file " + named(path) + " has no red/green/blue colours: every surface is grey 0.5");

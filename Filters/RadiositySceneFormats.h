@@ -93,7 +93,9 @@ Scene readGltf(
   const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget);
 
 /// PLY (ASCII or binary), element vertex (x, y, z, optional red/green/blue or
-/// diffuse_red/...), element face (vertex_indices or vertex_index, optional red/green/blue).
+/// diffuse_red/...), element face (vertex_indices or vertex_index, optional red/green/blue)
+/// and element tristrips (the same list, -1 ending a strip; every other triangle turned,
+/// those of repeated indices dropped).
 /// Colours: 8-bit integers /255, 16-bit /65535, float and double as they are. A face colour
 /// is the cell's reflectance, else the mean of its vertices' colours, else grey with a
 /// warning. One material named after the file. FileError when the file cannot be read, is

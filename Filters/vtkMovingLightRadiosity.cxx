@@ -40,6 +40,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -386,6 +387,91 @@ std::string propertyOutOfRange(vtkMovingLightRadiosity* self)
   }
   return {};
 }
+
+/**
+ * The error figures of streamed frames, by frame: the chunks hand them on with their frames,
+ * and the animation's summary has none per frame. Over ranks each rank holds those of the
+ * frames it received: a frame of a chunk one rank solved, or every frame when the ranks split
+ * the paths (then alike on every rank).
+ */
+struct StreamedErrors
+{
+  std::vector<double> median, p95, lit;
+  std::vector<double> received; ///< 1 for the frames this rank received
+
+  void add(std::size_t first, const mlr::ErrorEstimateSummary& chunk)
+  {
+    const std::size_t count = std::min(chunk.relativeErrorP95.size(),
+      std::min(chunk.relativeErrorMedian.size(), chunk.litElements.size()));
+    this->resize(std::max(this->received.size(), first + count));
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      this->median[first + i] = chunk.relativeErrorMedian[i];
+      this->p95[first + i] = chunk.relativeErrorP95[i];
+      this->lit[first + i] = static_cast<double>(chunk.litElements[i]);
+      this->received[first + i] = 1;
+    }
+  }
+
+  void resize(std::size_t frames)
+  {
+    for (std::vector<double>* v : { &this->median, &this->p95, &this->lit, &this->received })
+    {
+      v->resize(frames, 0.0);
+    }
+  }
+
+  /// Adds the animation's error field data with every frame's figures; nothing when a frame
+  /// has none. `sum` (over ranks, collective) gives each rank the frames only another holds,
+  /// exactly: a sum with zeros from the others, never of several ranks' values.
+  void addTo(vtkFieldData* fieldData, const mlr::ErrorEstimateSummary& animation,
+    std::size_t frames, const std::function<void(double*, std::size_t)>& sum)
+  {
+    this->resize(frames);
+    std::vector<double> holders = this->received;
+    if (sum)
+    {
+      sum(holders.data(), holders.size());
+      std::vector<double> alone(3 * frames, 0.0);
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        if (this->received[f] > 0 && holders[f] == 1)
+        {
+          alone[f] = this->median[f];
+          alone[frames + f] = this->p95[f];
+          alone[2 * frames + f] = this->lit[f];
+        }
+      }
+      sum(alone.data(), alone.size());
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        if (holders[f] == 1)
+        {
+          this->median[f] = alone[f];
+          this->p95[f] = alone[frames + f];
+          this->lit[f] = alone[2 * frames + f];
+          this->received[f] = 1;
+        }
+      }
+    }
+    mlr::Solution summary;
+    summary.errorEstimate = animation;
+    summary.errorEstimate.relativeErrorMedian.clear();
+    summary.errorEstimate.relativeErrorP95.clear();
+    summary.errorEstimate.litElements.clear();
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      if (!(this->received[f] > 0))
+      {
+        return;
+      }
+      summary.errorEstimate.relativeErrorMedian.push_back(this->median[f]);
+      summary.errorEstimate.relativeErrorP95.push_back(this->p95[f]);
+      summary.errorEstimate.litElements.push_back(static_cast<std::uint64_t>(this->lit[f]));
+    }
+    mlr::vtkoutputs::addErrorFieldData(fieldData, summary);
+  }
+};
 
 /// The number of lights whose poses the Trajectory holds: the Light's LightId groups for
 /// area lights, one for a directional or point light.
@@ -1420,7 +1506,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     // CachedChunks: the frames come chunk by chunk, and the last chunks stay.
     const bool cachesChunks = this->CachedChunks > 0 && !this->ChunkFramesObserver && !controller &&
       options.sensors.empty();
-    mlr::ErrorEstimateSummary chunkErrors;
+    StreamedErrors streamedErrors;
+    double secondsStreaming = 0;
     if (keepsRankFrames)
     {
       options.keptStreamedChunks = std::numeric_limits<std::size_t>::max();
@@ -1442,7 +1529,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       options.chunkFrames =
         [&](const mlr::Animation& solving, std::size_t first, mlr::Solution& frames)
       {
-        if (first == 0 && (frames.frameCount() == cache.Times.size() || frames.frameCount() == 1))
+        // Every solved frame at once (one chunk, or lights that do not move). Not a first
+        // chunk's single finished frame, which chunks of 2 hand on before their seam.
+        if (first == 0 && frames.frameCount() == mlr::frameCount(rig, true))
         {
           whole = std::move(frames);
           return;
@@ -1464,26 +1553,24 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         }
         // The frames carry the statistics of their chunk; the last update, the animation's.
         cache.Statistics = mlr::vtkoutputs::statisticsFieldData(frames.statistics, solverOptions);
+        // Every frame's error figures, for the field data of every time step after the solve
+        // (the command line's error line and --stats read the last one's).
+        streamedErrors.add(first, frames.errorEstimate);
         if (cachesChunks)
         {
-          // Every frame's error figures, for the field data of every time step.
-          const mlr::ErrorEstimateSummary& e = frames.errorEstimate;
-          chunkErrors.relativeErrorMedian.insert(chunkErrors.relativeErrorMedian.end(),
-            e.relativeErrorMedian.begin(), e.relativeErrorMedian.end());
-          chunkErrors.relativeErrorP95.insert(chunkErrors.relativeErrorP95.end(),
-            e.relativeErrorP95.begin(), e.relativeErrorP95.end());
-          chunkErrors.litElements.insert(
-            chunkErrors.litElements.end(), e.litElements.begin(), e.litElements.end());
           cache.cacheChunk(first, std::move(frames), static_cast<std::size_t>(this->CachedChunks));
           return;
         }
         cache.Solution = std::move(frames);
         cache.FirstFrame = first;
+        // Timed: handing frames on happens inside the solve, and a caller that writes them
+        // would otherwise count its writing as solving.
+        const auto handing = std::chrono::steady_clock::now();
         for (std::size_t f = first; f < first + cache.Solution.frameCount(); ++f)
         {
           if (this->CheckAbort())
           {
-            return;
+            break;
           }
           vtkNew<vtkPolyData> elements;
           if (this->FillOutput(ELEMENTS_PORT, f, elements))
@@ -1491,8 +1578,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
             this->ChunkFramesObserver(f, elements);
           }
         }
+        secondsStreaming +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - handing).count();
       };
     }
+    // Remeshing's warnings as soon as the scene is built, so that a run refused by its memory
+    // limit, cancelled or stopped during the solve still shows them.
+    options.sceneWarning = [this](const std::string& warning) { vtkWarningMacro(<< warning); };
     mlr::Animation animation = mlr::solveAnimation(soup, rig, options,
       [this, reportsProgress](double fraction)
       {
@@ -1532,14 +1624,15 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       // The frames went to the observer, or to the cache of chunks; the last chunk's stay,
       // with the whole solve's statistics.
       cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
-      if (cachesChunks)
+      if (this->ChunkFramesObserver)
       {
-        mlr::Solution summary;
-        summary.errorEstimate = solution.errorEstimate;
-        summary.errorEstimate.relativeErrorMedian = std::move(chunkErrors.relativeErrorMedian);
-        summary.errorEstimate.relativeErrorP95 = std::move(chunkErrors.relativeErrorP95);
-        summary.errorEstimate.litElements = std::move(chunkErrors.litElements);
-        mlr::vtkoutputs::addErrorFieldData(cache.Statistics, summary);
+        mlr::vtkoutputs::addValue<vtkDoubleArray>(
+          cache.Statistics, "SecondsStreaming", secondsStreaming);
+      }
+      if (!controller)
+      {
+        streamedErrors.addTo(cache.Statistics, solution.errorEstimate,
+          static_cast<std::size_t>(solution.statistics.frames), nullptr);
       }
     }
     else
@@ -1632,6 +1725,13 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       if (verdict.failed)
       {
         throw mlr::Error(verdict.message);
+      }
+      if (streamed)
+      {
+        // Every rank is here (agreed): each frame's figures from the rank that holds it.
+        streamedErrors.addTo(cache.Statistics, solution.errorEstimate,
+          static_cast<std::size_t>(solution.statistics.frames),
+          solverOptions.sumDoublesAcrossRanks);
       }
     }
     if (cachesChunks && streamed)

@@ -7,6 +7,7 @@ ctest sets MLR_CLI (the executable) and MLR_DATA_DIR (Data/); by hand:
 import json
 import os
 import re
+import subprocess
 import sys
 import shutil
 import xml.etree.ElementTree as ElementTree
@@ -14,11 +15,12 @@ import xml.etree.ElementTree as ElementTree
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
-from cli_support import FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
+from cli_support import CLI, FAST, LIGHT, SCENE, all_files, run, write_polydata  # noqa: E402
 
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkCommonCore import vtkPoints, vtkDoubleArray
+from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkIOImage import vtkPNGReader
 from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
 from paraview.modules.vtkPVVTKExtensionsIOCore import vtkPVDReader
@@ -268,6 +270,39 @@ def test_failed_solve_keeps_the_previous_series(tmp_path):
     after = {name: (tmp_path / name).read_bytes() for name in all_files(tmp_path)
              if name != "bad.vtp"}
     assert after == before
+
+
+def test_remeshing_warnings_show_before_the_solve(tmp_path):
+    """A ball of 6,960 triangles at a patch size of 10 cm keeps its triangles, far more patches
+    than the patch size aims at: the warning comes once, as soon as the scene is built, before
+    the solve's first line, and also when the solve is then refused for its memory."""
+    ball = vtkSphereSource()
+    ball.SetCenter(0.28, 0.2, 0.28)
+    ball.SetRadius(0.1)
+    ball.SetThetaResolution(60)
+    ball.SetPhiResolution(60)
+    ball.Update()
+    write_polydata(ball.GetOutput(), tmp_path / "ball.vtp")
+    common = ["--scene", "ball.vtp", "--light", LIGHT, "--from", "0.25,0.5478,0.25", "--to",
+              "0.3,0.5478,0.3", "--frames", "6", "--paths", "20000", "--patch-size", "0.1",
+              "--threads", "2"]
+    # Both streams in one pipe, in the order they were written.
+    result = subprocess.run([CLI] + common + ["--frames-per-chunk", "3", "--output", "s.pvd"],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, timeout=300)
+    assert result.returncode == 0, result.stdout
+    lines = result.stdout.splitlines()
+    warnings = [i for i, line in enumerate(lines) if "the scene keeps 6960 patches" in line]
+    assert len(warnings) == 1, result.stdout
+    solve = next(i for i, line in enumerate(lines) if line.startswith("chunk 1 of 2"))
+    assert warnings[0] < solve, result.stdout
+
+    # Remeshing fits in 16 MiB (about 10), the solve does not (about 43): refused after the
+    # scene is built, with the warning that says why it has so many patches.
+    refused = run(common + ["--memory-limit", "16", "--output", "r.pvd"], tmp_path)
+    assert refused.returncode == 1
+    assert "the solve needs an estimated" in refused.stderr
+    assert refused.stderr.count("the scene keeps 6960 patches") == 1, refused.stderr
 
 
 @pytest.mark.skipif(shutil.which("Xvfb") is None, reason="needs Xvfb")

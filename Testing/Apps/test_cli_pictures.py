@@ -20,7 +20,7 @@ import numpy
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
-from cli_support import run  # noqa: E402
+from cli_support import LIGHT, SCENE, run, write_polydata  # noqa: E402
 from test_cli_rigs_and_sun import Polygons, square_z, write_points  # noqa: E402
 
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
@@ -28,7 +28,7 @@ from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkFiltersCore import vtkProbeFilter
 from vtkmodules.vtkIOImage import vtkPNGReader
-from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLUnstructuredGridReader
 from vtkmodules.vtkRenderingCore import vtkCamera
 
 pytestmark = pytest.mark.skipif(shutil.which("Xvfb") is None and not os.environ.get("DISPLAY"),
@@ -198,3 +198,55 @@ def test_pixels_are_the_frames_point_colours(pictures):
         # The wall is lit unevenly: the comparison covers many colours.
         assert numpy.ptp(expected[:, 1]) > 60, k
         assert difference.max() <= 2, (k, difference.max(), numpy.argmax(difference.max(axis=1)))
+
+
+def picture_pixels(path):
+    png = vtkPNGReader()
+    png.SetFileName(str(path))
+    png.Update()
+    return vtk_to_numpy(png.GetOutput().GetPointData().GetScalars())[:, :3].astype(float)
+
+
+def share(pixels, channel, factor=1.5):
+    """The share of the pixels whose `channel` is `factor` times each of the other two."""
+    others = [c for c in range(3) if c != channel]
+    main = pixels[:, channel]
+    return float(numpy.mean((main > factor * pixels[:, others[0]]) &
+                            (main > factor * pixels[:, others[1]])))
+
+
+def test_a_closed_room_is_seen_from_inside(tmp_path):
+    """The Cornell box closed by a blue front wall (its normal into the room), the lamp inside.
+    From outside the picture is that wall, coloured by the light of its inner side; the
+    camera goes inside, near that wall, and sees the red and green walls. The open box keeps
+    the outside camera."""
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(SCENE)
+    reader.Update()
+    open_box = reader.GetOutput()
+    write_polydata(open_box, tmp_path / "open.vtp")
+    closed = vtkPolyData()
+    closed.DeepCopy(open_box)
+    x1, y1 = closed.GetBounds()[1], closed.GetBounds()[3]
+    ids = [closed.GetPoints().InsertNextPoint(*corner)
+           for corner in ((0, 0, 0), (x1, 0, 0), (x1, y1, 0), (0, y1, 0))]
+    closed.GetPolys().InsertNextCell(4, ids)
+    closed.GetCellData().GetArray("Reflectance").InsertNextTuple((0.1, 0.1, 0.6))
+    write_polydata(closed, tmp_path / "closed.vtp")
+    common = ["--light", LIGHT, "--from", "0.2,0.5478,0.25", "--to", "0.3,0.5478,0.3",
+              "--frames", "2", "--paths", "20000", "--patch-size", "0.08"]
+    result = run(["--scene", "closed.vtp", "--output", "c/s.pvd", "--png", "c-png"] + common,
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    for k in range(2):
+        pixels = picture_pixels(tmp_path / "c-png" / f"s_000{k}.png")
+        assert share(pixels, 2) < 0.1, k        # the blue wall, behind the camera
+        assert share(pixels, 0) > 0.04, k       # the red wall
+        assert share(pixels, 1, 1.3) > 0.04, k  # the green wall
+        assert pixels.mean() > 100, k           # lit walls, not the dark outside
+    assert "pictures from inside the scene, at (0.278, 0.274, " in result.stdout
+
+    result = run(["--scene", "open.vtp", "--output", "o/s.pvd", "--png", "o-png"] + common,
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "pictures from inside" not in result.stdout

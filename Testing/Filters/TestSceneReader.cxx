@@ -6,6 +6,7 @@
 #include "vtkDataArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
+#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkJPEGWriter.h"
 #include "vtkNew.h"
@@ -494,6 +495,136 @@ TEST(SceneReader, ObjGltfGlbAndPlyGiveTheSameReflectances)
   EXPECT_EQ(stringField(readScene(folder / "faces.ply").output, "SceneFormat"), "PLY");
   EXPECT_EQ(
     materialNames(readScene(folder / "faces.ply").output), (std::vector<std::string>{ "faces" }));
+}
+
+// --- PLY triangle strips (Stanford's igea.ply, the trimesh2 tools) ---------------------------
+namespace
+{
+// Six vertices along a 2 x 1 strip in z = 0; the strip 0 1 2 3 4 5 makes the triangles
+// (0 1 2), (2 1 3), (2 3 4), (4 3 5), every other one turned, all facing -z.
+const float StripCorners[6][3] = { { 0, 0, 0 }, { 0, 1, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 2, 0, 0 },
+  { 2, 1, 0 } };
+const std::vector<std::array<vtkIdType, 3>> StripTriangles = { { { 0, 1, 2 } }, { { 2, 1, 3 } },
+  { { 2, 3, 4 } }, { { 4, 3, 5 } } };
+
+std::string stripHeader(const std::string& format, const std::string& vertexExtra,
+  const std::string& between, std::size_t strips = 1)
+{
+  return "ply\nformat " + format +
+    " 1.0\ncomment strips as trimesh2 writes them\nelement vertex 6\nproperty float x\n"
+    "property float y\nproperty float z\n" +
+    vertexExtra + between + "element tristrips " + std::to_string(strips) +
+    "\nproperty list int int vertex_indices\nend_header\n";
+}
+
+std::string asciiStripFile(const std::vector<int>& indices)
+{
+  std::string text = stripHeader("ascii", "", "");
+  for (const auto& corner : StripCorners)
+  {
+    text += std::to_string(corner[0]) + " " + std::to_string(corner[1]) + " " +
+      std::to_string(corner[2]) + "\n";
+  }
+  text += std::to_string(indices.size());
+  for (int index : indices)
+  {
+    text += " " + std::to_string(index);
+  }
+  return text + "\n";
+}
+
+void appendBigEndian(std::string& out, std::uint32_t bits)
+{
+  for (int shift = 24; shift >= 0; shift -= 8)
+  {
+    out += static_cast<char>((bits >> shift) & 0xff);
+  }
+}
+
+std::vector<std::array<vtkIdType, 3>> triangles(vtkPolyData* mesh)
+{
+  std::vector<std::array<vtkIdType, 3>> result;
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < mesh->GetNumberOfCells(); ++c)
+  {
+    mesh->GetCellPoints(c, ids);
+    if (ids->GetNumberOfIds() == 3)
+    {
+      result.push_back({ { ids->GetId(0), ids->GetId(1), ids->GetId(2) } });
+    }
+  }
+  return result;
+}
+} // namespace
+
+TEST(SceneReader, PlyTriangleStripsBecomeTrianglesFacingOneWay)
+{
+  const TestFolder scratch("ply-strips");
+  const fs::path& folder = scratch.path;
+  // One strip; two strips split by -1; one strip joined by repeated indices, whose four
+  // triangles without area are dropped but still turn the ones after them.
+  writeFile(folder / "one.ply", asciiStripFile({ 0, 1, 2, 3, 4, 5 }));
+  writeFile(folder / "restart.ply", asciiStripFile({ 0, 1, 2, 3, -1, 2, 3, 4, 5, -1 }));
+  writeFile(folder / "joined.ply", asciiStripFile({ 0, 1, 2, 3, 3, 2, 2, 3, 4, 5 }));
+  // Big-endian binary with vertex colours and an empty face element before the strips, two
+  // strip rows (-1 ending the first) and a strip of two vertices, which makes nothing.
+  std::string binary = stripHeader("binary_big_endian",
+    "property uchar red\nproperty uchar green\nproperty uchar blue\n",
+    "element face 0\nproperty list uchar int vertex_indices\n", 3);
+  for (int v = 0; v < 6; ++v)
+  {
+    for (float coordinate : StripCorners[v])
+    {
+      std::uint32_t bits;
+      std::memcpy(&bits, &coordinate, 4);
+      appendBigEndian(binary, bits);
+    }
+    binary += static_cast<char>(v * 51); // red 0, 51, ..., 255 (0.2 steps); green, blue 0
+    binary += '\0';
+    binary += '\0';
+  }
+  for (const std::vector<int>& strip : { std::vector<int>{ 0, 1, 2, 3, -1 },
+         std::vector<int>{ 2, 3, 4, 5 }, std::vector<int>{ 4, 5 } })
+  {
+    appendBigEndian(binary, static_cast<std::uint32_t>(strip.size()));
+    for (int index : strip)
+    {
+      appendBigEndian(binary, static_cast<std::uint32_t>(index));
+    }
+  }
+  writeFile(folder / "binary.ply", binary);
+
+  for (const char* name : { "one.ply", "restart.ply", "joined.ply", "binary.ply" })
+  {
+    SCOPED_TRACE(name);
+    const ReadResult result = readScene(folder / name);
+    ASSERT_TRUE(result.succeeded) << result.errors();
+    EXPECT_EQ(result.errors(), "");
+    EXPECT_EQ(stringField(result.output, "SceneFormat"), "PLY");
+    EXPECT_EQ(triangles(result.output), StripTriangles);
+    for (vtkIdType c = 0; c < result.output->GetNumberOfCells(); ++c)
+    {
+      double a[3], b[3], d[3];
+      const auto& t = StripTriangles[static_cast<std::size_t>(c)];
+      result.output->GetPoint(t[0], a);
+      result.output->GetPoint(t[1], b);
+      result.output->GetPoint(t[2], d);
+      const double normalZ = (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]);
+      EXPECT_NEAR(normalZ, -1.0, 1e-12) << "triangle " << c;
+    }
+    if (std::string(name) == "binary.ply")
+    {
+      EXPECT_EQ(result.warnings(), "");
+      // A triangle's reflectance is the mean of its vertices' colours: (2 1 3) 0.4.
+      expectRgbNear(tuple3(result.output, "Reflectance", 1), 0.4, 0, 0, 1e-6);
+      expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.8, 0, 0, 1e-6);
+    }
+    else
+    {
+      EXPECT_NE(result.warnings().find("no red/green/blue colours"), std::string::npos)
+        << result.warnings();
+    }
+  }
 }
 
 TEST(SceneReader, GltfNodeTransformsAndEmission)
@@ -1060,6 +1191,78 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     EXPECT_EQ(result.output->GetNumberOfCells(), 0);
     EXPECT_EQ(result.output->GetNumberOfPoints(), 0);
   }
+}
+
+TEST(SceneReader, PlyTriangleStripsWithBadIndicesOrCountsAreRefused)
+{
+  const TestFolder scratch("ply-bad-strips");
+  const fs::path& folder = scratch.path;
+  // A binary list of 2^30 indices in a file of a few hundred bytes.
+  std::string huge = stripHeader("binary_big_endian", "", "");
+  huge.append(6 * 12, '\0');
+  appendBigEndian(huge, 1u << 30);
+  appendBigEndian(huge, 0);
+  // A list the file holds but the memory limit does not: 20,000 indices, up to 19,998
+  // triangles (about 2 MiB of output) over 1 MiB.
+  std::string long_ = stripHeader("binary_big_endian", "", "");
+  for (const auto& corner : StripCorners)
+  {
+    for (float coordinate : corner)
+    {
+      std::uint32_t bits;
+      std::memcpy(&bits, &coordinate, 4);
+      appendBigEndian(long_, bits);
+    }
+  }
+  appendBigEndian(long_, 20000);
+  for (int i = 0; i < 20000; ++i)
+  {
+    appendBigEndian(long_, static_cast<std::uint32_t>(i % 6));
+  }
+  std::string fraction = asciiStripFile({ 0, 1, 2 });
+  fraction.replace(fraction.rfind(" 2\n"), 2, " 2.5");
+  std::string truncated = asciiStripFile({ 0, 1, 2, 3, 4, 5 });
+  truncated.resize(truncated.size() - 6);
+  std::string beforeVertices = "ply\nformat ascii 1.0\nelement tristrips 1\nproperty list int int "
+                               "vertex_indices\nelement vertex 3\nproperty float x\nproperty "
+                               "float y\nproperty float z\nend_header\n3 0 1 2\n0 0 0\n1 0 0\n"
+                               "0 1 0\n";
+  const std::vector<BadFile> files = {
+    { "outside.ply", asciiStripFile({ 0, 1, 2, 6 }), "names vertex 6 in tristrips 0 but has 6" },
+    { "negative.ply", asciiStripFile({ 0, 1, 2, -2 }), "names vertex -2 in tristrips 0" },
+    { "fraction.ply", fraction, "names vertex 2.5" },
+    { "huge.ply", huge, "has a list of 1.07374e+09 values in tristrips 0, more than the file's" },
+    { "truncated.ply", truncated, "truncated" },
+    { "short.ply", asciiStripFile({ 0, 1, -1, 2, 3, -1 }), "no triangle in its strips" },
+    { "flat.ply", asciiStripFile({ 0, 1, 0, 1, 0 }), "no triangle in its strips" },
+    { "before.ply", beforeVertices, "lists its triangle strips before its vertices" },
+  };
+  for (const BadFile& file : files)
+  {
+    SCOPED_TRACE(file.name);
+    writeFile(folder / file.name, file.content);
+    const ReadResult result = readScene(folder / file.name);
+    EXPECT_FALSE(result.succeeded);
+    EXPECT_NE(result.errors().find((folder / file.name).string()), std::string::npos)
+      << result.errors();
+    EXPECT_NE(result.errors().find(file.expected), std::string::npos) << result.errors();
+    EXPECT_EQ(result.output->GetNumberOfCells(), 0);
+  }
+
+  writeFile(folder / "long.ply", long_);
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(reader);
+  reader->SetFileName((folder / "long.ply").string().c_str());
+  reader->SetMemoryLimit(1);
+  EXPECT_EQ(reader->GetExecutive()->Update(), 0);
+  EXPECT_NE(messages->allErrors().find("over the memory limit"), std::string::npos)
+    << messages->allErrors();
+  EXPECT_NE(messages->allErrors().find("20000 triangles"), std::string::npos)
+    << messages->allErrors();
+  reader->SetMemoryLimit(0);
+  EXPECT_EQ(reader->GetExecutive()->Update(), 1) << messages->allErrors();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 19998);
 }
 
 TEST(SceneReader, MissingFileAndNoFileNameAreErrors)

@@ -170,6 +170,21 @@ def reader_seeds():
         yield "vtk_polydata_" + suffix, 5, written(vtkPolyDataWriter(), box, legacy)
         yield "vtk_grid_" + suffix, 5, written(vtkUnstructuredGridWriter(), grid.GetOutput(),
                                                legacy)
+    # Triangle strips as scanned models store them (Stanford's igea.ply): one list, -1 ending
+    # each strip, with repeated indices joining strips.
+    corners = [(0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0), (2, 0, 0), (2, 1, 0)]
+    strips = [0, 1, 2, 3, -1, 2, 3, 3, 4, 4, 5]
+
+    def strip_header(form):
+        return (f"ply\nformat {form} 1.0\nelement vertex {len(corners)}\nproperty float x\n"
+                "property float y\nproperty float z\nelement tristrips 1\n"
+                "property list int int vertex_indices\nend_header\n").encode()
+    yield "ply_tristrips_ascii", 2, (strip_header("ascii") + "".join(
+        f"{x} {y} {z}\n" for x, y, z in corners).encode() +
+        (" ".join(str(i) for i in [len(strips)] + strips) + "\n").encode())
+    yield "ply_tristrips_binary", 2, (strip_header("binary_big_endian") + b"".join(
+        struct.pack(">3f", *c) for c in corners) + struct.pack(f">{len(strips) + 1}i",
+                                                               len(strips), *strips))
 
 
 # --- readers: photometric files (IES LM-63 types C, B and A, TILT=INCLUDE, EULUMDAT) ----------

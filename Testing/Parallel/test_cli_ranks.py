@@ -79,6 +79,10 @@ def test_ranks_with_chunks_write_the_serial_series(tmp_path, ranks, per_chunk):
     # The light's place in every frame, whichever rank wrote it.
     one_stats = json.loads((tmp_path / "one/s.json").read_text())
     assert stats["frames"] == one_stats["frames"]
+    # Every frame's error figures, from the rank that solved it, and the worst on the summary.
+    assert stats["errorEstimate"] == one_stats["errorEstimate"]
+    error_line = [line for line in one.stdout.splitlines() if line.startswith("relative error")]
+    assert len(error_line) == 1 and many.stdout.count(error_line[0]) == 1, many.stdout
     assert all_files(tmp_path / "many") == sorted(
         ["s.json", "s.pvd"] + [f"s_{f:04d}.vtu" for f in range(12)])
 
