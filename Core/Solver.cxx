@@ -342,6 +342,7 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
     batch.setStorageScale(solution.storageScale());
     batch.reflectanceData() = solution.reflectanceData();
     batch.emissionData() = solution.emissionData();
+    std::uint64_t batchIndex = 0;
     solveInBatches(
       options,
       [&](
@@ -349,6 +350,11 @@ Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& opt
       {
         batch.clearRadiosity();
         pass(batchOptions, batch, fraction);
+        if (options.batchSolved)
+        {
+          options.batchSolved(batchIndex, rig.firstFrame, batch);
+        }
+        ++batchIndex;
         return batch;
       },
       progress, plan.peak, secondsReducing, solution);
