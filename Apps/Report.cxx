@@ -317,6 +317,20 @@ std::string errorLine(vtkFieldData* statistics)
   }
   s << ", " << static_cast<long long>(value(statistics, "ErrorBatches")) << " batches in " << rounds
     << (rounds == 1 ? " round" : " rounds") << ", stopped by " << stoppedBy->GetValue(0);
+  vtkDataArray* sensorP95 = statistics->GetArray("SensorRelativeErrorP95");
+  vtkDataArray* sensorMedian = statistics->GetArray("SensorRelativeErrorMedian");
+  if (sensorP95 && sensorMedian && sensorP95->GetNumberOfTuples() > 0 &&
+    sensorMedian->GetNumberOfTuples() == sensorP95->GetNumberOfTuples())
+  {
+    vtkIdType frame = 0;
+    for (vtkIdType f = 1; f < sensorP95->GetNumberOfTuples(); ++f)
+    {
+      frame = sensorP95->GetComponent(f, 0) > sensorP95->GetComponent(frame, 0) ? f : frame;
+    }
+    s << "\nrelative error of the lit sensors: median "
+      << 100 * sensorMedian->GetComponent(frame, 0) << "%, p95 "
+      << 100 * sensorP95->GetComponent(frame, 0) << "% (frame " << frame << ", the worst)";
+  }
   return s.str();
 }
 
@@ -362,6 +376,23 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     }
     sensors["count"] = sensorCount;
     sensors["daylightAutonomyThresholdLx"] = jsonNumber(filter->GetDaylightAutonomyThreshold());
+    // Their error estimate's figures per frame, as the elements' (errorEstimate below).
+    for (const auto& [name, key] :
+      { std::make_pair("SensorRelativeErrorMedian", "relativeErrorMedian"),
+        std::make_pair("SensorRelativeErrorP95", "relativeErrorP95"),
+        std::make_pair("LitSensors", "litSensors") })
+    {
+      if (vtkDataArray* array = statistics ? statistics->GetArray(name) : nullptr)
+      {
+        nlohmann::ordered_json perFrameValues = nlohmann::ordered_json::array();
+        for (vtkIdType f = 0; f < array->GetNumberOfTuples(); ++f)
+        {
+          perFrameValues.push_back(jsonNumber(array->GetComponent(f, 0),
+            array->GetDataType() != VTK_FLOAT && array->GetDataType() != VTK_DOUBLE));
+        }
+        sensors["errorEstimate"][key] = perFrameValues;
+      }
+    }
     json["sensors"] = sensors;
   }
   json["settings"] = {

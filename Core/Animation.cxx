@@ -1,9 +1,11 @@
 #include "Animation.h"
 
 #include "Error.h"
+#include "ErrorEstimate.h"
 #include "MemoryBudget.h"
 
 #include <algorithm>
+#include <optional>
 
 namespace mlr
 {
@@ -171,8 +173,30 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       options.chunkFrames(animation, first, frames);
     };
   }
-  animation.solution = solveInChunks(scene, lights, options.solver, framesPerChunk, solveProgress,
+  // With batches, the sensors read every batch through their hemisphere rays: the spread of
+  // those reads is the solution's part of their standard error.
+  SolverOptions solverOptions = options.solver;
+  std::optional<SensorBatchSpread> sensorSpread;
+  if (!options.sensors.empty() && estimatesError(options.solver))
+  {
+    sensorSpread.emplace(scene, options.sensors, options.solver, options.sensorOptions,
+      frameCount(lights, scene.hasEmission()), framesPerChunk);
+    solverOptions.batchSolved =
+      [&](std::uint64_t batch, std::size_t firstFrame, const Solution& solution)
+    {
+      if (options.solver.batchSolved)
+      {
+        options.solver.batchSolved(batch, firstFrame, solution);
+      }
+      sensorSpread->add(batch, firstFrame, solution);
+    };
+  }
+  animation.solution = solveInChunks(scene, lights, solverOptions, framesPerChunk, solveProgress,
     onFrames, streamed ? options.firstChunkFigure : FirstChunkFigure());
+  if (sensorSpread)
+  {
+    sensorSpread->finish();
+  }
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
   animation.solution.statistics.patchEdgeLength = animation.remeshing.targetEdgeLength;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
@@ -184,8 +208,9 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     {
       sensorProgress = [&](double f) { return progress(1 - sensorShare + sensorShare * f); };
     }
-    animation.sensors = solveSensors(scene, lights, animation.solution, options.sensors,
-      options.solver, options.sensorOptions, sensorProgress);
+    animation.sensors =
+      solveSensors(scene, lights, animation.solution, options.sensors, options.solver,
+        options.sensorOptions, sensorProgress, sensorSpread ? &*sensorSpread : nullptr);
   }
   return animation;
 }

@@ -427,6 +427,11 @@ FrameError frameError(const Solution& solution, std::size_t frame,
       relative.push_back(stdError(e, solution.litSide(e)).sum() / totals[e]);
     }
   }
+  return relativeErrorFigures(relative);
+}
+
+FrameError relativeErrorFigures(std::vector<double>& relative)
+{
   FrameError result;
   result.litElements = relative.size();
   if (relative.empty())

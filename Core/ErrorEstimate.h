@@ -77,6 +77,10 @@ struct FrameError
 FrameError frameError(const Solution& solution, std::size_t frame,
   const std::function<Rgb(std::size_t element, Side side)>& stdError);
 
+/// The median and 95th percentile (nearest rank) of `relative`, which it reorders, and its
+/// size as litElements: frameError's figures of the relative errors given.
+FrameError relativeErrorFigures(std::vector<double>& relative);
+
 /// The batch count of the next round: `batches` times (p95 / target)^2, a tenth more so that
 /// the round lands under the target, clamped to [MinimumRoundGrowth, MaximumRoundGrowth]
 /// times `batches` and rounded up.

@@ -178,6 +178,16 @@ Rgb gatheredRadiosity(
   return bounced[element % Scene::ElementsPerPatch] + solution.direct(frame, element, side);
 }
 
+void gatheredRadiosities(const Scene& scene, const Solution& solution, std::size_t frame,
+  std::size_t patch, Side side, Rgb* out)
+{
+  elementsBounced(scene, solution, frame, patch, side, out);
+  for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
+  {
+    out[k] += solution.direct(frame, patch * Scene::ElementsPerPatch + k, side);
+  }
+}
+
 std::vector<std::uint32_t> gatheringSides(
   const Scene& scene, const std::vector<std::uint8_t>& reachable, double& rays, std::uint64_t total)
 {

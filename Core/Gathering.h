@@ -29,6 +29,11 @@ std::size_t gatheringBlockFrames(std::size_t elements, std::size_t frames, std::
 Rgb gatheredRadiosity(
   const Scene& scene, const Solution& solution, std::size_t frame, std::size_t element, Side side);
 
+/// gatheredRadiosity() of the four elements of side `side` of `patch` in `frame`, into `out`,
+/// from one reconstruction of the patch's bounced light.
+void gatheredRadiosities(const Scene& scene, const Solution& solution, std::size_t frame,
+  std::size_t patch, Side side, Rgb* out);
+
 /**
  * The element sides that gather: those of reachable patch sides whose reflectance is not
  * zero (a black element reflects nothing it gathers). Returns them as element * 2 + side,

@@ -1,5 +1,6 @@
 #include "Sensors.h"
 
+#include "Chunks.h"
 #include "Error.h"
 #include "Gathering.h"
 #include "MemoryBudget.h"
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace mlr
@@ -34,26 +36,35 @@ std::size_t poseOf(std::size_t positions, std::size_t frame)
 struct SensorScratch
 {
   std::vector<Rgb> total, sun, gathered;
-  std::vector<double> skySum;
+  /// The variance of the sensor's estimate per frame, and the sums it is made of: the squares
+  /// of the hemisphere rays' values, and per point of an area light its values (point-major,
+  /// frames innermost), their sum and squares and the strata's differences.
+  std::vector<Rgb> variance, gatheredSquares, pointSum, pointSquares, strata;
+  std::vector<Rgb> perPoint;
+  std::vector<double> skySum, skySquares;
   std::vector<std::size_t> hits, cells;
   std::vector<float> dx, dy, dz;
   std::vector<std::uint8_t> visible;
   std::vector<Rgb> values;
-  std::vector<std::uint32_t> targets;
+  std::vector<std::uint32_t> targets, points;
   std::vector<std::size_t> skyBase;
   /// The rays this worker cast (SensorStatistics).
   std::uint64_t shadowRays = 0, gatheringRays = 0;
 
   /// Room for every sensor's work, so that no vector grows (and memory is what
-  /// estimateSensorMemory says): `batch` shadow rays at most per light.
+  /// estimateSensorMemory says): `batch` shadow rays at most per light, and `pointFrames`
+  /// values of an area light's points over the frames.
   void reserve(std::size_t frames, std::size_t skyPositions, std::size_t skies, std::size_t rays,
-    std::size_t batch)
+    std::size_t batch, std::size_t pointFrames)
   {
-    for (std::vector<Rgb>* v : { &this->total, &this->sun, &this->gathered })
+    for (std::vector<Rgb>* v : { &this->total, &this->sun, &this->gathered, &this->variance,
+           &this->gatheredSquares, &this->pointSum, &this->pointSquares, &this->strata })
     {
       v->reserve(frames);
     }
+    this->perPoint.reserve(pointFrames);
     this->skySum.reserve(skyPositions);
+    this->skySquares.reserve(skyPositions);
     this->hits.reserve(rays);
     this->cells.reserve(rays * skies);
     for (std::vector<float>* v : { &this->dx, &this->dy, &this->dz })
@@ -63,18 +74,20 @@ struct SensorScratch
     this->visible.reserve(batch);
     this->values.reserve(batch);
     this->targets.reserve(batch);
+    this->points.reserve(batch);
     this->skyBase.reserve(skies);
   }
   /// The bytes reserve() takes.
   static std::uint64_t bytes(std::size_t frames, std::size_t skyPositions, std::size_t skies,
-    std::size_t rays, std::size_t batch)
+    std::size_t rays, std::size_t batch, std::size_t pointFrames)
   {
-    return saturatingSum(saturatingSum(saturatingProduct(3 * sizeof(Rgb), frames),
-                           saturatingProduct(sizeof(double), skyPositions)),
+    return saturatingSum(saturatingSum(saturatingSum(saturatingProduct(8 * sizeof(Rgb), frames),
+                                         saturatingProduct(2 * sizeof(double), skyPositions)),
+                           saturatingProduct(sizeof(Rgb), pointFrames)),
       saturatingSum(saturatingProduct({ sizeof(std::size_t), rays, 1 + skies }),
-        saturatingSum(
-          saturatingProduct(
-            3 * sizeof(float) + sizeof(std::uint8_t) + sizeof(Rgb) + sizeof(std::uint32_t), batch),
+        saturatingSum(saturatingProduct(3 * sizeof(float) + sizeof(std::uint8_t) + sizeof(Rgb) +
+                          2 * sizeof(std::uint32_t),
+                        batch),
           saturatingProduct(sizeof(std::size_t), skies))));
   }
 
@@ -85,16 +98,139 @@ struct SensorScratch
     this->dz.clear();
     this->values.clear();
     this->targets.clear();
+    this->points.clear();
   }
-  void addRay(const Vec3& d, const Rgb& value, std::size_t frame)
+  void addRay(const Vec3& d, const Rgb& value, std::size_t frame, std::uint32_t point = 0)
   {
     this->dx.push_back(static_cast<float>(d.x));
     this->dy.push_back(static_cast<float>(d.y));
     this->dz.push_back(static_cast<float>(d.z));
     this->values.push_back(value);
     this->targets.push_back(static_cast<std::uint32_t>(frame));
+    this->points.push_back(point);
   }
 };
+
+/**
+ * Casts sensor `s`'s hemisphere rays from `origin` about `n`, the streams of solveSensors
+ * and SensorBatchSpread alike, so that both read through the same rays: each ray that reaches
+ * an element side that gathers (front sides only when one-sided) goes to `hits` as
+ * 2 element + side, in ray order; `onMiss` gets the direction of each ray that escapes.
+ */
+template <typename OnMiss>
+void castHemisphere(const RayTracer& tracer, const Vec3& origin, const Vec3& n, std::size_t s,
+  const SolverOptions& options, std::uint32_t rays, std::vector<std::size_t>& hits,
+  const OnMiss& onMiss)
+{
+  RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
+  for (std::uint32_t r = 0; r < rays; ++r)
+  {
+    const Vec3 direction = sampleCosineDirection(n, random);
+    std::uint32_t element = 0;
+    Side side = Side::Front;
+    if (!tracer.nearestSide(origin, direction, element, side))
+    {
+      onMiss(direction);
+    }
+    else if (options.twoSided || side == Side::Front)
+    {
+      hits.push_back(2 * static_cast<std::size_t>(element) + static_cast<std::size_t>(side));
+    }
+  }
+}
+
+/// The variance of the mean of `n` independent values from their sum and sum of squares
+/// (per channel); for a single value, its square, which bounds it.
+Rgb varianceOfMean(const Rgb& sum, const Rgb& squares, double n)
+{
+  if (n < 2)
+  {
+    return squares;
+  }
+  const Rgb spread = squares - sum * sum * (1.0 / n);
+  const double scale = 1.0 / (n * (n - 1));
+  return Rgb(std::max(0.0, spread.r), std::max(0.0, spread.g), std::max(0.0, spread.b)) * scale;
+}
+
+/**
+ * Adds to scratch.variance, per frame, the variance of an area light's estimate: the sum of
+ * the values of its `count` points (scratch.perPoint, 0 where blocked or behind). The first
+ * m x m points are a jittered grid, one in each cell, whose estimate's variance is the sum of
+ * the cells' own, not the spread of the points over the light (their means differ, and the
+ * grid takes that difference out). Each cell's variance is estimated from the second
+ * difference of three cells next to each other along v (a - 2b + c: of variance
+ * s_a^2 + 4 s_b^2 + s_c^2, and free of any trend of the light's values that is linear across
+ * them; along v, since u picks the light's triangle and v moves within it), half its square
+ * counting for the three. Left-over rows count as the rows measured, a grid of 2 x 2 takes the
+ * differences of pairs (which keep the trend: an upper bound), and the points beyond the grid,
+ * independent and uniform on the light, take the spread of all the points, each of which is
+ * uniform on it.
+ */
+void addAreaLightVariance(std::uint32_t count, std::size_t frames, SensorScratch& scratch)
+{
+  const auto side = static_cast<std::uint32_t>(std::sqrt(static_cast<double>(count)));
+  const std::size_t grid = side >= 2 ? static_cast<std::size_t>(side) * side : 0;
+  const Rgb* v = scratch.perPoint.data();
+  scratch.pointSum.assign(frames, Rgb());
+  scratch.pointSquares.assign(frames, Rgb());
+  scratch.strata.assign(frames, Rgb());
+  for (std::uint32_t q = 0; q < count; ++q)
+  {
+    const Rgb* row = v + static_cast<std::size_t>(q) * frames;
+    for (std::size_t f = 0; f < frames; ++f)
+    {
+      scratch.pointSum[f] += row[f];
+      scratch.pointSquares[f] += row[f] * row[f];
+    }
+  }
+  double scale = 1;
+  if (side >= 3)
+  {
+    const std::uint32_t triples = side / 3;
+    scale = static_cast<double>(side) / (3.0 * triples);
+    for (std::uint32_t t = 0; t < triples; ++t)
+    {
+      for (std::uint32_t c = 0; c < side; ++c)
+      {
+        const std::size_t a = static_cast<std::size_t>(3 * t * side + c);
+        const Rgb* va = v + a * frames;
+        const Rgb* vb = va + static_cast<std::size_t>(side) * frames;
+        const Rgb* vc = vb + static_cast<std::size_t>(side) * frames;
+        for (std::size_t f = 0; f < frames; ++f)
+        {
+          const Rgb d = va[f] - vb[f] * 2.0 + vc[f];
+          scratch.strata[f] += d * d * 0.5;
+        }
+      }
+    }
+  }
+  else if (side == 2)
+  {
+    for (std::uint32_t c = 0; c < 2; ++c)
+    {
+      const Rgb* va = v + static_cast<std::size_t>(c) * frames;
+      const Rgb* vb = va + 2 * frames;
+      for (std::size_t f = 0; f < frames; ++f)
+      {
+        const Rgb d = va[f] - vb[f];
+        scratch.strata[f] += d * d;
+      }
+    }
+  }
+  const double independent = static_cast<double>(count - grid);
+  const double n = static_cast<double>(count);
+  for (std::size_t f = 0; f < frames; ++f)
+  {
+    Rgb variance = scratch.strata[f] * scale;
+    if (independent > 0)
+    {
+      // The variance of one point from all of them (varianceOfMean is that over n).
+      variance += varianceOfMean(scratch.pointSum[f], scratch.pointSquares[f], n) *
+        (n >= 2 ? n * independent : independent);
+    }
+    scratch.variance[f] += variance;
+  }
+}
 
 /// Adds to `into` the values of the rays in `scratch` that are not blocked, in ray order.
 void traceShadows(const RayTracer& tracer, const Vec3& origin, bool toInfinity,
@@ -141,16 +277,18 @@ double emittedDensity(const IntensityDistribution& f, const PhotometricFrame& fr
 void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& rig,
   const std::vector<MovingLight>& emitters, const Solution& solution, const SensorSet& sensors,
   std::size_t s, const SolverOptions& options, const SensorOptions& sensorOptions,
-  SensorScratch& scratch, SensorSolution& result)
+  const SensorBatchSpread* solutionSpread, SensorScratch& scratch, SensorSolution& result)
 {
   const std::size_t frames = solution.frameCount();
   const Vec3& p = sensors.points[s];
   const Vec3& n = sensors.normals[s];
   const Vec3 origin = tracer.liftOff(p, n);
   const double offset = tracer.surfaceOffset();
-  scratch.total.assign(frames, Rgb());
-  scratch.sun.assign(frames, Rgb());
-  scratch.gathered.assign(frames, Rgb());
+  for (std::vector<Rgb>* v : { &scratch.total, &scratch.sun, &scratch.gathered, &scratch.variance,
+         &scratch.gatheredSquares })
+  {
+    v->assign(frames, Rgb());
+  }
 
   // The hemisphere, once for all frames: sky visibility and the surface a ray reaches do not
   // depend on the frame, only the radiance found there does.
@@ -163,7 +301,7 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
     skyPositions += sky.positions();
   }
   scratch.skySum.assign(skyPositions, 0.0);
-  RandomStream random(options.seed, StreamPurpose::Sensors, s, 0);
+  scratch.skySquares.assign(skyPositions, 0.0);
   const std::uint32_t rays = sensorOptions.hemisphereRays;
   scratch.gatheringRays += rays;
   // What each ray found, as keys: an element side (2 element + side), or an escaped ray's sky
@@ -171,12 +309,8 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
   // however many rays found it, and the sums run in key order.
   scratch.hits.clear();
   scratch.cells.clear();
-  for (std::uint32_t r = 0; r < rays; ++r)
-  {
-    const Vec3 direction = sampleCosineDirection(n, random);
-    std::uint32_t element = 0;
-    Side side = Side::Front;
-    if (!tracer.nearestSide(origin, direction, element, side))
+  castHemisphere(tracer, origin, n, s, options, rays, scratch.hits,
+    [&](const Vec3& direction)
     {
       for (std::size_t k = 0; k < rig.skies.size(); ++k)
       {
@@ -186,13 +320,7 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
           scratch.cells.push_back(k * Sky::Cells + cell);
         }
       }
-    }
-    else if (options.twoSided || side == Side::Front)
-    {
-      scratch.hits.push_back(
-        2 * static_cast<std::size_t>(element) + static_cast<std::size_t>(side));
-    }
-  }
+    });
   std::sort(scratch.hits.begin(), scratch.hits.end());
   std::sort(scratch.cells.begin(), scratch.cells.end());
   for (std::size_t i = 0; i < scratch.hits.size();)
@@ -207,7 +335,9 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
     const Side side = static_cast<Side>(scratch.hits[i] % 2);
     for (std::size_t f = 0; f < frames; ++f)
     {
-      scratch.gathered[f] += gatheredRadiosity(scene, solution, f, element, side) * count;
+      const Rgb read = gatheredRadiosity(scene, solution, f, element, side);
+      scratch.gathered[f] += read * count;
+      scratch.gatheredSquares[f] += read * read * count;
     }
     i = end;
   }
@@ -223,23 +353,34 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
     const Sky& sky = rig.skies[k];
     const double* density = sky.densities(scratch.cells[i] % Sky::Cells);
     double* sum = scratch.skySum.data() + skyBase[k];
+    double* squares = scratch.skySquares.data() + skyBase[k];
     for (std::size_t j = 0; j < sky.positions(); ++j)
     {
       sum[j] += density[j] * count;
+      squares[j] += density[j] * density[j] * count;
     }
     i = end;
   }
   const double perRay = 1.0 / static_cast<double>(rays);
+  // An escaped ray's value is the sum of every sky's: with several skies the square of that
+  // sum is bounded by their count times the sum of their squares (Cauchy-Schwarz).
+  const double skyBound = static_cast<double>(std::max<std::size_t>(rig.skies.size(), 1));
   for (std::size_t f = 0; f < frames; ++f)
   {
-    scratch.total[f] += scratch.gathered[f] * perRay;
+    Rgb sum = scratch.gathered[f];
+    double skySquares = 0;
     // Cosine-distributed directions: L(w) cos / pdf = pi L(w), L = density Lambda.
     for (std::size_t k = 0; k < rig.skies.size(); ++k)
     {
       const Sky& sky = rig.skies[k];
       const std::size_t j = poseOf(sky.positions(), f);
-      scratch.total[f] += Rgb(M_PI * sky.integral(j) * scratch.skySum[skyBase[k] + j] * perRay);
+      const double weight = M_PI * sky.integral(j);
+      sum += Rgb(weight * scratch.skySum[skyBase[k] + j]);
+      skySquares += weight * weight * scratch.skySquares[skyBase[k] + j];
     }
+    scratch.total[f] += sum * perRay;
+    scratch.variance[f] += varianceOfMean(
+      sum, scratch.gatheredSquares[f] + Rgb(skyBound * skySquares), static_cast<double>(rays));
   }
 
   // Directional lights: one shadow ray per frame.
@@ -336,12 +477,23 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
         {
           // The end lifted off the light on the sensor's side, as the reuse kernel's.
           const Vec3 end = x + normal * (dot(d, normal) < 0 ? -offset : offset);
-          scratch.addRay(
-            end - origin, power * (density * cosine / (r2 * static_cast<double>(samples))), frame);
+          scratch.addRay(end - origin,
+            power * (density * cosine / (r2 * static_cast<double>(samples))), frame, q);
         }
       }
     }
     traceShadows(tracer, origin, false, scratch, scratch.total);
+    scratch.perPoint.assign(static_cast<std::size_t>(samples) * frames, Rgb());
+    for (std::size_t r = 0; r < scratch.visible.size() && r < scratch.values.size(); ++r)
+    {
+      if (scratch.visible[r])
+      {
+        scratch
+          .perPoint[static_cast<std::size_t>(scratch.points[r]) * frames + scratch.targets[r]] =
+          scratch.values[r];
+      }
+    }
+    addAreaLightVariance(samples, frames, scratch);
   }
 
   for (std::size_t frame = 0; frame < frames; ++frame)
@@ -349,6 +501,16 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
     result.irradianceData()[s * frames + frame] =
       FloatRgb(scratch.total[frame] + scratch.sun[frame]);
     result.sunData()[s * frames + frame] = FloatRgb(scratch.sun[frame]);
+    // The sensor's own sampling and the solution's noise are independent (different streams):
+    // their variances add.
+    Rgb variance = scratch.variance[frame];
+    if (solutionSpread)
+    {
+      const Rgb e = solutionSpread->stdError(frame, s);
+      variance += e * e;
+    }
+    result.stdErrorData()[s * frames + frame] =
+      FloatRgb(Rgb(std::sqrt(variance.r), std::sqrt(variance.g), std::sqrt(variance.b)));
   }
 }
 }
@@ -439,6 +601,30 @@ std::size_t shadowBatch(
   }
   return batch;
 }
+
+/// The values of an area light's points over the frames that a worker keeps: samples x frames
+/// when any area light (or emitter) lights the sensors.
+std::size_t pointFrames(
+  const LightRig& rig, bool sceneEmits, std::size_t frames, const SensorOptions& sensorOptions)
+{
+  return rig.areaLights.empty() && !sceneEmits
+    ? 0
+    : saturatingProduct(std::max<std::uint32_t>(sensorOptions.areaLightSamples, 1), frames);
+}
+
+/// SensorBatchSpread reads the batches a block of frames at a time, in a table of at most this
+/// many bytes.
+constexpr std::uint64_t SpreadTableBytes = 16ULL << 20;
+
+/// The most frames one solve of an animation in chunks of `framesPerChunk` reads.
+std::size_t framesPerSolve(std::size_t frames, std::size_t framesPerChunk)
+{
+  if (framesPerChunk == 0 || framesPerChunk >= frames)
+  {
+    return frames;
+  }
+  return std::min(frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk));
+}
 }
 
 std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std::size_t elements,
@@ -449,23 +635,271 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
   {
     return 0;
   }
-  // The two results (a FloatRgb each) and the unit points and normals.
+  // The three results (a FloatRgb each) and the unit points and normals.
   const std::uint64_t results =
-    saturatingSum(saturatingProduct({ 2 * sizeof(FloatRgb), sensors, frames }),
+    saturatingSum(saturatingProduct({ 3 * sizeof(FloatRgb), sensors, frames }),
       saturatingProduct(2 * sizeof(Vec3), sensors));
   const auto workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
   const std::uint64_t scratch = saturatingProduct(workers,
     SensorScratch::bytes(frames, skyPositionsOf(rig), rig.skies.size(),
-      sensorOptions.hemisphereRays, shadowBatch(rig, sceneEmits, frames, sensorOptions)));
+      sensorOptions.hemisphereRays, shadowBatch(rig, sceneEmits, frames, sensorOptions),
+      pointFrames(rig, sceneEmits, frames, sensorOptions)));
   // The scene's emitters as area lights: their triangles, generously per element.
   const std::uint64_t emitters = sceneEmits ? saturatingProduct(elements, 256) : 0;
-  return saturatingSum(saturatingSum(results, scratch),
+  // With batches, the reads of every batch (solveAnimation), the chunks' length unknown here
+  // unless set.
+  const std::uint64_t spread = estimatesError(options)
+    ? SensorBatchSpread::estimateMemory(sensors, frames,
+        static_cast<std::size_t>(options.framesPerChunk), elements / Scene::ElementsPerPatch,
+        sensorOptions, static_cast<int>(workers))
+    : 0;
+  return saturatingSum(saturatingSum(saturatingSum(results, scratch), spread),
     saturatingSum(RayTracer::estimateMemory(elements, points), emitters));
+}
+
+SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
+  const SolverOptions& options, const SensorOptions& sensorOptions, std::size_t frames,
+  std::size_t framesPerChunk)
+  : SceneRef(scene)
+  , Workers(resolveThreadCount(options.threads))
+  , Rays(sensorOptions.hemisphereRays)
+  , Frames(frames)
+  , FramesPerChunk(framesPerChunk)
+{
+  const SensorSet sensors = normalizedSensors(given, sensorOptions);
+  this->Sensors = sensors.size();
+  this->SolutionError.assign(this->Sensors * this->Frames, FloatRgb());
+  this->KeyBegin.assign(this->Sensors + 1, 0);
+  if (this->Sensors == 0 || this->Frames == 0)
+  {
+    return;
+  }
+  // The rays do not depend on the solution: traced once, each sensor's element sides sorted
+  // and counted as solveSensor counts them.
+  std::vector<std::vector<std::size_t>> hits(this->Sensors);
+  {
+    const RayTracer tracer(scene);
+    const std::size_t tasks = (this->Sensors + SensorsPerTask - 1) / SensorsPerTask;
+    parallelFor(
+      tasks, this->Workers,
+      [&](std::size_t task, int)
+      {
+        const std::size_t end = std::min(this->Sensors, (task + 1) * SensorsPerTask);
+        for (std::size_t s = task * SensorsPerTask; s < end; ++s)
+        {
+          const Vec3 origin = tracer.liftOff(sensors.points[s], sensors.normals[s]);
+          hits[s].reserve(this->Rays);
+          castHemisphere(tracer, origin, sensors.normals[s], s, options, this->Rays, hits[s],
+            [](const Vec3&) {});
+          std::sort(hits[s].begin(), hits[s].end());
+        }
+      },
+      [](std::size_t) { return true; });
+  }
+  std::size_t total = 0;
+  for (const std::vector<std::size_t>& h : hits)
+  {
+    total += h.size();
+  }
+  this->KeySlot.reserve(total);
+  this->KeyCount.reserve(total);
+  // The table's rows, the patch sides in the order the sensors first reach them.
+  std::vector<std::uint32_t> rowOf(
+    2 * scene.patchCount(), std::numeric_limits<std::uint32_t>::max());
+  for (std::size_t s = 0; s < this->Sensors; ++s)
+  {
+    const std::vector<std::size_t>& h = hits[s];
+    for (std::size_t i = 0; i < h.size();)
+    {
+      std::size_t end = i;
+      while (end < h.size() && h[end] == h[i])
+      {
+        ++end;
+      }
+      const std::size_t element = h[i] / 2, side = h[i] % 2;
+      const std::size_t patchSide = 2 * Scene::patchOfElement(element) + side;
+      if (rowOf[patchSide] == std::numeric_limits<std::uint32_t>::max())
+      {
+        rowOf[patchSide] = static_cast<std::uint32_t>(this->PatchSides.size());
+        this->PatchSides.push_back(static_cast<std::uint32_t>(patchSide));
+      }
+      this->KeySlot.push_back(static_cast<std::uint32_t>(
+        rowOf[patchSide] * Scene::ElementsPerPatch + element % Scene::ElementsPerPatch));
+      this->KeyCount.push_back(static_cast<std::uint32_t>(end - i));
+      i = end;
+    }
+    this->KeyBegin[s + 1] = this->KeySlot.size();
+    std::vector<std::size_t>().swap(hits[s]);
+  }
+}
+
+void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution)
+{
+  if (this->Sensors == 0 || this->Frames == 0)
+  {
+    return;
+  }
+  if (batch == 0)
+  {
+    this->fold();
+    this->AnySolve = true;
+    this->SolveFirst = firstFrame;
+    this->SolveFrames = solution.frameCount();
+    this->SolveBatches = 0;
+    this->Mean.assign(this->Sensors * this->SolveFrames, FloatRgb());
+    this->SquaredDeviations.assign(this->Sensors * this->SolveFrames, FloatRgb());
+  }
+  if (!this->AnySolve || solution.frameCount() != this->SolveFrames ||
+    this->SolveFirst + this->SolveFrames > this->Frames)
+  {
+    throw Error("internal error: the sensors' batch spread got a batch of another solve");
+  }
+  ++this->SolveBatches;
+  const double inverse = 1.0 / static_cast<double>(this->SolveBatches);
+  const double perRay = 1.0 / static_cast<double>(this->Rays);
+  const std::size_t rows = this->PatchSides.size() * Scene::ElementsPerPatch;
+  const std::size_t block = static_cast<std::size_t>(std::clamp<std::uint64_t>(
+    SpreadTableBytes / std::max<std::uint64_t>(rows * sizeof(FloatRgb), 1), 1,
+    std::max<std::size_t>(this->SolveFrames, 1)));
+  std::vector<FloatRgb> table(rows * block);
+  std::vector<std::vector<Rgb>> sums(
+    static_cast<std::size_t>(this->Workers), std::vector<Rgb>(block));
+  constexpr std::size_t PatchSidesPerTask = 64;
+  for (std::size_t first = 0; first < this->SolveFrames; first += block)
+  {
+    const std::size_t count = std::min(block, this->SolveFrames - first);
+    parallelFor((this->PatchSides.size() + PatchSidesPerTask - 1) / PatchSidesPerTask,
+      this->Workers,
+      [&](std::size_t task, int)
+      {
+        const std::size_t end = std::min(this->PatchSides.size(), (task + 1) * PatchSidesPerTask);
+        for (std::size_t row = task * PatchSidesPerTask; row < end; ++row)
+        {
+          const std::size_t patch = this->PatchSides[row] / 2;
+          const auto side = static_cast<Side>(this->PatchSides[row] % 2);
+          FloatRgb* out = table.data() + row * Scene::ElementsPerPatch * block;
+          for (std::size_t f = 0; f < count; ++f)
+          {
+            Rgb read[Scene::ElementsPerPatch];
+            gatheredRadiosities(this->SceneRef, solution, first + f, patch, side, read);
+            for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
+            {
+              out[k * block + f] = FloatRgb(read[k]);
+            }
+          }
+        }
+      },
+      [](std::size_t) { return true; });
+    parallelFor((this->Sensors + SensorsPerTask - 1) / SensorsPerTask, this->Workers,
+      [&](std::size_t task, int worker)
+      {
+        std::vector<Rgb>& sum = sums[static_cast<std::size_t>(worker)];
+        const std::size_t end = std::min(this->Sensors, (task + 1) * SensorsPerTask);
+        for (std::size_t s = task * SensorsPerTask; s < end; ++s)
+        {
+          std::fill(sum.begin(), sum.begin() + static_cast<std::ptrdiff_t>(count), Rgb());
+          for (std::size_t i = this->KeyBegin[s]; i < this->KeyBegin[s + 1]; ++i)
+          {
+            const FloatRgb* row = table.data() + static_cast<std::size_t>(this->KeySlot[i]) * block;
+            const double hits = static_cast<double>(this->KeyCount[i]);
+            for (std::size_t f = 0; f < count; ++f)
+            {
+              sum[f] += Rgb(row[f]) * hits;
+            }
+          }
+          // Welford's update, in batch order: the bits do not depend on the workers.
+          for (std::size_t f = 0; f < count; ++f)
+          {
+            const std::size_t i = s * this->SolveFrames + first + f;
+            const Rgb x = sum[f] * perRay;
+            const Rgb before = this->Mean[i];
+            const Rgb after = before + (x - before) * inverse;
+            this->Mean[i] = FloatRgb(after);
+            this->SquaredDeviations[i] =
+              FloatRgb(Rgb(this->SquaredDeviations[i]) + (x - before) * (x - after));
+          }
+        }
+      },
+      [](std::size_t) { return true; });
+  }
+}
+
+void SensorBatchSpread::finish()
+{
+  this->fold();
+}
+
+void SensorBatchSpread::fold()
+{
+  if (!this->AnySolve)
+  {
+    return;
+  }
+  const ChunkPlan plan = planChunks(this->Frames, this->FramesPerChunk);
+  std::size_t chunk = 0;
+  while (chunk < plan.chunks.size() && plan.chunks[chunk].solveBegin != this->SolveFirst)
+  {
+    ++chunk;
+  }
+  if (chunk == plan.chunks.size())
+  {
+    throw Error("internal error: the sensors' batch spread got a solve that is no chunk");
+  }
+  const double b = static_cast<double>(this->SolveBatches);
+  const double scale = b >= 2 ? 1.0 / (b * (b - 1)) : 0.0;
+  for (std::size_t s = 0; s < this->Sensors; ++s)
+  {
+    for (std::size_t f = 0; f < this->SolveFrames; ++f)
+    {
+      const std::size_t frame = this->SolveFirst + f;
+      // The seams blend two chunks' estimates, which share the paths of the positions both
+      // solve: taken as fully correlated, the blend's error is the blend of the errors.
+      const double weight = plan.chunks.size() == 1 ? 1.0 : plan.weight(chunk, frame);
+      const Rgb m2 = this->SquaredDeviations[s * this->SolveFrames + f];
+      const Rgb error(std::sqrt(std::max(0.0, m2.r * scale)),
+        std::sqrt(std::max(0.0, m2.g * scale)), std::sqrt(std::max(0.0, m2.b * scale)));
+      FloatRgb& into = this->SolutionError[s * this->Frames + frame];
+      into = FloatRgb(Rgb(into) + error * weight);
+    }
+  }
+  this->Batches =
+    this->Batches == 0 ? this->SolveBatches : std::min(this->Batches, this->SolveBatches);
+  std::vector<FloatRgb>().swap(this->Mean);
+  std::vector<FloatRgb>().swap(this->SquaredDeviations);
+  this->AnySolve = false;
+}
+
+std::uint64_t SensorBatchSpread::estimateMemory(std::size_t sensors, std::size_t frames,
+  std::size_t framesPerChunk, std::size_t patches, const SensorOptions& sensorOptions, int workers)
+{
+  if (sensors == 0 || frames == 0)
+  {
+    return 0;
+  }
+  // The hits as they are traced (a size_t each) and as kept (a slot and a count).
+  const std::uint64_t keys = saturatingSum(
+    saturatingProduct(
+      { sizeof(std::size_t) + 2 * sizeof(std::uint32_t), sensors, sensorOptions.hemisphereRays }),
+    saturatingProduct(sizeof(std::size_t) + sizeof(std::vector<std::size_t>), sensors));
+  const std::uint64_t running =
+    saturatingProduct({ 2 * sizeof(FloatRgb), sensors, framesPerSolve(frames, framesPerChunk) });
+  const std::uint64_t errors = saturatingProduct({ sizeof(FloatRgb), sensors, frames });
+  const std::uint64_t table = std::min<std::uint64_t>(
+    saturatingSum(SpreadTableBytes,
+      saturatingProduct({ 2 * Scene::ElementsPerPatch * sizeof(FloatRgb), patches })),
+    saturatingProduct({ 2 * Scene::ElementsPerPatch * sizeof(FloatRgb), patches, frames }));
+  // The patch sides' rows and their list, and every worker's sums over a block of frames.
+  const std::uint64_t rows =
+    saturatingSum(saturatingProduct(2 * sizeof(std::uint32_t), 2 * patches),
+      saturatingProduct({ sizeof(Rgb), static_cast<std::size_t>(std::max(workers, 1)),
+        framesPerSolve(frames, framesPerChunk) }));
+  return saturatingSum(
+    saturatingSum(keys, running), saturatingSum(errors, saturatingSum(table, rows)));
 }
 
 SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solution& solution,
   const SensorSet& given, const SolverOptions& options, const SensorOptions& sensorOptions,
-  const std::function<bool(double fraction)>& progress)
+  const std::function<bool(double fraction)>& progress, const SensorBatchSpread* solutionSpread)
 {
   const auto started = std::chrono::steady_clock::now();
   const SensorSet sensors = normalizedSensors(given, sensorOptions);
@@ -480,10 +914,20 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   const int workers = resolveThreadCount(options.threads);
   std::vector<SensorScratch> scratch(static_cast<std::size_t>(workers));
   const std::size_t batch = shadowBatch(rig, !emitters.empty(), frames, sensorOptions);
+  const std::size_t points = pointFrames(rig, !emitters.empty(), frames, sensorOptions);
   for (SensorScratch& worker : scratch)
   {
     worker.reserve(
-      frames, skyPositionsOf(rig), rig.skies.size(), sensorOptions.hemisphereRays, batch);
+      frames, skyPositionsOf(rig), rig.skies.size(), sensorOptions.hemisphereRays, batch, points);
+  }
+  if (solutionSpread &&
+    (solutionSpread->frameCount() != frames || solutionSpread->sensorCount() != sensors.size()))
+  {
+    throw Error("internal error: the sensors' batch spread is of other sensors or frames");
+  }
+  if (solutionSpread && solutionSpread->batches() >= 2)
+  {
+    result.setSolutionBatches(solutionSpread->batches());
   }
   const std::size_t tasks = (sensors.size() + SensorsPerTask - 1) / SensorsPerTask;
   parallelFor(
@@ -494,7 +938,7 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
       for (std::size_t s = task * SensorsPerTask; s < end; ++s)
       {
         solveSensor(scene, tracer, rig, emitters, solution, sensors, s, options, sensorOptions,
-          scratch[static_cast<std::size_t>(worker)], result);
+          solutionSpread, scratch[static_cast<std::size_t>(worker)], result);
       }
     },
     [&](std::size_t done)
@@ -507,6 +951,28 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   result.statistics().seconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
+}
+
+FrameError sensorFrameError(const SensorSolution& solution, std::size_t frame)
+{
+  const std::size_t sensors = solution.sensorCount();
+  double sum = 0;
+  for (std::size_t s = 0; s < sensors; ++s)
+  {
+    sum += solution.irradiance(frame, s).sum();
+  }
+  const double threshold =
+    LitFractionOfMean * sum / static_cast<double>(std::max<std::size_t>(sensors, 1));
+  std::vector<double> relative;
+  for (std::size_t s = 0; s < sensors; ++s)
+  {
+    const double e = solution.irradiance(frame, s).sum();
+    if (e > threshold && e > 0)
+    {
+      relative.push_back(solution.irradianceStdError(frame, s).sum() / e);
+    }
+  }
+  return relativeErrorFigures(relative);
 }
 
 DaylightMetrics daylightMetrics(const double* illuminance, const double* sunIlluminance,

@@ -4,6 +4,7 @@
 // "Sensors").
 #pragma once
 
+#include "ErrorEstimate.h"
 #include "LightSource.h"
 #include "Rgb.h"
 #include "Scene.h"
@@ -66,8 +67,8 @@ struct SensorStatistics
   double seconds = 0;
 };
 
-/// Every sensor's irradiance (W/m^2, RGB) in every frame, and the part of it that comes
-/// straight from the sun (the directional lights), which DirectSunHours counts.
+/// Every sensor's irradiance (W/m^2, RGB) in every frame, the part of it that comes straight
+/// from the sun (the directional lights), which DirectSunHours counts, and its standard error.
 class SensorSolution
 {
 public:
@@ -77,6 +78,7 @@ public:
     , Sensors(sensors)
     , Irradiance(frames * sensors)
     , Sun(frames * sensors)
+    , StdError(frames * sensors)
   {
   }
 
@@ -92,24 +94,111 @@ public:
   {
     return this->Sun[sensor * this->Frames + frame];
   }
+  /**
+   * The standard error of irradiance() (W/m^2, RGB): the sensor's own sampling (its
+   * hemisphere rays and its points on area lights; point and directional lights are exact)
+   * and, when solutionBatches() is 2 or more, the noise of the solution its hemisphere rays
+   * read, from the spread of those reads over the solve's batches (SensorBatchSpread).
+   */
+  Rgb irradianceStdError(std::size_t frame, std::size_t sensor) const
+  {
+    return this->StdError.empty() ? Rgb() : Rgb(this->StdError[sensor * this->Frames + frame]);
+  }
+  /// The batches whose spread gave the solution's part of irradianceStdError() (the fewest of
+  /// any chunk's); 0 when it has none, the solve having run without batches: the standard
+  /// error is then the sensors' own sampling alone.
+  std::uint64_t solutionBatches() const { return this->SolutionBatches; }
+  void setSolutionBatches(std::uint64_t batches) { this->SolutionBatches = batches; }
   /// Sensor-major with frames innermost, as Solution.
   std::vector<FloatRgb>& irradianceData() { return this->Irradiance; }
   std::vector<FloatRgb>& sunData() { return this->Sun; }
+  std::vector<FloatRgb>& stdErrorData() { return this->StdError; }
   const SensorStatistics& statistics() const { return this->Statistics; }
   SensorStatistics& statistics() { return this->Statistics; }
 
 private:
   std::size_t Frames = 0, Sensors = 0;
-  std::vector<FloatRgb> Irradiance, Sun;
+  std::vector<FloatRgb> Irradiance, Sun, StdError;
+  std::uint64_t SolutionBatches = 0;
   SensorStatistics Statistics;
+};
+
+/**
+ * The solution's noise as the sensors read it. A sensor's hemisphere rays read the patch
+ * solution (gatheredRadiosity()), whose error is correlated from element to element (the
+ * elements of a patch share its bounced light, neighbours its gradient, walks cross many
+ * patches), so the elements' standard errors do not give the error of the sensor's mean of
+ * them. Instead, every batch of a batched solve (SolverOptions::batchSolved) is read through
+ * the same rays solveSensors casts, and the spread of those reads over the batches is the
+ * standard error of the read of their mean, as for the elements (Documentation/Method.md,
+ * "Sensors and daylight metrics"). The rays are traced once, when it is made; each batch
+ * costs one reconstruction of the patch sides the rays reach per frame and one sum per
+ * sensor, distinct element side hit and frame.
+ */
+class SensorBatchSpread
+{
+public:
+  /// For `sensors` (checked) on `scene`, read with the streams of `options.seed` and
+  /// `sensorOptions`, over an animation of `frames` frames solved in chunks of
+  /// `framesPerChunk` (0: one solve), whose seams blend the chunks' errors.
+  SensorBatchSpread(const Scene& scene, const SensorSet& sensors, const SolverOptions& options,
+    const SensorOptions& sensorOptions, std::size_t frames, std::size_t framesPerChunk);
+
+  /// Reads batch `batch` of the solve whose frame 0 is the animation's `firstFrame` (the
+  /// arguments of SolverOptions::batchSolved). Batch 0 starts a new solve (a chunk).
+  void add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution);
+  /// Ends the last solve: stdError() is then complete.
+  void finish();
+
+  std::size_t frameCount() const { return this->Frames; }
+  std::size_t sensorCount() const { return this->Sensors; }
+  /// The fewest batches of any solve read (0 before finish() or without two batches).
+  std::uint64_t batches() const { return this->Batches; }
+  /// The standard error (W/m^2, RGB) of what sensor `sensor`'s hemisphere rays read in
+  /// `frame` from the batches' mean; at a chunk seam the blend of the two chunks' with their
+  /// weights, taken as fully correlated.
+  Rgb stdError(std::size_t frame, std::size_t sensor) const
+  {
+    return this->SolutionError[sensor * this->Frames + frame];
+  }
+
+  /// The bytes it holds at its peak on `workers` threads (its ray tracer, while it is made,
+  /// aside): the element sides each sensor's rays reach (one per ray), the running mean and
+  /// squared deviations of one solve's frames, the standard errors of every frame, a block of
+  /// the reads of the patch sides the rays reach and each worker's sums over it.
+  static std::uint64_t estimateMemory(std::size_t sensors, std::size_t frames,
+    std::size_t framesPerChunk, std::size_t patches, const SensorOptions& sensorOptions,
+    int workers);
+
+private:
+  void fold();
+
+  const Scene& SceneRef;
+  int Workers = 1;
+  std::uint32_t Rays = 0;
+  std::size_t Frames = 0, Sensors = 0, FramesPerChunk = 0;
+  /// Per sensor, its distinct element sides hit (as slots of the table) and their ray counts.
+  std::vector<std::size_t> KeyBegin;
+  std::vector<std::uint32_t> KeySlot, KeyCount;
+  /// The patch sides some sensor's rays reach (2 patch + side): the table's rows, four
+  /// elements each.
+  std::vector<std::uint32_t> PatchSides;
+  /// Of the solve being read: its first frame, frames, batches, and per sensor and frame the
+  /// running mean and squared deviations of the reads.
+  std::size_t SolveFirst = 0, SolveFrames = 0;
+  std::uint64_t SolveBatches = 0;
+  std::vector<FloatRgb> Mean, SquaredDeviations;
+  std::vector<FloatRgb> SolutionError;
+  std::uint64_t Batches = 0;
+  bool AnySolve = false;
 };
 
 /**
  * Bytes solveSensors() allocates at its peak for `sensors` sensors over `frames` frames on a
  * scene of `elements` elements on `points` points lit by `rig` (and by its own emitters when
- * `sceneEmits`): the two results per sensor and frame, the unit sensors, the sensors' own ray
- * tracer, and every worker's per-frame sums and shadow-ray batch (the longest: an area
- * light's samples x frames).
+ * `sceneEmits`): the three results per sensor and frame, the unit sensors, the sensors' own
+ * ray tracer, and every worker's per-frame sums and shadow-ray batch (the longest: an area
+ * light's samples x frames) with its values per sample and frame.
  */
 std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std::size_t elements,
   std::size_t points, const LightRig& rig, bool sceneEmits, const SolverOptions& options,
@@ -122,12 +211,23 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
  * one set of cosine-distributed hemisphere rays per sensor for all frames, whose escaping
  * rays weigh the skies' radiance and whose hits the patch radiosity of the surface hit.
  * Streams are keyed by options.seed and the sensor, and each sensor's sums run in a fixed
- * order, so the result does not depend on the thread count. `progress` gets the share done;
- * false cancels (mlr::Cancelled).
+ * order, so the result does not depend on the thread count. The standard error adds to the
+ * sampling variance of the sensor's own rays that of the solution, from `solutionSpread`
+ * (finished, made with the same sensors, options and counts) when given. `progress` gets the
+ * share done; false cancels (mlr::Cancelled).
  */
 SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solution& solution,
   const SensorSet& sensors, const SolverOptions& options, const SensorOptions& sensorOptions = {},
-  const std::function<bool(double fraction)>& progress = {});
+  const std::function<bool(double fraction)>& progress = {},
+  const SensorBatchSpread* solutionSpread = nullptr);
+
+/**
+ * The relative error of frame `frame` over its lit sensors, those whose irradiance (sum over
+ * channels) is over LitFractionOfMean of the frame's mean over all sensors, as frameError()
+ * has it for elements: per sensor the sum over channels of irradianceStdError() over that of
+ * irradiance(); litElements counts the lit sensors.
+ */
+FrameError sensorFrameError(const SensorSolution& solution, std::size_t frame);
 
 /// Daylight metrics of one sensor over a run's time steps.
 struct DaylightMetrics

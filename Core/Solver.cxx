@@ -372,6 +372,7 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
     batch.setStorageScale(solution.storageScale());
     batch.reflectanceData() = solution.reflectanceData();
     batch.emissionData() = solution.emissionData();
+    std::uint64_t batchIndex = 0;
     solveInBatches(
       options,
       [&](
@@ -379,6 +380,11 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
       {
         batch.clearRadiosity();
         pass(batchOptions, batch, fraction);
+        if (options.batchSolved)
+        {
+          options.batchSolved(batchIndex, rig.firstFrame, batch);
+        }
+        ++batchIndex;
         return batch;
       },
       passesProgress, plan.peak, secondsReducing, solution);

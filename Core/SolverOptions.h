@@ -9,6 +9,8 @@
 namespace mlr
 {
 
+class Solution;
+
 struct SolverOptions
 {
   /// N: effective shooting paths per frame.
@@ -71,6 +73,13 @@ struct SolverOptions
   /// Receives the solve's progress messages (the error estimate's rounds, its estimates of
   /// memory and time); may be empty.
   std::function<void(const std::string& message)> log;
+  /// With batches: receives every batch once it is solved, before it is merged, with its index
+  /// in the solve (from 0; each chunk of an animation is a solve of its own), the animation's
+  /// frame of its frame 0 (LightRig::firstFrame) and its solution, for what reads the batches
+  /// apart (the sensors' standard error, SensorBatchSpread in Sensors.h); may be empty. It runs
+  /// on every rank, with the same solution on each.
+  std::function<void(std::uint64_t batch, std::size_t firstFrame, const Solution& solution)>
+    batchSolved;
 };
 
 /// The largest pathsPerFrame accepted: past it a solve would run for months.
@@ -107,7 +116,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
     reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, errorBatches,
     targetRelativeError, timeLimitSeconds, storageScale, rank, ranks, sumAcrossRanks,
-    sumDoublesAcrossRanks, log] = options;
+    sumDoublesAcrossRanks, log, batchSolved] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -133,6 +142,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   visit("sumAcrossRanks", sumAcrossRanks, OptionRole::Hook);
   visit("sumDoublesAcrossRanks", sumDoublesAcrossRanks, OptionRole::Hook);
   visit("log", log, OptionRole::Hook);
+  visit("batchSolved", batchSolved, OptionRole::Hook);
 }
 
 } // namespace mlr

@@ -142,15 +142,56 @@ void addSensorArrays(
   pointData->AddArray(irradiance);
   pointData->AddArray(illuminance);
   pointData->SetActiveScalars("Illuminance");
+  // As the elements', only from a solve in batches: without them the solution's noise, which
+  // the sensors read, is unknown.
+  if (solution.solutionBatches() < 2)
+  {
+    return;
+  }
+  auto irradianceError = vtkoutputs::rgbArray("IrradianceStdError", n);
+  vtkNew<vtkFloatArray> illuminanceError;
+  illuminanceError->SetName("IlluminanceStdError");
+  illuminanceError->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Rgb e = solution.irradianceStdError(frame, i);
+    vtkoutputs::setRgb(irradianceError, i, e);
+    // The channels' errors come from the same rays and paths: the luminance of the channels'
+    // errors is the luminance's error when they move together, and bounds it otherwise.
+    illuminanceError->SetValue(
+      static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
+  }
+  pointData->AddArray(irradianceError);
+  pointData->AddArray(illuminanceError);
 }
 
-void addSensorStatistics(vtkFieldData* fieldData, const SensorStatistics& statistics)
+void addSensorStatistics(vtkFieldData* fieldData, const SensorSolution& solution)
 {
+  const SensorStatistics& statistics = solution.statistics();
   vtkoutputs::addValue<vtkIdTypeArray>(
     fieldData, "SensorShadowRays", static_cast<vtkIdType>(statistics.shadowRays));
   vtkoutputs::addValue<vtkIdTypeArray>(
     fieldData, "SensorGatheringRays", static_cast<vtkIdType>(statistics.gatheringRays));
   vtkoutputs::addValue<vtkDoubleArray>(fieldData, "SecondsSensors", statistics.seconds);
+  if (solution.solutionBatches() < 2)
+  {
+    return;
+  }
+  vtkNew<vtkDoubleArray> median, p95;
+  median->SetName("SensorRelativeErrorMedian");
+  p95->SetName("SensorRelativeErrorP95");
+  vtkNew<vtkIdTypeArray> lit;
+  lit->SetName("LitSensors");
+  for (std::size_t f = 0; f < solution.frameCount(); ++f)
+  {
+    const FrameError e = sensorFrameError(solution, f);
+    median->InsertNextValue(e.median);
+    p95->InsertNextValue(e.p95);
+    lit->InsertNextValue(static_cast<vtkIdType>(e.litElements));
+  }
+  fieldData->AddArray(median);
+  fieldData->AddArray(p95);
+  fieldData->AddArray(lit);
 }
 
 } // namespace mlr::vtksensors

@@ -43,12 +43,16 @@ vtkSmartPointer<vtkPolyData> sensorMesh(
   const SensorSet& sensors, const SensorSolution& solution, const MetricSteps& steps);
 
 /// Adds `Irradiance` (RGB, W/(scene unit)^2) and `Illuminance` (efficacy times its
-/// luminance) of `frame`, Illuminance active.
+/// luminance) of `frame`, Illuminance active, and when the solve ran in batches their
+/// standard errors `IrradianceStdError` (RGB) and `IlluminanceStdError` (efficacy times the
+/// luminance of IrradianceStdError).
 void addSensorArrays(
   const SensorSolution& solution, std::size_t frame, double efficacy, vtkPointData* pointData);
 
 /// Adds the sensors' ray counts and time: `SensorShadowRays`, `SensorGatheringRays` (counts)
-/// and `SecondsSensors`.
-void addSensorStatistics(vtkFieldData* fieldData, const SensorStatistics& statistics);
+/// and `SecondsSensors`; when the solve ran in batches, per frame the median and 95th
+/// percentile of the lit sensors' relative error (sensorFrameError) and their count:
+/// `SensorRelativeErrorMedian`, `SensorRelativeErrorP95`, `LitSensors`.
+void addSensorStatistics(vtkFieldData* fieldData, const SensorSolution& solution);
 
 } // namespace mlr::vtksensors

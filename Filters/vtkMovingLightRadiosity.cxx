@@ -1664,7 +1664,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
             : cache.SunEfficacy[std::min(t, cache.SunEfficacy.size() - 1)]);
       }
       cache.Sensors = std::move(animation.sensors);
-      mlr::vtksensors::addSensorStatistics(cache.Statistics, cache.Sensors.statistics());
+      mlr::vtksensors::addSensorStatistics(cache.Statistics, cache.Sensors);
       cache.SensorMesh = mlr::vtksensors::sensorMesh(options.sensors, cache.Sensors, steps);
       cache.SensorThreshold = steps.autonomyThreshold;
       cache.SensorPoints = std::move(options.sensors);

@@ -91,11 +91,16 @@
  *   (share of steps with at least DaylightAutonomyThreshold), `UDILow` (below 100 lx),
  *   `UDIUseful` (100 to 2000 lx), `UDIHigh` (above 2000 lx) and `DirectSunHours` (hours
  *   whose direct sun alone gives over 1000 lx; a step lasts the median spacing of the
- *   Trajectory's `Time`, in hours as vtkSunPathSource gives it, 1 hour with one step). Its
+ *   Trajectory's `Time`, in hours as vtkSunPathSource gives it, 1 hour with one step). With
+ *   ErrorBatches above 1, `IrradianceStdError` (3 components, W/m^2) and
+ *   `IlluminanceStdError` (lx, the efficacy times the luminance of IrradianceStdError): the
+ *   sensor's own sampling and the noise of the solution its rays read, from every batch. Its
  *   field data (and every output's, with a Sensors input) adds the rays the sensors cast,
  *   counted exactly: `SensorShadowRays` (towards the lights, per frame where they can reach
  *   the sensor), `SensorGatheringRays` (sensors x SensorRays, for all frames) and
- *   `SecondsSensors`. Empty without a Sensors input (Documentation/Method.md, "Sensors").
+ *   `SecondsSensors`, and with ErrorBatches above 1, per frame, the lit sensors' relative
+ *   error `SensorRelativeErrorMedian` and `SensorRelativeErrorP95` and their count
+ *   `LitSensors`. Empty without a Sensors input (Documentation/Method.md, "Sensors").
  *
  * Time: the outputs have one time step per light position (TIME_STEPS, TIME_RANGE). The
  * first update solves every frame at once and keeps the result; requests for other times

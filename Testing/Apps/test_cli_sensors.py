@@ -1,6 +1,7 @@
 """The command line's sensors: --work-plane over a small open-top room lit by a uniform sky
 and a lamp (the grid count, heights and illuminance arrays), --sensors FILE.vtp,
---da-threshold, and their bad inputs.
+--da-threshold, the sensors' standard errors (series, summary and --stats), and their bad
+inputs.
 
 The room is 3 x 2 (x, y) and 2.5 high, floor facing up. With SPACING 0.5 the lattice
 (i + 1/2) 0.5 puts 6 x 4 = 24 sensors inside the floor; the walls face inwards (never up) and
@@ -9,6 +10,7 @@ there is no ceiling, so the floor is the only upward face.
 ctest sets MLR_CLI and MLR_DATA_DIR; by hand:
     MLR_CLI=build/bin/moving-light-radiosity /usr/bin/python3 -m pytest Testing/Apps
 """
+import json
 import os
 import xml.etree.ElementTree as ElementTree
 
@@ -152,6 +154,47 @@ def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
         assert result.returncode == 0, result.stderr
         da = array(read_sensor_series(tmp_path)[0][1], "DaylightAutonomy")
         assert numpy.allclose(da, expected), (threshold, da)
+
+
+def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
+    # The default 16 error batches: every frame's sensors have IrradianceStdError (RGB) and
+    # IlluminanceStdError, the summary a line for the lit sensors, and --stats their figures
+    # per frame; with one batch none of them.
+    points = [(1.5, 1.0, 0.8), (0.5, 0.5, 0.8), (2.9, 1.0, 1.2)]
+    normals = [(0, 0, 1), (0, 0, 1), (-1, 0, 0)]
+    args = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
+            "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--frames", "3",
+            "--sensors", write_sensors(tmp_path, points, normals),
+            "--output", "out/room.pvd"] + FAST
+    stats = tmp_path / "stats.json"
+    result = run(args + ["--stats", str(stats)], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "relative error of the lit sensors: median" in result.stdout, result.stdout
+    frames = read_sensor_series(tmp_path)
+    assert len(frames) == 3
+    for _, sensors in frames:
+        data = sensors.GetPointData()
+        assert data.GetArray("IrradianceStdError").GetNumberOfComponents() == 3
+        assert data.GetArray("IlluminanceStdError").GetNumberOfComponents() == 1
+        error = array(sensors, "IrradianceStdError")
+        lux = array(sensors, "IlluminanceStdError")
+        assert error.shape == (3, 3) and lux.shape == (3,)
+        assert numpy.all(numpy.isfinite(error)) and numpy.all(error > 0)
+        assert numpy.all(error < 0.5 * array(sensors, "Irradiance"))
+        efficacy = sensors.GetFieldData().GetArray("LuminousEfficacy").GetValue(0)
+        assert lux == pytest.approx(efficacy * (error @ [0.2126, 0.7152, 0.0722]), rel=1e-5)
+    figures = json.loads(stats.read_text())["sensors"]["errorEstimate"]
+    assert len(figures["relativeErrorMedian"]) == 3
+    assert figures["litSensors"] == [3, 3, 3]
+    for median, p95 in zip(figures["relativeErrorMedian"], figures["relativeErrorP95"]):
+        assert 0 < median <= p95 < 0.5
+    result = run(args + ["--error-batches", "1", "--stats", str(stats)], tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "relative error of the lit sensors" not in result.stdout
+    data = read_sensor_series(tmp_path)[0][1].GetPointData()
+    assert data.GetArray("IrradianceStdError") is None
+    assert data.GetArray("IlluminanceStdError") is None
+    assert "errorEstimate" not in json.loads(stats.read_text())["sensors"]
 
 
 @pytest.mark.parametrize("extra,status,words", [

@@ -46,6 +46,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.storageScale = 0.25;
   else if (name == "log")
     options.log = [](const std::string&) {};
+  else if (name == "batchSolved")
+    options.batchSolved = [](std::uint64_t, std::size_t, const Solution&) {};
   else if (name == "rank")
     options.rank = 1;
   else if (name == "ranks")
@@ -75,7 +77,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 20u);
+  EXPECT_EQ(names.size(), 21u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

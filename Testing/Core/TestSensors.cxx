@@ -1,6 +1,7 @@
 // Sensors: the sky, the sun, point and area lights and the scene's light on measuring points
-// against exact values, their independence from the thread count, the surfaces' radiosity
-// untouched by them, the daylight metrics and bad input.
+// against exact values, their standard errors against their errors over seeds, their
+// independence from the thread count, the surfaces' radiosity untouched by them, the daylight
+// metrics and bad input.
 #include "Animation.h"
 #include "CoreChecks.h"
 #include "FormFactor.h"
@@ -448,6 +449,212 @@ TEST(Sensors, TheThreadCountDoesNotChangeTheResultBitForBit)
     sun += a.sunIrradiance(0, s).r;
   }
   EXPECT_GT(sun, 0.0) << "some sensors see the sun";
+}
+
+namespace
+{
+/**
+ * The root mean square of errors over that of the standard errors reported with them, which
+ * is 1 when the standard errors are right. Over n independent draws the RMS of normal errors
+ * over their deviation has a relative deviation of about 1/sqrt(2n): the ratio must be within
+ * 3/sqrt(2n) of 1, with n the seeds (values of one seed may share their errors, so the seeds
+ * are the independent draws that can be counted on).
+ */
+struct ErrorRatio
+{
+  double squares = 0, stdErrorSquares = 0;
+
+  void add(double error, double stdError)
+  {
+    EXPECT_TRUE(std::isfinite(stdError) && stdError >= 0) << stdError;
+    squares += error * error;
+    stdErrorSquares += stdError * stdError;
+  }
+  double ratio() const { return std::sqrt(squares / stdErrorSquares); }
+  static double tolerance(int seeds) { return 3 / std::sqrt(2.0 * seeds); }
+};
+}
+
+TEST(Sensors, TheStandardErrorMatchesTheErrorInAGlowingBox)
+{
+  // A closed box whose walls all emit M and reflect rho: the radiosity is M / (1 - rho)
+  // everywhere, and so is the irradiance at any point inside, facing any way. A sensor gets M
+  // from its points on the walls (emitters sampled as area lights: stratified, half of them
+  // behind it) and rho M / (1 - rho) from the walls' solution through its hemisphere rays. At
+  // 5,000 paths in 16 batches the solution's noise is most of the error, so both parts of
+  // the standard error are tested.
+  const Rgb rho(0.3, 0.5, 0.7), emission(10);
+  PolygonSoup soup = scenes::boxOfQuads({ 0, 0, 0 }, { 2, 2, 2 }, std::vector<Rgb>(6, rho), true);
+  for (Material& m : soup.materials)
+  {
+    m.emission = emission;
+  }
+  SensorSet sensors;
+  const std::vector<std::pair<Vec3, Vec3>> placed = { { { 1, 1, 1 }, { 0, 0, 1 } },
+    { { 0.3, 0.4, 0.2 }, { 1, 1, 1 } }, { { 1.7, 0.5, 1.5 }, { -1, 0, 0 } },
+    { { 0.5, 1.6, 0.9 }, { 0, -1, 0.3 } }, { { 1.2, 1.8, 0.3 }, { 0, 0, -1 } },
+    { { 0.2, 0.2, 1.8 }, { 1, 0, 0 } } };
+  for (const auto& [point, normal] : placed)
+  {
+    sensors.points.push_back(point);
+    sensors.normals.push_back(normal);
+  }
+  const int seeds = 20;
+  ErrorRatio all, ownOnly;
+  for (int seed = 1; seed <= seeds; ++seed)
+  {
+    AnimationOptions options;
+    options.remeshing.targetEdgeLength = 0.25;
+    options.solver.pathsPerFrame = 5000;
+    options.solver.errorBatches = 16;
+    options.solver.seed = static_cast<std::uint64_t>(seed);
+    options.sensors = sensors;
+    options.sensorOptions.areaLightSamples = 4096;
+    const Animation a = solveAnimation(soup, LightRig(), options);
+    ASSERT_EQ(a.sensors.frameCount(), 1u);
+    EXPECT_EQ(a.sensors.solutionBatches(), 16u);
+    // The same sensors without the solution's part, for comparison.
+    const SensorSolution own =
+      solveSensors(a.scene, LightRig(), a.solution, sensors, options.solver, options.sensorOptions);
+    EXPECT_EQ(own.solutionBatches(), 0u);
+    for (std::size_t i = 0; i < sensors.size(); ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        const double error = a.sensors.irradiance(0, i)[c] - emission[c] / (1 - rho[c]);
+        all.add(error, a.sensors.irradianceStdError(0, i)[c]);
+        ownOnly.add(error, own.irradianceStdError(0, i)[c]);
+        EXPECT_LE(own.irradianceStdError(0, i)[c], a.sensors.irradianceStdError(0, i)[c]);
+      }
+    }
+  }
+  std::printf("glowing box: RMS error / RMS standard error %.3f (without the solution's part "
+              "%.3f), tolerance %.3f\n",
+    all.ratio(), ownOnly.ratio(), ErrorRatio::tolerance(seeds));
+  EXPECT_NEAR(all.ratio(), 1.0, ErrorRatio::tolerance(seeds));
+}
+
+TEST(Sensors, TheOwnSamplingErrorMatchesTheErrorUnderASkyAndALamp)
+{
+  // Without batches the standard error is the sensor's own sampling alone, and nothing here
+  // reflects into the sensors: on open ground under a CIE clear sky an upward sensor reads
+  // E_dh through its hemisphere rays (the sky's radiance varies, so they have noise), and
+  // over a black floor the 64 stratified points on a lamp give Lambert's form factor (noise
+  // that independent points would overstate several times).
+  const int seeds = 20;
+  {
+    const Scene scene = ground(3);
+    const std::vector<SkyFrame> frames = { { sunDirection(25, 10), 80, 300 },
+      { sunDirection(60, 140), 150, 700 } };
+    LightRig rig;
+    rig.skies.emplace_back(SkyModel::CieClear, Vec3(0, 0, 1), frames);
+    const Solution solution = solve(scene, rig, quick());
+    SensorSet sensors = oneSensor({ 0.1, -0.2, 0.8 }, { 0, 0, 1 });
+    sensors.points.push_back({ -0.5, 0.4, 1.5 });
+    sensors.normals.push_back({ 0, 0, 1 });
+    SensorOptions counts;
+    counts.hemisphereRays = 256;
+    ErrorRatio sky;
+    for (int seed = 1; seed <= seeds; ++seed)
+    {
+      SolverOptions options = quick();
+      options.seed = static_cast<std::uint64_t>(seed);
+      const SensorSolution result = solveSensors(scene, rig, solution, sensors, options, counts);
+      for (std::size_t i = 0; i < sensors.size(); ++i)
+      {
+        for (std::size_t f = 0; f < frames.size(); ++f)
+        {
+          sky.add(result.irradiance(f, i).g - frames[f].diffuseHorizontal,
+            result.irradianceStdError(f, i).g);
+        }
+      }
+    }
+    std::printf("sky: RMS error / RMS standard error %.3f\n", sky.ratio());
+    EXPECT_NEAR(sky.ratio(), 1.0, ErrorRatio::tolerance(seeds));
+  }
+  {
+    const Scene scene = ground(2, Rgb(0.0));
+    const std::vector<std::vector<Vec3>> lamp = scenes::squareLightFacingDown({ 0, 0, 0.3 }, 0.3);
+    const std::vector<Vec3> moves = { { 0, 0, 0 }, { 0.1, 0.05, 0 }, { 0.3, 0.1, 0.1 } };
+    LightRig rig;
+    rig.areaLights.emplace_back(lamp, Rgb(10), moves);
+    const Solution solution = solve(scene, rig, quick());
+    SensorSet sensors;
+    for (const double x : { 0.0, 0.2, 0.4, 0.8, 1.5 })
+    {
+      sensors.points.push_back({ x, 0.05, 0 });
+      sensors.normals.push_back({ 0, 0, 1 });
+    }
+    SensorOptions counts;
+    counts.areaLightSamples = 64;
+    ErrorRatio lit;
+    for (int seed = 1; seed <= seeds; ++seed)
+    {
+      SolverOptions options = quick();
+      options.seed = static_cast<std::uint64_t>(seed);
+      const SensorSolution result = solveSensors(scene, rig, solution, sensors, options, counts);
+      for (std::size_t i = 0; i < sensors.size(); ++i)
+      {
+        for (std::size_t f = 0; f < moves.size(); ++f)
+        {
+          std::vector<Vec3> polygon = lamp[0];
+          for (Vec3& v : polygon)
+          {
+            v += moves[f];
+          }
+          const double exact =
+            10 / 0.09 * pointToPolygonFormFactor(sensors.points[i], sensors.normals[i], polygon);
+          lit.add(result.irradiance(f, i).r - exact, result.irradianceStdError(f, i).r);
+        }
+      }
+    }
+    std::printf("lamp: RMS error / RMS standard error %.3f\n", lit.ratio());
+    EXPECT_NEAR(lit.ratio(), 1.0, ErrorRatio::tolerance(seeds));
+  }
+}
+
+TEST(Sensors, TheStandardErrorIsTheSameForAnyThreadCountWholeOrInChunks)
+{
+  // The room of the tests above with its lamp moving over 3 frames, in 4 batches: the
+  // sensors read every batch, which changes no bit of the surfaces', and their standard
+  // errors do not depend on the threads, whole or in chunks of 2 frames.
+  RoomCase c = room();
+  for (const std::uint64_t framesPerChunk : { 0, 2 })
+  {
+    AnimationOptions one = roomOptions(1, c.sensors), three = roomOptions(3, c.sensors);
+    AnimationOptions none = roomOptions(2, {});
+    for (AnimationOptions* options : { &one, &three, &none })
+    {
+      options->solver.errorBatches = 4;
+      options->solver.framesPerChunk = framesPerChunk;
+    }
+    const Animation a = solveAnimation(c.soup, c.rig, one);
+    const Animation b = solveAnimation(c.soup, c.rig, three);
+    const Animation without = solveAnimation(c.soup, c.rig, none);
+    EXPECT_EQ(a.solution.statistics.chunks, framesPerChunk == 0 ? 1u : 2u);
+    SensorSolution sa = a.sensors, sb = b.sensors;
+    EXPECT_TRUE(sameBits(sa.irradianceData(), sb.irradianceData()));
+    EXPECT_TRUE(sameBits(sa.stdErrorData(), sb.stdErrorData()));
+    EXPECT_EQ(sa.solutionBatches(), 4u);
+    Solution with = a.solution, alone = without.solution;
+    EXPECT_TRUE(sameBits(with.directData(), alone.directData()));
+    EXPECT_TRUE(sameBits(with.indirectData(), alone.indirectData()));
+    EXPECT_TRUE(sameBits(with.stdErrorData(), alone.stdErrorData()));
+    for (std::size_t s = 0; s < c.sensors.size(); ++s)
+    {
+      for (std::size_t f = 0; f < 3; ++f)
+      {
+        const Rgb e = sa.irradianceStdError(f, s);
+        EXPECT_TRUE(std::isfinite(e.sum()) && e.r > 0 && e.g > 0 && e.b > 0)
+          << "sensor " << s << ", frame " << f << ", chunks of " << framesPerChunk;
+        EXPECT_LT(e.g, 0.5 * sa.irradiance(f, s).g);
+      }
+      const FrameError figures = sensorFrameError(sa, 1);
+      EXPECT_EQ(figures.litElements, c.sensors.size());
+      EXPECT_GT(figures.median, 0.0);
+      EXPECT_LE(figures.median, figures.p95);
+    }
+  }
 }
 
 TEST(Sensors, DaylightMetricsOfHandCheckedSeries)

@@ -452,3 +452,47 @@ TEST(SolveMemory, TheSensorEstimateBoundsWhatTheSensorsAllocate)
       << threads << " threads";
   }
 }
+
+TEST(SolveMemory, TheSensorSpreadEstimateBoundsWhatItHolds)
+{
+  // ManyFrames' closed box over its 1000 frames, 300 sensors of 64 hemisphere rays read from
+  // two batches: the running sums of one solve (7.2 MB), the standard errors (3.6 MB) and the
+  // table of reads (all 1000 frames of the patch sides the rays reach fit its 16 MB) are most
+  // of it, the rays' element sides (0.3 MB) and the workers' sums the rest. Its ray tracer,
+  // while it is made, counts as the sensors' (estimateSensorMemory). The estimate's table has
+  // rows for both sides of every patch (16 MB here), which sensors on both sides of two-sided
+  // walls reach; inside a closed box, facing up, they reach the inner sides of five walls.
+  const ManyFrames f(4);
+  const std::size_t frames = f.light.frameCount();
+  LightRig rig;
+  rig.areaLights.push_back(f.light);
+  SensorSet sensors;
+  for (int i = 0; i < 300; ++i)
+  {
+    sensors.points.push_back({ 0.1 + 0.8 * (i % 20) / 20.0, 0.1 + 0.8 * (i / 20) / 15.0, 0.3 });
+    sensors.normals.push_back({ 0, 0, 1 });
+  }
+  SensorOptions counts;
+  counts.hemisphereRays = 64;
+  for (int threads : { 1, 3 })
+  {
+    const SolverOptions options = optionsFor(threads, 0);
+    const Solution solution = solve(f.scene, rig, options);
+    const std::uint64_t estimate = SensorBatchSpread::estimateMemory(sensors.size(), frames, 0,
+                                     f.scene.patchCount(), counts, threads) +
+      RayTracer::estimateMemory(f.scene.elementCount(), f.scene.points().size());
+    const Measurement m;
+    SensorBatchSpread spread(f.scene, sensors, options, counts, frames, 0);
+    spread.add(0, 0, solution);
+    spread.add(1, 0, solution);
+    spread.finish();
+    const std::uint64_t peak = m.peak();
+    std::printf(
+      "sensor spread, %d threads: estimate %.3f MB, measured peak %.3f MB, held %.3f MB\n", threads,
+      estimate / 1e6, peak / 1e6, m.live() / 1e6);
+    EXPECT_EQ(spread.batches(), 2u);
+    EXPECT_LE(peak, estimate) << threads << " threads";
+    EXPECT_LE(static_cast<double>(estimate), 1.7 * static_cast<double>(peak))
+      << threads << " threads";
+  }
+}

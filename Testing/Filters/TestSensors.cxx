@@ -1,13 +1,15 @@
 // The filter's Sensors input and output: the output follows the time step, the lamp's
 // direct light on a sensor below it is Lambert's form factor plus the room's light, the
-// metrics stay constant over time and follow DaylightAutonomyThreshold without solving again,
-// and bad sensors are refused with empty outputs.
+// standard errors come as the elements' do, the metrics stay constant over time and follow
+// DaylightAutonomyThreshold without solving again, and bad sensors are refused with empty
+// outputs.
 #include "FilterTestSupport.h"
 
 #include "FormFactor.h"
 #include "GeneratedScenes.h"
 
 #include "vtkDataArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkInformation.h"
 #include "vtkMovingLightRadiosity.h"
@@ -18,6 +20,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 using namespace mlr;
@@ -101,6 +104,65 @@ TEST(FilterSensors, TheSensorsFollowTheTimeStepAndReadTheLamp)
   filter->Print(print);
   EXPECT_NE(print.str().find("DaylightAutonomyThreshold: 1e+09 lx"), std::string::npos);
   EXPECT_NE(print.str().find("SensorRays: 512"), std::string::npos);
+}
+
+TEST(FilterSensors, StandardErrorsComeWithBatchesAsTheElementsDo)
+{
+  // With ErrorBatches (16 by default) every frame's sensors carry IrradianceStdError (RGB) and
+  // IlluminanceStdError (the efficacy times its luminance), as the elements; the field data
+  // has the lit sensors' relative error per frame. With one batch neither is there.
+  const BoxSetup setup = closedBoxSetup(3);
+  auto filter = fastFilter(setup);
+  const std::vector<Vec3> points = { { 0.5, 0.5, 0.3 }, { 0.2, 0.8, 0.5 }, { 0.9, 0.1, 0.1 } };
+  filter->SetInputData(vtkMovingLightRadiosity::SENSORS_PORT,
+    sensorData(points, { { 0, 0, 1 }, { 1, 0, 0 }, { -1, 1, 1 } }));
+  const std::vector<double> times = timeSteps(filter);
+  ASSERT_EQ(times.size(), 3u);
+  EXPECT_EQ(filter->GetErrorBatches(), 16);
+  for (std::size_t f = 0; f < times.size(); ++f)
+  {
+    filter->UpdateTimeStep(times[f]);
+    vtkPolyData* sensors = filter->GetOutput(vtkMovingLightRadiosity::SENSORS_OUTPUT_PORT);
+    vtkDataArray* irradiance = sensors->GetPointData()->GetArray("IrradianceStdError");
+    vtkDataArray* lux = sensors->GetPointData()->GetArray("IlluminanceStdError");
+    ASSERT_NE(irradiance, nullptr);
+    ASSERT_NE(lux, nullptr);
+    EXPECT_EQ(irradiance->GetNumberOfComponents(), 3);
+    EXPECT_EQ(lux->GetNumberOfComponents(), 1);
+    ASSERT_EQ(irradiance->GetNumberOfTuples(), 3);
+    ASSERT_EQ(lux->GetNumberOfTuples(), 3);
+    EXPECT_STREQ(sensors->GetPointData()->GetScalars()->GetName(), "Illuminance");
+    for (vtkIdType i = 0; i < 3; ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        const double e = irradiance->GetComponent(i, c);
+        EXPECT_TRUE(std::isfinite(e) && e > 0) << "sensor " << i << ", frame " << f;
+        // A noisy estimate's error, not a second irradiance.
+        EXPECT_LT(e, 0.5 * value(sensors, "Irradiance", i, c));
+      }
+      EXPECT_NEAR(lux->GetComponent(i, 0), 179 * irradiance->GetComponent(i, 1),
+        1e-4 * lux->GetComponent(i, 0))
+        << "white light: the luminance of the error is the green channel's";
+    }
+    vtkFieldData* field = sensors->GetFieldData();
+    for (const char* name : { "SensorRelativeErrorMedian", "SensorRelativeErrorP95", "LitSensors" })
+    {
+      ASSERT_NE(field->GetArray(name), nullptr) << name;
+      EXPECT_EQ(field->GetArray(name)->GetNumberOfTuples(), 3) << name;
+    }
+    EXPECT_GT(field->GetArray("SensorRelativeErrorMedian")->GetComponent(f, 0), 0.0);
+    EXPECT_LE(field->GetArray("SensorRelativeErrorMedian")->GetComponent(f, 0),
+      field->GetArray("SensorRelativeErrorP95")->GetComponent(f, 0));
+    EXPECT_EQ(field->GetArray("LitSensors")->GetComponent(f, 0), 3);
+  }
+  filter->SetErrorBatches(1);
+  filter->UpdateTimeStep(times[0]);
+  vtkPolyData* sensors = filter->GetOutput(vtkMovingLightRadiosity::SENSORS_OUTPUT_PORT);
+  EXPECT_EQ(sensors->GetNumberOfPoints(), 3);
+  EXPECT_EQ(sensors->GetPointData()->GetArray("IrradianceStdError"), nullptr);
+  EXPECT_EQ(sensors->GetPointData()->GetArray("IlluminanceStdError"), nullptr);
+  EXPECT_EQ(sensors->GetFieldData()->GetArray("SensorRelativeErrorP95"), nullptr);
 }
 
 TEST(FilterSensors, BadSensorsAreRefusedWithEmptyOutputs)

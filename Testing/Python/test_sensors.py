@@ -1,7 +1,7 @@
 """Sensors through the filter: a Sensors input of points with Normals over a ground plane
-under a sun and a uniform sky, the Sensors output's per-frame Irradiance and Illuminance and
-its daylight metrics, the surfaces' radiosity untouched by the sensors, the thread count
-without effect, and bad sensors refused by name.
+under a sun and a uniform sky, the Sensors output's per-frame Irradiance and Illuminance, their
+standard errors and its daylight metrics, the surfaces' radiosity untouched by the sensors, the
+thread count without effect, and bad sensors refused by name.
 
 A uniform sky's estimator pi L is the same for every direction, so an up-facing sensor on
 open ground reads E_dh exactly (to single precision); the sun adds DNI sin(elevation).
@@ -10,6 +10,7 @@ import math
 import os
 import sys
 
+import numpy
 import pytest
 
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkFloatArray, vtkPoints
@@ -167,10 +168,45 @@ def test_thread_count_changes_no_sensor_bit():
     three = make_filter(sensors(points, normals), threads=3)
     for t in HOURS:
         assert one.UpdateTimeStep(t) and three.UpdateTimeStep(t)
-        for name in ("Irradiance", "Illuminance", "DirectSunHours", "UDIHigh"):
+        for name in ("Irradiance", "Illuminance", "IrradianceStdError", "IlluminanceStdError",
+                     "DirectSunHours", "UDIHigh"):
             a = vtk_to_numpy(one.GetOutput(3).GetPointData().GetArray(name))
             b = vtk_to_numpy(three.GetOutput(3).GetPointData().GetArray(name))
             assert a.tobytes() == b.tobytes(), name
+
+
+def test_standard_errors_come_as_the_elements_do():
+    # Sensors tilted towards the lit ground read its solution, whose noise they report with
+    # their own: with ErrorBatches (16 by default) every frame has IrradianceStdError (RGB,
+    # W/m^2) and IlluminanceStdError (lx, the efficacy times its luminance), as the elements
+    # have; with one batch neither.
+    points = [(0.3 * i - 0.6, 0.1, 0.3) for i in range(5)]
+    normals = [(1, 0.2 * i, 0.5) for i in range(5)]
+    radiosity = make_filter(sensors(points, normals))
+    assert radiosity.GetErrorBatches() == 16
+    for t in HOURS:
+        assert radiosity.UpdateTimeStep(t)
+        out = radiosity.GetOutput(vtkMovingLightRadiosity.SENSORS_OUTPUT_PORT)
+        data = out.GetPointData()
+        assert data.GetArray("IrradianceStdError").GetNumberOfComponents() == 3
+        assert data.GetArray("IlluminanceStdError").GetNumberOfComponents() == 1
+        error = vtk_to_numpy(data.GetArray("IrradianceStdError"))
+        lux = vtk_to_numpy(data.GetArray("IlluminanceStdError"))
+        irradiance = vtk_to_numpy(data.GetArray("Irradiance"))
+        assert error.shape == (5, 3) and lux.shape == (5,)
+        assert numpy.all(numpy.isfinite(error)) and numpy.all(error >= 0)
+        assert numpy.all(numpy.isfinite(lux)) and numpy.all(lux >= 0)
+        assert numpy.all(error < 0.5 * irradiance)
+        assert numpy.any(error > 0), "the ground's light has noise"
+        efficacy = out.GetFieldData().GetArray("LuminousEfficacy").GetValue(0)
+        assert lux == pytest.approx(efficacy * (error @ [0.2126, 0.7152, 0.0722]), rel=1e-5)
+        p95 = out.GetFieldData().GetArray("SensorRelativeErrorP95")
+        assert p95.GetNumberOfTuples() == len(HOURS)
+    radiosity.SetErrorBatches(1)
+    assert radiosity.UpdateTimeStep(HOURS[0])
+    data = radiosity.GetOutput(3).GetPointData()
+    assert data.GetArray("IrradianceStdError") is None
+    assert data.GetArray("IlluminanceStdError") is None
 
 
 @pytest.mark.parametrize(
