@@ -19,6 +19,7 @@
 
 #include "vtkAppendPolyData.h"
 #include "vtkCellData.h"
+#include "vtkCommand.h"
 #include "vtkDataObject.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
@@ -31,6 +32,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
+#include "vtkProgressObserver.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
@@ -139,6 +141,31 @@ struct vtkMovingLightRadiosity::vtkInternals
   bool OutputsLight = true;
 };
 
+namespace
+{
+/// Hands every progress report to a function: VTK's executive calls UpdateProgress(1.0) after
+/// RequestData whether the update was aborted or not, and UpdateProgress is not virtual, so
+/// the observer is the one place where the filter can drop it.
+class ProgressForwarder : public vtkProgressObserver
+{
+public:
+  static ProgressForwarder* New()
+  {
+    auto* result = new ProgressForwarder;
+    result->InitializeObjectBase();
+    return result;
+  }
+  void UpdateProgress(double amount) override
+  {
+    if (this->Report)
+    {
+      this->Report(amount);
+    }
+  }
+  std::function<void(double)> Report;
+};
+}
+
 vtkStandardNewMacro(vtkMovingLightRadiosity);
 
 //------------------------------------------------------------------------------
@@ -191,6 +218,21 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
 
   this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(4);
+  vtkNew<ProgressForwarder> progress;
+  progress->Report = [this](double amount) { this->ReportProgress(amount); };
+  this->SetProgressObserver(progress);
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::ReportProgress(double amount)
+{
+  // Nothing past an abort: neither the solve's last reports nor the executive's 1.0.
+  if (this->ProgressStopped || this->AbortExecute)
+  {
+    return;
+  }
+  this->Progress = amount;
+  this->InvokeEvent(vtkCommand::ProgressEvent, &amount);
 }
 
 //------------------------------------------------------------------------------
@@ -802,6 +844,9 @@ int vtkMovingLightRadiosity::RequestUpdateExtent(
   {
     return 0;
   }
+  // The executive asks for the update extent before every execution, and before its progress
+  // of 0: an abort silences the update it stopped, not the next one.
+  this->ProgressStopped = false;
   // Our time is the light's position, not the inputs' time: a new time must not make the
   // scene, the light or the trajectory execute again.
   for (int port = 0; port < this->GetNumberOfInputPorts(); ++port)
@@ -845,6 +890,7 @@ int vtkMovingLightRadiosity::RequestData(
     // on every rank alike, and only their change solves again.
     if (cache.Aborted)
     {
+      this->ProgressStopped = true;
       vtkErrorMacro(<< "the last solve was aborted and nothing has changed since: change a "
                        "property or an input, or call Modified() (on every rank), to solve "
                        "again");
@@ -958,6 +1004,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     }
     catch (const mlr::Cancelled&)
     {
+      this->ProgressStopped = true;
       vtkErrorMacro(<< "aborted while solving chunk " << chunk + 1 << " again for time step "
                     << frame);
       return false;
@@ -1797,6 +1844,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   if (aborted)
   {
     this->AbortExecute = 0;
+    this->ProgressStopped = true;
   }
   this->SetAbortOutput(false);
   if (propertiesAsAttempted)
@@ -1870,6 +1918,8 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SensorRays: " << this->SensorRays << "\n";
   os << indent
      << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
+     << "\n";
+  os << indent << "Progress reports: " << (this->ProgressStopped ? "stopped by an abort" : "on")
      << "\n";
   os << indent << "Last attempt: "
      << (this->Internals->Aborted     ? "aborted"

@@ -108,13 +108,18 @@
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with
- * empty outputs and an error, and clears the flag. An aborted or failed solve is not tried
- * again until a property or an input changes (or Modified() is called): a request for another
- * time step or output port meanwhile repeats the error without solving. Bad input (NaN
- * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to
- * fix and empty outputs. An empty scene gives empty outputs and no error. Numeric properties
- * are kept as given, not clamped: a value outside the range its description gives (NaN
- * included) fails the update with an error naming the property, the value and what to give.
+ * empty outputs and an error, and clears the flag. An aborted update reports no progress after
+ * the abort, not even the 1.0 VTK's executive reports at the end of every execution (which
+ * ParaView shows as a finished update): the progress goes through the filter's own
+ * vtkProgressObserver, and a ProgressEvent past an abort is dropped. Replacing that observer
+ * with SetProgressObserver replaces this too. A failed update still ends at 1.0, as in VTK. An
+ * aborted or failed solve is not tried again until a property or an input changes (or Modified() is
+ * called): a request for another time step or output port meanwhile repeats the error without
+ * solving. Bad input (NaN points, a wrong `Reflectance`, a light without polygons, ...) gives an
+ * error naming what to fix and empty outputs. An empty scene gives empty outputs and no error.
+ * Numeric properties are kept as given, not clamped: a value outside the range its description
+ * gives (NaN included) fails the update with an error naming the property, the value and what to
+ * give.
  *
  * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
  * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
@@ -369,14 +374,15 @@ public:
   /**
    * A sky, alone or with the sun (LightType Directional): none, uniform, CIE overcast, CIE
    * clear (type 12) or Perez all-weather; with a lamp (a Light, a LightMaterial or a point
-   * light) it is an error, since one frame's Illuminance takes one efficacy, the daylight's. The clear and Perez skies need LightType Directional: they follow its sun in
-   * every frame (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is
-   * scaled so that an unobstructed horizontal surface receives SkyDiffuseHorizontal, or the
-   * Trajectory's point array SkyDiffuseHorizontal per frame; the Perez sky also reads the
-   * direct normal irradiance, the array DirectNormalIrradiance or else the sun's irradiance
-   * (SunIrradiance times Power). Nothing lights from below the horizon. With a sky the
-   * Illuminance arrays use the Perez luminous efficacy of each frame's daylight (field data
-   * LuminousEfficacy and LuminousEfficacyModel). Default none.
+   * light) it is an error, since one frame's Illuminance takes one efficacy, the daylight's. The
+   * clear and Perez skies need LightType Directional: they follow its sun in every frame
+   * (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is scaled so that an
+   * unobstructed horizontal surface receives SkyDiffuseHorizontal, or the Trajectory's point array
+   * SkyDiffuseHorizontal per frame; the Perez sky also reads the direct normal irradiance, the
+   * array DirectNormalIrradiance or else the sun's irradiance (SunIrradiance times Power). Nothing
+   * lights from below the horizon. With a sky the Illuminance arrays use the Perez luminous
+   * efficacy of each frame's daylight (field data LuminousEfficacy and LuminousEfficacyModel).
+   * Default none.
    */
   vtkSetMacro(SkyModel, int);
   vtkGetMacro(SkyModel, int);
@@ -737,9 +743,15 @@ private:
   /// that frame is not kept.
   bool FillOutput(int port, std::size_t frame, vtkPolyData* output);
 
+  /// Every UpdateProgress ends here (the filter's vtkProgressObserver): a ProgressEvent,
+  /// unless this update was aborted.
+  void ReportProgress(double amount);
+
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
   std::function<void(std::size_t, vtkPolyData*)> ChunkFramesObserver;
+  /// This update was aborted: nothing more is reported until the next one starts.
+  bool ProgressStopped = false;
 };
 
 #endif
