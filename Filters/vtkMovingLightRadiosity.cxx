@@ -210,6 +210,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
+  this->PathFromLightMaterial = 1;
   this->ErrorBatches = 16;
   this->TargetRelativeError = defaults.targetRelativeError;
   this->TimeLimit = defaults.timeLimitSeconds;
@@ -604,8 +605,10 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
   }
 }
 
-mlr::vtkinputs::Trajectory trajectoryOf(
-  vtkMovingLightRadiosity* self, vtkInformationVector* trajectoryInput, std::size_t lights)
+/// The Trajectory's positions, else the straight path from PathStart (or from `start`, where
+/// the Scene has a LightMaterial's lamp) to PathEnd.
+mlr::vtkinputs::Trajectory trajectoryOf(vtkMovingLightRadiosity* self,
+  vtkInformationVector* trajectoryInput, std::size_t lights, const std::optional<mlr::Vec3>& start)
 {
   if (self->GetNumberOfInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT) == 0)
   {
@@ -615,18 +618,18 @@ mlr::vtkinputs::Trajectory trajectoryOf(
         " lights (LightId): "
         "connect a Trajectory with one polyline per light");
     }
-    const double* start = self->GetPathStart();
+    const double* given = self->GetPathStart();
+    const mlr::Vec3 first = start ? *start : mlr::Vec3(given[0], given[1], given[2]);
     const double* end = self->GetPathEnd();
     if (self->GetLightType() == vtkMovingLightRadiosity::AREA_LIGHT && !*self->GetLightMaterial() &&
       self->GetNumberOfInputConnections(vtkMovingLightRadiosity::LIGHT_PORT) == 0)
     {
       // No light: the scene's own emissive surfaces light it, and nothing moves: one frame,
       // not NumberOfPositions copies of it.
-      return mlr::vtkinputs::straightTrajectory(
-        { start[0], start[1], start[2] }, { start[0], start[1], start[2] }, 1);
+      return mlr::vtkinputs::straightTrajectory(first, first, 1);
     }
     mlr::vtkinputs::Trajectory line = mlr::vtkinputs::straightTrajectory(
-      { start[0], start[1], start[2] }, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
+      first, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
     if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
     {
       for (std::size_t k = 0; k < line.lights[0].size(); ++k)
@@ -804,9 +807,10 @@ int vtkMovingLightRadiosity::RequestInformation(
   std::vector<double> times;
   try
   {
-    times =
-      trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]))
-        .times;
+    // Where the straight path starts does not change its times.
+    times = trajectoryOf(
+      this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]), std::nullopt)
+              .times;
   }
   catch (const mlr::Error& e)
   {
@@ -1255,16 +1259,25 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
                        "out. Solve the lamp and the sky apart (their Irradiance arrays add up), "
                        "or set SkyModel to none");
     }
-    const mlr::vtkinputs::Trajectory trajectory =
-      trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]));
     vtkPolyData* sceneData = vtkPolyData::GetData(inputs[SCENE_PORT], 0);
     const bool fromMaterial = this->LightType == AREA_LIGHT && !this->LightMaterial.empty();
     mlr::vtkinputs::MaterialLight materialLight;
+    std::optional<mlr::Vec3> lampInScene;
     if (fromMaterial)
     {
       materialLight =
         mlr::vtkinputs::materialLight(sceneData, this->LightMaterial, this->EmissionArrayName);
+      if (this->PathFromLightMaterial)
+      {
+        // The centroid the light's poses are taken about, so that the first frame moves the
+        // lamp by exactly nothing.
+        lampInScene = mlr::MovingLight(
+          materialLight.light.polygons, mlr::Rgb(1, 1, 1), std::vector<mlr::Vec3>{ mlr::Vec3() })
+                        .centroid();
+      }
     }
+    const mlr::vtkinputs::Trajectory trajectory =
+      trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]), lampInScene);
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
       this->EmissionArrayName, materialLight.materialId);
@@ -1911,6 +1924,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LightFluxFromFile: " << (this->LightFluxFromFile ? "On" : "Off") << "\n";
   os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off")
      << "\n";
+  os << indent << "PathFromLightMaterial: " << (this->PathFromLightMaterial ? "On" : "Off") << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "LuminousEfficacy: " << this->LuminousEfficacy << " lm/W\n";

@@ -39,7 +39,8 @@
  *   outputs' field data; `DirectNormalIrradiance` (W/m^2) replaces SunIrradiance per frame,
  *   and `SkyDiffuseHorizontal` (W/m^2) and `DayOfYear` (1 to 366, the Perez sky's date) set
  *   the sky per frame. Without this input the light moves in a straight line from
- *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does);
+ *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does; a
+ *   LightMaterial's lamp from where the Scene has it, see PathFromLightMaterial);
  *   with neither a Light nor a LightMaterial, the scene's own emissive surfaces light it in
  *   one frame.
  * - port 3, Sensors (optional): measuring points (any point set, e.g. a work-plane grid at
@@ -294,7 +295,9 @@ public:
 
   ///@{
   /**
-   * First light centroid position when no Trajectory is connected. Default 0, 0, 0.
+   * First light centroid position when no Trajectory is connected. Not used for a
+   * LightMaterial with PathFromLightMaterial on: that lamp starts where the Scene has it.
+   * Default 0, 0, 0.
    */
   vtkSetVector3Macro(PathStart, double);
   vtkGetVector3Macro(PathStart, double);
@@ -495,6 +498,20 @@ public:
    */
   vtkSetStdStringFromCharMacro(LightMaterial);
   vtkGetCharFromStdStringMacro(LightMaterial);
+  ///@}
+
+  ///@{
+  /**
+   * With LightMaterial and no Trajectory: the first position is the lamp where the Scene has
+   * it (the area centroid of the material's polygons), so that the first time step shows the
+   * scene as modelled, and the straight path moves it from there to PathEnd in
+   * NumberOfPositions frames; PathStart is not used. Off: from PathStart to PathEnd, as for a
+   * Light input, whose polygons are a shape the path places. A Trajectory places the lamp
+   * either way. Default on.
+   */
+  vtkSetMacro(PathFromLightMaterial, vtkTypeBool);
+  vtkGetMacro(PathFromLightMaterial, vtkTypeBool);
+  vtkBooleanMacro(PathFromLightMaterial, vtkTypeBool);
   ///@}
 
   ///@{
@@ -723,6 +740,7 @@ protected:
   std::string ReflectanceArrayName;
   std::string EmissionArrayName;
   std::string LightMaterial;
+  vtkTypeBool PathFromLightMaterial;
   vtkTypeBool LightPowerFromMaterial;
   int ErrorBatches;
   double TargetRelativeError;
