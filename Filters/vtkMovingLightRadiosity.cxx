@@ -1086,7 +1086,8 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     }
     else if (cache.OutputsLight)
     {
-      // Every area light, posed as in this frame, at this frame's power.
+      // Every area and point light as solved: posed as in this frame, at this frame's power
+      // (its Trajectory Power and TILT factors included) and that power's flux.
       vtkNew<vtkAppendPolyData> lights;
       for (const mlr::MovingLight& light : cache.Rig.areaLights)
       {
@@ -1097,10 +1098,17 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
         lights->AddInputData(mlr::vtkoutputs::posedLight(
           light.polygons(), transform, light.power() * light.pose(k).power));
       }
+      for (const mlr::PointLight& light : cache.Rig.pointLights)
+      {
+        const std::size_t k = light.frameCount() > 1 ? frame : 0;
+        lights->AddInputData(
+          mlr::vtkoutputs::posedPointLight(light.position(k), light.power() * light.pose(k).power));
+      }
       if (lights->GetNumberOfInputConnections(0) > 0)
       {
         lights->Update();
         output->ShallowCopy(lights->GetOutput());
+        mlr::vtkoutputs::addLuminousFlux(output, this->LuminousEfficacy);
       }
     }
     vtkNew<vtkFieldData> fieldData;

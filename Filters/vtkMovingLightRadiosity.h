@@ -84,8 +84,12 @@
  *   scene in metres).
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
- * - port 2, Light: the light's polygons where they are in the frame shown, with the cell
- *   array `Power` (RGB, W: each polygon's share of LightPower, by area).
+ * - port 2, Light: the lights as solved in the frame shown: each area light's polygons where
+ *   they are and each point light (LightType Point, or a Luminaire without an opening) as a
+ *   vertex at its position, with the cell arrays `Power` (RGB, W: the power emitted in that
+ *   frame, LightFluxLumens, the file's flux, the Trajectory's `Power` and TILT factors
+ *   applied; an area light's shared between its polygons by area) and `LuminousFlux` (lm:
+ *   LuminousEfficacy times the luminance of `Power`).
  * - port 3, Sensors: the sensor points as vertices with `Normals`, `Irradiance` (RGB, W/m^2)
  *   and `Illuminance` (lx, with the efficacy of the element arrays) of the frame shown, and
  *   the daylight metrics over all the time steps (constant over time): `DaylightAutonomy`
