@@ -946,6 +946,8 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkPropertyRange<long long>("--frames", *o.frames, "NumberOfPositions");
     filter->SetPathStart(o.from->data());
     filter->SetPathEnd(o.to->data());
+    // --from is where a --light-material lamp starts too, not where the scene has it.
+    filter->SetPathFromLightMaterial(false);
     filter->SetNumberOfPositions(static_cast<int>(*o.frames));
   }
 }

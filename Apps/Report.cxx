@@ -2,8 +2,6 @@
 
 #include "CommandLine.h"
 
-#include "Photometry.h"
-
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
@@ -71,14 +69,10 @@ nlohmann::ordered_json jsonTriple(const double* v)
 
 namespace
 {
-double luminance(const double rgb[3])
-{
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
-}
-
-/// The light as solved: its kind, files and settings, and its power. The filter's Light output
-/// gives the area lights' (each polygon's Power); it has no point lights, whose power is the
-/// filter's rule: --light-lumens, else --light-power's watts, else the file's own flux.
+/// The light as solved: its kind, files and settings, and its power, from the filter's Light
+/// output, which holds every area light's polygons and every point light's vertex with their
+/// Power and LuminousFlux in one frame. Nothing is derived here: lumens, a file's flux, TILT
+/// factors and the Trajectory's Power are the filter's to apply.
 nlohmann::ordered_json lightingJson(
   const Options& o, vtkMovingLightRadiosity* filter, const PosedLight& posed)
 {
@@ -86,8 +80,10 @@ nlohmann::ordered_json lightingJson(
   const bool sky = o.sky.has_value();
   const bool areaKinds = !o.usesSun() && !o.sceneLightsItself() && !o.pointLight;
   vtkDataArray* powers = posed.light ? posed.light->GetCellData()->GetArray("Power") : nullptr;
-  const bool fromOutput =
-    areaKinds && powers && powers->GetNumberOfComponents() == 3 && powers->GetNumberOfTuples() > 0;
+  vtkDataArray* fluxes =
+    posed.light ? posed.light->GetCellData()->GetArray("LuminousFlux") : nullptr;
+  const bool fromOutput = powers && fluxes && powers->GetNumberOfComponents() == 3 &&
+    powers->GetNumberOfTuples() > 0 && fluxes->GetNumberOfTuples() == powers->GetNumberOfTuples();
   j["kind"] = o.usesSun()   ? "sun"
     : sky                   ? "sky"
     : o.sceneLightsItself() ? "scene emission"
@@ -97,8 +93,9 @@ nlohmann::ordered_json lightingJson(
                             : "area light";
   if (o.luminaire)
   {
-    j["emitsFrom"] =
-      fromOutput ? "the file's luminous opening" : "a point (no opening in the file)";
+    j["emitsFrom"] = posed.light && posed.light->GetNumberOfPolys() > 0
+      ? "the file's luminous opening"
+      : "a point (no opening in the file)";
   }
   if (!o.light.empty())
   {
@@ -128,55 +125,24 @@ nlohmann::ordered_json lightingJson(
 
   if (!o.usesSun() && !sky && !o.sceneLightsItself())
   {
-    double power[3] = { 0, 0, 0 };
-    double lumens = 0;
     if (fromOutput)
     {
+      double power[3] = { 0, 0, 0 };
+      double lumens = 0;
       for (vtkIdType c = 0; c < powers->GetNumberOfTuples(); ++c)
       {
         for (int k = 0; k < 3; ++k)
         {
           power[k] += powers->GetComponent(c, k);
         }
+        lumens += fluxes->GetComponent(c, 0);
       }
-      lumens = filter->GetLuminousEfficacy() * luminance(power);
-    }
-    else
-    {
-      const double* colour = filter->GetLightPower();
-      std::copy(colour, colour + 3, power);
-      lumens = o.lightLumens.value_or(0.0);
-      if (!(lumens > 0) && filter->GetLightFluxFromFile())
-      {
-        try
-        {
-          lumens = mlr::readPhotometricFile(o.lightDistribution).lumens;
-        }
-        catch (const std::exception&)
-        {
-          lumens = 0; // the filter read it: it has not changed since
-        }
-      }
-      if (lumens > 0 && luminance(colour) > 0)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          power[k] = colour[k] * lumens / filter->GetLuminousEfficacy() / luminance(colour);
-        }
-      }
-      else
-      {
-        lumens = filter->GetLuminousEfficacy() * luminance(power);
-      }
-    }
-    j["powerW"] = jsonTriple(power);
-    if (fromOutput)
-    {
+      j["powerW"] = jsonTriple(power);
       // The Light output poses the lights in one frame, with that frame's Power factor and
       // TILT factor.
       j["powerFrame"] = posed.frame;
+      j["lumens"] = jsonNumber(lumens);
     }
-    j["lumens"] = jsonNumber(lumens);
     j["powerFrom"] = o.lightLumens     ? "--light-lumens"
       : filter->GetLightFluxFromFile() ? "the distribution file's flux"
       : o.lightPower                   ? "--light-power"

@@ -58,7 +58,8 @@ std::string timeLine(const StageTimes& stages);
 /// of the lit sensors: median 0.9%, p95 1.6% (frame 2, the worst)").
 std::string errorLine(vtkFieldData* statistics);
 
-/// The filter's Light output in one frame: the area lights posed, each polygon with its Power.
+/// The filter's Light output in one frame: the lights as solved (area lights' polygons, point
+/// lights' vertices), each cell with its Power and LuminousFlux.
 struct PosedLight
 {
   vtkSmartPointer<vtkPolyData> light; ///< null or empty without area lights

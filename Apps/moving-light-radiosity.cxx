@@ -788,7 +788,7 @@ int run(int argc, char** argv, RankJob& job)
   // A copy: the next update clears the output's field data in place.
   vtkNew<vtkFieldData> statistics;
   statistics->ShallowCopy(first->GetFieldData());
-  // The update of the Elements serves the Light output too: the area lights as solved.
+  // The update of the Elements serves the Light output too: the lights as solved.
   PosedLight posedLight;
   posedLight.light = vtkSmartPointer<vtkPolyData>::New();
   posedLight.light->DeepCopy(filter->GetOutput(vtkMovingLightRadiosity::LIGHT_OUTPUT_PORT));

@@ -91,7 +91,9 @@ for name, file, material, start, end in SCENES:
     scene = pv.RadiositySceneReader(registrationName=file,
                                     FileName=os.path.join(args.data, file))
     radiosity = MovingLightRadiosity(registrationName=f"MovingLightRadiosity ({name})",
-                                     Scene=scene, LightMaterial=material, PathStart=list(start),
+                                     Scene=scene, LightMaterial=material,
+                                     # from this start, not where the scene has the lamp
+                                     PathFromLightMaterial=0, PathStart=list(start),
                                      PathEnd=list(end), NumberOfPositions=args.frames,
                                      NumberOfPaths=args.paths)
     started = time.time()

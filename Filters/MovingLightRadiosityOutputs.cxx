@@ -335,16 +335,53 @@ vtkSmartPointer<vtkPolyData> posedLight(
     areas.push_back(0.5 * length(newell));
   }
   const double totalArea = std::accumulate(areas.begin(), areas.end(), 0.0);
-  auto powerArray = rgbArray("Power", polygons.size());
+  // Doubles: the command line's --stats reports the power solved from this array.
+  auto powerArray = rgbArray<vtkDoubleArray>("Power", polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i)
   {
-    setRgb(powerArray, i, totalArea > 0 ? power * (areas[i] / totalArea) : Rgb());
+    const Rgb share = totalArea > 0 ? power * (areas[i] / totalArea) : Rgb();
+    powerArray->SetTuple3(static_cast<vtkIdType>(i), share.r, share.g, share.b);
   }
   auto light = vtkSmartPointer<vtkPolyData>::New();
   light->SetPoints(points);
   light->SetPolys(cells);
   light->GetCellData()->AddArray(powerArray);
   return light;
+}
+
+vtkSmartPointer<vtkPolyData> posedPointLight(const Vec3& position, const Rgb& power)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->InsertNextPoint(position.x, position.y, position.z);
+  vtkNew<vtkCellArray> vertices;
+  vertices->InsertNextCell(1);
+  vertices->InsertCellPoint(0);
+  auto powerArray = rgbArray<vtkDoubleArray>("Power", 1);
+  powerArray->SetTuple3(0, power.r, power.g, power.b);
+  auto light = vtkSmartPointer<vtkPolyData>::New();
+  light->SetPoints(points);
+  light->SetVerts(vertices);
+  light->GetCellData()->AddArray(powerArray);
+  return light;
+}
+
+void addLuminousFlux(vtkPolyData* light, double efficacy)
+{
+  vtkDataArray* power = light->GetCellData()->GetArray("Power");
+  if (!power || power->GetNumberOfComponents() != 3)
+  {
+    return;
+  }
+  vtkNew<vtkDoubleArray> flux;
+  flux->SetName("LuminousFlux");
+  flux->SetNumberOfTuples(power->GetNumberOfTuples());
+  for (vtkIdType c = 0; c < power->GetNumberOfTuples(); ++c)
+  {
+    const double* p = power->GetTuple3(c);
+    flux->SetValue(c, efficacy * (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]));
+  }
+  light->GetCellData()->AddArray(flux);
 }
 
 } // namespace mlr::vtkoutputs

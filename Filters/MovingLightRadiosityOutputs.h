@@ -110,9 +110,17 @@ struct LightTransform
 };
 
 /// The light's polygons, given in its own frame, posed by `transform`, with the cell array
-/// `Power` (RGB, W): each polygon's share of `power`, by area, so that they sum to it. Every
-/// light pose of the Light output goes through here.
+/// `Power` (RGB, W, doubles): each polygon's share of `power`, by area, so that they sum to
+/// it. Every light pose of the Light output goes through here.
 vtkSmartPointer<vtkPolyData> posedLight(const std::vector<std::vector<Vec3>>& polygons,
   const LightTransform& transform, const Rgb& power);
+
+/// A point light in the Light output: one vertex at `position` with the cell array `Power`
+/// (RGB, W, doubles) of `power`.
+vtkSmartPointer<vtkPolyData> posedPointLight(const Vec3& position, const Rgb& power);
+
+/// Adds the cell array `LuminousFlux` (lm) to a Light output: each cell's `Power` at
+/// `efficacy` lm per W of luminance (0.2126 R + 0.7152 G + 0.0722 B).
+void addLuminousFlux(vtkPolyData* light, double efficacy);
 
 } // namespace mlr::vtkoutputs

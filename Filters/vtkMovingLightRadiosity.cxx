@@ -19,6 +19,7 @@
 
 #include "vtkAppendPolyData.h"
 #include "vtkCellData.h"
+#include "vtkCommand.h"
 #include "vtkDataObject.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
@@ -31,6 +32,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
+#include "vtkProgressObserver.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
@@ -139,6 +141,31 @@ struct vtkMovingLightRadiosity::vtkInternals
   bool OutputsLight = true;
 };
 
+namespace
+{
+/// Hands every progress report to a function: VTK's executive calls UpdateProgress(1.0) after
+/// RequestData whether the update was aborted or not, and UpdateProgress is not virtual, so
+/// the observer is the one place where the filter can drop it.
+class ProgressForwarder : public vtkProgressObserver
+{
+public:
+  static ProgressForwarder* New()
+  {
+    auto* result = new ProgressForwarder;
+    result->InitializeObjectBase();
+    return result;
+  }
+  void UpdateProgress(double amount) override
+  {
+    if (this->Report)
+    {
+      this->Report(amount);
+    }
+  }
+  std::function<void(double)> Report;
+};
+}
+
 vtkStandardNewMacro(vtkMovingLightRadiosity);
 
 //------------------------------------------------------------------------------
@@ -183,6 +210,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
+  this->PathFromLightMaterial = 1;
   this->ErrorBatches = 16;
   this->TargetRelativeError = defaults.targetRelativeError;
   this->TimeLimit = defaults.timeLimitSeconds;
@@ -191,6 +219,21 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
 
   this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(4);
+  vtkNew<ProgressForwarder> progress;
+  progress->Report = [this](double amount) { this->ReportProgress(amount); };
+  this->SetProgressObserver(progress);
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::ReportProgress(double amount)
+{
+  // Nothing past an abort: neither the solve's last reports nor the executive's 1.0.
+  if (this->ProgressStopped || this->AbortExecute)
+  {
+    return;
+  }
+  this->Progress = amount;
+  this->InvokeEvent(vtkCommand::ProgressEvent, &amount);
 }
 
 //------------------------------------------------------------------------------
@@ -562,8 +605,10 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
   }
 }
 
-mlr::vtkinputs::Trajectory trajectoryOf(
-  vtkMovingLightRadiosity* self, vtkInformationVector* trajectoryInput, std::size_t lights)
+/// The Trajectory's positions, else the straight path from PathStart (or from `start`, where
+/// the Scene has a LightMaterial's lamp) to PathEnd.
+mlr::vtkinputs::Trajectory trajectoryOf(vtkMovingLightRadiosity* self,
+  vtkInformationVector* trajectoryInput, std::size_t lights, const std::optional<mlr::Vec3>& start)
 {
   if (self->GetNumberOfInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT) == 0)
   {
@@ -573,18 +618,18 @@ mlr::vtkinputs::Trajectory trajectoryOf(
         " lights (LightId): "
         "connect a Trajectory with one polyline per light");
     }
-    const double* start = self->GetPathStart();
+    const double* given = self->GetPathStart();
+    const mlr::Vec3 first = start ? *start : mlr::Vec3(given[0], given[1], given[2]);
     const double* end = self->GetPathEnd();
     if (self->GetLightType() == vtkMovingLightRadiosity::AREA_LIGHT && !*self->GetLightMaterial() &&
       self->GetNumberOfInputConnections(vtkMovingLightRadiosity::LIGHT_PORT) == 0)
     {
       // No light: the scene's own emissive surfaces light it, and nothing moves: one frame,
       // not NumberOfPositions copies of it.
-      return mlr::vtkinputs::straightTrajectory(
-        { start[0], start[1], start[2] }, { start[0], start[1], start[2] }, 1);
+      return mlr::vtkinputs::straightTrajectory(first, first, 1);
     }
     mlr::vtkinputs::Trajectory line = mlr::vtkinputs::straightTrajectory(
-      { start[0], start[1], start[2] }, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
+      first, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
     if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
     {
       for (std::size_t k = 0; k < line.lights[0].size(); ++k)
@@ -762,9 +807,10 @@ int vtkMovingLightRadiosity::RequestInformation(
   std::vector<double> times;
   try
   {
-    times =
-      trajectoryOf(this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]))
-        .times;
+    // Where the straight path starts does not change its times.
+    times = trajectoryOf(
+      this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]), std::nullopt)
+              .times;
   }
   catch (const mlr::Error& e)
   {
@@ -802,6 +848,9 @@ int vtkMovingLightRadiosity::RequestUpdateExtent(
   {
     return 0;
   }
+  // The executive asks for the update extent before every execution, and before its progress
+  // of 0: an abort silences the update it stopped, not the next one.
+  this->ProgressStopped = false;
   // Our time is the light's position, not the inputs' time: a new time must not make the
   // scene, the light or the trajectory execute again.
   for (int port = 0; port < this->GetNumberOfInputPorts(); ++port)
@@ -845,6 +894,7 @@ int vtkMovingLightRadiosity::RequestData(
     // on every rank alike, and only their change solves again.
     if (cache.Aborted)
     {
+      this->ProgressStopped = true;
       vtkErrorMacro(<< "the last solve was aborted and nothing has changed since: change a "
                        "property or an input, or call Modified() (on every rank), to solve "
                        "again");
@@ -958,6 +1008,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     }
     catch (const mlr::Cancelled&)
     {
+      this->ProgressStopped = true;
       vtkErrorMacro(<< "aborted while solving chunk " << chunk + 1 << " again for time step "
                     << frame);
       return false;
@@ -1035,7 +1086,8 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     }
     else if (cache.OutputsLight)
     {
-      // Every area light, posed as in this frame, at this frame's power.
+      // Every area and point light as solved: posed as in this frame, at this frame's power
+      // (its Trajectory Power and TILT factors included) and that power's flux.
       vtkNew<vtkAppendPolyData> lights;
       for (const mlr::MovingLight& light : cache.Rig.areaLights)
       {
@@ -1046,10 +1098,17 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
         lights->AddInputData(mlr::vtkoutputs::posedLight(
           light.polygons(), transform, light.power() * light.pose(k).power));
       }
+      for (const mlr::PointLight& light : cache.Rig.pointLights)
+      {
+        const std::size_t k = light.frameCount() > 1 ? frame : 0;
+        lights->AddInputData(
+          mlr::vtkoutputs::posedPointLight(light.position(k), light.power() * light.pose(k).power));
+      }
       if (lights->GetNumberOfInputConnections(0) > 0)
       {
         lights->Update();
         output->ShallowCopy(lights->GetOutput());
+        mlr::vtkoutputs::addLuminousFlux(output, this->LuminousEfficacy);
       }
     }
     vtkNew<vtkFieldData> fieldData;
@@ -1208,16 +1267,25 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
                        "out. Solve the lamp and the sky apart (their Irradiance arrays add up), "
                        "or set SkyModel to none");
     }
-    const mlr::vtkinputs::Trajectory trajectory =
-      trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]));
     vtkPolyData* sceneData = vtkPolyData::GetData(inputs[SCENE_PORT], 0);
     const bool fromMaterial = this->LightType == AREA_LIGHT && !this->LightMaterial.empty();
     mlr::vtkinputs::MaterialLight materialLight;
+    std::optional<mlr::Vec3> lampInScene;
     if (fromMaterial)
     {
       materialLight =
         mlr::vtkinputs::materialLight(sceneData, this->LightMaterial, this->EmissionArrayName);
+      if (this->PathFromLightMaterial)
+      {
+        // The centroid the light's poses are taken about, so that the first frame moves the
+        // lamp by exactly nothing.
+        lampInScene = mlr::MovingLight(
+          materialLight.light.polygons, mlr::Rgb(1, 1, 1), std::vector<mlr::Vec3>{ mlr::Vec3() })
+                        .centroid();
+      }
     }
+    const mlr::vtkinputs::Trajectory trajectory =
+      trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]), lampInScene);
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
       this->EmissionArrayName, materialLight.materialId);
@@ -1797,6 +1865,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   if (aborted)
   {
     this->AbortExecute = 0;
+    this->ProgressStopped = true;
   }
   this->SetAbortOutput(false);
   if (propertiesAsAttempted)
@@ -1863,6 +1932,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LightFluxFromFile: " << (this->LightFluxFromFile ? "On" : "Off") << "\n";
   os << indent << "LightPowerFromMaterial: " << (this->LightPowerFromMaterial ? "On" : "Off")
      << "\n";
+  os << indent << "PathFromLightMaterial: " << (this->PathFromLightMaterial ? "On" : "Off") << "\n";
   os << indent << "SolveCount: " << this->SolveCount << "\n";
   os << indent << "Exposure: " << this->Exposure << " EV\n";
   os << indent << "LuminousEfficacy: " << this->LuminousEfficacy << " lm/W\n";
@@ -1870,6 +1940,8 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SensorRays: " << this->SensorRays << "\n";
   os << indent
      << "Cached frames: " << (this->Internals->HasResult ? this->Internals->Times.size() : 0)
+     << "\n";
+  os << indent << "Progress reports: " << (this->ProgressStopped ? "stopped by an abort" : "on")
      << "\n";
   os << indent << "Last attempt: "
      << (this->Internals->Aborted     ? "aborted"

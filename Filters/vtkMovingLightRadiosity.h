@@ -39,7 +39,8 @@
  *   outputs' field data; `DirectNormalIrradiance` (W/m^2) replaces SunIrradiance per frame,
  *   and `SkyDiffuseHorizontal` (W/m^2) and `DayOfYear` (1 to 366, the Perez sky's date) set
  *   the sky per frame. Without this input the light moves in a straight line from
- *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does);
+ *   PathStart to PathEnd in NumberOfPositions frames (Directional: the direction does; a
+ *   LightMaterial's lamp from where the Scene has it, see PathFromLightMaterial);
  *   with neither a Light nor a LightMaterial, the scene's own emissive surfaces light it in
  *   one frame.
  * - port 3, Sensors (optional): measuring points (any point set, e.g. a work-plane grid at
@@ -83,8 +84,12 @@
  *   scene in metres).
  * - port 1, Patches: the patch mesh with `Radiosity` (the patch-level shooting solution of
  *   the patch's lit side) and `Reflectance`.
- * - port 2, Light: the light's polygons where they are in the frame shown, with the cell
- *   array `Power` (RGB, W: each polygon's share of LightPower, by area).
+ * - port 2, Light: the lights as solved in the frame shown: each area light's polygons where
+ *   they are and each point light (LightType Point, or a Luminaire without an opening) as a
+ *   vertex at its position, with the cell arrays `Power` (RGB, W: the power emitted in that
+ *   frame, LightFluxLumens, the file's flux, the Trajectory's `Power` and TILT factors
+ *   applied; an area light's shared between its polygons by area) and `LuminousFlux` (lm:
+ *   LuminousEfficacy times the luminance of `Power`).
  * - port 3, Sensors: the sensor points as vertices with `Normals`, `Irradiance` (RGB, W/m^2)
  *   and `Illuminance` (lx, with the efficacy of the element arrays) of the frame shown, and
  *   the daylight metrics over all the time steps (constant over time): `DaylightAutonomy`
@@ -113,13 +118,18 @@
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream
  * algorithm, see vtkAlgorithm::CheckAbort) stops the solve within a fraction of a second, with
- * empty outputs and an error, and clears the flag. An aborted or failed solve is not tried
- * again until a property or an input changes (or Modified() is called): a request for another
- * time step or output port meanwhile repeats the error without solving. Bad input (NaN
- * points, a wrong `Reflectance`, a light without polygons, ...) gives an error naming what to
- * fix and empty outputs. An empty scene gives empty outputs and no error. Numeric properties
- * are kept as given, not clamped: a value outside the range its description gives (NaN
- * included) fails the update with an error naming the property, the value and what to give.
+ * empty outputs and an error, and clears the flag. An aborted update reports no progress after
+ * the abort, not even the 1.0 VTK's executive reports at the end of every execution (which
+ * ParaView shows as a finished update): the progress goes through the filter's own
+ * vtkProgressObserver, and a ProgressEvent past an abort is dropped. Replacing that observer
+ * with SetProgressObserver replaces this too. A failed update still ends at 1.0, as in VTK. An
+ * aborted or failed solve is not tried again until a property or an input changes (or Modified() is
+ * called): a request for another time step or output port meanwhile repeats the error without
+ * solving. Bad input (NaN points, a wrong `Reflectance`, a light without polygons, ...) gives an
+ * error naming what to fix and empty outputs. An empty scene gives empty outputs and no error.
+ * Numeric properties are kept as given, not clamped: a value outside the range its description
+ * gives (NaN included) fails the update with an error naming the property, the value and what to
+ * give.
  *
  * Several MPI ranks (pvbatch --symmetric or pvserver under mpiexec; the global controller
  * has more than one process): every rank gathers the whole Scene, Light and Trajectory from
@@ -294,7 +304,9 @@ public:
 
   ///@{
   /**
-   * First light centroid position when no Trajectory is connected. Default 0, 0, 0.
+   * First light centroid position when no Trajectory is connected. Not used for a
+   * LightMaterial with PathFromLightMaterial on: that lamp starts where the Scene has it.
+   * Default 0, 0, 0.
    */
   vtkSetVector3Macro(PathStart, double);
   vtkGetVector3Macro(PathStart, double);
@@ -374,14 +386,15 @@ public:
   /**
    * A sky, alone or with the sun (LightType Directional): none, uniform, CIE overcast, CIE
    * clear (type 12) or Perez all-weather; with a lamp (a Light, a LightMaterial or a point
-   * light) it is an error, since one frame's Illuminance takes one efficacy, the daylight's. The clear and Perez skies need LightType Directional: they follow its sun in
-   * every frame (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is
-   * scaled so that an unobstructed horizontal surface receives SkyDiffuseHorizontal, or the
-   * Trajectory's point array SkyDiffuseHorizontal per frame; the Perez sky also reads the
-   * direct normal irradiance, the array DirectNormalIrradiance or else the sun's irradiance
-   * (SunIrradiance times Power). Nothing lights from below the horizon. With a sky the
-   * Illuminance arrays use the Perez luminous efficacy of each frame's daylight (field data
-   * LuminousEfficacy and LuminousEfficacyModel). Default none.
+   * light) it is an error, since one frame's Illuminance takes one efficacy, the daylight's. The
+   * clear and Perez skies need LightType Directional: they follow its sun in every frame
+   * (SunIrradiance 0 keeps the sun's frames with no direct sun). Each sky is scaled so that an
+   * unobstructed horizontal surface receives SkyDiffuseHorizontal, or the Trajectory's point array
+   * SkyDiffuseHorizontal per frame; the Perez sky also reads the direct normal irradiance, the
+   * array DirectNormalIrradiance or else the sun's irradiance (SunIrradiance times Power). Nothing
+   * lights from below the horizon. With a sky the Illuminance arrays use the Perez luminous
+   * efficacy of each frame's daylight (field data LuminousEfficacy and LuminousEfficacyModel).
+   * Default none.
    */
   vtkSetMacro(SkyModel, int);
   vtkGetMacro(SkyModel, int);
@@ -494,6 +507,20 @@ public:
    */
   vtkSetStdStringFromCharMacro(LightMaterial);
   vtkGetCharFromStdStringMacro(LightMaterial);
+  ///@}
+
+  ///@{
+  /**
+   * With LightMaterial and no Trajectory: the first position is the lamp where the Scene has
+   * it (the area centroid of the material's polygons), so that the first time step shows the
+   * scene as modelled, and the straight path moves it from there to PathEnd in
+   * NumberOfPositions frames; PathStart is not used. Off: from PathStart to PathEnd, as for a
+   * Light input, whose polygons are a shape the path places. A Trajectory places the lamp
+   * either way. Default on.
+   */
+  vtkSetMacro(PathFromLightMaterial, vtkTypeBool);
+  vtkGetMacro(PathFromLightMaterial, vtkTypeBool);
+  vtkBooleanMacro(PathFromLightMaterial, vtkTypeBool);
   ///@}
 
   ///@{
@@ -722,6 +749,7 @@ protected:
   std::string ReflectanceArrayName;
   std::string EmissionArrayName;
   std::string LightMaterial;
+  vtkTypeBool PathFromLightMaterial;
   vtkTypeBool LightPowerFromMaterial;
   int ErrorBatches;
   double TargetRelativeError;
@@ -742,9 +770,15 @@ private:
   /// that frame is not kept.
   bool FillOutput(int port, std::size_t frame, vtkPolyData* output);
 
+  /// Every UpdateProgress ends here (the filter's vtkProgressObserver): a ProgressEvent,
+  /// unless this update was aborted.
+  void ReportProgress(double amount);
+
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
   std::function<void(std::size_t, vtkPolyData*)> ChunkFramesObserver;
+  /// This update was aborted: nothing more is reported until the next one starts.
+  bool ProgressStopped = false;
 };
 
 #endif

@@ -159,7 +159,8 @@ def test_stats_record_the_point_light_as_solved(tmp_path):
     lighting = json.loads((tmp_path / "out" / "c.json").read_text())["lighting"]
     scale = 50 / (0.2126 * 2 + 0.7152 * 1)
     assert lighting["powerW"] == pytest.approx([2 * scale, scale, 0], rel=1e-9)
-    assert lighting["lumens"] == 8950 and lighting["powerFrom"] == "--light-lumens"
+    assert lighting["lumens"] == pytest.approx(8950, rel=1e-12)
+    assert lighting["powerFrom"] == "--light-lumens"
     assert lighting["spot"] == {"halfAngleDegrees": 40, "softEdgeDegrees": 0}
 
     # A luminaire of an opening: its power is the Light output's, the file's flux.
@@ -176,6 +177,31 @@ def test_stats_record_the_point_light_as_solved(tmp_path):
     assert stats["light"] == "luminaire" and lighting["emitsFrom"] == "the file's luminous opening"
     assert lighting["powerW"] == pytest.approx([2000 * math.pi / 179] * 3, rel=1e-6)
     assert lighting["powerFrame"] == 0
+
+
+def test_stats_take_the_point_light_from_the_filter(tmp_path):
+    """--stats took a point light's power from LightPower scaled to --light-lumens, itself:
+    without the TILT factor the filter solved with. It takes the Light output's: a TILT table of
+    1 at 0 and 0.4 at 90 degrees, with up +y, tilts the light (nadir -z) by 90 degrees, and
+    the filter emits 0.4 of the 8950 lm asked for, in the colour (2, 1, 0)."""
+    (tmp_path / "tilted.ies").write_text(
+        "IESNA:LM-63-2002\n[TEST] tilt\nTILT=INCLUDE\n1\n2\n0 90\n1 0.4\n"
+        "1 -1 1 3 1 1 2 0 0 0\n1 1 0\n0 45 90\n0\n1000 1000 1000\n")
+    result = run(["--scene", write_floor(tmp_path), "--point-light", "--from", f"0,0,{HEIGHT}",
+                  "--to", f"0.5,0,{HEIGHT}", "--frames", "2", "--light-distribution",
+                  "tilted.ies", "--light-lumens", "8950", "--light-power", "2,1,0", "--up",
+                  "0,1,0", "--paths", "2000", "--output", "out/t.pvd", "--stats", "out/t.json"],
+                 tmp_path)
+    assert result.returncode == 0, result.stderr
+    stats = json.loads((tmp_path / "out" / "t.json").read_text())
+    lighting = stats["lighting"]
+    scale = 0.4 * 50 / (0.2126 * 2 + 0.7152 * 1)
+    assert lighting["powerW"] == pytest.approx([2 * scale, scale, 0], rel=1e-12, abs=1e-12)
+    assert lighting["lumens"] == pytest.approx(0.4 * 8950, rel=1e-12)
+    # Either frame (the last when streamed): the light is tilted alike in both.
+    assert lighting["powerFrame"] in (0, 1) and lighting["powerFrom"] == "--light-lumens"
+    assert stats["settings"]["lightPower"] == lighting["powerW"]
+    assert [f["lightPosition"] for f in stats["frames"]] == [[0, 0, HEIGHT], [0.5, 0, HEIGHT]]
 
 
 def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):

@@ -19,6 +19,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 using namespace mlr;
 using namespace mlr::testing;
@@ -347,6 +349,102 @@ TEST(FilterBadInput, AnAbortHoldsUntilAPropertyChanges)
   EXPECT_TRUE(again.succeeded) << again.messages->allErrors();
   EXPECT_GT(again.elements, 0);
   EXPECT_EQ(filter->GetSolveCount(), 1);
+}
+
+namespace
+{
+/// Every progress value the filter reports, and where in them an abort was asked for: at the
+/// first value past `threshold`, as a ParaView progress observer or a user pressing Stop.
+struct ProgressLog
+{
+  double threshold = 2.0; // above any progress: no abort unless set
+  std::vector<double> values;
+  std::size_t abortedAfter = 0; // values reported before the abort, the one asking included
+  bool aborted = false;
+};
+
+void logProgress(vtkMovingLightRadiosity* filter, ProgressLog& log, vtkCallbackCommand* command)
+{
+  command->SetClientData(&log);
+  command->SetCallback(
+    [](vtkObject* caller, unsigned long, void* data, void* amount)
+    {
+      auto* self = static_cast<ProgressLog*>(data);
+      self->values.push_back(*static_cast<double*>(amount));
+      if (!self->aborted && self->values.back() > self->threshold)
+      {
+        self->aborted = true;
+        self->abortedAfter = self->values.size();
+        static_cast<vtkAlgorithm*>(caller)->AbortExecuteOn();
+      }
+    });
+  filter->AddObserver(vtkCommand::ProgressEvent, command);
+}
+
+std::string listed(const std::vector<double>& values, std::size_t from)
+{
+  std::string text;
+  for (std::size_t i = from; i < values.size(); ++i)
+  {
+    text += (i > from ? ", " : "") + std::to_string(values[i]);
+  }
+  return text;
+}
+}
+
+TEST(FilterBadInput, NoProgressIsReportedAfterAnAbort)
+{
+  // VTK's executive reports 1.0 at the end of every execution, aborted or not, which ParaView
+  // shows as done: an aborted update must end at the value its abort came from.
+  BoxSetup setup = closedBoxSetup(5);
+  auto filter = fastFilter(setup);
+  filter->SetNumberOfPaths(2000000);
+  ProgressLog log;
+  log.threshold = 0.2;
+  vtkNew<vtkCallbackCommand> command;
+  logProgress(filter, log, command);
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(filter);
+  EXPECT_FALSE(filter->UpdateTimeStep(0));
+  ASSERT_TRUE(log.aborted) << listed(log.values, 0);
+  EXPECT_EQ(log.values.size(), log.abortedAfter)
+    << "reported after the abort: " << listed(log.values, log.abortedAfter);
+  for (double value : log.values)
+  {
+    EXPECT_LT(value, 1.0) << listed(log.values, 0);
+  }
+  EXPECT_GT(log.values.back(), 0.2);
+  EXPECT_NE(messages->allErrors().find("aborted"), std::string::npos) << messages->allErrors();
+  EXPECT_DOUBLE_EQ(filter->GetProgress(), log.values.back());
+  for (int port = 0; port < filter->GetNumberOfOutputPorts(); ++port)
+  {
+    EXPECT_EQ(filter->GetOutput(port)->GetNumberOfCells(), 0) << port;
+  }
+
+  // Another time step repeats the abort's error without solving: no 1.0 either.
+  log.values.clear();
+  EXPECT_FALSE(filter->UpdateTimeStep(timeSteps(filter).back()));
+  for (double value : log.values)
+  {
+    EXPECT_LT(value, 1.0) << listed(log.values, 0);
+  }
+
+  // An abort asked for before the update stops it before anything is reported.
+  filter->SetNumberOfPaths(2000001);
+  log.values.clear();
+  filter->SetAbortExecute(1);
+  EXPECT_FALSE(filter->UpdateTimeStep(0));
+  EXPECT_TRUE(log.values.empty()) << listed(log.values, 0);
+  EXPECT_EQ(filter->GetSolveCount(), 0);
+
+  // An update that runs to its end still reports its progress up to 1.0.
+  filter->SetNumberOfPaths(20000);
+  log.values.clear();
+  EXPECT_TRUE(filter->UpdateTimeStep(0)) << messages->allErrors();
+  ASSERT_FALSE(log.values.empty());
+  EXPECT_EQ(log.values.front(), 0.0);
+  EXPECT_EQ(log.values.back(), 1.0);
+  filter->RemoveAllObservers();
 }
 
 TEST(FilterBadInput, AnErrorIsRepeatedWithoutSolvingUntilSomethingChanges)

@@ -132,6 +132,9 @@ BOOLEANS |= {"BalanceFrames"}
 ADVANCED |= {"BalanceFrames"}
 # The sensors' properties.
 EXPECTED |= {"DaylightAutonomyThreshold", "SensorRays"}
+# Where a Light Material's lamp starts without a Trajectory.
+EXPECTED |= {"PathFromLightMaterial"}
+BOOLEANS |= {"PathFromLightMaterial"}
 # The chunks of a long animation.
 EXPECTED |= {"FramesPerChunk", "CachedChunks"}
 ADVANCED |= {"FramesPerChunk", "CachedChunks"}

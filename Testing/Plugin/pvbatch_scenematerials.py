@@ -10,7 +10,9 @@ shipped Data/CornellBox-Original.obj:
   float32 precision: the two are one computation, not two estimates that agree on average;
 - every element carries the Kd of the material it lies on (from the .mtl), the lamp is gone
   from the elements, and the Light output is the lamp at each frame's place with the power
-  pi x Ke x area.
+  pi x Ke x area;
+- with the path left at its defaults, the lamp starts where the OBJ has it, not at Path Start
+  (the middle of the scene's -x face).
 
     pvbatch --force-offscreen-rendering pvbatch_scenematerials.py --plugin MovingLightRadiosity.so \
         --cli moving-light-radiosity"""
@@ -74,8 +76,10 @@ check(len(cli_frames) == FRAMES, f"the command line wrote {len(cli_frames)} fram
 # --- ParaView ---------------------------------------------------------------------------------
 scene = RadiositySceneReader(FileName=OBJ)  # noqa: F405
 radiosity = MovingLightRadiosity(  # noqa: F405
-    Scene=scene, LightMaterial="light", PathStart=list(START), PathEnd=list(END),
-    NumberOfPositions=FRAMES, NumberOfPaths=PATHS, Seed=SEED, NumberOfThreads=THREADS)
+    # --from is where the command line's lamp starts: PathStart, not where the OBJ has it.
+    Scene=scene, LightMaterial="light", PathFromLightMaterial=0, PathStart=list(START),
+    PathEnd=list(END), NumberOfPositions=FRAMES, NumberOfPaths=PATHS, Seed=SEED,
+    NumberOfThreads=THREADS)
 radiosity.UpdatePipeline(0.0)
 times = list(radiosity.TimestepValues)
 check(times == [t for t, _ in cli_frames],
@@ -171,6 +175,27 @@ if reflectance is not None and material_ids is not None:
         if name != "light":
             check(any(numpy.abs(reflectance - numpy.array(colour)).max(axis=1) < 1e-6),
                   f"no element has {name}'s Kd {colour}")
+
+# --- The path left at its defaults -----------------------------------------------------------
+# Path Start defaults to the middle of the scene's -x face; the lamp starts where the OBJ has it
+# (its centroid), not there, and moves from there to Path End.
+LAMP = numpy.array([[-0.2338, 1.9641, 0.1892], [-0.2338, 1.9641, -0.1885],
+                    [0.2338, 1.9641, -0.1885], [0.2338, 1.9641, 0.1892]])
+defaults = MovingLightRadiosity(  # noqa: F405
+    Scene=scene, LightMaterial="light", NumberOfPositions=3, NumberOfPaths=PATHS, Seed=SEED,
+    NumberOfThreads=THREADS)
+check(numpy.abs(numpy.array(defaults.PathStart) - LAMP.mean(axis=0)).max() > 0.5,
+      f"Path Start defaults to {list(defaults.PathStart)}, near the lamp: the check proves nothing")
+for time, expected in ((0.0, LAMP.mean(axis=0)), (2.0, numpy.array(defaults.PathEnd))):
+    defaults.UpdatePipeline(time)
+    position = vtk_to_numpy(servermanager.Fetch(defaults).GetFieldData().GetArray("LightPosition"))[0]
+    check(numpy.abs(position - expected).max() < 1e-5,
+          f"t = {time}: the lamp is at {position}, expected {expected}")
+defaults.UpdatePipeline(0.0)
+light = servermanager.Fetch(defaults, idx=2)
+points = vtk_to_numpy(light.GetPoints().GetData()) if light.GetNumberOfPoints() else numpy.zeros((0, 3))
+check(points.shape == LAMP.shape and numpy.abs(numpy.sort(points, axis=0) - numpy.sort(LAMP, axis=0)).max() < 1e-5,
+      f"the first time step's Light is {points.tolist()}, not the lamp where the OBJ has it")
 
 shutil.rmtree(folder, ignore_errors=True)
 checks.finish()

@@ -67,7 +67,10 @@ def test_point_light_needs_no_light_input_and_moves():
         near = numpy_hypot(xyz - (x, 0, 0)) < 0.6
         centre = (xyz[near, :2] * values[near, None]).sum(axis=0) / values[near].sum()
         assert math.hypot(centre[0] - x, centre[1]) < 0.05, centre
-        assert radiosity.GetOutput(2).GetNumberOfCells() == 0  # no polygons to show
+        # The light as solved: one vertex where it is, no polygons to show.
+        light = radiosity.GetOutput(2)
+        assert (light.GetNumberOfVerts(), light.GetNumberOfPolys()) == (1, 0)
+        assert light.GetPoint(0) == (x, 0.0, 1.0)
 
 
 def test_spot_darkens_the_floor_outside_its_cone():
@@ -176,7 +179,7 @@ def test_luminaire_emits_from_the_files_opening(tmp_path):
                              LightDistributionFile=ies_file(tmp_path / "point.ies", "0 0 0"))
     warnings = warnings_of(point)
     point.UpdateTimeStep(0.0)
-    assert point.GetOutput(2).GetNumberOfCells() == 0
+    assert (point.GetOutput(2).GetNumberOfVerts(), point.GetOutput(2).GetNumberOfPolys()) == (1, 0)
     assert any("gives no luminous opening" in w and "point light" in w for w in warnings), warnings
     # Without a file there is no opening to emit from.
     assert "LightDistributionFile" in failure(
@@ -194,6 +197,72 @@ def test_area_light_of_another_size_than_the_opening_is_warned_of(tmp_path):
     warnings = warnings_of(same)
     same.UpdateTimeStep(0.0)
     assert not any("luminous opening" in w for w in warnings), warnings
+
+
+def two_point_trajectory(normals=None, power=None):
+    """(0, 0, 1) then (0.5, 0, 1), with the point arrays Normal and Power when given."""
+    points = vtkPoints()
+    points.InsertNextPoint(0, 0, 1)
+    points.InsertNextPoint(0.5, 0, 1)
+    trajectory = vtkPolyData()
+    trajectory.SetPoints(points)
+    line = vtkPolyLine()
+    line.GetPointIds().SetNumberOfIds(2)
+    line.GetPointIds().SetId(0, 0)
+    line.GetPointIds().SetId(1, 1)
+    lines = vtkCellArray()
+    lines.InsertNextCell(line)
+    trajectory.SetLines(lines)
+    for name, tuples in (("Normal", normals), ("Power", power)):
+        if tuples is not None:
+            array = vtkDoubleArray()
+            array.SetName(name)
+            array.SetNumberOfComponents(len(tuples[0]))
+            for t in tuples:
+                array.InsertNextTuple(t)
+            trajectory.GetPointData().AddArray(array)
+    return trajectory
+
+
+def test_light_output_carries_the_point_light_as_solved(tmp_path):
+    # The command line's --stats took a point light's power from LightPower and its own sums,
+    # for the Light output had nothing of it: it now holds the light as solved, in each frame
+    # at its place, with its power (lumens of the light's colour, times the TILT factor and
+    # the Trajectory's Power) and that power's flux.
+    tilt = math.radians(60)
+    trajectory = two_point_trajectory(
+        normals=[(0, 0, -1), (math.sin(tilt), 0, -math.cos(tilt))], power=[(1,), (0.5,)])
+    radiosity = radiosity_filter(
+        LightType=vtkMovingLightRadiosity.POINT_LIGHT, LightPower=(2.0, 1.0, 0.0),
+        LightFluxLumens=895.0, LightDistributionFile=ies_file(
+            tmp_path / "tilt.ies", "0 0 0", "TILT=INCLUDE\n1\n2\n0 90\n1 0.5"))
+    radiosity.SetTrajectoryData(trajectory)
+    watts = 895.0 / 179.0 / (0.2126 * 2 + 0.7152 * 1)  # per unit of the colour (2, 1, 0)
+    for time, position, factor in ((0.0, (0, 0, 1), 1.0),
+                                   (1.0, (0.5, 0, 1), (1 - 0.5 * 60 / 90) * 0.5)):
+        errors = recorded(radiosity, "ErrorEvent")
+        assert radiosity.UpdateTimeStep(time), errors
+        light = radiosity.GetOutput(2)
+        assert (light.GetNumberOfPoints(), light.GetNumberOfVerts(),
+                light.GetNumberOfPolys()) == (1, 1, 0), time
+        assert light.GetPoint(0) == position
+        assert field(radiosity.GetOutput(0), "LightPosition") == position
+        power = light.GetCellData().GetArray("Power").GetTuple3(0)
+        expected = (2 * watts * factor, watts * factor, 0.0)
+        assert all(abs(p - e) <= 1e-12 * watts for p, e in zip(power, expected)), (power, expected)
+        flux = light.GetCellData().GetArray("LuminousFlux").GetValue(0)
+        assert abs(flux - 895.0 * factor) < 1e-9, (time, flux)
+
+    # An area light's polygons carry their share of the flux too.
+    area = radiosity_filter(LightType=vtkMovingLightRadiosity.LUMINAIRE_LIGHT,
+                            LightFluxLumens=895.0,
+                            LightDistributionFile=ies_file(tmp_path / "opening.ies"))
+    assert area.UpdateTimeStep(0.0)
+    cells = area.GetOutput(2).GetCellData()
+    assert area.GetOutput(2).GetNumberOfPolys() > 0
+    total = sum(cells.GetArray("LuminousFlux").GetValue(c)
+                for c in range(cells.GetNumberOfTuples()))
+    assert abs(total - 895.0) < 1e-9, total
 
 
 def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):

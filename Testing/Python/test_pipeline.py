@@ -302,6 +302,83 @@ def test_a_multiblock_matches_materials_by_name():
         assert radiosity.GetOutput(2).GetNumberOfCells() == polygons, material
 
 
+def lamp_scene():
+    """A floor and, 1.5 above it, a lamp material of two quads facing down: area centroid
+    (0.4333, 1.4167, 1.5), not the mean of its points (x 0.55)."""
+    scene = material_block([((0, 0, 0), (2, 0, 0), (0, 2, 0), 0),
+                            ((0.2, 1.6, 1.5), (0.6, 1.6, 1.5), (0.2, 1.2, 1.5), 1),
+                            ((0.6, 1.6, 1.5), (0.8, 1.6, 1.5), (0.6, 1.5, 1.5), 1)],
+                           ["floor", "lamp"])
+    centroid = ((0.16 * 0.4 + 0.02 * 0.7) / 0.18, (0.16 * 1.4 + 0.02 * 1.55) / 0.18, 1.5)
+    return scene, centroid
+
+
+def light_material_filter(scene):
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(scene)
+    radiosity.SetLightMaterial("lamp")
+    radiosity.SetNumberOfPositions(3)
+    radiosity.SetNumberOfPaths(2000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetNumberOfThreads(2)
+    radiosity.SetErrorBatches(1)
+    return radiosity
+
+
+def sorted_points(data):
+    return sorted(tuple(round(c, 9) for c in data.GetPoint(i)) for i in range(data.GetNumberOfPoints()))
+
+
+def test_a_light_material_starts_where_the_scene_has_it():
+    # ParaView gives the straight path the middles of the Scene's -x and +x faces: the lamp
+    # jumped there in the first frame. It starts where the scene has it and moves to PathEnd.
+    scene, centroid = lamp_scene()
+    lamp_points = sorted_points(light_material_filter_lamp(scene))
+    for bounds_path in (True, False):  # ParaView's defaults, then the filter's own
+        radiosity = light_material_filter(scene)
+        if bounds_path:
+            radiosity.SetPathStart(0, 1, 0.75)
+            radiosity.SetPathEnd(2, 1, 0.75)
+        end = radiosity.GetPathEnd()
+        errors = recorded(radiosity, "ErrorEvent")
+        assert radiosity.UpdateTimeStep(0.0), errors
+        assert field(radiosity.GetOutput(0), "LightPosition") == pytest.approx(centroid, abs=1e-6)
+        assert field(radiosity.GetOutput(0), "LightTranslation") == pytest.approx((0, 0, 0),
+                                                                                  abs=1e-12)
+        # The Light output is the lamp's polygons as the scene has them, not moved.
+        assert radiosity.GetOutput(2).GetNumberOfCells() == 2
+        assert sorted_points(radiosity.GetOutput(2)) == pytest.approx(lamp_points, abs=1e-12)
+        assert radiosity.UpdateTimeStep(1.0)
+        middle = [(c + e) / 2 for c, e in zip(centroid, end)]
+        assert field(radiosity.GetOutput(0), "LightPosition") == pytest.approx(middle, abs=1e-6)
+        assert radiosity.UpdateTimeStep(2.0)
+        assert field(radiosity.GetOutput(0), "LightPosition") == pytest.approx(end, abs=1e-12)
+
+    # Off: from PathStart, as for a Light input.
+    radiosity = light_material_filter(scene)
+    assert radiosity.GetPathFromLightMaterial()
+    radiosity.SetPathFromLightMaterial(False)
+    radiosity.SetPathStart(0, 1, 0.75)
+    radiosity.SetPathEnd(2, 1, 0.75)
+    assert radiosity.UpdateTimeStep(0.0)
+    assert field(radiosity.GetOutput(0), "LightPosition") == pytest.approx((0, 1, 0.75))
+
+
+def light_material_filter_lamp(scene):
+    """The lamp's polygons as the scene holds them: its cells of MaterialId 1."""
+    from vtkmodules.vtkFiltersCore import vtkThreshold
+    from vtkmodules.vtkFiltersGeometry import vtkGeometryFilter
+    threshold = vtkThreshold()
+    threshold.SetInputData(scene)
+    threshold.SetInputArrayToProcess(0, 0, 0, 1, "MaterialId")  # cells
+    threshold.SetLowerThreshold(1)
+    threshold.SetUpperThreshold(1)
+    surface = vtkGeometryFilter()
+    surface.SetInputConnection(threshold.GetOutputPort())
+    surface.Update()
+    return surface.GetOutput()
+
+
 def test_an_empty_light_is_named_before_nothing_emits():
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     radiosity = vtkMovingLightRadiosity()
