@@ -234,24 +234,29 @@ std::string runLargeChunked(const ScaleCaseOptions& scale)
     o.memoryLimitBytes = std::uint64_t(7) << 30;
   }
   const Scene& scene = large.scene;
-  const std::size_t c = chooseFramesPerChunk(
+  // As solveAnimation does: the chunks' length from the sides light reaches, probed once.
+  const SolveSetup setup(scene, large.rig, o);
+  const std::size_t bound = chooseFramesPerChunk(
     scene.patchCount(), scene.elementCount(), scene.points().size(), frames, o, 1, 0, true);
-  const std::uint64_t estimate = estimateChunkedMemory(
-    scene.patchCount(), scene.elementCount(), scene.points().size(), frames, c, o, 1, 0, true);
+  const std::size_t c = chooseFramesPerChunk(scene.patchCount(), scene.elementCount(),
+    scene.points().size(), frames, o, 1, 0, true, 0, &setup.reachable(), &setup.firstHits());
+  const std::uint64_t estimate = estimateChunkedMemory(scene.patchCount(), scene.elementCount(),
+    scene.points().size(), frames, c, o, 1, 0, true, 0, &setup.reachable(), &setup.firstHits());
   std::printf("\nThe large scene over %zu frames: %zu patches, %zu elements, N = %llu, full "
-              "reuse, streamed in chunks of %zu (overlap %zu) that a %.1f GiB limit chooses; "
-              "estimate %.2f GiB\n",
+              "reuse, streamed in chunks of %zu (overlap %zu) that a %.1f GiB limit chooses "
+              "for the sides light reaches (%zu for every side); estimate %.2f GiB\n",
     frames, scene.patchCount(), scene.elementCount(), static_cast<unsigned long long>(paths), c,
-    chunkOverlap(c), double(o.memoryLimitBytes) / (1024 * MiB), double(estimate) / (1024 * MiB));
+    chunkOverlap(c), double(o.memoryLimitBytes) / (1024 * MiB), bound,
+    double(estimate) / (1024 * MiB));
   std::fflush(stdout);
   malloc_trim(0);
   const std::uint64_t before = statusBytes("VmRSS");
   resetPeak();
   std::size_t streamed = 0;
-  const SolverStatistics s = solveInChunks(scene, large.rig, o, c, {},
-    [&](std::size_t, Solution& f) {
-      streamed += f.frameCount();
-    }).statistics;
+  const SolverStatistics s = solveInChunks(
+    scene, large.rig, o, c, {}, [&](std::size_t, Solution& f) { streamed += f.frameCount(); }, {},
+    &setup)
+                               .statistics;
   const std::uint64_t peak = statusBytes("VmHWM");
   const std::uint64_t solvePeak = peak > before ? peak - before : 0;
   std::printf("%llu chunks, %zu frames streamed in %.1f s (%.0f ms per frame, %d threads); peak "

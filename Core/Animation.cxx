@@ -96,18 +96,20 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   // scene and its patches.
   std::size_t framesPerChunk = frames;
   const std::uint64_t input = soupBytes(soup);
-  auto checkChunkedMemory =
-    [&](std::size_t patches, std::size_t elements, std::size_t points, bool approximate)
+  auto checkChunkedMemory = [&](std::size_t patches, std::size_t elements, std::size_t points,
+                              bool approximate, const SolveSetup* setup = nullptr)
   {
+    const std::vector<std::uint8_t>* reachable = setup ? &setup->reachable() : nullptr;
+    const std::vector<std::uint8_t>* firstHits = setup ? &setup->firstHits() : nullptr;
     const std::uint64_t outputs =
       saturatingSum(saturatingSum(outputBytes(options, lights, soupEmits, elements, points, frames),
                       Scene::estimateMemory(patches, elements, points, soupEmits)),
         input);
     const std::size_t kept = streamed ? options.keptStreamedChunks : 0;
-    framesPerChunk = chooseFramesPerChunk(
-      patches, elements, points, frames, options.solver, lightCount, outputs, streamed, kept);
+    framesPerChunk = chooseFramesPerChunk(patches, elements, points, frames, options.solver,
+      lightCount, outputs, streamed, kept, reachable, firstHits);
     checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
-                       options.solver, lightCount, outputs, streamed, kept),
+                       options.solver, lightCount, outputs, streamed, kept, reachable, firstHits),
       streamed ? std::min(frames, framesPerChunk) : frames, patches, elements, options.solver,
       approximate);
   };
@@ -155,14 +157,40 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       checkChunkedMemory(scene.patchCount(), scene.elementCount(), scene.points().size(), false);
     });
   const Scene& scene = animation.scene;
-  agreeOnChunks(options.solver, framesPerChunk);
 
+  // The tracer and the sides light can reach, built once for every chunk (SolveSetup); its
+  // share of the solve's progress by its rays. Unless given, the chunks' length is chosen
+  // again from the memory those sides take, less than the bound of every side checked above
+  // (a quarter less in the large room of Performance.md): longer chunks, fewer seams.
   const double sensorShare = options.sensors.empty() ? 0.0 : SensorShare;
   const double solveShare = 1 - RemeshingShare - sensorShare;
+  const double setupCost = SolveSetup::cost(scene, options.solver);
+  const double setupShare = setupCost / (setupCost + solveCost(scene, lights, options.solver));
+  std::optional<SolveSetup> setup;
+  agreeAcrossRanks(options.solver,
+    [&]
+    {
+      setup.emplace(scene, lights, options.solver,
+        [&](double f)
+        { return !progress || progress(RemeshingShare + solveShare * setupShare * f); });
+      if (options.solver.framesPerChunk == 0)
+      {
+        checkChunkedMemory(
+          scene.patchCount(), scene.elementCount(), scene.points().size(), false, &*setup);
+      }
+    });
+  agreeOnChunks(options.solver, framesPerChunk);
+  // The last fraction reported, which the sensors' reads of a batch repeat to ask whether to
+  // go on.
+  double lastFraction = RemeshingShare + solveShare * setupShare;
   ProgressCallback solveProgress;
   if (progress)
   {
-    solveProgress = [&](double f) { return progress(RemeshingShare + solveShare * f); };
+    solveProgress = [&](double f)
+    {
+      lastFraction = RemeshingShare + solveShare * (setupShare + (1 - setupShare) * f);
+      return progress(lastFraction);
+    };
   }
   ChunkFramesCallback onFrames;
   if (streamed)
@@ -188,11 +216,12 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       {
         options.solver.batchSolved(batch, firstFrame, solution);
       }
-      sensorSpread->add(batch, firstFrame, solution);
+      sensorSpread->add(
+        batch, firstFrame, solution, [&] { return !progress || progress(lastFraction); });
     };
   }
   animation.solution = solveInChunks(scene, lights, solverOptions, framesPerChunk, solveProgress,
-    onFrames, streamed ? options.firstChunkFigure : FirstChunkFigure());
+    onFrames, streamed ? options.firstChunkFigure : FirstChunkFigure(), &*setup);
   if (sensorSpread)
   {
     sensorSpread->finish();

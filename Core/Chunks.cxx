@@ -502,13 +502,20 @@ void exchangeFrames(const SolverOptions& options, Solution& frames, double& seco
 
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames,
-  const FirstChunkFigure& figure)
+  const FirstChunkFigure& figure, const SolveSetup* givenSetup)
 {
   const std::size_t frames = frameCount(rig, scene.hasEmission());
   const ChunkPlan plan = planChunks(frames, framesPerChunk);
   if (plan.chunks.size() == 1)
   {
-    Solution solution = solve(scene, rig, options, progress);
+    // A setup of the whole rig probes what the solve would: the same sides, the same bits.
+    Solution solution = givenSetup ? solve(scene, rig, options, progress, *givenSetup)
+                                   : solve(scene, rig, options, progress);
+    if (givenSetup)
+    {
+      solution.statistics.reachabilityRays += givenSetup->reachabilityRays();
+      solution.statistics.secondsSetup += givenSetup->seconds();
+    }
     solution.statistics.framesPerChunk = frames;
     if (onFrames)
     {
@@ -538,8 +545,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     chunkOptions.rank = 0;
   }
 
-  // Progress: the setup, then each chunk, by their expected rays.
-  const double setupCost = SolveSetup::cost(scene, options);
+  // Progress: the setup (unless given), then each chunk, by their expected rays.
+  const double setupCost = givenSetup ? 0.0 : SolveSetup::cost(scene, options);
   double chunksCost = 0;
   for (std::size_t k = rank; k < chunkCount; k += ranks)
   {
@@ -547,13 +554,17 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       solveCost(scene, rig, options, plan.chunks[k].solveEnd - plan.chunks[k].solveBegin);
   }
   const double totalCost = setupCost + chunksCost;
-  std::optional<SolveSetup> setup;
-  agreeAcrossRanks(options,
-    [&]
-    {
-      setup.emplace(scene, rig, options,
-        [&](double f) { return !progress || progress(f * setupCost / totalCost); });
-    });
+  std::optional<SolveSetup> ownSetup;
+  if (!givenSetup)
+  {
+    agreeAcrossRanks(options,
+      [&]
+      {
+        ownSetup.emplace(scene, rig, options,
+          [&](double f) { return !progress || progress(f * setupCost / totalCost); });
+      });
+  }
+  const SolveSetup* setup = givenSetup ? givenSetup : &*ownSetup;
   Solution whole; // every frame, without onFrames
   Solution result;
   SolverStatistics& stats = result.statistics;

@@ -91,10 +91,13 @@ struct FirstChunkFigure
  * rank, the warnings this rank's. Otherwise the ranks split each chunk's paths and every rank
  * gets every frame. Throws as solve() does; a failure or cancel on one rank stops every rank
  * after the chunks of that round.
+ * `setup`: a SolveSetup of this scene and rig (the caller chose the chunks' length from its
+ * reachable sides), else one is built here when there are several chunks. The same bits.
  */
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress = {},
-  const ChunkFramesCallback& onFrames = {}, const FirstChunkFigure& figure = {});
+  const ChunkFramesCallback& onFrames = {}, const FirstChunkFigure& figure = {},
+  const SolveSetup* setup = nullptr);
 
 /**
  * The frames that chunk `chunk` of planChunks(frames, framesPerChunk) finishes, solved again

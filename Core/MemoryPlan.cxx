@@ -282,12 +282,15 @@ std::uint64_t estimateSolveMemory(
 
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks)
+  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks,
+  const std::vector<std::uint8_t>* reachable, const std::vector<std::uint8_t>* firstHits)
 {
   if (framesPerChunk == 0 || framesPerChunk >= frames)
   {
     return saturatingSum(
-      estimateSolveMemory(patches, elements, points, frames, options, lights), fixedBytes);
+      planSolveMemory(patches, elements, points, frames, options, lights, reachable, firstHits)
+        .peak,
+      fixedBytes);
   }
   const std::size_t m = chunkOverlap(framesPerChunk);
   // The frames a Solution holds outside a solve: direct and indirect irradiance and the
@@ -295,8 +298,9 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
   const std::uint64_t perFrame = saturatingProduct(
     { 2 * elements * (errorEstimateBytes(patches, elements, 1, options) > 0 ? 3 : 2) + 2 * patches,
       sizeof(PackedRgb) });
-  const std::uint64_t solving = estimateSolveMemory(
-    patches, elements, points, std::min(frames, framesPerChunk + 2 * m), options, lights);
+  const std::uint64_t solving = planSolveMemory(patches, elements, points,
+    std::min(frames, framesPerChunk + 2 * m), options, lights, reachable, firstHits)
+                                  .peak;
   std::size_t finished = streamed ? framesPerChunk : frames;
   if (streamed && keptChunks > 0)
   {
@@ -311,7 +315,8 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
 
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed, std::size_t keptChunks)
+  bool streamed, std::size_t keptChunks, const std::vector<std::uint8_t>* reachable,
+  const std::vector<std::uint8_t>* firstHits)
 {
   if (options.framesPerChunk > 0)
   {
@@ -321,7 +326,7 @@ std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std:
   auto fits = [&](std::size_t c)
   {
     return estimateChunkedMemory(patches, elements, points, frames, c, options, lights, fixedBytes,
-             streamed, keptChunks) <= limit;
+             streamed, keptChunks, reachable, firstHits) <= limit;
   };
   if (frames <= MinimumFramesPerChunk || fits(frames))
   {

@@ -92,18 +92,22 @@ std::uint64_t estimateSolveMemory(std::size_t patches, std::size_t elements, std
  * `keptChunks` chunks' frames of those it gets (0: none beyond the one handed on): over
  * R = options.ranks ranks that take whole chunks (at least R chunks, Chunks.h) every R-th
  * chunk's, else every chunk's. `fixedBytes` (the caller's
- * outputs) is added.
+ * outputs) is added. `reachable` and `firstHits`: those of the whole animation (SolveSetup),
+ * which bound every chunk's; null, the bound of every side.
  */
 std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, std::size_t framesPerChunk, const SolverOptions& options, std::size_t lights,
-  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks = 0);
+  std::uint64_t fixedBytes, bool streamed, std::size_t keptChunks = 0,
+  const std::vector<std::uint8_t>* reachable = nullptr,
+  const std::vector<std::uint8_t>* firstHits = nullptr);
 
 /// C: options.framesPerChunk when set, else every frame when that fits the memory limit,
 /// else the most frames per chunk whose estimateChunkedMemory does (at least 2: the memory
 /// check then says what does not fit).
 std::size_t chooseFramesPerChunk(std::size_t patches, std::size_t elements, std::size_t points,
   std::size_t frames, const SolverOptions& options, std::size_t lights, std::uint64_t fixedBytes,
-  bool streamed, std::size_t keptChunks = 0);
+  bool streamed, std::size_t keptChunks = 0, const std::vector<std::uint8_t>* reachable = nullptr,
+  const std::vector<std::uint8_t>* firstHits = nullptr);
 
 /// options.memoryLimitBytes, or the default when it is 0.
 std::uint64_t memoryLimitBytes(const SolverOptions& options);

@@ -613,7 +613,7 @@ std::size_t pointFrames(
 }
 
 /// SensorBatchSpread reads the batches a block of frames at a time, in a table of at most this
-/// many bytes.
+/// many bytes, or of one frame's reads when those alone take more.
 constexpr std::uint64_t SpreadTableBytes = 16ULL << 20;
 
 /// The most frames one solve of an animation in chunks of `framesPerChunk` reads.
@@ -733,7 +733,8 @@ SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
   }
 }
 
-void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution)
+void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution,
+  const std::function<bool()>& keepGoing)
 {
   if (this->Sensors == 0 || this->Frames == 0)
   {
@@ -789,7 +790,7 @@ void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const S
           }
         }
       },
-      [](std::size_t) { return true; });
+      [&](std::size_t) { return !keepGoing || keepGoing(); });
     parallelFor((this->Sensors + SensorsPerTask - 1) / SensorsPerTask, this->Workers,
       [&](std::size_t task, int worker)
       {
@@ -820,7 +821,7 @@ void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const S
           }
         }
       },
-      [](std::size_t) { return true; });
+      [&](std::size_t) { return !keepGoing || keepGoing(); });
   }
 }
 

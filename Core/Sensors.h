@@ -146,7 +146,10 @@ public:
 
   /// Reads batch `batch` of the solve whose frame 0 is the animation's `firstFrame` (the
   /// arguments of SolverOptions::batchSolved). Batch 0 starts a new solve (a chunk).
-  void add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution);
+  /// `keepGoing` is asked between tasks: false stops it with mlr::Cancelled (a year of
+  /// frames over a thousand sensors reads for seconds).
+  void add(std::uint64_t batch, std::size_t firstFrame, const Solution& solution,
+    const std::function<bool()>& keepGoing = {});
   /// Ends the last solve: stdError() is then complete.
   void finish();
 

@@ -224,8 +224,10 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
       workers = resolveThreadCount(options.threads);
       emitters = sceneEmitters(scene);
       sources = lightSources(scene, rig, emitters);
+      // With a setup, the sides it found bound this solve's (the bound of every side else).
       plan = planSolveMemory(scene.patchCount(), scene.elementCount(), scene.points().size(),
-        frames, options, sources.size());
+        frames, options, sources.size(), setup ? &setup->reachable() : nullptr,
+        setup ? &setup->firstHits() : nullptr);
       checkSolveMemory(plan.peak, frames, scene.patchCount(), scene.elementCount(), options);
       for (const LightSource& source : sources)
       {

@@ -589,3 +589,37 @@ TEST(Chunks, TheSceneAndTheInputCountAgainstTheMemoryLimit)
   options.solver.memoryLimitBytes = solveOnly + 2 * sceneBytes + (std::uint64_t(1) << 20);
   EXPECT_NO_THROW(solveAnimation(soup, rig(), options));
 }
+
+TEST(Chunks, TheChunksLengthFollowsTheSidesLightCanReach)
+{
+  // Inside a closed box the outer sides, half of them, take no sums and no results: a memory
+  // limit that holds 8 frames per chunk with every side's holds more with the sides light
+  // reaches, which solveAnimation probes before it chooses. The frames are streamed, so that
+  // memory grows with the chunks' length.
+  constexpr std::size_t Long = 60;
+  const PolygonSoup soup = scenes::boxOfQuads({ 0, 0, 0 }, { 1, 1, 1 }, { Rgb(0.5) }, true);
+  AnimationOptions options;
+  options.solver.pathsPerFrame = 10000;
+  options.solver.threads = 1;
+  options.remeshing.targetEdgeLength = 0.1;
+  const Scene scene = Scene::fromPatchMesh(remesh(soup, options.remeshing).mesh);
+  const std::size_t patches = scene.patchCount(), elements = scene.elementCount(),
+                    points = scene.points().size();
+  const std::uint64_t bound8 =
+    estimateChunkedMemory(patches, elements, points, Long, 8, options.solver, 1, 0, true);
+  options.solver.memoryLimitBytes = bound8;
+  ASSERT_EQ(chooseFramesPerChunk(patches, elements, points, Long, options.solver, 1, 0, true), 8u);
+  const SolveSetup setup(scene, rig(Long), options.solver);
+  const std::size_t reached = chooseFramesPerChunk(patches, elements, points, Long, options.solver,
+    1, 0, true, 0, &setup.reachable(), &setup.firstHits());
+  std::size_t streamed = 0;
+  options.chunkFrames = [&](const Animation&, std::size_t, Solution& frames)
+  { streamed += frames.frameCount(); };
+  const Animation a = solveAnimation(soup, rig(Long), options);
+  std::printf("chunks of %zu frames from the reachable sides (%zu without the scene's own "
+              "memory), 8 from every side\n",
+    a.solution.statistics.framesPerChunk, reached);
+  EXPECT_GT(a.solution.statistics.framesPerChunk, 8u);
+  EXPECT_LE(a.solution.statistics.framesPerChunk, reached);
+  EXPECT_EQ(streamed, Long);
+}

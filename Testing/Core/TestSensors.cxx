@@ -719,3 +719,26 @@ TEST(Sensors, BadSensorsAreRefusedByName)
   options.outputBytesPerSensorFrame = std::uint64_t(1) << 40;
   expectError([&] { solveAnimation(big.soup, big.rig, options); }, "memory");
 }
+
+TEST(Sensors, ReadingABatchAsksWhetherToGoOn)
+{
+  // The sensors read every batch between the batches' progress calls (a year over a thousand
+  // sensors reads for seconds): they ask again with the last fraction reported, and stop
+  // there when told to.
+  RoomCase c = room();
+  AnimationOptions options = roomOptions(2, c.sensors);
+  options.solver.errorBatches = 4;
+  bool stop = false;
+  std::vector<double> before, after;
+  options.solver.batchSolved = [&](std::uint64_t, std::size_t, const Solution&) { stop = true; };
+  EXPECT_THROW(solveAnimation(c.soup, c.rig, options,
+                 [&](double f)
+                 {
+                   (stop ? after : before).push_back(f);
+                   return !stop;
+                 }),
+    Cancelled);
+  ASSERT_FALSE(before.empty());
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(after.front(), before.back());
+}
