@@ -210,7 +210,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->ReflectanceArrayName = "Reflectance";
   this->EmissionArrayName = "Emission";
   this->LightPowerFromMaterial = 1;
-  this->PathFromLightMaterial = 1;
+  this->PathFromLightMaterial = 0;
   this->ErrorBatches = 16;
   this->TargetRelativeError = defaults.targetRelativeError;
   this->TimeLimit = defaults.timeLimitSeconds;

@@ -516,7 +516,8 @@ public:
    * scene as modelled, and the straight path moves it from there to PathEnd in
    * NumberOfPositions frames; PathStart is not used. Off: from PathStart to PathEnd, as for a
    * Light input, whose polygons are a shape the path places. A Trajectory places the lamp
-   * either way. Default on.
+   * either way. Default off, so that a script's PathStart keeps its meaning; on in the
+   * ParaView plugin, where PathStart's default comes from the Scene's bounds, not the lamp.
    */
   vtkSetMacro(PathFromLightMaterial, vtkTypeBool);
   vtkGetMacro(PathFromLightMaterial, vtkTypeBool);

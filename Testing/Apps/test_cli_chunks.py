@@ -107,13 +107,10 @@ def test_streamed_chunks_print_the_error_line_and_time_their_writing(tmp_path):
     whole_p95 = whole_stats["errorEstimate"]["RelativeErrorP95"]
     assert 0.5 < max(p95) / max(whole_p95) < 2
 
-    timing, whole_timing = stats["timing"], whole_stats["timing"]
+    timing = stats["timing"]
     streaming = stats["statistics"]["SecondsStreaming"]
     assert 0 < streaming <= timing["secondsWriting"]
     assert "SecondsStreaming" not in whole_stats["statistics"]
-    # The streamed frames' writing counts as writing (it counted as solving), not as a
-    # share of the solve: no comparison of times across runs, which a loaded machine skews.
-    assert whole_timing["secondsWriting"] > 0
     stages = ("secondsReading", "secondsRemeshing", "secondsSolving", "secondsWriting")
     assert sum(timing[key] for key in stages) <= timing["secondsTotal"] + 1e-6
 
