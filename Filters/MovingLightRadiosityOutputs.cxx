@@ -379,7 +379,7 @@ void addLuminousFlux(vtkPolyData* light, double efficacy)
   for (vtkIdType c = 0; c < power->GetNumberOfTuples(); ++c)
   {
     const double* p = power->GetTuple3(c);
-    flux->SetValue(c, efficacy * (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]));
+    flux->SetValue(c, efficacy * luminance(Rgb(p[0], p[1], p[2])));
   }
   light->GetCellData()->AddArray(flux);
 }
