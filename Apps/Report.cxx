@@ -61,6 +61,18 @@ nlohmann::ordered_json jsonNumber(double x, bool integral = false)
   return x;
 }
 
+/// The per-frame values of a field array: one number per frame (integers stay integers).
+nlohmann::ordered_json perFrameJson(vtkDataArray* array)
+{
+  const bool integral = array->GetDataType() != VTK_FLOAT && array->GetDataType() != VTK_DOUBLE;
+  nlohmann::ordered_json values = nlohmann::ordered_json::array();
+  for (vtkIdType f = 0; f < array->GetNumberOfTuples(); ++f)
+  {
+    values.push_back(jsonNumber(array->GetComponent(f, 0), integral));
+  }
+  return values;
+}
+
 nlohmann::ordered_json jsonTriple(const double* v)
 {
   return { jsonNumber(v[0]), jsonNumber(v[1]), jsonNumber(v[2]) };
@@ -350,13 +362,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     {
       if (vtkDataArray* array = statistics ? statistics->GetArray(name) : nullptr)
       {
-        nlohmann::ordered_json perFrameValues = nlohmann::ordered_json::array();
-        for (vtkIdType f = 0; f < array->GetNumberOfTuples(); ++f)
-        {
-          perFrameValues.push_back(jsonNumber(array->GetComponent(f, 0),
-            array->GetDataType() != VTK_FLOAT && array->GetDataType() != VTK_DOUBLE));
-        }
-        sensors["errorEstimate"][key] = perFrameValues;
+        sensors["errorEstimate"][key] = perFrameJson(array);
       }
     }
     json["sensors"] = sensors;
@@ -413,13 +419,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   {
     if (vtkDataArray* array = statistics ? statistics->GetArray(name) : nullptr)
     {
-      nlohmann::ordered_json perFrameValues = nlohmann::ordered_json::array();
-      for (vtkIdType f = 0; f < array->GetNumberOfTuples(); ++f)
-      {
-        perFrameValues.push_back(jsonNumber(array->GetComponent(f, 0),
-          array->GetDataType() != VTK_FLOAT && array->GetDataType() != VTK_DOUBLE));
-      }
-      json["errorEstimate"][name] = perFrameValues;
+      json["errorEstimate"][name] = perFrameJson(array);
     }
   }
   json["timing"] = {

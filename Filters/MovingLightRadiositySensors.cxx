@@ -128,41 +128,34 @@ void addSensorArrays(
   const SensorSolution& solution, std::size_t frame, double efficacy, vtkPointData* pointData)
 {
   const std::size_t n = solution.sensorCount();
-  auto irradiance = vtkoutputs::rgbArray("Irradiance", n);
-  vtkNew<vtkFloatArray> illuminance;
-  illuminance->SetName("Illuminance");
-  illuminance->SetNumberOfTuples(static_cast<vtkIdType>(n));
-  for (std::size_t i = 0; i < n; ++i)
+  // An RGB irradiance per sensor and its illuminance: the values, then their standard errors.
+  // The channels' errors come from the same rays and paths: the luminance of the channels'
+  // errors is the luminance's error when they move together, and bounds it otherwise.
+  auto addPair = [&](const char* rgbName, const char* luxName,
+                   Rgb (SensorSolution::*value)(std::size_t, std::size_t) const)
   {
-    const Rgb e = solution.irradiance(frame, i);
-    vtkoutputs::setRgb(irradiance, i, e);
-    illuminance->SetValue(
-      static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
-  }
-  pointData->AddArray(irradiance);
-  pointData->AddArray(illuminance);
+    auto rgb = vtkoutputs::rgbArray(rgbName, n);
+    vtkNew<vtkFloatArray> lux;
+    lux->SetName(luxName);
+    lux->SetNumberOfTuples(static_cast<vtkIdType>(n));
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const Rgb e = (solution.*value)(frame, i);
+      vtkoutputs::setRgb(rgb, i, e);
+      lux->SetValue(
+        static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
+    }
+    pointData->AddArray(rgb);
+    pointData->AddArray(lux);
+  };
+  addPair("Irradiance", "Illuminance", &SensorSolution::irradiance);
   pointData->SetActiveScalars("Illuminance");
   // As the elements', only from a solve in batches: without them the solution's noise, which
   // the sensors read, is unknown.
-  if (solution.solutionBatches() < 2)
+  if (solution.solutionBatches() >= 2)
   {
-    return;
+    addPair("IrradianceStdError", "IlluminanceStdError", &SensorSolution::irradianceStdError);
   }
-  auto irradianceError = vtkoutputs::rgbArray("IrradianceStdError", n);
-  vtkNew<vtkFloatArray> illuminanceError;
-  illuminanceError->SetName("IlluminanceStdError");
-  illuminanceError->SetNumberOfTuples(static_cast<vtkIdType>(n));
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const Rgb e = solution.irradianceStdError(frame, i);
-    vtkoutputs::setRgb(irradianceError, i, e);
-    // The channels' errors come from the same rays and paths: the luminance of the channels'
-    // errors is the luminance's error when they move together, and bounds it otherwise.
-    illuminanceError->SetValue(
-      static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
-  }
-  pointData->AddArray(irradianceError);
-  pointData->AddArray(illuminanceError);
 }
 
 void addSensorStatistics(vtkFieldData* fieldData, const SensorSolution& solution)

@@ -270,25 +270,8 @@ def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):
     # array), with and without a TILT table of factors 1 at 0 and 0.5 at 90 degrees: the same
     # paths, so frame 1's light is exactly 1 - 0.5 (60 / 90) of the untilted one's, and
     # frame 0's equal.
-    points = vtkPoints()
-    points.InsertNextPoint(0, 0, 1)
-    points.InsertNextPoint(0.5, 0, 1)
-    trajectory = vtkPolyData()
-    trajectory.SetPoints(points)
-    line = vtkPolyLine()
-    line.GetPointIds().SetNumberOfIds(2)
-    line.GetPointIds().SetId(0, 0)
-    line.GetPointIds().SetId(1, 1)
-    lines = vtkCellArray()
-    lines.InsertNextCell(line)
-    trajectory.SetLines(lines)
-    normals = vtkDoubleArray()
-    normals.SetName("Normal")
-    normals.SetNumberOfComponents(3)
     tilt = math.radians(60)
-    normals.InsertNextTuple((0, 0, -1))
-    normals.InsertNextTuple((math.sin(tilt), 0, -math.cos(tilt)))
-    trajectory.GetPointData().AddArray(normals)
+    trajectory = two_point_trajectory(normals=[(0, 0, -1), (math.sin(tilt), 0, -math.cos(tilt))])
     # The point light, and the luminaire of the file's 0.4 by 0.8 m opening (an area light).
     for kind in (vtkMovingLightRadiosity.POINT_LIGHT, vtkMovingLightRadiosity.LUMINAIRE_LIGHT):
         runs = {}
@@ -307,6 +290,7 @@ def test_tilt_include_scales_each_frame_by_its_factor(tmp_path):
             assert abs(ratio / factor - 1).max() < 4 * 2.0 ** -10, \
                 (kind, frame, ratio.min(), ratio.max())
     # Tilted beyond the table: the end factor, with a warning naming the position.
+    normals = trajectory.GetPointData().GetArray("Normal")
     normals.SetTuple3(1, 0, 0, 1)  # aimed straight up: 180 degrees
     normals.Modified()
     beyond = radiosity_filter(LightType=vtkMovingLightRadiosity.POINT_LIGHT,
