@@ -3,6 +3,7 @@
 #include "Error.h"
 #include "ErrorEstimate.h"
 #include "GeneratedScenes.h"
+#include "ProcessMeasures.h"
 #include "RigBenchmarks.h"
 #include "Solver.h"
 #include "SunPath.h"
@@ -14,21 +15,12 @@
 #include <cstdio>
 #include <functional>
 #include <sstream>
-#include <sys/resource.h>
 #include <vector>
 
 namespace mlr::bench
 {
 namespace
 {
-
-double cpuSeconds()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-    1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 /// A scene with a light whose positions can be taken in runs: rig(first, count) lights
 /// frames first .. first + count - 1 of the animation.
@@ -89,18 +81,7 @@ Scenario turningLight(std::size_t frames)
 Scenario sunOverTown()
 {
   const scenes::TownBlock town = scenes::townBlock();
-  SunPathRequest request;
-  request.latitude = 48.85;
-  request.longitude = 2.35;
-  request.year = 2024;
-  request.month = 6;
-  request.day = 21;
-  request.startHour = 8;
-  request.endHour = 19.75;
-  request.stepMinutes = 15;
-  request.timeZoneHours = 2;
-  request.north = town.north;
-  request.up = town.up;
+  const SunPathRequest request = sunOverTownRequest(town);
   std::vector<Vec3> directions;
   for (const SunPosition& s : sunPath(request))
   {
@@ -185,12 +166,12 @@ Scheme measure(const std::string& name, std::size_t frames, int seeds, const Sch
   for (int seed = 0; seed < seeds; ++seed)
   {
     std::vector<double> mse(frames, 0.0);
-    const double cpu = cpuSeconds();
+    const double cpu = processCpuSeconds();
     const auto start = std::chrono::steady_clock::now();
     run(static_cast<std::uint64_t>(seed + 1), mse);
     s.wall +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / seeds;
-    s.cpu += (cpuSeconds() - cpu) / seeds;
+    s.cpu += (processCpuSeconds() - cpu) / seeds;
     for (std::size_t f = 0; f < frames; ++f)
     {
       s.mse[f] += mse[f] / seeds;
@@ -869,9 +850,9 @@ std::string runTargetError(const AccuracyCaseOptions& c)
     s.name.c_str(), s.scene.elementCount(), s.frames,
     static_cast<unsigned long long>(o.pathsPerFrame), c.target);
   std::fflush(stdout);
-  const double cpu = cpuSeconds();
+  const double cpu = processCpuSeconds();
   const Solution run = solve(s.scene, rig, o);
-  const double cpuTaken = cpuSeconds() - cpu;
+  const double cpuTaken = processCpuSeconds() - cpu;
   const ErrorEstimateSummary& est = run.errorEstimate;
   double reportedP95 = 0;
   for (double p : est.relativeErrorP95)

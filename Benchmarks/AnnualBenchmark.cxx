@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "MemoryPlan.h"
+#include "ProcessMeasures.h"
 #include "RigBenchmarks.h"
 #include "Sensors.h"
 #include "Sky.h"
@@ -16,7 +17,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/resource.h>
 #include <vector>
 
 #ifndef MLR_SOURCE_DIR
@@ -32,23 +32,6 @@ using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point start)
 {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// The process's peak resident set so far (bytes).
-std::uint64_t peakResidentBytes()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
-}
-
-/// The process's resident set now (bytes), from /proc/self/statm.
-std::uint64_t residentBytes()
-{
-  std::ifstream statm("/proc/self/statm");
-  std::uint64_t size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * 4096;
 }
 
 void parseDates(const std::string& text, WeatherSelection& s)
@@ -189,7 +172,7 @@ std::string runAnnual(const AnnualCaseOptions& c)
   options.firstBounceSurvival = 0.25;
   options.seed = 1;
   const SensorOptions sensorOptions;
-  const std::uint64_t baseline = residentBytes();
+  const std::uint64_t baseline = statusBytes("VmRSS");
 
   // The year, full reuse, end to end: the weather file, the sky's tables, the solve, the
   // sensors and their metrics.
@@ -265,7 +248,7 @@ std::string runAnnual(const AnnualCaseOptions& c)
   const double secondsMetrics = secondsSince(t);
   const double secondsYear =
     secondsReading + secondsSky + secondsSolving + secondsSensors + secondsMetrics;
-  const std::uint64_t peak = peakResidentBytes();
+  const std::uint64_t peak = lifetimePeakResidentBytes();
   const SolverStatistics& ys = solution.statistics;
   const SensorStatistics& ss = yearSensors.statistics();
   // The solve's own estimate, made with what its reachability probes found; the bound it

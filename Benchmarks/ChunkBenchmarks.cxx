@@ -3,6 +3,7 @@
 #include "Chunks.h"
 #include "GeneratedScenes.h"
 #include "MemoryPlan.h"
+#include "ProcessMeasures.h"
 #include "Solver.h"
 
 #include <chrono>
@@ -20,29 +21,6 @@ namespace
 {
 constexpr double MiB = 1024.0 * 1024.0;
 constexpr std::uint64_t Paths = 600000;
-
-std::uint64_t statusBytes(const std::string& field)
-{
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-  {
-    if (line.compare(0, field.size() + 1, field + ":") == 0)
-    {
-      std::istringstream value(line.substr(field.size() + 1));
-      std::uint64_t kib = 0;
-      value >> kib;
-      return kib * 1024;
-    }
-  }
-  return 0;
-}
-
-void resetPeak()
-{
-  std::ofstream clear("/proc/self/clear_refs");
-  clear << "5" << std::flush;
-}
 
 SolverOptions optionsFor(const ScaleCaseOptions& scale, bool reuse, std::uint64_t seed = 0)
 {
@@ -126,7 +104,7 @@ std::string runChunkedAnimation(const ScaleCaseOptions& scale)
     // the process is this run's.
     malloc_trim(0);
     const std::uint64_t before = statusBytes("VmRSS");
-    resetPeak();
+    resetPeakResidentMemory();
     const SolverStatistics s = solveInChunks(r.scene, r.rig, o, framesPerChunk, {},
       [](std::size_t, Solution&) {
       }).statistics;
@@ -251,7 +229,7 @@ std::string runLargeChunked(const ScaleCaseOptions& scale)
   std::fflush(stdout);
   malloc_trim(0);
   const std::uint64_t before = statusBytes("VmRSS");
-  resetPeak();
+  resetPeakResidentMemory();
   std::size_t streamed = 0;
   const SolverStatistics s = solveInChunks(
     scene, large.rig, o, c, {}, [&](std::size_t, Solution& f) { streamed += f.frameCount(); }, {},

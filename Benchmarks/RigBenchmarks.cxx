@@ -5,6 +5,7 @@
 #include "GeneratedScenes.h"
 #include "Photometry.h"
 #include "PointLight.h"
+#include "ProcessMeasures.h"
 #include "Solver.h"
 #include "SunPath.h"
 #include "TownScenes.h"
@@ -17,11 +18,27 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <sys/resource.h>
 #include <vector>
 
 namespace mlr::bench
 {
+
+SunPathRequest sunOverTownRequest(const scenes::TownBlock& town)
+{
+  SunPathRequest request;
+  request.latitude = 48.85;
+  request.longitude = 2.35;
+  request.year = 2024;
+  request.month = 6;
+  request.day = 21;
+  request.startHour = 8;
+  request.endHour = 19.75;
+  request.stepMinutes = 15;
+  request.timeZoneHours = 2;
+  request.north = town.north;
+  request.up = town.up;
+  return request;
+}
 namespace
 {
 
@@ -325,16 +342,6 @@ double meanRadiosity(const Scene& scene, const Reference& ref, std::size_t frame
   return sum / area;
 }
 
-/// CPU seconds (user + system, all threads) this process has used: unlike wall time, it
-/// hardly changes when other processes share the cores.
-double processCpuSeconds()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-    1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 /// A solve with the process CPU seconds it took.
 Solution timedSolve(
   const Scene& scene, const LightRig& rig, const SolverOptions& o, double& cpuSeconds)
@@ -613,18 +620,7 @@ std::string runSunOverTown(const RigCaseOptions& c)
   checkOptions(c);
   const scenes::TownBlock town = scenes::townBlock();
   const Scene scene = Scene::fromPatchMesh(town.mesh);
-  SunPathRequest request;
-  request.latitude = 48.85;
-  request.longitude = 2.35;
-  request.year = 2024;
-  request.month = 6;
-  request.day = 21;
-  request.startHour = 8;
-  request.endHour = 19.75;
-  request.stepMinutes = 15;
-  request.timeZoneHours = 2;
-  request.north = town.north;
-  request.up = town.up;
+  const SunPathRequest request = sunOverTownRequest(town);
   const std::vector<SunPosition> sun = sunPath(request);
   std::vector<Vec3> directions;
   std::size_t highest = 0;

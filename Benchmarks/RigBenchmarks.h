@@ -6,6 +6,8 @@
 #include "Scene.h"
 #include "Solution.h"
 #include "SolverOptions.h"
+#include "SunPath.h"
+#include "TownScenes.h"
 
 #include <cstdint>
 #include <string>
@@ -19,6 +21,10 @@ struct PatchMesh;
 
 namespace mlr::bench
 {
+
+/// The sun of the sun cases: 48 positions of 2024-06-21 in Paris, every 15 minutes from 8:00
+/// to 19:45 (UTC+2), over the town block's north and up.
+SunPathRequest sunOverTownRequest(const scenes::TownBlock& town);
 
 struct RigCaseOptions
 {

@@ -1,4 +1,5 @@
 #include "ScaleBenchmarks.h"
+#include "ProcessMeasures.h"
 
 #include "BareEmbree.h"
 #include "GeneratedScenes.h"
@@ -14,33 +15,6 @@ namespace mlr::bench
 namespace
 {
 constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
-
-/// A field of /proc/self/status in bytes (VmRSS, VmHWM), or 0 where there is none.
-std::uint64_t statusBytes(const std::string& field)
-{
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-  {
-    if (line.compare(0, field.size() + 1, field + ":") == 0)
-    {
-      std::istringstream value(line.substr(field.size() + 1));
-      std::uint64_t kib = 0;
-      value >> kib;
-      return kib * 1024;
-    }
-  }
-  return 0;
-}
-
-/// Starts a new peak of resident memory (VmHWM) at the current resident size: Linux resets it
-/// when "5" is written to clear_refs. False where the kernel does not allow it.
-bool resetPeakResidentMemory()
-{
-  std::ofstream clear("/proc/self/clear_refs");
-  clear << "5" << std::flush;
-  return static_cast<bool>(clear);
-}
 
 SolverOptions optionsFor(const ScaleCaseOptions& scale, std::uint64_t paths, bool reuse)
 {
