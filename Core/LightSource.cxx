@@ -112,6 +112,30 @@ void distributionKernel(const IntensityDistribution& f, const PhotometricFrame* 
     kernel[j] = g;
   }
 }
+
+/**
+ * A path of light arriving from direction `towards` (unit, from the scene to the light) over
+ * the bounding sphere (`centre`, `radius`): it starts on the disc of the sphere's radius
+ * facing `towards`, just outside the sphere, at a uniform point, so that every point of the
+ * scene sees the same density of paths (the sun's and the sky's emission).
+ */
+void emitFromDisc(const Vec3& centre, double radius, const Vec3& towards, double offset,
+  RandomStream& random, EmittedPath& path)
+{
+  Vec3 t, b;
+  orthonormalBasis(towards, t, b);
+  // A uniform point of the disc by rejection, as sampleCosineDirection does.
+  double u, v;
+  do
+  {
+    u = 2.0 * random.uniform() - 1.0;
+    v = 2.0 * random.uniform() - 1.0;
+  } while (u * u + v * v >= 1.0);
+  path.start = centre + towards * (radius + 2 * offset) + (t * u + b * v) * radius;
+  path.direction = -towards;
+  path.ownPoint = path.start;
+  path.ownNormal = path.direction;
+}
 }
 
 void AreaSource::emit(
@@ -326,21 +350,7 @@ BoundingDisc DirectionalSource::boundingDisc(std::size_t position, double offset
 void DirectionalSource::emit(
   std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
 {
-  const Vec3& s = this->Light->direction(position);
-  Vec3 t, b;
-  orthonormalBasis(s, t, b);
-  // A uniform point of the disc by rejection, as sampleCosineDirection does.
-  double u, v;
-  do
-  {
-    u = 2.0 * random.uniform() - 1.0;
-    v = 2.0 * random.uniform() - 1.0;
-  } while (u * u + v * v >= 1.0);
-  const double radius = this->Radius;
-  path.start = this->Centre + s * (radius + 2 * offset) + (t * u + b * v) * radius;
-  path.direction = -s;
-  path.ownPoint = path.start;
-  path.ownNormal = path.direction;
+  emitFromDisc(this->Centre, this->Radius, this->Light->direction(position), offset, random, path);
 }
 
 std::size_t DirectionalSource::kernel(const EmittedPath&, const Vec3& y, const Vec3& ny,
@@ -399,20 +409,8 @@ void SkySource::emit(
   std::size_t position, RandomStream& random, double offset, EmittedPath& path) const
 {
   const double u0 = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
-  const Vec3 w = this->SkyRef->sample(position, u0, u1, u2);
-  Vec3 t, b;
-  orthonormalBasis(w, t, b);
-  double u, v;
-  do
-  {
-    u = 2.0 * random.uniform() - 1.0;
-    v = 2.0 * random.uniform() - 1.0;
-  } while (u * u + v * v >= 1.0);
-  const double radius = this->Radius;
-  path.start = this->Centre + w * (radius + 2 * offset) + (t * u + b * v) * radius;
-  path.direction = -w;
-  path.ownPoint = path.start;
-  path.ownNormal = path.direction;
+  emitFromDisc(
+    this->Centre, this->Radius, this->SkyRef->sample(position, u0, u1, u2), offset, random, path);
 }
 
 std::size_t SkySource::kernel(const EmittedPath& path, const Vec3&, const Vec3&, std::size_t,
