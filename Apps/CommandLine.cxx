@@ -470,6 +470,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   option("--threads", "T", o.threads, parseInteger);
   option("--memory-limit", "MIB", o.memoryLimit, parseInteger);
   option("--frames-per-chunk", "C", o.framesPerChunk, parseInteger);
+  option("--chunk-overlap", "M", o.chunkOverlap, parseInteger);
   option("--error-batches", "B", o.errorBatches, parseInteger);
   option("--target-error", "FRACTION", o.targetError, parseNumber);
   option("--time-limit", "SECONDS", o.timeLimit, parseNumber);
@@ -877,6 +878,18 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     checkPropertyRange<long long>("--frames-per-chunk", *o.framesPerChunk, "FramesPerChunk");
     filter->SetFramesPerChunk(static_cast<int>(*o.framesPerChunk));
   }
+  if (o.chunkOverlap)
+  {
+    checkPropertyRange<long long>("--chunk-overlap", *o.chunkOverlap, "ChunkOverlap");
+    if (o.framesPerChunk && *o.framesPerChunk > 0 && *o.chunkOverlap > *o.framesPerChunk / 2)
+    {
+      throw UsageError("--chunk-overlap " + std::to_string(*o.chunkOverlap) +
+        " is more than half of --frames-per-chunk " + std::to_string(*o.framesPerChunk) +
+        ": give 0 (an eighth of a chunk) or at most " + std::to_string(*o.framesPerChunk / 2) +
+        ", so that the blends at a chunk's two seams do not overlap");
+    }
+    filter->SetChunkOverlap(static_cast<int>(*o.chunkOverlap));
+  }
   if (o.paths && *o.paths < o.errorBatches.value_or(filter->GetErrorBatches()))
   {
     throw UsageError("--paths " + std::to_string(*o.paths) + " cannot make " +
@@ -1071,10 +1084,14 @@ Solver:
   --memory-limit MIB    refuse, before allocating, a solve (or reading a file) estimated to
                         need more memory than this (default: half the physical memory)
   --frames-per-chunk C  solve the frames in chunks of C consecutive frames (at least 2), each
-                        a full-reuse solve blended with the next over C/8 frames (at least 1)
+                        a full-reuse solve blended with the next over --chunk-overlap frames
                         around each seam: memory depends on C, not on the frame count
                         (default 0: every frame at once when that fits --memory-limit, else
                         the longest chunks that do)
+  --chunk-overlap M     with chunks, each also solves M positions beyond its frames on each
+                        side, and each seam blends the two chunks over those 2M frames: the
+                        flicker at a seam falls as 1/M, each chunk solves C + 2M positions
+                        (default 0: C/8, at least 1; at most C/2)
   --error-batches B     solve as B independent batches of N/B paths: their spread gives
                         every element's standard error, RadiosityStdError (default 16;
                         1: no error estimate)

@@ -80,6 +80,7 @@ struct Options
   std::optional<long long> threads;
   std::optional<long long> memoryLimit; ///< MiB
   std::optional<long long> framesPerChunk;
+  std::optional<long long> chunkOverlap;
   std::optional<long long> errorBatches;
   std::optional<double> targetError; ///< a fraction: 0.02 is 2%
   std::optional<double> timeLimit;   ///< seconds, with targetError

@@ -382,6 +382,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     { "targetError", jsonNumber(filter->GetTargetRelativeError()) },
     { "timeLimit", jsonNumber(filter->GetTimeLimit()) },
     { "framesPerChunk", filter->GetFramesPerChunk() },
+    { "chunkOverlap", filter->GetChunkOverlap() },
   };
   if (lighting.contains("powerW"))
   {

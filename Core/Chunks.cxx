@@ -17,12 +17,15 @@
 namespace mlr
 {
 
-std::size_t chunkOverlap(std::size_t framesPerChunk)
+std::size_t chunkOverlap(std::size_t framesPerChunk, std::uint64_t asked)
 {
-  return std::max<std::size_t>(1, framesPerChunk / 8);
+  const std::size_t m = asked == 0
+    ? framesPerChunk / 8
+    : static_cast<std::size_t>(std::min<std::uint64_t>(asked, framesPerChunk / 2));
+  return std::max<std::size_t>(1, m);
 }
 
-ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk)
+ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk, std::uint64_t overlap)
 {
   if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk && framesPerChunk < frames)
   {
@@ -32,7 +35,7 @@ ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk)
   ChunkPlan plan;
   plan.frames = frames;
   plan.framesPerChunk = framesPerChunk == 0 || framesPerChunk >= frames ? frames : framesPerChunk;
-  plan.overlap = plan.framesPerChunk >= frames ? 0 : chunkOverlap(plan.framesPerChunk);
+  plan.overlap = plan.framesPerChunk >= frames ? 0 : chunkOverlap(plan.framesPerChunk, overlap);
   for (std::size_t begin = 0; begin < frames || plan.chunks.empty(); begin += plan.framesPerChunk)
   {
     ChunkPlan::Chunk chunk;
@@ -505,7 +508,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   const FirstChunkFigure& figure, const SolveSetup* givenSetup)
 {
   const std::size_t frames = frameCount(rig, scene.hasEmission());
-  const ChunkPlan plan = planChunks(frames, framesPerChunk);
+  const ChunkPlan plan = planChunks(frames, framesPerChunk, options.chunkOverlap);
   if (plan.chunks.size() == 1)
   {
     // A setup of the whole rig probes what the solve would: the same sides, the same bits.
@@ -572,6 +575,14 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   ErrorEstimateSummary errors;
   std::vector<Side> litSides, patchLitSides;
   std::vector<std::string> warnings;
+  if (options.chunkOverlap > plan.overlap)
+  {
+    warnings.push_back("the chunk overlap of " + std::to_string(options.chunkOverlap) +
+      " frames is more than half of the " + std::to_string(plan.framesPerChunk) +
+      " frames per chunk the memory limit allows: each seam blends over " +
+      std::to_string(plan.overlap) +
+      " frames on each side (give longer chunks, or more memory, for more)");
+  }
   // The estimate of the frames around the seam before this rank's next chunk, which that
   // chunk blends with, and (over ranks) a solved chunk's shape for the seams received.
   std::optional<Solution> tail;
@@ -775,6 +786,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   out.statistics.frames = frames;
   out.statistics.chunks = plan.chunks.size();
   out.statistics.framesPerChunk = plan.framesPerChunk;
+  out.statistics.chunkOverlap = plan.overlap;
   out.statistics.meanPathLength = stats.pathsCast > 0 ? 1.0 +
       (static_cast<double>(stats.shootingRays) / static_cast<double>(stats.pathsCast) - 1.0) /
         options.firstBounceSurvival
@@ -790,7 +802,7 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   const std::vector<Side>& patchLitSides, const ProgressCallback& progress)
 {
   const std::size_t frames = frameCount(rig, scene.hasEmission());
-  const ChunkPlan plan = planChunks(frames, framesPerChunk);
+  const ChunkPlan plan = planChunks(frames, framesPerChunk, options.chunkOverlap);
   if (chunk >= plan.chunks.size())
   {
     throw Error("chunk " + std::to_string(chunk) + " of an animation in " +

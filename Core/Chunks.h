@@ -21,8 +21,9 @@ namespace mlr
 /// overlap.
 constexpr std::size_t MinimumFramesPerChunk = 2;
 
-/// The positions a chunk solves beyond its own frames on each side: C / 8, at least 1.
-std::size_t chunkOverlap(std::size_t framesPerChunk);
+/// The positions a chunk of C frames solves beyond its own frames on each side: `asked`
+/// (SolverOptions::chunkOverlap) cut to C / 2, or C / 8 for 0; at least 1.
+std::size_t chunkOverlap(std::size_t framesPerChunk, std::uint64_t asked = 0);
 
 /**
  * How the frames of an animation are split. Chunk k owns frames [begin, end) (C of them, the
@@ -54,8 +55,9 @@ struct ChunkPlan
 };
 
 /// The chunks of `frames` frames in chunks of `framesPerChunk` (0 or at least `frames`: one
-/// chunk). Throws mlr::Error for 1 frame per chunk.
-ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk);
+/// chunk), overlapping by chunkOverlap(framesPerChunk, overlap). Throws mlr::Error for 1 frame
+/// per chunk.
+ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk, std::uint64_t overlap = 0);
 
 /// The rig restricted to frames [first, first + count): every moving light keeps those poses,
 /// static lights stay as they are, and its firstFrame says where the slice starts, so that its
@@ -77,7 +79,8 @@ struct FirstChunkFigure
 };
 
 /**
- * Solves the animation in the chunks of planChunks(frames, framesPerChunk). With one chunk
+ * Solves the animation in the chunks of planChunks(frames, framesPerChunk,
+ * options.chunkOverlap). With one chunk
  * this is solve(scene, rig, options, progress), bit for bit. With several, each is a solve of
  * sliceRig over its positions with the same seed, so that chunks cast the same paths from the
  * positions they share; the result is bit-identical for any thread count.
@@ -100,7 +103,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   const SolveSetup* setup = nullptr);
 
 /**
- * The frames that chunk `chunk` of planChunks(frames, framesPerChunk) finishes, solved again
+ * The frames that chunk `chunk` of planChunks(frames, framesPerChunk, options.chunkOverlap)
+ * finishes, solved again
  * alone (a cache that dropped them): that chunk and, for the blend at its first seam, the
  * chunk before it, so about twice one chunk's solve. The same bits as the frames
  * solveInChunks hands on for it with the same scene, rig and options (any thread count), with

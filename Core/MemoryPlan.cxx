@@ -292,7 +292,7 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
         .peak,
       fixedBytes);
   }
-  const std::size_t m = chunkOverlap(framesPerChunk);
+  const std::size_t m = chunkOverlap(framesPerChunk, options.chunkOverlap);
   // The frames a Solution holds outside a solve: direct and indirect irradiance and the
   // patches, and the standard errors of a batched solve.
   const std::uint64_t perFrame = saturatingProduct(
@@ -304,7 +304,8 @@ std::uint64_t estimateChunkedMemory(std::size_t patches, std::size_t elements, s
   std::size_t finished = streamed ? framesPerChunk : frames;
   if (streamed && keptChunks > 0)
   {
-    const std::size_t chunks = planChunks(frames, framesPerChunk).chunks.size();
+    const std::size_t chunks =
+      planChunks(frames, framesPerChunk, options.chunkOverlap).chunks.size();
     const auto ranks = static_cast<std::size_t>(std::max(options.ranks, 1));
     const std::size_t received = chunks >= ranks ? (chunks + ranks - 1) / ranks : chunks;
     finished = std::min(frames, std::min(keptChunks, received) * framesPerChunk);

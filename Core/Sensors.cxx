@@ -616,14 +616,15 @@ std::size_t pointFrames(
 /// many bytes, or of one frame's reads when those alone take more.
 constexpr std::uint64_t SpreadTableBytes = 16ULL << 20;
 
-/// The most frames one solve of an animation in chunks of `framesPerChunk` reads.
-std::size_t framesPerSolve(std::size_t frames, std::size_t framesPerChunk)
+/// The most frames one solve of an animation in chunks of `framesPerChunk` overlapping by
+/// chunkOverlap(framesPerChunk, `overlap`) reads.
+std::size_t framesPerSolve(std::size_t frames, std::size_t framesPerChunk, std::uint64_t overlap)
 {
   if (framesPerChunk == 0 || framesPerChunk >= frames)
   {
     return frames;
   }
-  return std::min(frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk));
+  return std::min(frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk, overlap));
 }
 }
 
@@ -650,8 +651,8 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
   // unless set.
   const std::uint64_t spread = estimatesError(options)
     ? SensorBatchSpread::estimateMemory(sensors, frames,
-        static_cast<std::size_t>(options.framesPerChunk), elements / Scene::ElementsPerPatch,
-        sensorOptions, static_cast<int>(workers))
+        static_cast<std::size_t>(options.framesPerChunk), options.chunkOverlap,
+        elements / Scene::ElementsPerPatch, sensorOptions, static_cast<int>(workers))
     : 0;
   return saturatingSum(saturatingSum(saturatingSum(results, scratch), spread),
     saturatingSum(RayTracer::estimateMemory(elements, points), emitters));
@@ -665,6 +666,7 @@ SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
   , Rays(sensorOptions.hemisphereRays)
   , Frames(frames)
   , FramesPerChunk(framesPerChunk)
+  , ChunkOverlap(options.chunkOverlap)
 {
   const SensorSet sensors = normalizedSensors(given, sensorOptions);
   this->Sensors = sensors.size();
@@ -836,7 +838,7 @@ void SensorBatchSpread::fold()
   {
     return;
   }
-  const ChunkPlan plan = planChunks(this->Frames, this->FramesPerChunk);
+  const ChunkPlan plan = planChunks(this->Frames, this->FramesPerChunk, this->ChunkOverlap);
   std::size_t chunk = 0;
   while (chunk < plan.chunks.size() && plan.chunks[chunk].solveBegin != this->SolveFirst)
   {
@@ -871,7 +873,8 @@ void SensorBatchSpread::fold()
 }
 
 std::uint64_t SensorBatchSpread::estimateMemory(std::size_t sensors, std::size_t frames,
-  std::size_t framesPerChunk, std::size_t patches, const SensorOptions& sensorOptions, int workers)
+  std::size_t framesPerChunk, std::uint64_t overlap, std::size_t patches,
+  const SensorOptions& sensorOptions, int workers)
 {
   if (sensors == 0 || frames == 0)
   {
@@ -882,8 +885,8 @@ std::uint64_t SensorBatchSpread::estimateMemory(std::size_t sensors, std::size_t
     saturatingProduct(
       { sizeof(std::size_t) + 2 * sizeof(std::uint32_t), sensors, sensorOptions.hemisphereRays }),
     saturatingProduct(sizeof(std::size_t) + sizeof(std::vector<std::size_t>), sensors));
-  const std::uint64_t running =
-    saturatingProduct({ 2 * sizeof(FloatRgb), sensors, framesPerSolve(frames, framesPerChunk) });
+  const std::uint64_t running = saturatingProduct(
+    { 2 * sizeof(FloatRgb), sensors, framesPerSolve(frames, framesPerChunk, overlap) });
   const std::uint64_t errors = saturatingProduct({ sizeof(FloatRgb), sensors, frames });
   const std::uint64_t table = std::min<std::uint64_t>(
     saturatingSum(SpreadTableBytes,
@@ -893,7 +896,7 @@ std::uint64_t SensorBatchSpread::estimateMemory(std::size_t sensors, std::size_t
   const std::uint64_t rows =
     saturatingSum(saturatingProduct(2 * sizeof(std::uint32_t), 2 * patches),
       saturatingProduct({ sizeof(Rgb), static_cast<std::size_t>(std::max(workers, 1)),
-        framesPerSolve(frames, framesPerChunk) }));
+        framesPerSolve(frames, framesPerChunk, overlap) }));
   return saturatingSum(
     saturatingSum(keys, running), saturatingSum(errors, saturatingSum(table, rows)));
 }

@@ -140,7 +140,8 @@ class SensorBatchSpread
 public:
   /// For `sensors` (checked) on `scene`, read with the streams of `options.seed` and
   /// `sensorOptions`, over an animation of `frames` frames solved in chunks of
-  /// `framesPerChunk` (0: one solve), whose seams blend the chunks' errors.
+  /// `framesPerChunk` (0: one solve) overlapping by options.chunkOverlap, whose seams blend
+  /// the chunks' errors.
   SensorBatchSpread(const Scene& scene, const SensorSet& sensors, const SolverOptions& options,
     const SensorOptions& sensorOptions, std::size_t frames, std::size_t framesPerChunk);
 
@@ -170,8 +171,8 @@ public:
   /// squared deviations of one solve's frames, the standard errors of every frame, a block of
   /// the reads of the patch sides the rays reach and each worker's sums over it.
   static std::uint64_t estimateMemory(std::size_t sensors, std::size_t frames,
-    std::size_t framesPerChunk, std::size_t patches, const SensorOptions& sensorOptions,
-    int workers);
+    std::size_t framesPerChunk, std::uint64_t overlap, std::size_t patches,
+    const SensorOptions& sensorOptions, int workers);
 
 private:
   void fold();
@@ -180,6 +181,7 @@ private:
   int Workers = 1;
   std::uint32_t Rays = 0;
   std::size_t Frames = 0, Sensors = 0, FramesPerChunk = 0;
+  std::uint64_t ChunkOverlap = 0; ///< SolverOptions::chunkOverlap
   /// Per sensor, its distinct element sides hit (as slots of the table) and their ray counts.
   std::vector<std::size_t> KeyBegin;
   std::vector<std::uint32_t> KeySlot, KeyCount;

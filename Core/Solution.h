@@ -22,6 +22,8 @@ struct SolverStatistics
   /// The chunks the frames were solved in, of framesPerChunk frames each (Chunks.h).
   std::uint64_t chunks = 1;
   std::uint64_t framesPerChunk = 0;
+  /// m, the frames each seam's blend takes from either chunk (0 for one chunk).
+  std::uint64_t chunkOverlap = 0;
   std::uint64_t patches = 0;
   std::uint64_t elements = 0;
   std::uint64_t effectivePathsPerFrame = 0;

@@ -171,6 +171,19 @@ void validateOptions(const SolverOptions& options)
     throw Error("the frames per chunk are 1: give 0 (the memory limit chooses) or at least 2, "
                 "so that the blends at a chunk's two seams do not overlap");
   }
+  if (options.framesPerChunk > 0 && options.chunkOverlap > options.framesPerChunk / 2)
+  {
+    throw Error("the chunk overlap is " + std::to_string(options.chunkOverlap) +
+      " frames, more than half of the " + std::to_string(options.framesPerChunk) +
+      " frames per chunk: give 0 (an eighth of a chunk) or at most " +
+      std::to_string(options.framesPerChunk / 2) +
+      ", so that the blends at a chunk's two seams do not overlap");
+  }
+  if (options.chunkOverlap > MaximumChunkOverlap)
+  {
+    throw Error("the chunk overlap is " + std::to_string(options.chunkOverlap) +
+      " frames: give at most " + std::to_string(MaximumChunkOverlap));
+  }
   if (options.threads < 0 || options.threads > 1024)
   {
     throw Error("the thread count is " + std::to_string(options.threads) +

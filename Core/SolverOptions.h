@@ -43,6 +43,12 @@ struct SolverOptions
   /// solve of its own, so that memory depends on C, not on the frame count (Chunks.h);
   /// 0 lets the memory limit choose (the whole animation when it fits). At least 2.
   std::uint64_t framesPerChunk = 0;
+  /// m: with chunks, each chunk also solves m positions beyond its frames on each side, and
+  /// each seam blends the two chunks over those 2m frames. The seams' flicker falls as 1/m,
+  /// and each chunk solves C + 2m positions (Documentation/Method.md, "Long animations:
+  /// chunks"). 0 takes C / 8 (at least 1); at most C / 2 (a larger m is cut to C / 2 when the
+  /// memory limit chooses C).
+  std::uint64_t chunkOverlap = 0;
 
   /// B: the solve runs as B independent batches of N/B paths per frame (and k N/B gathering
   /// rays) whose mean is the result and whose spread gives every element's standard error
@@ -85,6 +91,9 @@ struct SolverOptions
 /// The largest pathsPerFrame accepted: past it a solve would run for months.
 constexpr std::uint64_t MaximumPathsPerFrame = 100000000000ULL;
 
+/// The largest chunk overlap accepted (SolverOptions::chunkOverlap), far beyond any chunk.
+constexpr std::uint64_t MaximumChunkOverlap = 1000000;
+
 /// The most batches ErrorEstimate accepts for the first round (SolverOptions::errorBatches).
 constexpr std::uint64_t MaximumErrorBatches = 4096;
 
@@ -114,8 +123,8 @@ template <typename Visitor>
 void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
-    reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, errorBatches,
-    targetRelativeError, timeLimitSeconds, storageScale, rank, ranks, sumAcrossRanks,
+    reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, chunkOverlap,
+    errorBatches, targetRelativeError, timeLimitSeconds, storageScale, rank, ranks, sumAcrossRanks,
     sumDoublesAcrossRanks, log, batchSolved] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
@@ -131,6 +140,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   visit("memoryLimitBytes", memoryLimitBytes, OptionRole::PerRank);
   // The chunks decide the seeds and the blends: the ranks solve the same chunks.
   visit("framesPerChunk", framesPerChunk, OptionRole::Result);
+  visit("chunkOverlap", chunkOverlap, OptionRole::Result);
   visit("errorBatches", errorBatches, OptionRole::Result);
   visit("targetRelativeError", targetRelativeError, OptionRole::Result);
   // The ranks stop together (the first to run out of time stops all), so they must agree on

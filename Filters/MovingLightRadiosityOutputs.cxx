@@ -240,6 +240,7 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("Frames", statistics.frames);
   count("Chunks", statistics.chunks);
   count("FramesPerChunk", statistics.framesPerChunk);
+  count("ChunkOverlap", statistics.chunkOverlap);
   count("Patches", statistics.patches);
   count("Elements", statistics.elements);
   real("PatchEdgeLength", statistics.patchEdgeLength);

@@ -190,6 +190,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
   this->NumberOfPositions = 10;
   this->MemoryLimit = 0;
   this->FramesPerChunk = 0;
+  this->ChunkOverlap = 0;
   this->CachedChunks = 0;
   this->SolveCount = 0;
   this->Exposure = 0.0;
@@ -289,6 +290,9 @@ const PropertyRange PropertyRanges[] = {
     [](Self* f) { return static_cast<double>(f->GetMemoryLimit()); } },
   { "FramesPerChunk", 0, VTK_INT_MAX, "0 (MemoryLimit chooses) or at least 2",
     [](Self* f) { return static_cast<double>(f->GetFramesPerChunk()); } },
+  { "ChunkOverlap", 0, static_cast<double>(mlr::MaximumChunkOverlap),
+    "0 (FramesPerChunk/8) or a count of frames, at most FramesPerChunk/2",
+    [](Self* f) { return static_cast<double>(f->GetChunkOverlap()); } },
   { "CachedChunks", 0, VTK_INT_MAX, "0 (every frame kept) or a count of chunks",
     [](Self* f) { return static_cast<double>(f->GetCachedChunks()); } },
   { "ErrorBatches", 1, static_cast<double>(mlr::MaximumErrorBatches),
@@ -427,6 +431,14 @@ std::string propertyOutOfRange(vtkMovingLightRadiosity* self)
   {
     return "FramesPerChunk is 1: give 0 (MemoryLimit chooses) or at least 2, so that the "
            "blends at a chunk's two seams do not overlap";
+  }
+  if (self->GetFramesPerChunk() > 0 && self->GetChunkOverlap() > self->GetFramesPerChunk() / 2)
+  {
+    return "ChunkOverlap is " + std::to_string(self->GetChunkOverlap()) +
+      ", more than half of FramesPerChunk (" + std::to_string(self->GetFramesPerChunk()) +
+      "): give 0 (an eighth of a chunk) or at most " +
+      std::to_string(self->GetFramesPerChunk() / 2) +
+      ", so that the blends at a chunk's two seams do not overlap";
   }
   return {};
 }
@@ -988,7 +1000,8 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
   if (!held && cache.ChunkScene && (port == ELEMENTS_PORT || port == PATCHES_PORT))
   {
     // A chunk the cache dropped: solved again, with the chunk before it for its seam.
-    const mlr::ChunkPlan plan = mlr::planChunks(cache.Times.size(), cache.FramesPerChunk);
+    const mlr::ChunkPlan plan =
+      mlr::planChunks(cache.Times.size(), cache.FramesPerChunk, cache.ChunkOptions.chunkOverlap);
     std::size_t chunk = 0;
     while (chunk + 1 < plan.chunks.size() && frame >= plan.finishedEnd(chunk))
     {
@@ -1506,6 +1519,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     solverOptions.threads = this->NumberOfThreads;
     solverOptions.memoryLimitBytes = static_cast<std::uint64_t>(this->MemoryLimit) << 20;
     solverOptions.framesPerChunk = static_cast<std::uint64_t>(this->FramesPerChunk);
+    solverOptions.chunkOverlap = static_cast<std::uint64_t>(this->ChunkOverlap);
     // Core refuses the other bad values (NaN targets included) naming the property to fix.
     solverOptions.errorBatches = static_cast<std::uint64_t>(this->ErrorBatches);
     solverOptions.targetRelativeError = this->TargetRelativeError;
@@ -1904,6 +1918,7 @@ void vtkMovingLightRadiosity::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPositions: " << this->NumberOfPositions << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB\n";
   os << indent << "FramesPerChunk: " << this->FramesPerChunk << "\n";
+  os << indent << "ChunkOverlap: " << this->ChunkOverlap << "\n";
   os << indent << "CachedChunks: " << this->CachedChunks << "\n";
   os << indent << "ErrorBatches: " << this->ErrorBatches << "\n";
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";

@@ -182,7 +182,7 @@ def test_every_option_of_the_help_is_known(tmp_path):
     --help, --point-light, --night, --luminaire and --equal-shares take none)."""
     options = sorted(set(re.findall(r"--[a-z][a-z-]+", run(["--help"], tmp_path).stdout)) -
                      {"--help", "--point-light", "--night", "--luminaire", "--equal-shares"})
-    assert len(options) == 43, options
+    assert len(options) == 44, options
     for option in options:
         result = run([option], tmp_path)
         assert result.returncode == 2

@@ -59,6 +59,35 @@ def test_frames_per_chunk_of_one_is_refused(tmp_path):
     assert all_files(tmp_path) == []
 
 
+def test_chunk_overlap_solves_more_positions_and_is_reported(tmp_path):
+    common = ["--scene", SCENE, "--light", LIGHT] + PATH + ["--frames", str(FRAMES),
+                                                            "--error-batches", "1"] + FAST
+    result = run(common + ["--frames-per-chunk", "4", "--chunk-overlap", "2", "--output",
+                           "c/s.pvd", "--stats", "c/s.json"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    # m = 2 positions on each side, where the default C/8 gives 1.
+    assert "chunk 2 of 3: frames 4 to 7, solving positions 2 to 9" in result.stdout
+    stats = json.loads((tmp_path / "c/s.json").read_text())
+    assert stats["settings"]["chunkOverlap"] == 2
+    assert stats["statistics"]["ChunkOverlap"] == 2
+    default = run(common + ["--frames-per-chunk", "4", "--output", "d/s.pvd", "--stats",
+                            "d/s.json"], tmp_path)
+    assert default.returncode == 0, default.stderr
+    assert "chunk 2 of 3: frames 4 to 7, solving positions 3 to 8" in default.stdout
+    assert json.loads((tmp_path / "d/s.json").read_text())["statistics"]["ChunkOverlap"] == 1
+
+
+def test_chunk_overlap_over_half_a_chunk_is_refused(tmp_path):
+    result = run(["--frames-per-chunk", "4", "--chunk-overlap", "3"], tmp_path)
+    assert result.returncode == 2
+    assert "--chunk-overlap 3 is more than half of --frames-per-chunk 4: give 0" in result.stderr
+    assert all_files(tmp_path) == []
+    negative = run(["--chunk-overlap", "-1"], tmp_path)
+    assert negative.returncode == 2
+    assert "--chunk-overlap is -1: give a value from 0 to" in negative.stderr, negative.stderr
+    assert all_files(tmp_path) == []
+
+
 def test_interrupt_in_the_third_chunk_writes_nothing(tmp_path):
     process = subprocess.Popen(
         [CLI, "--scene", SCENE, "--light", LIGHT] + PATH +

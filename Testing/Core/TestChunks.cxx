@@ -204,20 +204,28 @@ TEST(Chunks, StreamedFramesAreTheAssembledOnes)
   EXPECT_EQ(stats.statistics.shadowRays, whole.statistics.shadowRays);
 }
 
-TEST(Chunks, MeanOverSeedsAtASeamIsClassics)
+class ChunkOverlaps : public ::testing::TestWithParam<std::uint64_t>
 {
-  // 4 frames per chunk, m = 1: frames 3 and 4 blend chunks 0 and 1. Over S seeds the mean of
-  // each mode's frame mean differs from the other's by noise only: 4 standard errors of the
-  // difference, from the seeds' own spread.
+};
+
+TEST_P(ChunkOverlaps, MeanOverSeedsAtASeamIsClassics)
+{
+  // 4 frames per chunk. m = 1 (the default, C/8 at least 1): frames 3 and 4 blend chunks 0
+  // and 1; m = 2: frames 2 to 5 do. Over S seeds the mean of each mode's frame mean differs
+  // from the other's by noise only: 4 standard errors of the difference, from the seeds' own
+  // spread.
   const Scene scene = box();
   constexpr int Seeds = 12;
   constexpr std::uint64_t Paths = 8000;
-  const std::vector<std::size_t> frames{ 1, 3, 4, 8 };
+  const std::vector<std::size_t> frames{ 1, 2, 3, 4, 5, 8 };
   std::vector<double> sumC(frames.size()), sqC(frames.size()), sumR(frames.size()),
     sqR(frames.size());
   for (int seed = 0; seed < Seeds; ++seed)
   {
-    const Solution chunked = solveInChunks(scene, rig(), options(Paths, 100 + seed), 4);
+    SolverOptions o = options(Paths, 100 + seed);
+    o.chunkOverlap = GetParam();
+    const Solution chunked = solveInChunks(scene, rig(), o, 4);
+    ASSERT_EQ(chunked.statistics.chunkOverlap, std::max<std::uint64_t>(1, GetParam()));
     const Solution classic =
       solve(scene, rig(), checks::modeOptions(false, Paths, 500 + static_cast<unsigned>(seed)));
     for (std::size_t i = 0; i < frames.size(); ++i)
@@ -239,6 +247,65 @@ TEST(Chunks, MeanOverSeedsAtASeamIsClassics)
     EXPECT_NEAR(mc, mr, tolerance) << "frame " << frames[i];
     EXPECT_GT(mc, 0);
   }
+}
+
+INSTANTIATE_TEST_SUITE_P(Chunks, ChunkOverlaps, ::testing::Values(0, 2));
+
+TEST(Chunks, AnOverlapAskedForBlendsEachSeamOverItsFrames)
+{
+  // m = 15 in chunks of 30: each seam ramps over 30 frames in steps of 1/30, the blends of a
+  // chunk's two seams meet without overlapping, and a larger m is cut to C / 2.
+  const ChunkPlan plan = planChunks(100, 30, 15);
+  EXPECT_EQ(plan.overlap, 15u);
+  EXPECT_EQ(plan.chunks[1].solveBegin, 15u);
+  EXPECT_EQ(plan.chunks[1].solveEnd, 75u);
+  for (std::size_t f = 0; f < 100; ++f)
+  {
+    double sum = 0;
+    int solvedBy = 0;
+    for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+    {
+      sum += plan.weight(k, f);
+      solvedBy += plan.weight(k, f) > 0;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12) << "frame " << f;
+    EXPECT_LE(solvedBy, 2);
+  }
+  for (std::size_t f = 15; f + 1 < 45; ++f)
+  {
+    EXPECT_NEAR(plan.weight(1, f + 1) - plan.weight(1, f), 1.0 / 30, 1e-12) << "frame " << f;
+  }
+  EXPECT_EQ(planChunks(100, 30, 20).overlap, 15u);
+  EXPECT_EQ(planChunks(100, 30, 0).overlap, 3u);
+  EXPECT_EQ(planChunks(100, 30, 1).overlap, 1u);
+
+  SolverOptions o;
+  o.framesPerChunk = 30;
+  o.chunkOverlap = 15;
+  validateOptions(o);
+  o.chunkOverlap = 16;
+  checks::expectError([&] { validateOptions(o); }, "chunk overlap is 16 frames, more than half");
+
+  // A chunk length chosen elsewhere (options.framesPerChunk 0, as when the memory limit
+  // chooses) cuts a larger m, with a warning; the same bits for any thread count.
+  const Scene scene = box();
+  SolverOptions cut = options(20000, 3, 1);
+  cut.chunkOverlap = 3;
+  Solution one = solveInChunks(scene, rig(), cut, 4);
+  EXPECT_EQ(one.statistics.chunkOverlap, 2u);
+  ASSERT_EQ(one.warnings.size(), 1u);
+  EXPECT_NE(one.warnings[0].find("chunk overlap of 3 frames is more than half"), std::string::npos)
+    << one.warnings[0];
+  cut.threads = 3;
+  Solution three = solveInChunks(scene, rig(), cut, 4);
+  EXPECT_TRUE(checks::sameBits(one.directData(), three.directData()));
+  EXPECT_TRUE(checks::sameBits(one.indirectData(), three.indirectData()));
+  // The overlap changes the blended frames: m = 2 against m = 1.
+  cut.chunkOverlap = 0;
+  Solution narrow = solveInChunks(scene, rig(), cut, 4);
+  EXPECT_EQ(narrow.statistics.chunkOverlap, 1u);
+  EXPECT_TRUE(narrow.warnings.empty());
+  EXPECT_FALSE(checks::sameBits(one.directData(), narrow.directData()));
 }
 
 TEST(Chunks, MemoryLimitForTwoFramesPerChunkGivesTheRightResult)

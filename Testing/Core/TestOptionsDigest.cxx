@@ -40,6 +40,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.targetRelativeError = 0.02;
   else if (name == "framesPerChunk")
     options.framesPerChunk = 8;
+  else if (name == "chunkOverlap")
+    options.chunkOverlap = 4;
   else if (name == "timeLimitSeconds")
     options.timeLimitSeconds = 60;
   else if (name == "storageScale")
@@ -77,7 +79,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 21u);
+  EXPECT_EQ(names.size(), 22u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)

@@ -478,7 +478,7 @@ TEST(SolveMemory, TheSensorSpreadEstimateBoundsWhatItHolds)
   {
     const SolverOptions options = optionsFor(threads, 0);
     const Solution solution = solve(f.scene, rig, options);
-    const std::uint64_t estimate = SensorBatchSpread::estimateMemory(sensors.size(), frames, 0,
+    const std::uint64_t estimate = SensorBatchSpread::estimateMemory(sensors.size(), frames, 0, 0,
                                      f.scene.patchCount(), counts, threads) +
       RayTracer::estimateMemory(f.scene.elementCount(), f.scene.points().size());
     const Measurement m;

@@ -254,6 +254,40 @@ TEST(FilterTime, CachedChunksSolveADroppedChunkAgainWithTheSameValues)
   EXPECT_EQ(fieldValue(all->GetOutput(), "ChunksSolvedAgain"), 0);
 }
 
+TEST(FilterTime, AChunkOverlapIsKeptWhenADroppedChunkIsSolvedAgain)
+{
+  // 12 frames in chunks of 4 overlapping by 2 (the default would be 1): a cache of one chunk
+  // against one of all three gives the same arrays at every time step, the dropped chunks
+  // solved again with the same overlap; ChunkOverlap more than half a chunk is refused.
+  BoxSetup setup = closedBoxSetup(12);
+  auto all = fastFilter(setup);
+  all->SetFramesPerChunk(4);
+  all->SetChunkOverlap(2);
+  all->SetCachedChunks(3);
+  auto one = fastFilter(setup);
+  one->SetFramesPerChunk(4);
+  one->SetChunkOverlap(2);
+  one->SetCachedChunks(1);
+  for (const double t : { 0.0, 11.0, 3.0, 5.0, 1.0 })
+  {
+    ASSERT_TRUE(all->UpdateTimeStep(t));
+    ASSERT_TRUE(one->UpdateTimeStep(t));
+    EXPECT_EQ(
+      arrayValues(one->GetOutput(), "Radiosity"), arrayValues(all->GetOutput(), "Radiosity"))
+      << "time " << t;
+    EXPECT_EQ(fieldValue(one->GetOutput(), "ChunkOverlap"), 2);
+  }
+  EXPECT_GT(fieldValue(one->GetOutput(), "ChunksSolvedAgain"), 0);
+  one->SetChunkOverlap(3);
+  vtkNew<MessageRecorder> messages;
+  messages->watch(one);
+  EXPECT_EQ(one->UpdateTimeStep(0), 0);
+  EXPECT_NE(
+    messages->allErrors().find("ChunkOverlap is 3, more than half of FramesPerChunk (4): give 0"),
+    std::string::npos)
+    << messages->allErrors();
+}
+
 TEST(FilterTime, TheFiltersTimeIsNotPassedUpstream)
 {
   BoxSetup setup = closedBoxSetup(3);

@@ -139,8 +139,8 @@ BOOLEANS |= {"PathFromLightMaterial"}
 # comes from the Scene's bounds, not the lamp, while a script's PathStart keeps its meaning.
 PARAVIEW_OWN = {"PathFromLightMaterial": ([1.0], [0.0])}
 # The chunks of a long animation.
-EXPECTED |= {"FramesPerChunk", "CachedChunks"}
-ADVANCED |= {"FramesPerChunk", "CachedChunks"}
+EXPECTED |= {"FramesPerChunk", "ChunkOverlap", "CachedChunks"}
+ADVANCED |= {"FramesPerChunk", "ChunkOverlap", "CachedChunks"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
