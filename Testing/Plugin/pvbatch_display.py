@@ -2,7 +2,8 @@
 
 - every output port shown as the Apply button shows it (ShowInPreferredView): the Elements
   coloured by the point array Color with Map Scalars off and unlit (Ambient 1, Diffuse 0),
-  the Patches not shown, the Light shown in a solid colour distinct from the scene;
+  the Patches not shown, the Light shown in a solid colour distinct from the scene, its
+  vertices (a point light) as spheres of several pixels;
 - the Elements' point data holds Radiosity and Color (and the cells keep Radiosity);
 - the Light port at frames 0, 3 and the last: its area centroid is the trajectory's point
   of that time, its Power adds up to Light Power;
@@ -59,6 +60,11 @@ check(light_display.ColorArrayName[1] == "",
 yellow = list(light_display.DiffuseColor)
 check(yellow[0] > 0.8 and yellow[1] > 0.6 and yellow[2] < 0.5,
       f"the Light's colour {yellow} is not the documented yellow")
+# A point light is one vertex: drawn as a sphere of some pixels, not a dot of 1 or 2
+# (pvbatch_screenshots.py counts them).
+check(light_display.RenderPointsAsSpheres == 1 and light_display.PointSize >= 8,
+      f"the Light's vertices are drawn as {'spheres' if light_display.RenderPointsAsSpheres else 'dots'}"
+      f" {light_display.PointSize} pixels across, expected spheres of 8 pixels or more")
 
 
 def fetch(time, port=0):

@@ -6,6 +6,9 @@
   the VTK filter's default, the filter's range (refused by name just outside), advanced or not;
 - every property's documentation names its unit (or says it has none) and its effect on
   the cost of a solve;
+- the panel's decorators name properties of the filter, and the Light Material's own
+  properties (Light Power From Material, Path From Light Material) are shown only while a
+  material is named, as ParaView's GenericDecorator evaluates them;
 - what the first Apply shows: TimestepValues and the time keeper with one step per light
   position, the Elements in the true colours of point Color (Map Scalars off), the Patches
   not shown, the Light shown (pvbatch_display.py checks the display in detail).
@@ -31,7 +34,7 @@ import sys  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
 from movinglightradiosity import vtkMovingLightRadiosity  # noqa: E402
 from vtk_messages import recorded  # noqa: E402
-from vtkmodules.vtkCommonCore import vtkDoubleArray  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkVariant  # noqa: E402
 from vtkmodules.vtkFiltersSources import vtkCubeSource  # noqa: E402
 
 
@@ -214,6 +217,65 @@ while not iterator.IsAtEnd():
             check(any(name in e for e in errors),
                   f"{where}: {value}, outside the domain, is not refused by name: {errors}")
 check(found == EXPECTED, f"properties {sorted(found)}, expected {sorted(EXPECTED)}")
+
+
+# --- Shown when they apply ----------------------------------------------------------------
+def generic_decorators(prop):
+    hints = prop.GetHints()
+    for i in range(hints.GetNumberOfNestedElements() if hints else 0):
+        element = hints.GetNestedElement(i)
+        if element.GetName() == "PropertyWidgetDecorator" and \
+                element.GetAttribute("type") == "GenericDecorator":
+            yield element
+
+
+def decorator_matches(source, decorator):
+    """Whether ParaView 5.11's GenericDecorator (pqGenericPropertyWidgetDecorator::valueMatch)
+    shows or enables its widget: the named property's unchecked element `index` (the value in
+    the panel before Apply) as vtkVariant spells it, equal to `value` or to one of the
+    space-separated `values`; inverse="1" negates. Int and string properties only: the ones
+    the XML depends on, whose spelling is exact."""
+    other = source.GetProperty(decorator.GetAttribute("property"))
+    index = int(decorator.GetAttribute("index") or 0)
+    if other.IsA("vtkSMIntVectorProperty") or other.IsA("vtkSMStringVectorProperty"):
+        value = vtkVariant(other.GetUncheckedElement(index)).ToString()
+    else:
+        raise TypeError(f"{other.GetXMLName()} is a {other.GetClassName()}")
+    given = decorator.GetAttribute("value")
+    status = value in ([given] if given is not None else decorator.GetAttribute("values").split(" "))
+    return status != (decorator.GetAttribute("inverse") == "1")
+
+
+# The panel silently ignores a decorator naming no property of the proxy, and the widget is
+# then always there: every decorator must name one, in a mode ParaView knows.
+iterator = pristine.NewPropertyIterator()
+iterator.Begin()
+while not iterator.IsAtEnd():
+    name, prop = iterator.GetKey(), iterator.GetProperty()
+    iterator.Next()
+    for decorator in generic_decorators(prop):
+        depends = decorator.GetAttribute("property")
+        check(pristine.GetProperty(depends) is not None,
+              f"property {name}: its decorator depends on {depends!r}, no property of the filter")
+        check(decorator.GetAttribute("mode") in ("visibility", "enabled_state"),
+              f"property {name}: decorator mode {decorator.GetAttribute('mode')!r}")
+
+# The material's own properties are hidden until a Light Material is named, and leave again
+# when it is cleared; their defaults are checked above.
+for name in ("LightPowerFromMaterial", "PathFromLightMaterial"):
+    prop = pristine.GetProperty(name)
+    rules = [d for d in generic_decorators(prop) if d.GetAttribute("mode") == "visibility"]
+    if not check(len(rules) == 1, f"property {name}: {len(rules)} visibility decorators, "
+                 "expected one, on Light Material"):
+        continue
+    material = pristine.GetProperty("LightMaterial")
+    shown = {}
+    for typed in ("", "light", ""):
+        material.SetUncheckedElement(0, typed)
+        shown.setdefault(typed, []).append(decorator_matches(pristine, rules[0]))
+    material.ClearUncheckedElements()
+    check(shown == {"": [False, False], "light": [True]},
+          f"property {name}: shown {shown} by Light Material, expected only when one is named")
 
 # --- The first Apply ----------------------------------------------------------------------
 radiosity.UpdatePipeline()

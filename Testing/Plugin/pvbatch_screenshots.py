@@ -4,7 +4,8 @@ as Apply shows them (their display colours, one exposure for the whole animation
 brightness compares across frames). The camera looks up at the floor of the box (seen from
 outside, the colours show its lit inner side); the pictures are compared by pixel
 statistics around the spots under the light (pvbatch_baseline.py compares a whole picture
-with a baseline).
+with a baseline). A point light's Light output, one vertex, is drawn as a yellow disc of
+about 12 pixels across where the lamp is.
 
     xvfb-run -a pvbatch pvbatch_screenshots.py --plugin MovingLightRadiosity.so [--keep DIR]"""
 import os
@@ -55,14 +56,18 @@ scene = GetAnimationScene()
 scene.UpdateAnimationUsingDataTimeSteps()
 
 
-def luminance(path):
+def colours(path):
     reader = vtkPNGReader()
     reader.SetFileName(path)
     reader.Update()
     image = reader.GetOutput()
     width, height, _ = image.GetDimensions()
     pixels = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, -1)
-    return pixels[:, :, :3].astype(float).mean(axis=2)  # row 0 is the bottom, as on screen
+    return pixels[:, :, :3].astype(float)  # row 0 is the bottom, as on screen
+
+
+def luminance(path):
+    return colours(path).mean(axis=2)
 
 
 def spot_on_screen(frame):
@@ -117,5 +122,41 @@ if len(pictures) == 2:
           f"moved ({where_moved:.1f})")
     print(f"brightness under the light at frame 0 / last: frame 0 {at_first[0]:.0f} / "
           f"{at_first[1]:.0f}, last frame {at_final[0]:.0f} / {at_final[1]:.0f}")
+
+
+# --- A point light as Apply shows it ----------------------------------------------------------
+# The Light output alone, seen through the box's floor: the point light's one vertex should be
+# a yellow disc about 12 pixels across where the lamp is, not the 2 x 2 pixels of a vertex.
+point = MovingLightRadiosity(Scene=sources["box"], Trajectory=sources["trajectory"],
+                             LightType="Point", NumberOfPaths=support.TEST_PATHS)
+point.UpdatePipeline(0.0)
+lamp_view = CreateRenderView()
+for name in ("ViewSize", "OrientationAxesVisibility", "UseColorPaletteForBackground", "Background",
+             "CameraPosition", "CameraFocalPoint", "CameraViewUp", "CameraViewAngle"):
+    setattr(lamp_view, name, getattr(view, name))
+Show(OutputPort(point, 2), lamp_view)
+lamp_view.ViewTime = 0.0
+Render(lamp_view)
+with tempfile.TemporaryDirectory(prefix="mlr-plugin-point-light-") as folder:
+    path = os.path.join(folder, "point_light.png")
+    SaveScreenshot(path, lamp_view, ImageResolution=[SIZE, SIZE])
+    picture = colours(path) if check(os.path.isfile(path), "no screenshot of the point light") else None
+if picture is not None:
+    red, green, blue = picture[:, :, 0], picture[:, :, 1], picture[:, :, 2]
+    yellow = (red > 150) & (green > 100) & (blue < 100)
+    disc = numpy.pi * (12 / 2) ** 2
+    check(0.5 * disc < yellow.sum() < 2 * disc,
+          f"the point light covers {yellow.sum()} yellow pixels, expected a disc of about "
+          f"{disc:.0f} (12 pixels across)")
+    rows, columns = numpy.nonzero(yellow)
+    renderer = lamp_view.GetRenderer()
+    renderer.SetWorldPoint(*support.light_position(0), 1.0)
+    renderer.WorldToDisplay()
+    where = numpy.array(renderer.GetDisplayPoint()[:2])
+    if yellow.any():
+        centre = numpy.array([columns.mean(), rows.mean()])
+        check(numpy.linalg.norm(centre - where) < 3,
+              f"the point light is drawn at pixel {centre}, the lamp is at {where}")
+    print(f"point light: {yellow.sum()} yellow pixels")
 
 checks.finish()
