@@ -714,7 +714,7 @@ mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour,
   {
     return colour;
   }
-  const double luminance = 0.2126 * colour.r + 0.7152 * colour.g + 0.0722 * colour.b;
+  const double luminance = mlr::luminance(colour);
   if (!(luminance > 0))
   {
     std::ostringstream message;
