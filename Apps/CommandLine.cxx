@@ -1107,10 +1107,10 @@ Sensors (measuring points that receive light but neither block nor reflect it):
   --work-plane HEIGHT,SPACING
                         a grid of sensors facing up over every upward-facing face (within
                         5 degrees of --up: floors, and roofs), HEIGHT above it, SPACING
-                        apart on a lattice at (i + 1/2) SPACING, inside the polygons; with
-                        lights (not the sun or a sky) also over the faces facing down that
-                        see a light from above (a room modelled with outward normals),
-                        without that room's roof
+                        apart on a lattice at (i + 1/2) SPACING, inside the polygons; also
+                        over the faces facing down that see a light, or the sky, from
+                        above (a room modelled with outward normals), without that room's
+                        roof
   --sensor-rays N       rays each sensor casts over its hemisphere (default 512), and an
                         eighth as many points it samples on each area light: raise it
                         for less noise on the sensors

@@ -1,5 +1,7 @@
 #include "FrameRenderer.h"
 
+#include "Rgb.h"
+
 #include "vtkActor.h"
 #include "vtkCamera.h"
 #include "vtkCellData.h"
@@ -270,10 +272,10 @@ void FrameRenderer::sampleLighting(vtkPolyData* elements)
   {
     return; // not the mesh of the frames sampled before
   }
-  auto luminance = [](vtkDataArray* array, vtkIdType c)
+  auto cellLuminance = [](vtkDataArray* array, vtkIdType c)
   {
-    return 0.2126 * array->GetComponent(c, 0) + 0.7152 * array->GetComponent(c, 1) +
-      0.0722 * array->GetComponent(c, 2);
+    return mlr::luminance(
+      mlr::Rgb(array->GetComponent(c, 0), array->GetComponent(c, 1), array->GetComponent(c, 2)));
   };
   const bool emission = emittedArray && emittedArray->GetNumberOfTuples() == cells &&
     emittedArray->GetNumberOfComponents() == 3;
@@ -281,9 +283,9 @@ void FrameRenderer::sampleLighting(vtkPolyData* elements)
   {
     const auto k = static_cast<std::size_t>(c);
     // Emission leaves the front only.
-    p.front[k] +=
-      std::max(0.0, luminance(frontArray, c) - (emission ? luminance(emittedArray, c) : 0.0));
-    p.back[k] += backArray ? luminance(backArray, c) : 0.0;
+    p.front[k] += std::max(
+      0.0, cellLuminance(frontArray, c) - (emission ? cellLuminance(emittedArray, c) : 0.0));
+    p.back[k] += backArray ? cellLuminance(backArray, c) : 0.0;
   }
 }
 

@@ -77,6 +77,22 @@ nlohmann::ordered_json jsonTriple(const double* v)
 {
   return { jsonNumber(v[0]), jsonNumber(v[1]), jsonNumber(v[2]) };
 }
+
+/// The frame of the largest p95 relative error (the first on ties) with its median and p95,
+/// as the elements' and the sensors' lines both give it.
+std::string worstFrameText(const char* what, vtkDataArray* median, vtkDataArray* p95)
+{
+  vtkIdType worst = 0;
+  for (vtkIdType f = 1; f < p95->GetNumberOfTuples(); ++f)
+  {
+    worst = p95->GetComponent(f, 0) > p95->GetComponent(worst, 0) ? f : worst;
+  }
+  std::ostringstream s;
+  s << std::setprecision(3) << "relative error of the lit " << what << ": median "
+    << 100 * median->GetComponent(worst, 0) << "%, p95 " << 100 * p95->GetComponent(worst, 0)
+    << "% (frame " << worst << ", the worst)";
+  return s.str();
+}
 }
 
 namespace
@@ -278,16 +294,9 @@ std::string errorLine(vtkFieldData* statistics)
   {
     return {};
   }
-  vtkIdType worst = 0;
-  for (vtkIdType f = 1; f < p95->GetNumberOfTuples(); ++f)
-  {
-    worst = p95->GetComponent(f, 0) > p95->GetComponent(worst, 0) ? f : worst;
-  }
-  double medianOfWorst = median->GetComponent(worst, 0);
   const auto rounds = static_cast<long long>(value(statistics, "ErrorRounds"));
   std::ostringstream s;
-  s << std::setprecision(3) << "relative error of the lit elements: median " << 100 * medianOfWorst
-    << "%, p95 " << 100 * p95->GetComponent(worst, 0) << "% (frame " << worst << ", the worst)";
+  s << std::setprecision(3) << worstFrameText("elements", median, p95);
   const double target = value(statistics, "TargetRelativeError");
   if (target > 0)
   {
@@ -300,14 +309,7 @@ std::string errorLine(vtkFieldData* statistics)
   if (sensorP95 && sensorMedian && sensorP95->GetNumberOfTuples() > 0 &&
     sensorMedian->GetNumberOfTuples() == sensorP95->GetNumberOfTuples())
   {
-    vtkIdType frame = 0;
-    for (vtkIdType f = 1; f < sensorP95->GetNumberOfTuples(); ++f)
-    {
-      frame = sensorP95->GetComponent(f, 0) > sensorP95->GetComponent(frame, 0) ? f : frame;
-    }
-    s << "\nrelative error of the lit sensors: median "
-      << 100 * sensorMedian->GetComponent(frame, 0) << "%, p95 "
-      << 100 * sensorP95->GetComponent(frame, 0) << "% (frame " << frame << ", the worst)";
+    s << "\n" << worstFrameText("sensors", sensorMedian, sensorP95);
   }
   return s.str();
 }

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -59,6 +60,17 @@ V unit(const V& a)
   return scaled(a, 1 / std::sqrt(dot(a, a)));
 }
 
+/// Twice the area times the unit normal (Newell's method) of a polygon's corners.
+V areaVector(const std::vector<V>& corners)
+{
+  V sum{ 0, 0, 0 };
+  for (std::size_t i = 0; i < corners.size(); ++i)
+  {
+    sum = sum + cross(corners[i], corners[(i + 1) % corners.size()]);
+  }
+  return sum;
+}
+
 /// A polygon of the scene across up, seen along up: its corners (u along t, v along b).
 struct Face
 {
@@ -83,11 +95,6 @@ void checkSensorCount(double area, double spacing)
   }
 }
 
-/**
- * What rays through the scene say of a horizontal polygon's upper side: whether it sees one of
- * the lights (at most 16 of their positions, spread over the frames), and whether it is a roof
- * in the dark (nothing above it and no light in sight).
- */
 /// Faces sorted by level, grouped where consecutive levels are within `tolerance`: one floor
 /// each.
 std::vector<std::vector<Face>> levelsOf(const std::vector<Face>& sorted, double tolerance)
@@ -104,11 +111,85 @@ std::vector<std::vector<Face>> levelsOf(const std::vector<Face>& sorted, double 
   return levels;
 }
 
+/// The faces of one level in groups whose extents across up overlap or touch (within
+/// `tolerance`), directly or through others: a floor with its parts and what stands on it,
+/// apart from the next building's.
+std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, double tolerance)
+{
+  struct Extent
+  {
+    double uLo, uHi, vLo, vHi;
+  };
+  std::vector<Extent> extents;
+  for (const Face& face : level)
+  {
+    const auto [uLo, uHi] = std::minmax_element(face.us.begin(), face.us.end());
+    const auto [vLo, vHi] = std::minmax_element(face.vs.begin(), face.vs.end());
+    extents.push_back({ *uLo - tolerance, *uHi + tolerance, *vLo - tolerance, *vHi + tolerance });
+  }
+  std::vector<std::size_t> parent(level.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](std::size_t i)
+  {
+    while (parent[i] != i)
+    {
+      i = parent[i] = parent[parent[i]];
+    }
+    return i;
+  };
+  // A sweep along u: each face meets the faces whose u extent still reaches it.
+  std::vector<std::size_t> order(level.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+    [&](std::size_t i, std::size_t j) { return extents[i].uLo < extents[j].uLo; });
+  std::vector<std::size_t> reaching;
+  for (const std::size_t i : order)
+  {
+    const Extent& e = extents[i];
+    reaching.erase(std::remove_if(reaching.begin(), reaching.end(),
+                     [&](std::size_t j) { return extents[j].uHi < e.uLo; }),
+      reaching.end());
+    for (const std::size_t j : reaching)
+    {
+      if (extents[j].vLo <= e.vHi && e.vLo <= extents[j].vHi)
+      {
+        parent[root(j)] = root(i);
+      }
+    }
+    reaching.push_back(i);
+  }
+  std::vector<std::vector<Face>> groups;
+  std::vector<std::size_t> groupOfRoot(level.size(), level.size());
+  for (std::size_t i = 0; i < level.size(); ++i)
+  {
+    std::size_t& group = groupOfRoot[root(i)];
+    if (group == level.size())
+    {
+      group = groups.size();
+      groups.emplace_back();
+    }
+    groups[group].push_back(level[i]);
+  }
+  return groups;
+}
+
+/**
+ * What rays through the scene say of a horizontal polygon's upper side: whether it sees one of
+ * the lights (at most 16 of their positions, spread over the frames) or the sky, what lies
+ * straight below and above it, and whether it is a roof (nothing above it and, unless
+ * daylight lights the scene, no light in sight).
+ */
 class FloorFinder
 {
 public:
-  FloorFinder(vtkPolyData* scene, const std::vector<Triple>& lights, const V& up)
+  /// `t` and `b`: two axes across `up`, for the sky's directions.
+  FloorFinder(vtkPolyData* scene, const std::vector<Triple>& lights, bool daylight, const V& up,
+    const V& t, const V& b)
     : Up(up)
+    , T(t)
+    , B(b)
+    , Daylight(daylight)
+    , Scene(scene)
   {
     double bounds[6];
     scene->GetBounds(bounds);
@@ -116,6 +197,10 @@ public:
       (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) +
       (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
     this->Offset = 1e-6 * this->Size;
+    // VTK's polygons meet a line only where the intersection lies within this distance of
+    // them: at 0 a rounding error loses about one hit in twenty, and light leaks through
+    // closed walls.
+    this->Tolerance = 1e-9 * this->Size;
     const std::size_t count = std::min<std::size_t>(lights.size(), 16);
     for (std::size_t k = 0; k < count; ++k)
     {
@@ -133,14 +218,31 @@ public:
   /// lies under a polygon facing down at `point` (a shelf over the floor), which is no floor.
   bool litBelow(const V& point) const
   {
-    const V from = point - scaled(this->Up, this->Offset);
-    const V to = from - scaled(this->Up, 2 * this->Size + 1);
-    double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
-    double t = 0, x[3], pcoords[3];
-    int subId = 0;
-    vtkIdType cell = -1;
-    return this->Locator->IntersectWithLine(a, z, 0.0, t, x, pcoords, subId, cell) != 0 &&
-      this->seesALight({ x[0], x[1], x[2] });
+    V hit;
+    return this->firstBelow(point, hit) >= 0 && this->seesALight(hit);
+  }
+
+  /// Whether the first polygon below `point` faces up, towards it: then a polygon facing down
+  /// at `point` is a correctly oriented room's ceiling (or an underside over its floor), where
+  /// the sky, seen from above the ceiling, says nothing.
+  bool facedFromBelow(const V& point) const
+  {
+    V hit;
+    const vtkIdType cell = this->firstBelow(point, hit);
+    if (cell < 0)
+    {
+      return false;
+    }
+    vtkNew<vtkIdList> ids;
+    this->Scene->GetCellPoints(cell, ids);
+    std::vector<V> corners;
+    for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
+    {
+      double p[3];
+      this->Scene->GetPoint(ids->GetId(i), p);
+      corners.push_back({ p[0], p[1], p[2] });
+    }
+    return dot(areaVector(corners), this->Up) > 0;
   }
 
   /// Whether one of `cells` lies straight below `point`.
@@ -151,10 +253,36 @@ public:
     double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
     vtkNew<vtkIdList> hits;
     vtkNew<vtkGenericCell> cell;
-    this->Locator->IntersectWithLine(a, z, 0.0, nullptr, hits, cell);
+    this->Locator->IntersectWithLine(a, z, this->Tolerance, nullptr, hits, cell);
     for (vtkIdType i = 0; i < hits->GetNumberOfIds(); ++i)
     {
       if (cells.count(hits->GetId(i)))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Whether the sky is in sight from just above `point`, along one of SkyDirections
+  /// directions spread evenly over the hemisphere (a spiral of equal solid angles, from the
+  /// horizon to the zenith). The spiral of turn k is turned by k golden angles and its
+  /// heights shifted by k golden ratios: probes of one floor, with turns 0, 1, 2..., look
+  /// between one another's directions, towards an opening that one alone could miss.
+  bool seesTheSky(const V& point, std::size_t turn) const
+  {
+    const double goldenRatio = (std::sqrt(5.0) - 1) / 2;
+    const double goldenAngle = 2 * M_PI * (1 - goldenRatio);
+    const double shift = std::fmod(0.5 + goldenRatio * static_cast<double>(turn), 1.0);
+    const V from = this->above(point);
+    for (int i = 0; i < SkyDirections; ++i)
+    {
+      const double z = (i + shift) / SkyDirections;
+      const double r = std::sqrt(1 - z * z);
+      const double phi = goldenAngle * static_cast<double>(static_cast<std::size_t>(i) + turn);
+      const V direction = scaled(this->T, r * std::cos(phi)) + scaled(this->B, r * std::sin(phi)) +
+        scaled(this->Up, z);
+      if (!this->blocked(from, from + scaled(direction, 2 * this->Size + 1)))
       {
         return true;
       }
@@ -179,16 +307,34 @@ public:
     return false;
   }
 
-  /// Nothing above `point`, and no light in sight from it.
-  bool isDarkRoof(const V& point) const
+  /// Nothing above `point` and, under lights, no light in sight from it: a roof. Daylight
+  /// reaches a roof, and a room's own faces up under its roof have something above them.
+  bool isRoof(const V& point) const
   {
     const V from = this->above(point);
     return !this->blocked(from, from + scaled(this->Up, 2 * this->Size + 1)) &&
-      !this->seesALight(point);
+      (this->Daylight || !this->seesALight(point));
   }
 
 private:
   V above(const V& point) const { return point + scaled(this->Up, this->Offset); }
+
+  /// The first cell straight below `point` and where the line meets it; -1 when none.
+  vtkIdType firstBelow(const V& point, V& hit) const
+  {
+    const V from = point - scaled(this->Up, this->Offset);
+    const V to = from - scaled(this->Up, 2 * this->Size + 1);
+    double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
+    double t = 0, x[3], pcoords[3];
+    int subId = 0;
+    vtkIdType cell = -1;
+    if (this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) == 0)
+    {
+      return -1;
+    }
+    hit = { x[0], x[1], x[2] };
+    return cell;
+  }
 
   bool blocked(const V& from, const V& to) const
   {
@@ -196,12 +342,14 @@ private:
     double t = 0, x[3], pcoords[3];
     int subId = 0;
     vtkIdType cell = -1;
-    return this->Locator->IntersectWithLine(a, z, 0.0, t, x, pcoords, subId, cell) != 0;
+    return this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) != 0;
   }
 
-  V Up;
-  double Size = 0, Offset = 0;
+  V Up, T, B;
+  bool Daylight;
+  double Size = 0, Offset = 0, Tolerance = 0;
   std::vector<V> Lights;
+  vtkPolyData* Scene;
   vtkNew<vtkStaticCellLocator> Locator;
 };
 
@@ -221,7 +369,7 @@ bool inside(const std::vector<double>& us, const std::vector<double>& vs, double
 }
 
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& upGiven,
-  double height, double spacing, const std::vector<Triple>& lights)
+  double height, double spacing, const std::vector<Triple>& lights, bool daylight)
 {
   const V up = unit({ upGiven[0], upGiven[1], upGiven[2] });
   // The lattice's axes: the world axis least along up, made orthogonal to it, and up x it.
@@ -236,6 +384,7 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
   std::vector<Face> faces, facingDown;
   double area = 0;
   bool anyFacingDown = false;
+  bool floorsFacingDown = false;
   vtkCellArray* polys = scene->GetPolys();
   vtkNew<vtkIdList> ids;
   // Polygons come after the vertices and lines in a polydata's cell ids.
@@ -255,17 +404,12 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       scene->GetPoint(ids->GetId(i), p);
       corners.push_back({ p[0], p[1], p[2] });
     }
-    V newell{ 0, 0, 0 };
-    for (std::size_t i = 0; i < corners.size(); ++i)
-    {
-      const V c = cross(corners[i], corners[(i + 1) % corners.size()]);
-      newell = { newell.x + c.x, newell.y + c.y, newell.z + c.z };
-    }
+    const V newell = areaVector(corners);
     const double twiceArea = std::sqrt(dot(newell, newell));
     const bool facesUp = twiceArea > 0 && dot(newell, up) >= minimumCosine * twiceArea;
     const bool facesDown = twiceArea > 0 && -dot(newell, up) >= minimumCosine * twiceArea;
     anyFacingDown = anyFacingDown || facesDown;
-    if (!facesUp && !(facesDown && !lights.empty()))
+    if (!facesUp && !(facesDown && (daylight || !lights.empty())))
     {
       continue;
     }
@@ -288,7 +432,9 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     std::ostringstream s;
     s << "--work-plane: the scene has no polygon facing up (within " << WorkPlaneToleranceDegrees
       << " degrees of --up " << upGiven[0] << "," << upGiven[1] << "," << upGiven[2] << ")"
-      << (facingDown.empty() ? "" : ", nor one facing down that sees a light from above")
+      << (facingDown.empty() ? ""
+                             : (daylight ? ", nor one facing down that sees the sky from above"
+                                         : ", nor one facing down that sees a light from above"))
       << ": give a scene with floors whose normals point up, or --sensors";
     return InputError(s.str());
   };
@@ -342,32 +488,59 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
   if (!facingDown.empty())
   {
     // A floor whose normal points down (a room modelled with outward normals) is found by
-    // the lights it sees: its upper side, where the sensors go, sees a light; a correctly
-    // oriented room's ceilings and undersides see none from above.
-    const FloorFinder finder(scene, lights, up);
-    // Faces at one height are one floor: a part in shadow goes with the parts that see the
-    // light.
+    // the light it sees: its upper side, where the sensors go, sees a light or the sky. A
+    // correctly oriented room's ceilings and undersides see no light from above; the sky
+    // they may see, but they lie over the room's floor, which faces up at them.
+    const FloorFinder finder(scene, lights, daylight, up, t, b);
+    // Faces that touch at one height are one floor: a part in shadow goes with the parts
+    // that see the light; another building's floor at that height is decided by its own.
     std::sort(facingDown.begin(), facingDown.end(),
       [](const Face& f, const Face& g) { return f.level < g.level; });
     std::vector<Face> floors;
+    std::vector<std::vector<Face>> groups;
     for (const std::vector<Face>& level : levelsOf(facingDown, finder.levelTolerance()))
     {
-      double levelArea = 0;
-      for (const Face& face : level)
+      for (std::vector<Face>& group : touchingGroups(level, finder.levelTolerance()))
       {
-        levelArea += face.area;
-      }
-      // At most about 64 probes a level, and at least its lattice's points.
-      const double probeStep = std::max(spacing, std::sqrt(levelArea / 64));
-      const std::vector<Sensor> probes = lattice(level, probeStep);
-      if (std::any_of(probes.begin(), probes.end(),
-            [&](const Sensor& probe)
-            { return finder.seesALight(probe.point) && !finder.litBelow(probe.point); }))
-      {
-        floors.insert(floors.end(), level.begin(), level.end());
+        groups.push_back(std::move(group));
       }
     }
-    if (!floors.empty())
+    for (const std::vector<Face>& group : groups)
+    {
+      double groupArea = 0;
+      for (const Face& face : group)
+      {
+        groupArea += face.area;
+      }
+      // At most about 64 probes a group, and at least its lattice's points.
+      const double probeStep = std::max(spacing, std::sqrt(groupArea / 64));
+      const std::vector<Sensor> probes = lattice(group, probeStep);
+      bool floor = false;
+      if (daylight)
+      {
+        floor = std::none_of(probes.begin(), probes.end(),
+          [&](const Sensor& probe) { return finder.facedFromBelow(probe.point); });
+        const std::size_t stride = (probes.size() + SkyProbes - 1) / SkyProbes;
+        bool sky = false;
+        for (std::size_t k = 0; floor && !sky && k < probes.size(); k += stride)
+        {
+          sky = finder.seesTheSky(probes[k].point, k / stride);
+        }
+        floor = floor && sky;
+      }
+      else
+      {
+        floor = std::any_of(probes.begin(), probes.end(),
+          [&](const Sensor& probe)
+          { return finder.seesALight(probe.point) && !finder.litBelow(probe.point); });
+      }
+      if (floor)
+      {
+        floors.insert(floors.end(), group.begin(), group.end());
+      }
+    }
+    floorsFacingDown = !floors.empty();
+    if (floorsFacingDown)
     {
       double floorArea = 0;
       for (const Face& face : floors)
@@ -375,8 +548,8 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
         floorArea += face.area;
       }
       checkSensorCount(area + floorArea, spacing);
-      // Such a room's roof faces up: above it nothing, below it its floor, and no light
-      // reaches it.
+      // Such a room's roof faces up: above it nothing, below it its floor, and no lamp of
+      // the room reaches it.
       std::set<vtkIdType> floorCells;
       for (const Face& face : floors)
       {
@@ -384,10 +557,11 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       }
       for (Sensor& sensor : sensors)
       {
-        sensor.keep =
-          !(finder.isDarkRoof(sensor.point) && finder.standsOver(sensor.point, floorCells));
+        sensor.keep = !(finder.isRoof(sensor.point) && finder.standsOver(sensor.point, floorCells));
       }
       std::vector<Sensor> more;
+      std::stable_sort(floors.begin(), floors.end(),
+        [](const Face& f, const Face& g) { return f.level < g.level; });
       for (const std::vector<Face>& level : levelsOf(floors, finder.levelTolerance()))
       {
         // An object's underside on the floor adds nothing to the floor's lattice.
@@ -432,16 +606,17 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     above += w > top ? 1 : 0;
   }
   // Above a flat ground every sensor lies above the scene; over a closed room whose floor
-  // faces down, its roof's do.
-  if (anyFacingDown && points->GetNumberOfPoints() > 0 &&
+  // faces down and was not found, its roof's do.
+  if (anyFacingDown && !floorsFacingDown && points->GetNumberOfPoints() > 0 &&
     above == static_cast<std::size_t>(points->GetNumberOfPoints()))
   {
     std::ostringstream s;
     s << "--work-plane: every sensor lies above the scene, " << height
       << " above its polygons facing up (roofs?), while polygons facing down may be its floors: "
-      << (lights.empty() ? "under the sun or a sky the floors are the polygons facing up: turn "
-                           "the floors' normals up, or give --sensors"
-                         : "none of them sees a light from above: give --sensors");
+      << (daylight            ? "none of them sees the sky from above: give --sensors"
+             : lights.empty() ? "the floors are the polygons facing up: turn the floors' "
+                                "normals up, or give --sensors"
+                              : "none of them sees a light from above: give --sensors");
     printWarning(s.str());
   }
   auto result = vtkSmartPointer<vtkPolyData>::New();

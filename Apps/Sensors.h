@@ -17,26 +17,34 @@ namespace mlr::cli
 /// Faces whose normal is within this angle of up carry the work plane (degrees).
 constexpr double WorkPlaneToleranceDegrees = 5;
 
+/// Under daylight, a floor facing down looks for the sky from this many of its points, along
+/// this many directions from each: as many rays as under lights, from 64 points to 16 lights.
+constexpr std::size_t SkyProbes = 32;
+constexpr int SkyDirections = 32;
+
 /**
  * Sensors facing `up` at `height` above the scene's floors, on the lattice (i + 1/2)
  * `spacing`, (j + 1/2) `spacing` of two axes across `up` (x and y for a z up), at the lattice
  * points inside each floor polygon seen along `up`. Point array Normals.
  *
  * The floors are the polygons whose normal is within WorkPlaneToleranceDegrees of `up`. With
- * `lights` (where the lights are, for a scene not lit by the sun or a sky) the floors are
- * also found by geometry, as the solve is two-sided: the polygons within that angle of down
- * whose upper side sees a light and that have nothing lit straight below them (a room
- * modelled with outward normals), with every polygon facing down at their height; the
- * lattice then loses its points over the polygons facing up that have nothing above them,
- * see no light and stand over such a floor (that room's roof). A correctly oriented room's
- * polygons facing down (ceilings, undersides, a shelf over a lit floor) find no floor, and
- * its work plane is the one of the polygons facing up alone, as without `lights`. Warns when
- * every sensor lies above the scene while some polygon faces down. Throws InputError when no
- * polygon is a floor, and UsageError when the grid would have more sensors than a solve
- * accepts.
+ * `lights` (where the lights are) or `daylight` (the sun or a sky light the scene) the floors
+ * are also found by geometry, as the solve is two-sided: the polygons within that angle of
+ * down that touch one another at one height are the floor of a room modelled with outward
+ * normals when, under lights, one of their points sees a light from its upper side and has
+ * nothing lit straight below it, and under daylight, one of their points sees the sky (along
+ * one of SkyDirections directions from each of up to SkyProbes points) and none has a
+ * polygon facing up at it straight below; the lattice then loses its points over the
+ * polygons facing up that have nothing above them, stand over such a floor and, under
+ * lights, see no light (that room's roof). A correctly oriented room's polygons facing down
+ * (ceilings, undersides, a shelf over a lit floor) find no floor, and its work plane is the
+ * one of the polygons facing up alone, as without either. Warns when every sensor lies above
+ * the scene while some polygon faces down and no floor was found among them. Throws
+ * InputError when no polygon is a floor, and UsageError when the grid would have more
+ * sensors than a solve accepts.
  */
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& up, double height,
-  double spacing, const std::vector<Triple>& lights = {});
+  double spacing, const std::vector<Triple>& lights = {}, bool daylight = false);
 
 /// Writes the Sensors output of one frame (points as vertices and their arrays) to `path`,
 /// a .vtp file. Throws std::runtime_error when it cannot be written.

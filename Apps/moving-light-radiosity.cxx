@@ -610,7 +610,8 @@ int run(int argc, char** argv, RankJob& job)
   {
     sensors =
       workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1],
-        lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()));
+        lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()),
+        options.usesSun() || options.sky.has_value());
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);

@@ -124,8 +124,6 @@ Illuminances illuminances(const SensorSolution& s, const std::vector<WeatherFram
   {
     for (std::size_t f = 0; f < n; ++f)
     {
-      const auto luminance = [](const Rgb& e)
-      { return 0.2126 * e.r + 0.7152 * e.g + 0.0722 * e.b; };
       out.total[i * n + f] = efficacy[f] * luminance(s.irradiance(f, i));
       out.sun[i * n + f] = sunEfficacy[f] * luminance(s.sunIrradiance(f, i));
     }

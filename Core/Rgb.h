@@ -56,6 +56,12 @@ constexpr Rgb operator*(double s, const Rgb& c)
   return c * s;
 }
 
+/// Luminance of linear sRGB/Rec. 709 primaries: a luminous efficacy times it gives lumens.
+constexpr double luminance(const Rgb& c)
+{
+  return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
 /**
  * An RGB triplet stored in single precision, for results that are few (a sensor's per frame)
  * and compared with thresholds: seven significant digits. Arithmetic is done in Rgb; values

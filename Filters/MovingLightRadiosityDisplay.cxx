@@ -17,11 +17,6 @@
 namespace mlr::vtkoutputs
 {
 
-double luminance(const Rgb& rgb)
-{
-  return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b;
-}
-
 double acesFilmic(double x)
 {
   if (!(x > 0))

@@ -15,9 +15,6 @@ class vtkPointData;
 namespace mlr::vtkoutputs
 {
 
-/// Luminance of linear sRGB/Rec. 709 primaries.
-double luminance(const Rgb& rgb);
-
 /// The ACES filmic tone curve as fitted by K. Narkowicz (2015), per channel: maps an exposed
 /// linear value x >= 0 to [0, 1], x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped.
 double acesFilmic(double x);

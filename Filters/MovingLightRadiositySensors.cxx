@@ -108,10 +108,8 @@ vtkSmartPointer<vtkPolyData> sensorMesh(
   {
     for (std::size_t t = 0; t < count; ++t)
     {
-      illuminance[t] =
-        steps.efficacy[t] * vtkoutputs::luminance(solution.irradiance(steps.frame[t], i));
-      sun[t] =
-        steps.sunEfficacy[t] * vtkoutputs::luminance(solution.sunIrradiance(steps.frame[t], i));
+      illuminance[t] = steps.efficacy[t] * luminance(solution.irradiance(steps.frame[t], i));
+      sun[t] = steps.sunEfficacy[t] * luminance(solution.sunIrradiance(steps.frame[t], i));
     }
     const DaylightMetrics m = daylightMetrics(
       illuminance.data(), sun.data(), count, steps.autonomyThreshold, steps.hoursPerStep);
@@ -142,8 +140,7 @@ void addSensorArrays(
     {
       const Rgb e = (solution.*value)(frame, i);
       vtkoutputs::setRgb(rgb, i, e);
-      lux->SetValue(
-        static_cast<vtkIdType>(i), static_cast<float>(efficacy * vtkoutputs::luminance(e)));
+      lux->SetValue(static_cast<vtkIdType>(i), static_cast<float>(efficacy * luminance(e)));
     }
     pointData->AddArray(rgb);
     pointData->AddArray(lux);

@@ -5,6 +5,7 @@
 #include "MovingLightRadiosityOutputs.h"
 #include "MovingLightRadiosityParallel.h"
 #include "MovingLightRadiositySensors.h"
+#include "ProgressForwarder.h"
 
 #include "Animation.h"
 #include "Error.h"
@@ -32,7 +33,6 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
-#include "vtkProgressObserver.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
@@ -141,31 +141,6 @@ struct vtkMovingLightRadiosity::vtkInternals
   bool OutputsLight = true;
 };
 
-namespace
-{
-/// Hands every progress report to a function: VTK's executive calls UpdateProgress(1.0) after
-/// RequestData whether the update was aborted or not, and UpdateProgress is not virtual, so
-/// the observer is the one place where the filter can drop it.
-class ProgressForwarder : public vtkProgressObserver
-{
-public:
-  static ProgressForwarder* New()
-  {
-    auto* result = new ProgressForwarder;
-    result->InitializeObjectBase();
-    return result;
-  }
-  void UpdateProgress(double amount) override
-  {
-    if (this->Report)
-    {
-      this->Report(amount);
-    }
-  }
-  std::function<void(double)> Report;
-};
-}
-
 vtkStandardNewMacro(vtkMovingLightRadiosity);
 
 //------------------------------------------------------------------------------
@@ -220,7 +195,7 @@ vtkMovingLightRadiosity::vtkMovingLightRadiosity()
 
   this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(4);
-  vtkNew<ProgressForwarder> progress;
+  vtkNew<mlr::ProgressForwarder> progress;
   progress->Report = [this](double amount) { this->ReportProgress(amount); };
   this->SetProgressObserver(progress);
 }
@@ -726,7 +701,7 @@ mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour,
   {
     return colour;
   }
-  const double luminance = 0.2126 * colour.r + 0.7152 * colour.g + 0.0722 * colour.b;
+  const double luminance = mlr::luminance(colour);
   if (!(luminance > 0))
   {
     std::ostringstream message;

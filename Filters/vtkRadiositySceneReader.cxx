@@ -1,11 +1,13 @@
 #include "vtkRadiositySceneReader.h"
 
+#include "ProgressForwarder.h"
 #include "RadiositySceneFormats.h"
 
 #include "MemoryBudget.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
+#include "vtkCommand.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
@@ -61,6 +63,21 @@ vtkSmartPointer<vtkStringArray> stringField(const char* name, const std::string&
 vtkRadiositySceneReader::vtkRadiositySceneReader()
 {
   this->SetNumberOfInputPorts(0);
+  vtkNew<mlr::ProgressForwarder> progress;
+  progress->Report = [this](double amount) { this->ReportProgress(amount); };
+  this->SetProgressObserver(progress);
+}
+
+//------------------------------------------------------------------------------
+void vtkRadiositySceneReader::ReportProgress(double amount)
+{
+  // Nothing past an abort: neither the reading's last reports nor the executive's 1.0.
+  if (this->ProgressStopped || this->AbortExecute)
+  {
+    return;
+  }
+  this->Progress = amount;
+  this->InvokeEvent(vtkCommand::ProgressEvent, &amount);
 }
 
 //------------------------------------------------------------------------------
@@ -91,18 +108,21 @@ const char* vtkRadiositySceneReader::GetFileExtensions()
 }
 
 //------------------------------------------------------------------------------
+int vtkRadiositySceneReader::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // The executive asks for the update extent before every execution, and before its progress
+  // of 0: an abort silences the update it stopped, not the next one.
+  this->ProgressStopped = false;
+  return this->Superclass::RequestUpdateExtent(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
 int vtkRadiositySceneReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector);
   output->Initialize();
-  if (this->Aborted)
-  {
-    // The flag that stopped the last update would stop this one at once (see
-    // vtkAlgorithm::CheckAbort): an update after an abort reads again.
-    this->AbortExecute = 0;
-    this->Aborted = false;
-  }
   if (!this->FileName || !*this->FileName)
   {
     vtkErrorMacro(<< "no FileName: give an .obj, .gltf, .glb or .ply scene file");
@@ -155,7 +175,11 @@ int vtkRadiositySceneReader::RequestData(
   }
   catch (const sf::Aborted&)
   {
-    this->Aborted = true;
+    // The flag that stopped this update would stop the next one at once (see
+    // vtkAlgorithm::CheckAbort), and this VTK's executive does not clear it: an update after
+    // an abort reads again, and one aborted before it starts stops.
+    this->AbortExecute = 0;
+    this->ProgressStopped = true;
     vtkErrorMacro(<< "reading '" << path << "' was aborted");
     return 0;
   }
@@ -235,5 +259,6 @@ void vtkRadiositySceneReader::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB (0: half of physical memory)\n";
-  os << indent << "Aborted: " << (this->Aborted ? "yes" : "no") << "\n";
+  os << indent << "Progress reports: " << (this->ProgressStopped ? "stopped by an abort" : "on")
+     << "\n";
 }

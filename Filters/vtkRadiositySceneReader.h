@@ -54,7 +54,11 @@
  * Bad input (a missing, unreadable or malformed file, an unknown extension, a file without
  * faces or triangles) gives an error naming the file and what is wrong, and an empty output.
  * Progress is reported through UpdateProgress; AbortExecute stops the reading with an empty
- * output.
+ * output and an error, and clears the flag. As in vtkMovingLightRadiosity, an aborted update
+ * reports no progress after the abort, not even the 1.0 VTK's executive reports at the end of
+ * every execution (which ParaView shows as a finished update): the progress goes through the
+ * reader's own vtkProgressObserver, and a ProgressEvent past an abort is dropped. Replacing
+ * that observer with SetProgressObserver replaces this too.
  *
  * @sa
  * vtkMovingLightRadiosity
@@ -111,16 +115,21 @@ protected:
   vtkRadiositySceneReader();
   ~vtkRadiositySceneReader() override;
 
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
   vtkRadiositySceneReader(const vtkRadiositySceneReader&) = delete;
   void operator=(const vtkRadiositySceneReader&) = delete;
 
+  /// Every UpdateProgress ends here (the reader's vtkProgressObserver): a ProgressEvent,
+  /// unless this update was aborted.
+  void ReportProgress(double amount);
+
   char* FileName = nullptr;
   int MemoryLimit = 0;
-  /// The last update stopped on AbortExecute, which this VTK does not clear by itself.
-  bool Aborted = false;
+  /// This update was aborted: nothing more is reported until the next one starts.
+  bool ProgressStopped = false;
 };
 
 #endif

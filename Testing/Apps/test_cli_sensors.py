@@ -17,7 +17,7 @@ import xml.etree.ElementTree as ElementTree
 import numpy
 import pytest
 
-from test_cli_rigs_and_sun import Polygons, run
+from test_cli_rigs_and_sun import Polygons, run, write_points
 
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints
@@ -282,6 +282,56 @@ def test_work_plane_finds_the_floor_of_a_room_with_outward_normals(tmp_path):
             vtk_to_numpy(b.GetPoints().GetData()), abs=1e-12)
         assert numpy.allclose(array(a, "Normals"), [0, 0, 1])
         assert numpy.all(array(a, "Illuminance") > 0)
+
+
+def write_windowed_room(directory, outward):
+    """The room of write_room closed by a ceiling, with a 1 x 1 window (x in [1, 2], z in
+    [1, 2]) in its wall y = 0, its normals inward or outward."""
+    room = Polygons()
+
+    def add(inward_corners):
+        room.add(inward_corners[::-1] if outward else inward_corners)
+
+    add([(0, 0, 0), (W, 0, 0), (W, D, 0), (0, D, 0)])              # floor
+    add([(0, 0, H), (0, D, H), (W, D, H), (W, 0, H)])              # ceiling
+    add([(0, 0, 0), (0, D, 0), (0, D, H), (0, 0, H)])              # x = 0
+    add([(W, 0, 0), (W, 0, H), (W, D, H), (W, D, 0)])              # x = W
+    add([(0, D, 0), (W, D, 0), (W, D, H), (0, D, H)])              # y = D
+    for x0, x1, z0, z1 in ((0, 1, 0, H), (2, W, 0, H), (1, 2, 0, 1), (1, 2, 2, H)):
+        add([(x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0)])  # y = 0, around the window
+    return room.write(directory / ("outward.vtp" if outward else "inward.vtp"))
+
+
+@pytest.mark.parametrize("daylight", ["sky", "sun"])
+def test_work_plane_under_daylight_does_not_depend_on_the_normals(tmp_path, daylight):
+    """The solve is two-sided, so a room with a window modelled with outward normals is lit
+    as the same room with inward ones, under the sky as under the sun through its window.
+    Under daylight its work plane was 0.8 above its roof, in full daylight (polygons facing
+    down were not looked at): it is the same grid over its floor, with the same illuminance
+    within the noise."""
+    light = (["--sky", "uniform", "--sky-diffuse-horizontal", str(EDH)] if daylight == "sky"
+             else ["--sun-directions",
+                   write_points(tmp_path / "sun.vtp", [(0, -1, 1), (0.3, -1, 0.8)])])
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_windowed_room(tmp_path, outward), "--work-plane",
+                      f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd", "--paths", "200000",
+                      "--threads", "2", "--patch-size", "0.25"] + light, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")
+    assert len(frames["inward"]) == len(frames["outward"]) == (1 if daylight == "sky" else 2)
+    for (_, inward), (_, outward) in zip(frames["inward"], frames["outward"]):
+        assert inward.GetNumberOfPoints() == outward.GetNumberOfPoints() == 24
+        points = vtk_to_numpy(outward.GetPoints().GetData())
+        assert points == pytest.approx(vtk_to_numpy(inward.GetPoints().GetData()), abs=1e-12)
+        assert numpy.allclose(points[:, 2], HEIGHT)
+        a, b = array(inward, "Illuminance"), array(outward, "Illuminance")
+        sigma = numpy.hypot(array(inward, "IlluminanceStdError"),
+                            array(outward, "IlluminanceStdError"))
+        assert numpy.all(a > 0) and numpy.all(b > 0)
+        assert numpy.all(numpy.abs(a - b) <= 5 * sigma + 1e-6 * a), numpy.abs(a - b) / sigma
 
 
 def test_work_plane_follows_up(tmp_path):

@@ -3,6 +3,7 @@
 #include "GeneratedScenes.h"
 
 #include "vtkAlgorithm.h"
+#include "vtkCallbackCommand.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -192,6 +193,34 @@ std::string MessageRecorder::allWarnings() const
     all += w + "\n";
   }
   return all;
+}
+
+void logProgress(vtkAlgorithm* algorithm, ProgressLog& log, vtkCallbackCommand* command)
+{
+  command->SetClientData(&log);
+  command->SetCallback(
+    [](vtkObject* caller, unsigned long, void* data, void* amount)
+    {
+      auto* self = static_cast<ProgressLog*>(data);
+      self->values.push_back(*static_cast<double*>(amount));
+      if (!self->aborted && self->values.back() > self->threshold)
+      {
+        self->aborted = true;
+        self->abortedAfter = self->values.size();
+        static_cast<vtkAlgorithm*>(caller)->AbortExecuteOn();
+      }
+    });
+  algorithm->AddObserver(vtkCommand::ProgressEvent, command);
+}
+
+std::string listed(const std::vector<double>& values, std::size_t from)
+{
+  std::string text;
+  for (std::size_t i = from; i < values.size(); ++i)
+  {
+    text += (i > from ? ", " : "") + std::to_string(values[i]);
+  }
+  return text;
 }
 
 } // namespace mlr::testing

@@ -7,11 +7,13 @@
 #include "vtkCommand.h"
 #include "vtkSmartPointer.h"
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 class vtkAlgorithm;
+class vtkCallbackCommand;
 class vtkDataObject;
 class vtkMovingLightRadiosity;
 class vtkPolyData;
@@ -85,5 +87,22 @@ public:
   std::string allErrors() const;
   std::string allWarnings() const;
 };
+
+/// Every progress value an algorithm reports, and where in them an abort was asked for: at the
+/// first value past `threshold`, as a ParaView progress observer or a user pressing Stop.
+struct ProgressLog
+{
+  double threshold = 2.0; // above any progress: no abort unless set
+  std::vector<double> values;
+  std::size_t abortedAfter = 0; // values reported before the abort, the one asking included
+  bool aborted = false;
+};
+
+/// Logs `algorithm`'s ProgressEvents into `log` through `command` (which sets AbortExecute at
+/// the threshold).
+void logProgress(vtkAlgorithm* algorithm, ProgressLog& log, vtkCallbackCommand* command);
+
+/// `values` from index `from` on, separated by commas, for assertion messages.
+std::string listed(const std::vector<double>& values, std::size_t from);
 
 } // namespace mlr::testing

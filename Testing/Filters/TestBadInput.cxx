@@ -351,47 +351,6 @@ TEST(FilterBadInput, AnAbortHoldsUntilAPropertyChanges)
   EXPECT_EQ(filter->GetSolveCount(), 1);
 }
 
-namespace
-{
-/// Every progress value the filter reports, and where in them an abort was asked for: at the
-/// first value past `threshold`, as a ParaView progress observer or a user pressing Stop.
-struct ProgressLog
-{
-  double threshold = 2.0; // above any progress: no abort unless set
-  std::vector<double> values;
-  std::size_t abortedAfter = 0; // values reported before the abort, the one asking included
-  bool aborted = false;
-};
-
-void logProgress(vtkMovingLightRadiosity* filter, ProgressLog& log, vtkCallbackCommand* command)
-{
-  command->SetClientData(&log);
-  command->SetCallback(
-    [](vtkObject* caller, unsigned long, void* data, void* amount)
-    {
-      auto* self = static_cast<ProgressLog*>(data);
-      self->values.push_back(*static_cast<double*>(amount));
-      if (!self->aborted && self->values.back() > self->threshold)
-      {
-        self->aborted = true;
-        self->abortedAfter = self->values.size();
-        static_cast<vtkAlgorithm*>(caller)->AbortExecuteOn();
-      }
-    });
-  filter->AddObserver(vtkCommand::ProgressEvent, command);
-}
-
-std::string listed(const std::vector<double>& values, std::size_t from)
-{
-  std::string text;
-  for (std::size_t i = from; i < values.size(); ++i)
-  {
-    text += (i > from ? ", " : "") + std::to_string(values[i]);
-  }
-  return text;
-}
-}
-
 TEST(FilterBadInput, NoProgressIsReportedAfterAnAbort)
 {
   // VTK's executive reports 1.0 at the end of every execution, aborted or not, which ParaView

@@ -2,6 +2,7 @@
 // the same reflectances from every format, and bad input with an error naming the file.
 #include "FilterTestSupport.h"
 
+#include "vtkCallbackCommand.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkExecutive.h"
@@ -1107,6 +1108,76 @@ TEST(SceneReader, AbortGivesAnEmptyOutputAndTheNextUpdateReads)
   reader->Modified();
   reader->Update();
   EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 4);
+}
+
+/// An n x n grid of unit quads at z = 0 without materials: about 2 n^2 lines, so that the
+/// reader reports progress on the way (every 65,536 lines).
+std::string gridObj(int n)
+{
+  std::string text;
+  for (int j = 0; j <= n; ++j)
+  {
+    for (int i = 0; i <= n; ++i)
+    {
+      text += "v " + std::to_string(i) + " " + std::to_string(j) + " 0\n";
+    }
+  }
+  for (int j = 0; j < n; ++j)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      const int corner = j * (n + 1) + i + 1; // OBJ counts from 1
+      text += "f " + std::to_string(corner) + " " + std::to_string(corner + 1) + " " +
+        std::to_string(corner + n + 2) + " " + std::to_string(corner + n + 1) + "\n";
+    }
+  }
+  return text;
+}
+
+TEST(SceneReader, NoProgressIsReportedAfterAnAbort)
+{
+  // As for the filter (FilterBadInput.NoProgressIsReportedAfterAnAbort): VTK's executive
+  // reports 1.0 at the end of every execution, aborted or not, which ParaView shows as a
+  // finished read.
+  const TestFolder scratch("abort-progress");
+  const fs::path file = scratch.path / "grid.obj";
+  writeFile(file, gridObj(400));
+  auto reader = vtkSmartPointer<vtkRadiositySceneReader>::New();
+  reader->SetFileName(file.string().c_str());
+  ProgressLog log;
+  log.threshold = 0.2;
+  vtkNew<vtkCallbackCommand> command;
+  logProgress(reader, log, command);
+  auto messages = vtkSmartPointer<MessageRecorder>::New();
+  messages->watch(reader);
+  reader->Update();
+  ASSERT_TRUE(log.aborted) << listed(log.values, 0);
+  EXPECT_EQ(log.values.size(), log.abortedAfter)
+    << "reported after the abort: " << listed(log.values, log.abortedAfter);
+  for (double value : log.values)
+  {
+    EXPECT_LT(value, 1.0) << listed(log.values, 0);
+  }
+  EXPECT_NE(messages->allErrors().find("aborted"), std::string::npos) << messages->allErrors();
+  EXPECT_DOUBLE_EQ(reader->GetProgress(), log.values.back());
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+
+  // An abort asked for before the update stops it before anything is reported.
+  log.values.clear();
+  reader->SetAbortExecute(1);
+  reader->Update();
+  EXPECT_TRUE(log.values.empty()) << listed(log.values, 0);
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+
+  // A read that runs to its end still reports its progress from 0 to 1.0.
+  reader->Modified();
+  log.values.clear();
+  reader->Update();
+  ASSERT_FALSE(log.values.empty());
+  EXPECT_EQ(log.values.front(), 0.0);
+  EXPECT_EQ(log.values.back(), 1.0);
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 400 * 400);
+  reader->RemoveAllObservers();
 }
 
 // --- Bad input: an error naming the file and what is wrong, an empty output -------------------
