@@ -579,8 +579,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   {
     warnings.push_back("the chunk overlap of " + std::to_string(options.chunkOverlap) +
       " frames is more than half of the " + std::to_string(plan.framesPerChunk) +
-      " frames per chunk the memory limit allows: each seam blends over " +
-      std::to_string(plan.overlap) +
+      " frames per chunk chosen: each seam blends over " + std::to_string(plan.overlap) +
       " frames on each side (give longer chunks, or more memory, for more)");
   }
   // The estimate of the frames around the seam before this rank's next chunk, which that

@@ -5,6 +5,7 @@
 #include "Chunks.h"
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
+#include "MemoryPlan.h"
 #include "ThreadRanks.h"
 
 #include <gtest/gtest.h>
@@ -279,10 +280,28 @@ TEST(Chunks, AnOverlapAskedForBlendsEachSeamOverItsFrames)
   EXPECT_EQ(planChunks(100, 30, 0).overlap, 3u);
   EXPECT_EQ(planChunks(100, 30, 1).overlap, 1u);
 
+  // The memory check counts the longer overlap's positions.
+  {
+    const Scene scene = box();
+    SolverOptions wide;
+    wide.chunkOverlap = 15;
+    auto estimate = [&](const SolverOptions& o)
+    {
+      return estimateChunkedMemory(
+        scene.patchCount(), scene.elementCount(), scene.points().size(), 300, 30, o, 1, 0, true);
+    };
+    EXPECT_GT(estimate(wide), estimate(SolverOptions()));
+  }
+
   SolverOptions o;
   o.framesPerChunk = 30;
   o.chunkOverlap = 15;
   validateOptions(o);
+  o.framesPerChunk = 3;
+  o.chunkOverlap = 1;
+  validateOptions(o);
+  o.chunkOverlap = 2;
+  checks::expectError([&] { validateOptions(o); }, "more than half of the 3 frames per chunk");
   o.chunkOverlap = 16;
   checks::expectError([&] { validateOptions(o); }, "chunk overlap is 16 frames, more than half");
 
