@@ -1162,12 +1162,16 @@ TEST(SceneReader, NoProgressIsReportedAfterAnAbort)
   EXPECT_DOUBLE_EQ(reader->GetProgress(), log.values.back());
   EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
 
-  // An abort asked for before the update stops it before anything is reported.
+  // An abort asked for before the update stops it before anything is reported: the update
+  // runs (the reader is modified) and fails as aborted again.
   log.values.clear();
+  messages->errors.clear();
+  reader->Modified();
   reader->SetAbortExecute(1);
   reader->Update();
   EXPECT_TRUE(log.values.empty()) << listed(log.values, 0);
   EXPECT_EQ(reader->GetOutput()->GetNumberOfCells(), 0);
+  EXPECT_NE(messages->allErrors().find("aborted"), std::string::npos) << messages->allErrors();
 
   // A read that runs to its end still reports its progress from 0 to 1.0.
   reader->Modified();
