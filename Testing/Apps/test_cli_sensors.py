@@ -133,13 +133,19 @@ def test_work_plane_under_the_sky_gives_the_grid_and_its_illuminance(tmp_path):
     assert sensors.GetFieldData().GetArray("SensorGatheringRays").GetValue(0) == 24 * 64
 
 
-def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
+def moving_lamp_args(tmp_path):
+    """The closed room with a lamp moving over 3 frames and three sensors (two on the work
+    plane, one on the wall at x = 2.9 facing in)."""
     points = [(1.5, 1.0, 0.8), (0.5, 0.5, 0.8), (2.9, 1.0, 1.2)]
     normals = [(0, 0, 1), (0, 0, 1), (-1, 0, 0)]
-    args = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
+    return ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
             "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--frames", "3",
             "--sensors", write_sensors(tmp_path, points, normals),
             "--output", "out/room.pvd"] + FAST
+
+
+def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
+    args = moving_lamp_args(tmp_path)
     result = run(args, tmp_path)
     assert result.returncode == 0, result.stderr
     frames = read_sensor_series(tmp_path)
@@ -160,12 +166,7 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
     # The default 16 error batches: every frame's sensors have IrradianceStdError (RGB) and
     # IlluminanceStdError, the summary a line for the lit sensors, and --stats their figures
     # per frame; with one batch none of them.
-    points = [(1.5, 1.0, 0.8), (0.5, 0.5, 0.8), (2.9, 1.0, 1.2)]
-    normals = [(0, 0, 1), (0, 0, 1), (-1, 0, 0)]
-    args = ["--scene", write_room(tmp_path, ceiling=True), "--light", write_lamp(tmp_path),
-            "--from", "1.5,1,2.4", "--to", "1,0.8,2.4", "--frames", "3",
-            "--sensors", write_sensors(tmp_path, points, normals),
-            "--output", "out/room.pvd"] + FAST
+    args = moving_lamp_args(tmp_path)
     stats = tmp_path / "stats.json"
     result = run(args + ["--stats", str(stats)], tmp_path)
     assert result.returncode == 0, result.stderr
