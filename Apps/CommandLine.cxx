@@ -5,6 +5,8 @@
 
 #include "vtkMovingLightRadiosity.h"
 
+#include "Chunks.h"
+
 #include <vtk_cli11.h>
 
 #include <cctype>
@@ -870,25 +872,21 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.framesPerChunk)
   {
-    if (*o.framesPerChunk == 1)
-    {
-      throw UsageError("--frames-per-chunk is 1: give 0 (the memory limit chooses) or at least "
-                       "2, so that the blends at a chunk's two seams do not overlap");
-    }
     checkPropertyRange<long long>("--frames-per-chunk", *o.framesPerChunk, "FramesPerChunk");
     filter->SetFramesPerChunk(static_cast<int>(*o.framesPerChunk));
   }
   if (o.chunkOverlap)
   {
     checkPropertyRange<long long>("--chunk-overlap", *o.chunkOverlap, "ChunkOverlap");
-    if (o.framesPerChunk && *o.framesPerChunk > 0 && *o.chunkOverlap > *o.framesPerChunk / 2)
-    {
-      throw UsageError("--chunk-overlap " + std::to_string(*o.chunkOverlap) +
-        " is more than half of --frames-per-chunk " + std::to_string(*o.framesPerChunk) +
-        ": give 0 (an eighth of a chunk) or at most " + std::to_string(*o.framesPerChunk / 2) +
-        ", so that the blends at a chunk's two seams do not overlap");
-    }
     filter->SetChunkOverlap(static_cast<int>(*o.chunkOverlap));
+  }
+  if (const std::string problem =
+        mlr::chunkSettingsProblem(static_cast<std::uint64_t>(o.framesPerChunk.value_or(0)),
+          static_cast<std::uint64_t>(o.chunkOverlap.value_or(0)), "--frames-per-chunk",
+          "--chunk-overlap");
+      !problem.empty())
+  {
+    throw UsageError(problem);
   }
   if (o.paths && *o.paths < o.errorBatches.value_or(filter->GetErrorBatches()))
   {

@@ -17,6 +17,25 @@
 namespace mlr
 {
 
+std::string chunkSettingsProblem(std::uint64_t framesPerChunk, std::uint64_t overlap,
+  const std::string& framesPerChunkName, const std::string& overlapName)
+{
+  const std::string why = ", so that the blends at a chunk's two seams do not overlap";
+  if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk)
+  {
+    return framesPerChunkName + " is " + std::to_string(framesPerChunk) +
+      ": give 0 (the memory limit chooses) or at least " + std::to_string(MinimumFramesPerChunk) +
+      why;
+  }
+  if (framesPerChunk != 0 && overlap > framesPerChunk / 2)
+  {
+    return overlapName + " is " + std::to_string(overlap) + ", more than half of " +
+      framesPerChunkName + " (" + std::to_string(framesPerChunk) +
+      "): give 0 (an eighth of a chunk) or at most " + std::to_string(framesPerChunk / 2) + why;
+  }
+  return {};
+}
+
 std::size_t chunkOverlap(std::size_t framesPerChunk, std::uint64_t asked)
 {
   const std::size_t m = asked == 0
@@ -27,10 +46,12 @@ std::size_t chunkOverlap(std::size_t framesPerChunk, std::uint64_t asked)
 
 ChunkPlan planChunks(std::size_t frames, std::size_t framesPerChunk, std::uint64_t overlap)
 {
-  if (framesPerChunk != 0 && framesPerChunk < MinimumFramesPerChunk && framesPerChunk < frames)
+  // The overlap is cut to half a chunk below, as when the memory limit chooses the length.
+  if (const std::string problem =
+        chunkSettingsProblem(framesPerChunk, 0, "the chunk length", "the chunk overlap");
+      !problem.empty() && framesPerChunk < frames)
   {
-    throw Error("the frames per chunk are " + std::to_string(framesPerChunk) +
-      ": give 0 (the memory limit chooses) or at least " + std::to_string(MinimumFramesPerChunk));
+    throw Error(problem);
   }
   ChunkPlan plan;
   plan.frames = frames;

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace mlr
@@ -20,6 +21,14 @@ namespace mlr
 /// The fewest frames a chunk may have: with fewer, the blends of a chunk's two seams would
 /// overlap.
 constexpr std::size_t MinimumFramesPerChunk = 2;
+
+/// Why a chunk length and an overlap asked for cannot be used, empty when they can: a chunk of
+/// 1 frame, or an overlap above half a chunk, would let the blends at a chunk's two seams
+/// overlap. A length of 0 (the memory limit chooses) passes with any overlap, which is cut to
+/// half the length chosen. The message names the setting with the caller's names (an option,
+/// a property) so that it says what to fix.
+std::string chunkSettingsProblem(std::uint64_t framesPerChunk, std::uint64_t overlap,
+  const std::string& framesPerChunkName, const std::string& overlapName);
 
 /// The positions a chunk of C frames solves beyond its own frames on each side: `asked`
 /// (SolverOptions::chunkOverlap) cut to C / 2, or C / 8 for 0; at least 1.

@@ -1,5 +1,6 @@
 #include "Solver.h"
 
+#include "Chunks.h"
 #include "Error.h"
 #include "ErrorEstimate.h"
 #include "Gathering.h"
@@ -166,18 +167,11 @@ void validateOptions(const SolverOptions& options)
   {
     throw Error("the storage scale must be 0 (from the scene and its lights) or positive");
   }
-  if (options.framesPerChunk == 1)
+  if (const std::string problem = chunkSettingsProblem(
+        options.framesPerChunk, options.chunkOverlap, "framesPerChunk", "chunkOverlap");
+      !problem.empty())
   {
-    throw Error("the frames per chunk are 1: give 0 (the memory limit chooses) or at least 2, "
-                "so that the blends at a chunk's two seams do not overlap");
-  }
-  if (options.framesPerChunk > 0 && options.chunkOverlap > options.framesPerChunk / 2)
-  {
-    throw Error("the chunk overlap is " + std::to_string(options.chunkOverlap) +
-      " frames, more than half of the " + std::to_string(options.framesPerChunk) +
-      " frames per chunk: give 0 (an eighth of a chunk) or at most " +
-      std::to_string(options.framesPerChunk / 2) +
-      ", so that the blends at a chunk's two seams do not overlap");
+    throw Error("the option " + problem);
   }
   if (options.chunkOverlap > MaximumChunkOverlap)
   {

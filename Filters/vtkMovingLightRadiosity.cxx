@@ -8,6 +8,7 @@
 #include "ProgressForwarder.h"
 
 #include "Animation.h"
+#include "Chunks.h"
 #include "Error.h"
 #include "LuminaireTilt.h"
 #include "MovingLight.h"
@@ -402,20 +403,9 @@ std::string propertyOutOfRange(vtkMovingLightRadiosity* self)
       return std::string(range.name) + " is " + format(value) + ": give " + range.give;
     }
   }
-  if (self->GetFramesPerChunk() == 1)
-  {
-    return "FramesPerChunk is 1: give 0 (MemoryLimit chooses) or at least 2, so that the "
-           "blends at a chunk's two seams do not overlap";
-  }
-  if (self->GetFramesPerChunk() > 0 && self->GetChunkOverlap() > self->GetFramesPerChunk() / 2)
-  {
-    return "ChunkOverlap is " + std::to_string(self->GetChunkOverlap()) +
-      ", more than half of FramesPerChunk (" + std::to_string(self->GetFramesPerChunk()) +
-      "): give 0 (an eighth of a chunk) or at most " +
-      std::to_string(self->GetFramesPerChunk() / 2) +
-      ", so that the blends at a chunk's two seams do not overlap";
-  }
-  return {};
+  // The ranges above make both counts non-negative.
+  return mlr::chunkSettingsProblem(static_cast<std::uint64_t>(self->GetFramesPerChunk()),
+    static_cast<std::uint64_t>(self->GetChunkOverlap()), "FramesPerChunk", "ChunkOverlap");
 }
 
 /**

@@ -80,7 +80,8 @@ def test_chunk_overlap_solves_more_positions_and_is_reported(tmp_path):
 def test_chunk_overlap_over_half_a_chunk_is_refused(tmp_path):
     result = run(["--frames-per-chunk", "4", "--chunk-overlap", "3"], tmp_path)
     assert result.returncode == 2
-    assert "--chunk-overlap 3 is more than half of --frames-per-chunk 4: give 0" in result.stderr
+    assert "--chunk-overlap is 3, more than half of --frames-per-chunk (4): give 0 (an " \
+        "eighth of a chunk) or at most 2" in result.stderr
     assert all_files(tmp_path) == []
     negative = run(["--chunk-overlap", "-1"], tmp_path)
     assert negative.returncode == 2

@@ -95,10 +95,11 @@ TEST(Chunks, PlanCoversEveryFrameWithWeightsSummingToOne)
   EXPECT_EQ(planChunks(30, 30).chunks.size(), 1u);
   EXPECT_EQ(planChunks(30, 100).chunks.size(), 1u);
   EXPECT_EQ(planChunks(1, 1).chunks.size(), 1u); // a static scene: one frame, one chunk
-  checks::expectError([] { planChunks(30, 1); }, "at least 2");
+  checks::expectError([] { planChunks(30, 1); }, "the chunk length is 1: give 0");
   SolverOptions o;
   o.framesPerChunk = 1;
-  checks::expectError([&] { validateOptions(o); }, "frames per chunk");
+  checks::expectError([&] { validateOptions(o); },
+    "the option framesPerChunk is 1: give 0 (the memory limit chooses) or at least 2");
 }
 
 TEST(Chunks, SlicedRigKeepsThePosesOfItsFrames)
@@ -301,9 +302,11 @@ TEST(Chunks, AnOverlapAskedForBlendsEachSeamOverItsFrames)
   o.chunkOverlap = 1;
   validateOptions(o);
   o.chunkOverlap = 2;
-  checks::expectError([&] { validateOptions(o); }, "more than half of the 3 frames per chunk");
+  checks::expectError([&] { validateOptions(o); },
+    "the option chunkOverlap is 2, more than half of framesPerChunk (3): give 0 (an eighth of a "
+    "chunk) or at most 1");
   o.chunkOverlap = 16;
-  checks::expectError([&] { validateOptions(o); }, "chunk overlap is 16 frames, more than half");
+  checks::expectError([&] { validateOptions(o); }, "chunkOverlap is 16, more than half");
 
   // A chunk length chosen elsewhere (options.framesPerChunk 0, as when the memory limit
   // chooses) cuts a larger m, with a warning; the same bits for any thread count.
