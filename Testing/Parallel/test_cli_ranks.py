@@ -60,12 +60,15 @@ def assert_same_series(one, many, frames):
                 (f, name)
 
 
-@pytest.mark.parametrize("ranks,per_chunk", [(2, 4), (3, 4), (3, 6)])
-def test_ranks_with_chunks_write_the_serial_series(tmp_path, ranks, per_chunk):
+@pytest.mark.parametrize("ranks,per_chunk,overlap", [(2, 4, 0), (3, 4, 0), (3, 6, 0), (2, 6, 3)])
+def test_ranks_with_chunks_write_the_serial_series(tmp_path, ranks, per_chunk, overlap):
     # 12 frames in chunks of 4: with 2 ranks rank 0 solves chunks 1 and 3, with 3 one each,
     # each rank streaming its own. In chunks of 6, fewer than the 3 ranks: they split the
-    # paths, every rank gets every frame, rank 0 writes them.
-    args = COMMON + ["--frames", "12", "--frames-per-chunk", str(per_chunk)]
+    # paths, every rank gets every frame, rank 0 writes them. In chunks of 6 overlapping by
+    # 3 (every frame blended), each of 2 ranks solves 9 positions and finishes the seam's
+    # frames it holds with the other's.
+    args = COMMON + ["--frames", "12", "--frames-per-chunk", str(per_chunk), "--chunk-overlap",
+                     str(overlap)]
     one = run(args + ["--output", "one/s.pvd", "--stats", "one/s.json"], tmp_path)
     assert one.returncode == 0, one.stderr
     many = run_ranks(ranks, args + ["--output", "many/s.pvd", "--stats", "many/s.json"],
@@ -75,6 +78,7 @@ def test_ranks_with_chunks_write_the_serial_series(tmp_path, ranks, per_chunk):
     assert_same_series(tmp_path / "one", tmp_path / "many", 12)
     stats = json.loads((tmp_path / "many/s.json").read_text())
     assert stats["statistics"]["Chunks"] == 12 // per_chunk
+    assert stats["statistics"]["ChunkOverlap"] == (overlap or per_chunk // 8 or 1)
     assert stats["statistics"]["Frames"] == 12
     # The light's place in every frame, whichever rank wrote it.
     one_stats = json.loads((tmp_path / "one/s.json").read_text())
