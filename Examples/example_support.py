@@ -3,8 +3,6 @@
 Run the examples with pvpython. Without an X display (DISPLAY unset) they start a private
 Xvfb for the run, the way the tests and the command line do (Testing/Plugin/xvfb_display.py).
 """
-import atexit
-import contextlib
 import ctypes
 import glob
 import os
@@ -40,20 +38,18 @@ def hold_x_display():
 
 def require_display(parser, script):
     """Debian's ParaView renders through X only and would abort at the first picture, after
-    the whole solve: without DISPLAY, start a private Xvfb for this run (stopped at exit), or
+    the whole solve: without DISPLAY, start a private Xvfb that ends with this process, or
     refuse to start when Xvfb is not installed. Keep what it returns until the end."""
     if os.environ.get("DISPLAY"):
         return hold_x_display()
     sys.path.insert(0, os.path.join(ROOT, "Testing", "Plugin"))
-    from xvfb_display import virtual_display
-    stack = contextlib.ExitStack()
+    from xvfb_display import display_for_this_process
     try:
-        os.environ["DISPLAY"] = stack.enter_context(virtual_display())
+        os.environ["DISPLAY"] = display_for_this_process()
     except RuntimeError as error:  # Xvfb missing, or it did not start
         parser.error(f"no X display (DISPLAY is not set) and {error}; on a desktop, run "
                      f"pvpython {script} ... there")
-    atexit.register(stack.close)
-    return stack
+    return hold_x_display()
 
 
 def load_plugin(pv, parser, plugin=None):

@@ -3,7 +3,9 @@ shipped Cornell box, with few paths and small pictures: it writes one lit PNG an
 trajectory position and a .pvd listing their times."""
 import os
 import shutil
+import signal
 import subprocess
+import time
 import xml.etree.ElementTree as ElementTree
 
 import pytest
@@ -59,6 +61,54 @@ def test_example_writes_the_animation(tmp_path):
         red = ((pixels[:, 0] > 1.5 * pixels[:, 1]) & (pixels[:, 0] > 40)).mean()
         green = ((pixels[:, 1] > 1.5 * pixels[:, 0]) & (pixels[:, 1] > 40)).mean()
         assert red > 0.05 and green > 0.05, f"{picture.name}: red {red:.2f}, green {green:.2f} of the picture"
+
+
+def session_processes(session):
+    """The processes left in session `session` (their pids)."""
+    left = []
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/stat") as stat:
+                fields = stat.read().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # not a process, or it ended meanwhile
+        if fields[0] != "Z" and int(fields[3]) == session:
+            left.append(int(entry))
+    return left
+
+
+def test_example_under_pvbatch_without_a_display_ends(tmp_path):
+    """Under pvbatch without DISPLAY the example starts its own Xvfb. It used to stop it from
+    Python's exit handlers, before pvbatch's ParaView closed its X connection: pvbatch then
+    failed on an X I/O error, aborted on a double free and hung for ever, after writing
+    everything. It exits 0, and nothing it started outlives it."""
+    if not shutil.which("Xvfb"):
+        pytest.skip("Xvfb is not installed")
+    plugin = os.environ.get("MLR_PLUGIN")
+    assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PV_PLUGIN_PATH", "PYTHONPATH", "DISPLAY")}
+    output = tmp_path / "animation"
+    process = subprocess.Popen(
+        [os.environ.get("MLR_PVBATCH", "pvbatch"), "--force-offscreen-rendering",
+         os.path.join(ROOT, "Examples", "cornell_box_animation.py"), "--plugin", plugin,
+         "--output", str(output), "--paths", "20000", "--size", "64"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
+        start_new_session=True)
+    try:
+        log, _ = process.communicate(timeout=240)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert process.returncode == 0, log
+    assert len(list((output / "png").glob("frame_*.png"))) == POSITIONS, log
+    # The kernel stops the Xvfb when pvbatch ends: give it a moment.
+    for _ in range(50):
+        if not session_processes(process.pid):
+            break
+        time.sleep(0.1)
+    assert session_processes(process.pid) == [], log
 
 
 def test_sun_example_writes_a_day(tmp_path):

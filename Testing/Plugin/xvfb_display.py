@@ -15,53 +15,81 @@ Two ways an X display fails ParaView with "bad X server connection" (SIGABRT):
 
     python3 xvfb_display.py COMMAND [ARGUMENTS...]   runs COMMAND with DISPLAY set, returns
                                                      its exit code
-    with virtual_display() as display: ...           the same from Python ("DISPLAY" value)"""
+    with virtual_display() as display: ...           the same from Python ("DISPLAY" value)
+    display_for_this_process()                       one that ends with the process"""
 import contextlib
+import ctypes
 import os
 import random
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
 
 
-@contextlib.contextmanager
-def virtual_display(attempts=20):
+def _start(attempts, preexec_fn=None):
+    """An Xvfb server on a free display: (the process, ":N")."""
     xvfb = shutil.which("Xvfb")
     if xvfb is None:
         raise RuntimeError("Xvfb is not installed: apt-get install xvfb")
     failures = []
     for number in random.Random().sample(range(1000, 30000), attempts):
-        with tempfile.TemporaryFile() as log:
-            read_end, write_end = os.pipe()
-            server = subprocess.Popen(
-                [xvfb, f":{number}", "-displayfd", str(write_end), "-screen", "0", "1280x1024x24",
-                 "-nolisten", "tcp", "-noreset"],
-                pass_fds=(write_end,), stdin=subprocess.DEVNULL, stdout=log, stderr=log)
-            os.close(write_end)
-            with os.fdopen(read_end, "rb") as pipe:
-                ready = pipe.readline().strip()  # written once the server accepts connections
-            if not ready:  # the number is taken, or Xvfb cannot start at all
-                server.wait(timeout=30)
-                log.seek(0)
-                failures.append(f":{number}: " + log.read().decode(errors="replace").strip())
-                continue
-            try:
-                yield f":{number}"
-            finally:
-                if server.poll() is not None:
-                    log.seek(0)
-                    print(f"Xvfb :{number} exited early with code {server.returncode}:\n"
-                          + log.read().decode(errors="replace"), file=sys.stderr)
-                else:
-                    server.terminate()
-                    try:
-                        server.wait(timeout=10)
-                    except subprocess.TimeoutExpired:
-                        server.kill()
-                        server.wait()
-            return
+        log = tempfile.TemporaryFile()
+        read_end, write_end = os.pipe()
+        server = subprocess.Popen(
+            [xvfb, f":{number}", "-displayfd", str(write_end), "-screen", "0", "1280x1024x24",
+             "-nolisten", "tcp", "-noreset"],
+            pass_fds=(write_end,), stdin=subprocess.DEVNULL, stdout=log, stderr=log,
+            preexec_fn=preexec_fn)
+        os.close(write_end)
+        with os.fdopen(read_end, "rb") as pipe:
+            ready = pipe.readline().strip()  # written once the server accepts connections
+        if ready:
+            server.log = log
+            return server, f":{number}"
+        server.wait(timeout=30)  # the number is taken, or Xvfb cannot start at all
+        log.seek(0)
+        failures.append(f":{number}: " + log.read().decode(errors="replace").strip())
+        log.close()
     raise RuntimeError("Xvfb did not start:\n" + "\n".join(failures[-3:]))
+
+
+@contextlib.contextmanager
+def virtual_display(attempts=20):
+    server, display = _start(attempts)
+    try:
+        yield display
+    finally:
+        if server.poll() is not None:
+            server.log.seek(0)
+            print(f"Xvfb {display} exited early with code {server.returncode}:\n"
+                  + server.log.read().decode(errors="replace"), file=sys.stderr)
+        else:
+            server.terminate()
+            try:
+                server.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+                server.wait()
+        server.log.close()
+
+
+def display_for_this_process(attempts=20):
+    """A private display that lives as long as this process: the kernel stops its Xvfb when
+    the process ends, however it ends (PR_SET_PDEATHSIG). For scripts run by pvbatch, whose
+    ParaView closes its X connection after Python's exit handlers have run: a server stopped
+    by such a handler made that close fail (an X I/O error, then a double free whose abort
+    handler hangs pvbatch for ever)."""
+    parent = os.getpid()
+    libc = ctypes.CDLL(None, use_errno=True)
+
+    def die_with_parent():
+        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent:  # the parent ended before the call took effect
+            os._exit(1)
+
+    return _start(attempts, die_with_parent)[1]
 
 
 def main(command):
