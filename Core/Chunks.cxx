@@ -421,9 +421,10 @@ void accumulate(const ErrorEstimateSummary& c, bool first, ErrorEstimateSummary&
     s = c;
     return;
   }
-  s.batches += c.batches;
+  // The batches and N of the animation are those of its least solved chunk, as each frame's
+  // result and error bar come from its own chunk's; a limit that stopped one says so.
+  s.batches = std::min(s.batches, c.batches);
   s.rounds = std::max(s.rounds, c.rounds);
-  // The animation's N is that of its least solved chunk; a limit that stopped one says so.
   s.pathsPerFrame = std::min(s.pathsPerFrame, c.pathsPerFrame);
   if (c.stoppedBy == "time limit" || c.stoppedBy == "path limit")
   {

@@ -133,6 +133,9 @@ def test_streamed_chunks_print_the_error_line_and_time_their_writing(tmp_path):
     assert all(value > 0 for value in p95)
     worst = max(range(FRAMES), key=lambda f: p95[f])
     assert f"(frame {worst}, the worst)" in lines[0]
+    # Each frame's figures come from its chunk's 16 batches, as in one chunk (it said 48).
+    assert ", 16 batches in 1 round, stopped by batches" in lines[0], lines[0]
+    assert stats["statistics"]["ErrorBatches"] == whole_stats["statistics"]["ErrorBatches"] == 16
     # The same paths per frame as the run in one chunk: the same error within the noise.
     whole_p95 = whole_stats["errorEstimate"]["RelativeErrorP95"]
     assert 0.5 < max(p95) / max(whole_p95) < 2
