@@ -645,9 +645,11 @@ Options parseCommandLine(int argc, const char* const* argv)
   {
     throw UsageError("--time-zone and --north need --sun-path ... (--north also --weather)");
   }
-  if (!o.sunPath && !o.sky && o.lightDistribution.empty() && !o.workPlane && o.up)
+  if (!o.sunPath && o.sunDirections.empty() && !o.sky && o.lightDistribution.empty() &&
+    !o.workPlane && o.up)
   {
-    throw UsageError("--up needs --sun-path ..., --weather FILE.epw, --sky MODEL, "
+    throw UsageError("--up needs --sun-path ..., --sun-directions FILE, --weather FILE.epw, "
+                     "--sky MODEL, "
                      "--light-distribution FILE (whose TILT table it sets the vertical of) or "
                      "--work-plane HEIGHT,SPACING");
   }
@@ -848,6 +850,11 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.equalShares)
   {
+    if (o.reuse && *o.reuse != "shooting" && *o.reuse != "both")
+    {
+      throw UsageError("--equal-shares shares the reused shooting paths among the positions: "
+                       "give it with --reuse shooting or both, or leave it out");
+    }
     filter->SetBalanceFrames(0);
   }
   if (o.patchSize)
@@ -1035,7 +1042,9 @@ Light path (the positions of the light's area centroid, one per frame):
 The sun (a directional light, instead of --light; needs --scene; --north and --up also
 apply to --weather):
   --sun-directions FILE the points of a file are directions towards the sun, one per frame
-                        (any length but 0); point arrays Time and Power as above
+                        (any length but 0); point arrays Time and Power as above; a
+                        direction below the horizon (across --up) is a dark frame, with a
+                        warning
   --sun-path LAT,LON,YYYY-MM-DD,HH:MM,HH:MM,MINUTES
                         the sun seen from latitude LAT, longitude LON (degrees, north and
                         east positive) on that day, from the first clock time to the

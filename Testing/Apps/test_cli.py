@@ -136,6 +136,8 @@ def test_shorter_run_replaces_the_whole_series(tmp_path):
     (["--scene", SCENE], "--scene needs --light"),
     (["--output", "series.vtu"], "ending in .pvd"),
     (["--reuse", "sometimes"], "give none, gathering, shooting or both"),
+    (["--equal-shares", "--reuse", "none"], "give it with --reuse shooting or both"),
+    (["--equal-shares", "--reuse", "gathering"], "give it with --reuse shooting or both"),
 ])
 def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, message):
     result = run(args + ["--output", "out/x.pvd"] if "--output" not in args else args, tmp_path)

@@ -437,6 +437,30 @@ def test_sun_directions_with_power_and_irradiance(tmp_path):
     assert not full[2][1].cells("DirectRadiosity")[north_wall].any()
 
 
+def test_sun_directions_below_the_horizon_are_dark_frames_with_a_warning(tmp_path):
+    """A direction below the horizon is night, dark as --sun-path's. The solve's surfaces are
+    two-sided: such a sun used to light the town from below (the ground's underside) and take
+    its share of the mixture's paths from the frames lit from above, whose sunny ground then
+    came out 10% low wherever the noise had picked the underside as an element's lit side."""
+    boxes = BOXES[:1]
+    scene = write_town(tmp_path, boxes)
+    directions = write_points(tmp_path / "sun.vtp", [(0, 0, 1), (0, 0, -1), (0, -1, 1)])
+    frames = solve(tmp_path, ["--scene", scene, "--sun-directions", directions])
+    assert ("1 of 3 directions point below the horizon (--up 0,0,1), frame 1: that frame is "
+            "night, dark") in frames.stderr, frames.stderr
+    assert not frames[1][1].cells("Radiosity").any()
+    for (_, frame), elevation in ((frames[0], 90.0), (frames[2], 45.0)):
+        region = sun_region(frame, elevation, boxes)
+        expected = RHO * SUN * math.sin(math.radians(elevation))
+        assert frame.mean("DirectRadiosity", region) == pytest.approx(
+            [expected] * 3, rel=sun_tolerance(frame, region, [90.0, 45.0]))
+    # The horizon is across --up: with y up, (0, 0, -1) is on it and (0, -1, 1) below.
+    result = run(["--scene", scene, "--sun-directions", directions, "--up", "0,1,0",
+                  "--output", "y/s.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "1 of 3 directions point below the horizon (--up 0,1,0), frame 2:" in result.stderr
+
+
 # --- Area lights: aim, Normal, Orientation, Power --------------------------------------------
 def test_aim_turns_the_light_to_face_the_point(tmp_path):
     paths = 100000
