@@ -6,6 +6,7 @@
 #include "vtkMovingLightRadiosity.h"
 
 #include "Chunks.h"
+#include "Error.h"
 
 #include <vtk_cli11.h>
 
@@ -577,13 +578,13 @@ Options parseCommandLine(int argc, const char* const* argv)
   if (o.spot &&
     !((*o.spot)[0] > 0 && (*o.spot)[0] <= 180 && (*o.spot)[1] >= 0 && (*o.spot)[1] <= 180))
   {
-    throw UsageError("--spot is " + std::to_string((*o.spot)[0]) + "," +
-      std::to_string((*o.spot)[1]) +
+    throw UsageError("--spot is " + mlr::formatNumber((*o.spot)[0]) + "," +
+      mlr::formatNumber((*o.spot)[1]) +
       ": give a half angle above 0 and at most 180 degrees and a soft edge from 0 to 180");
   }
   if (o.lightLumens && !(*o.lightLumens > 0))
   {
-    throw UsageError("--light-lumens is " + std::to_string(*o.lightLumens) +
+    throw UsageError("--light-lumens is " + mlr::formatNumber(*o.lightLumens) +
       ": give the luminaire's luminous flux in lumens, above 0");
   }
   if (!o.sunDirections.empty() && o.sunPath)
@@ -655,7 +656,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   }
   if (o.sunIrradiance && !(*o.sunIrradiance >= 0 && std::isfinite(*o.sunIrradiance)))
   {
-    throw UsageError("--sun-irradiance is " + std::to_string(*o.sunIrradiance) +
+    throw UsageError("--sun-irradiance is " + mlr::formatNumber(*o.sunIrradiance) +
       ": give the irradiance on a surface facing the sun in W/m^2, 0 or above (1000 by "
       "default; 0 keeps the sun's frames for the sky with no direct sun)");
   }
@@ -704,7 +705,7 @@ Options parseCommandLine(int argc, const char* const* argv)
   if (o.skyDiffuseHorizontal &&
     !(*o.skyDiffuseHorizontal >= 0 && std::isfinite(*o.skyDiffuseHorizontal)))
   {
-    throw UsageError("--sky-diffuse-horizontal is " + std::to_string(*o.skyDiffuseHorizontal) +
+    throw UsageError("--sky-diffuse-horizontal is " + mlr::formatNumber(*o.skyDiffuseHorizontal) +
       ": give the sky's diffuse horizontal irradiance in W/m^2, 0 or above (100 by default)");
   }
   if (!o.trajectory.empty() && (o.from || o.to))

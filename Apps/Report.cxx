@@ -249,11 +249,14 @@ std::string summaryLine(vtkFieldData* statistics)
 {
   const double rays = value(statistics, "ShootingRays") + value(statistics, "ShadowRays") +
     value(statistics, "GatheringRays");
+  // Counts with every digit: a stream shows a double of 1,000,000 as "1e+06".
+  const auto count = [&](const char* name)
+  { return static_cast<long long>(value(statistics, name)); };
+  const long long frames = count("Frames");
   std::ostringstream s;
-  s << value(statistics, "Frames") << " frames, " << value(statistics, "Elements") << " elements ("
-    << value(statistics, "Patches") << " patches), " << value(statistics, "PathsPerFrame")
-    << " paths/frame, " << millions(rays) << " rays ("
-    << millions(value(statistics, "ShootingRays")) << " shooting, "
+  s << frames << (frames == 1 ? " frame, " : " frames, ") << count("Elements") << " elements ("
+    << count("Patches") << " patches), " << count("PathsPerFrame") << " paths/frame, "
+    << millions(rays) << " rays (" << millions(value(statistics, "ShootingRays")) << " shooting, "
     << millions(value(statistics, "ShadowRays")) << " shadow, "
     << millions(value(statistics, "GatheringRays")) << " gathering), solve "
     << seconds(value(statistics, "SecondsTotal")) << " (remeshing "

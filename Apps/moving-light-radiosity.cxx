@@ -1033,7 +1033,8 @@ int run(int argc, char** argv, RankJob& job)
 
   const std::string errors = errorLine(statistics);
   std::cout << summaryLine(statistics) << (errors.empty() ? "" : "\n" + errors) << "\nwrote "
-            << collection.string() << " and " << times.size() << " frames";
+            << collection.string() << " and " << times.size()
+            << (times.size() == 1 ? " frame" : " frames");
   if (!options.png.empty())
   {
     std::cout << ", pictures in " << options.png;

@@ -1,11 +1,21 @@
 // Errors raised at Core's boundary. Every message names what to fix.
 #pragma once
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace mlr
 {
+
+/// `value` as messages show it: the shortest of fixed and scientific, without trailing zeros
+/// (std::to_string gives "0.000000").
+inline std::string formatNumber(double value)
+{
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
 
 /// Bad input or a failure that prevents a result (the message says what to fix).
 class Error : public std::runtime_error

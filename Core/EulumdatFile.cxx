@@ -12,7 +12,6 @@ namespace mlr
 
 namespace
 {
-using photometry::formatNumber;
 using photometry::MaximumAngles;
 using photometry::MaximumValues;
 

@@ -14,7 +14,6 @@ namespace mlr
 
 namespace
 {
-using photometry::formatNumber;
 using photometry::MaximumAngles;
 using photometry::MaximumValues;
 

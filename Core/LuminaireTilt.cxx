@@ -86,7 +86,6 @@ std::vector<LightPose> tiltPoses(const TiltTable& tilt, const PhotometricFrame& 
     }
     pose.power = pose.power * tilt.factor(angle);
   }
-  using photometry::formatNumber;
   auto rounded = [](double degrees) { return formatNumber(std::round(degrees * 10) / 10); };
   if (outside > 0)
   {

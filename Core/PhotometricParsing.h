@@ -30,9 +30,6 @@ bool parseNumber(std::string_view token, double& value);
 /// `text` without its leading and trailing blanks.
 std::string_view trim(std::string_view text);
 
-/// `value` as messages show it: the shortest of fixed and scientific, without trailing zeros.
-std::string formatNumber(double value);
-
 /// The symmetry a file stores its planes with (the C angles of `planesDegrees` below).
 enum class PlaneSymmetry
 {

@@ -606,13 +606,6 @@ std::string_view trim(std::string_view text)
   return text;
 }
 
-std::string formatNumber(double value)
-{
-  std::ostringstream s;
-  s << value;
-  return s.str();
-}
-
 bool parseNumber(std::string_view token, double& value)
 {
   if (!token.empty() && token.front() == '+')

@@ -984,12 +984,12 @@ DaylightMetrics daylightMetrics(const double* illuminance, const double* sunIllu
 {
   if (!(threshold >= 0) || !std::isfinite(threshold))
   {
-    throw Error("the daylight autonomy threshold is " + std::to_string(threshold) +
+    throw Error("the daylight autonomy threshold is " + formatNumber(threshold) +
       " lx: give a finite illuminance of 0 or more (300 lx is typical)");
   }
   if (!(hoursPerStep >= 0) || !std::isfinite(hoursPerStep))
   {
-    throw Error("a time step lasts " + std::to_string(hoursPerStep) +
+    throw Error("a time step lasts " + formatNumber(hoursPerStep) +
       " hours: give the frames' times in hours, increasing");
   }
   DaylightMetrics m;

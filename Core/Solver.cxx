@@ -154,7 +154,7 @@ void validateOptions(const SolverOptions& options)
   }
   if (!(options.gatheringRatio >= 0.0) || !std::isfinite(options.gatheringRatio))
   {
-    throw Error("the gathering ratio k is " + std::to_string(options.gatheringRatio) +
+    throw Error("the gathering ratio k is " + formatNumber(options.gatheringRatio) +
       ": it must be 0 (no final gathering) or positive (1 is typical)");
   }
   if (options.gatheringRatio * static_cast<double>(options.pathsPerFrame) >

@@ -103,12 +103,12 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
 {
   if (!(r.latitude >= -90 && r.latitude <= 90))
   {
-    throw Error("the latitude is " + std::to_string(r.latitude) +
+    throw Error("the latitude is " + formatNumber(r.latitude) +
       ": give degrees from -90 (south pole) to 90 (north pole)");
   }
   if (!(r.longitude >= -180 && r.longitude <= 180))
   {
-    throw Error("the longitude is " + std::to_string(r.longitude) +
+    throw Error("the longitude is " + formatNumber(r.longitude) +
       ": give degrees from -180 to 180, east positive");
   }
   if (r.year < -4000 || r.year > 9999 || r.month < 1 || r.month > 12 || r.day < 1 ||
@@ -137,7 +137,7 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
   }
   if (!(std::abs(r.timeZoneHours) <= 14))
   {
-    throw Error("the time zone is " + std::to_string(r.timeZoneHours) +
+    throw Error("the time zone is " + formatNumber(r.timeZoneHours) +
       " hours from UTC: give an offset from -14 to 14");
   }
   const Horizon horizon = horizonOf(r.north, r.up);

@@ -137,6 +137,9 @@ def test_shorter_run_replaces_the_whole_series(tmp_path):
     (["--output", "series.vtu"], "ending in .pvd"),
     (["--reuse", "sometimes"], "give none, gathering, shooting or both"),
     (["--equal-shares", "--reuse", "none"], "give it with --reuse shooting or both"),
+    # Numbers as given, not as std::to_string shows a double ("0.000000").
+    (["--light-lumens", "0"], "--light-lumens is 0: give"),
+    (["--spot", "30,-1"], "--spot is 30,-1: give"),
     (["--equal-shares", "--reuse", "gathering"], "give it with --reuse shooting or both"),
 ])
 def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, message):

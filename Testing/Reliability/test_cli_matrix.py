@@ -243,7 +243,7 @@ ROWS = [
         "the trajectory file 'path.vtp' has no points"),
     Row("trajectory_of_one_point", trajectory([(0.3, 0.5478, 0.3)]),
         ["--scene", SCENE, "--light", LIGHT, "--trajectory", "path.vtp"] + FAST, 0,
-        "wrote out/series.pvd and 1 frames", stream="stdout",
+        "wrote out/series.pvd and 1 frame", stream="stdout",
         outputs=["series.pvd", "series_0000.vtu"]),
     # In one chunk: left to the memory limit, chunks would solve it (slowly).
     Row("ten_thousand_frames_in_one_chunk_on_a_large_scene", lambda directory: None,
