@@ -71,6 +71,9 @@ V areaVector(const std::vector<V>& corners)
   return sum;
 }
 
+/// Horizontal rays from a point that tell a room from the outdoors.
+constexpr int WallDirections = 16;
+
 /// A polygon of the scene across up, seen along up: its corners (u along t, v along b).
 struct Face
 {
@@ -80,6 +83,27 @@ struct Face
   double area = 0;
   vtkIdType cell = -1; ///< in the scene
 };
+
+/// Bounds across up (u along t, v along b).
+struct Extent
+{
+  double uLo, uHi, vLo, vHi;
+};
+
+/// The bounds of `faces` across up, widened by `margin` on every side.
+Extent extentOf(const std::vector<Face>& faces, double margin)
+{
+  Extent e{ std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+    std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  for (const Face& face : faces)
+  {
+    const auto [uLo, uHi] = std::minmax_element(face.us.begin(), face.us.end());
+    const auto [vLo, vHi] = std::minmax_element(face.vs.begin(), face.vs.end());
+    e = { std::min(e.uLo, *uLo - margin), std::max(e.uHi, *uHi + margin),
+      std::min(e.vLo, *vLo - margin), std::max(e.vHi, *vHi + margin) };
+  }
+  return e;
+}
 
 /// UsageError when a lattice of `spacing` over `area` would have more sensors than a solve
 /// accepts.
@@ -116,16 +140,10 @@ std::vector<std::vector<Face>> levelsOf(const std::vector<Face>& sorted, double 
 /// apart from the next building's.
 std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, double tolerance)
 {
-  struct Extent
-  {
-    double uLo, uHi, vLo, vHi;
-  };
   std::vector<Extent> extents;
   for (const Face& face : level)
   {
-    const auto [uLo, uHi] = std::minmax_element(face.us.begin(), face.us.end());
-    const auto [vLo, vHi] = std::minmax_element(face.vs.begin(), face.vs.end());
-    extents.push_back({ *uLo - tolerance, *uHi + tolerance, *vLo - tolerance, *vHi + tolerance });
+    extents.push_back(extentOf({ face }, tolerance));
   }
   std::vector<std::size_t> parent(level.size());
   std::iota(parent.begin(), parent.end(), 0);
@@ -176,19 +194,20 @@ std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, do
 /**
  * What rays through the scene say of a horizontal polygon's upper side: whether it sees one of
  * the lights (at most 16 of their positions, spread over the frames) or the sky, what lies
- * straight below and above it, and whether it is a roof (nothing above it and, unless
- * daylight lights the scene, no light in sight).
+ * straight below and above it, whether the work plane over it is in a room (walled in) or
+ * outdoors, and whether it is a roof.
  */
 class FloorFinder
 {
 public:
-  /// `t` and `b`: two axes across `up`, for the sky's directions.
+  /// `t` and `b`: two axes across `up`, for the sky's directions; `height`: the work plane's.
   FloorFinder(vtkPolyData* scene, const std::vector<Triple>& lights, bool daylight, const V& up,
-    const V& t, const V& b)
+    const V& t, const V& b, double height)
     : Up(up)
     , T(t)
     , B(b)
     , Daylight(daylight)
+    , Height(height)
     , Scene(scene)
   {
     double bounds[6];
@@ -222,10 +241,19 @@ public:
     return this->firstBelow(point, hit) >= 0 && this->seesALight(hit);
   }
 
-  /// Whether the first polygon below `point` faces up, towards it: then a polygon facing down
-  /// at `point` is a correctly oriented room's ceiling (or an underside over its floor), where
-  /// the sky, seen from above the ceiling, says nothing.
-  bool facedFromBelow(const V& point) const
+  /// Whether `point`, on a polygon facing down of a group within `extent`, is on a correctly
+  /// oriented room's ceiling over its floor, where the sky seen from above the ceiling says
+  /// nothing. Seen from `point` alone, such a ceiling and the floor of a room modelled with
+  /// outward normals standing on a ground (or on the roof below, or on stilts over the ground)
+  /// look alike: a polygon facing down over one facing up at it. They differ in which side of
+  /// the polygon is a room: a space that holds the work plane and is walled in. The space
+  /// between the two polygons is a room when it is higher than the work plane (the floor's
+  /// work plane lies under the ceiling) and its work plane is walled in; lower, it is a gap
+  /// (under an outward room's floor on a ground), never a room. When it is high but open,
+  /// the space above `point` decides: walled in, it is the room of a floor raised over open
+  /// ground; open too, neither side is a room (a canopy, a pavilion's ceiling) and the normals
+  /// are taken as given: a ceiling.
+  bool ceilingOverItsFloor(const V& point, const Extent& extent) const
   {
     V hit;
     const vtkIdType cell = this->firstBelow(point, hit);
@@ -242,26 +270,62 @@ public:
       this->Scene->GetPoint(ids->GetId(i), p);
       corners.push_back({ p[0], p[1], p[2] });
     }
-    return dot(areaVector(corners), this->Up) > 0;
+    if (dot(areaVector(corners), this->Up) <= 0 || dot(point - hit, this->Up) <= this->Height)
+    {
+      return false;
+    }
+    return this->walledIn(hit + scaled(this->Up, this->Height), extent) ||
+      !this->walledIn(point + scaled(this->Up, this->Height), extent);
   }
 
-  /// Whether one of `cells` lies straight below `point`.
-  bool standsOver(const V& point, const std::set<vtkIdType>& cells) const
+  /// The nearest of `cells` straight below `point` (-1 when none), and its height along up.
+  vtkIdType nearestBelow(const V& point, const std::set<vtkIdType>& cells, double& level) const
   {
     const V from = point - scaled(this->Up, this->Offset);
     const V to = from - scaled(this->Up, 2 * this->Size + 1);
     double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
+    vtkNew<vtkPoints> points;
     vtkNew<vtkIdList> hits;
     vtkNew<vtkGenericCell> cell;
-    this->Locator->IntersectWithLine(a, z, this->Tolerance, nullptr, hits, cell);
+    this->Locator->IntersectWithLine(a, z, this->Tolerance, points, hits, cell);
+    vtkIdType nearest = -1;
+    level = -std::numeric_limits<double>::infinity();
     for (vtkIdType i = 0; i < hits->GetNumberOfIds(); ++i)
     {
-      if (cells.count(hits->GetId(i)))
+      double x[3];
+      points->GetPoint(i, x);
+      const double h = dot({ x[0], x[1], x[2] }, this->Up);
+      if (cells.count(hits->GetId(i)) && h > level)
       {
-        return true;
+        nearest = hits->GetId(i);
+        level = h;
       }
     }
-    return false;
+    return nearest;
+  }
+
+  /// Whether `point` is walled in: more than half of WallDirections horizontal rays from it
+  /// meet a polygon before they leave `extent`, the bounds of the floor or ceiling in question.
+  /// A room's walls stand at the edges of its floor and ceiling, within their bounds; a
+  /// neighbour's wall across the street lies beyond them and walls in no room of theirs.
+  /// More than half: a room's windows and doors let some rays out.
+  bool walledIn(const V& point, const Extent& extent) const
+  {
+    const double u = dot(point, this->T), v = dot(point, this->B);
+    // The answer is known once more than half of the rays meet a wall, or half do not.
+    int walls = 0, open = 0;
+    for (int k = 0; 2 * walls <= WallDirections && 2 * open < WallDirections; ++k)
+    {
+      // Half a step off the axes: no ray runs along a wall.
+      const double phi = 2 * M_PI * (k + 0.5) / WallDirections;
+      const double cu = std::cos(phi), cv = std::sin(phi);
+      const double reach = std::min((cu > 0 ? extent.uHi - u : extent.uLo - u) / cu,
+        (cv > 0 ? extent.vHi - v : extent.vLo - v) / cv);
+      const bool wall = reach > 0 &&
+        this->blocked(point, point + scaled(this->T, cu * reach) + scaled(this->B, cv * reach));
+      (wall ? walls : open) += 1;
+    }
+    return 2 * walls > WallDirections;
   }
 
   /// Whether the sky is in sight from just above `point`, along one of SkyDirections
@@ -347,6 +411,7 @@ private:
 
   V Up, T, B;
   bool Daylight;
+  double Height;
   double Size = 0, Offset = 0, Tolerance = 0;
   std::vector<V> Lights;
   vtkPolyData* Scene;
@@ -490,8 +555,9 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     // A floor whose normal points down (a room modelled with outward normals) is found by
     // the light it sees: its upper side, where the sensors go, sees a light or the sky. A
     // correctly oriented room's ceilings and undersides see no light from above; the sky
-    // they may see, but they lie over the room's floor, which faces up at them.
-    const FloorFinder finder(scene, lights, daylight, up, t, b);
+    // they may see, but they lie over the room's floor, which faces up at them across the
+    // room (ceilingOverItsFloor).
+    const FloorFinder finder(scene, lights, daylight, up, t, b, height);
     // Faces that touch at one height are one floor: a part in shadow goes with the parts
     // that see the light; another building's floor at that height is decided by its own.
     std::sort(facingDown.begin(), facingDown.end(),
@@ -515,11 +581,12 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       // At most about 64 probes a group, and at least its lattice's points.
       const double probeStep = std::max(spacing, std::sqrt(groupArea / 64));
       const std::vector<Sensor> probes = lattice(group, probeStep);
+      const Extent extent = extentOf(group, finder.levelTolerance());
       bool floor = false;
       if (daylight)
       {
         floor = std::none_of(probes.begin(), probes.end(),
-          [&](const Sensor& probe) { return finder.facedFromBelow(probe.point); });
+          [&](const Sensor& probe) { return finder.ceilingOverItsFloor(probe.point, extent); });
         const std::size_t stride = (probes.size() + SkyProbes - 1) / SkyProbes;
         bool sky = false;
         for (std::size_t k = 0; floor && !sky && k < probes.size(); k += stride)
@@ -548,8 +615,6 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
         floorArea += face.area;
       }
       checkSensorCount(area + floorArea, spacing);
-      // Such a room's roof faces up: above it nothing, below it its floor, and no lamp of
-      // the room reaches it.
       std::set<vtkIdType> floorCells;
       for (const Face& face : floors)
       {
@@ -557,7 +622,16 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       }
       for (Sensor& sensor : sensors)
       {
-        sensor.keep = !(finder.isRoof(sensor.point) && finder.standsOver(sensor.point, floorCells));
+        double level = 0;
+        const vtkIdType floor =
+          finder.nearestBelow(sensor.point + scaled(up, height), floorCells, level);
+        // A floor between a face and its sensor's point, or at the face's level, puts the
+        // point in that floor's room, whose own lattice covers it: the ground's under a room
+        // standing on it, a lower roof's under the next storey's floor. Under a floor
+        // standing higher (on stilts) the point is outdoors and stays. Otherwise the face
+        // may be that room's roof.
+        sensor.keep =
+          floor < 0 || (level < sensor.w - finder.levelTolerance() && !finder.isRoof(sensor.point));
       }
       std::vector<Sensor> more;
       std::stable_sort(floors.begin(), floors.end(),

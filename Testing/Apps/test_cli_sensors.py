@@ -27,6 +27,7 @@ from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPolyDataWriter
 W, D, H = 3.0, 2.0, 2.5
 HEIGHT, SPACING = 0.8, 0.5
 EDH = 100.0
+GROUND = (-2.0, 5.0, -2.0, 4.0)  # x0, x1, y0, y1: a ground around the room's footprint
 FAST = ["--paths", "20000", "--threads", "2", "--patch-size", "0.5"]
 
 
@@ -285,10 +286,14 @@ def test_work_plane_finds_the_floor_of_a_room_with_outward_normals(tmp_path):
         assert numpy.all(array(a, "Illuminance") > 0)
 
 
-def write_windowed_room(directory, outward):
+def write_windowed_room(directory, outward, ground=None):
     """The room of write_room closed by a ceiling, with a 1 x 1 window (x in [1, 2], z in
-    [1, 2]) in its wall y = 0, its normals inward or outward."""
+    [1, 2]) in its wall y = 0, its normals inward or outward; with `ground`, on a ground
+    (GROUND, facing up) at that height."""
     room = Polygons()
+    if ground is not None:
+        x0, x1, y0, y1 = GROUND
+        room.add([(x0, y0, ground), (x1, y0, ground), (x1, y1, ground), (x0, y1, ground)])
 
     def add(inward_corners):
         room.add(inward_corners[::-1] if outward else inward_corners)
@@ -333,6 +338,66 @@ def test_work_plane_under_daylight_does_not_depend_on_the_normals(tmp_path, dayl
                             array(outward, "IlluminanceStdError"))
         assert numpy.all(a > 0) and numpy.all(b > 0)
         assert numpy.all(numpy.abs(a - b) <= 5 * sigma + 1e-6 * a), numpy.abs(a - b) / sigma
+
+
+def lattice(x0, x1, y0, y1, z):
+    """--work-plane's points over [x0, x1] x [y0, y1] at height z, for bounds on its lattice
+    (multiples of SPACING): (i + 1/2) SPACING along x and y."""
+    xs = numpy.arange(x0 + SPACING / 2, x1, SPACING)
+    ys = numpy.arange(y0 + SPACING / 2, y1, SPACING)
+    return [(x, y, z) for x in xs for y in ys]
+
+
+def keys(points):
+    return sorted(tuple(numpy.round(p, 6)) for p in points)
+
+
+def same_illuminance(a, b):
+    """Each of `a`'s sensors has the illuminance of `b`'s sensor at its point (the first, if
+    several) within 5 standard errors; both lit."""
+    first = {}
+    for i, p in enumerate(vtk_to_numpy(b.GetPoints().GetData())):
+        first.setdefault(tuple(numpy.round(p, 6)), i)
+    at = [first[tuple(numpy.round(p, 6))] for p in vtk_to_numpy(a.GetPoints().GetData())]
+    la, lb = array(a, "Illuminance"), array(b, "Illuminance")[at]
+    sigma = numpy.hypot(array(a, "IlluminanceStdError"), array(b, "IlluminanceStdError")[at])
+    assert numpy.all(la > 0) and numpy.all(lb > 0)
+    assert numpy.all(numpy.abs(la - lb) <= 5 * sigma + 1e-6 * lb), numpy.abs(la - lb) / sigma
+
+
+DAYLIGHT = ["--sky", "uniform", "--sky-diffuse-horizontal", str(EDH), "--paths", "200000",
+            "--threads", "2", "--patch-size", "0.25"]
+
+
+@pytest.mark.parametrize("ground", [-0.01, 0.0, -1.5])
+def test_work_plane_finds_the_floor_of_an_outward_room_on_a_ground(tmp_path, ground):
+    """The windowed room with outward normals on a ground facing up: just under its floor, at
+    its level, or 1.5 below it (on stilts). A ground under the floor made the floor a ceiling
+    over its floor (a polygon facing up at it straight below): the room's sensors stayed 0.8
+    above its roof in full daylight, without a warning; at the floor's level the ground's
+    sensors under the room doubled the floor's. Its grid is that of the same room with inward
+    normals, 24 sensors 0.8 above the floor with the same illuminance within the noise, and
+    the ground's outside the room; none above the roof. The ground's sensors under the room go
+    when the floor lies between the ground and them (they are in the room, whose grid covers
+    them); 1.5 below they stay, outdoors under the room."""
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_windowed_room(tmp_path, outward, ground), "--work-plane",
+                      f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd"] + DAYLIGHT, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")[0][1]
+    room = lattice(0, W, 0, D, HEIGHT)
+    outdoors = lattice(*GROUND, ground + HEIGHT)
+    # The polygons facing up alone: the floor's grid, and the ground's all over.
+    assert keys(vtk_to_numpy(frames["inward"].GetPoints().GetData())) == keys(room + outdoors)
+    if -ground < HEIGHT:
+        outdoors = [p for p in outdoors if not (0 < p[0] < W and 0 < p[1] < D)]
+    points = vtk_to_numpy(frames["outward"].GetPoints().GetData())
+    assert numpy.all(points[:, 2] < H)
+    assert keys(points) == keys(room + outdoors)
+    same_illuminance(frames["outward"], frames["inward"])
 
 
 def test_work_plane_follows_up(tmp_path):
