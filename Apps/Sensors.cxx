@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -257,20 +258,8 @@ public:
   {
     V hit;
     const vtkIdType cell = this->firstBelow(point, hit);
-    if (cell < 0)
-    {
-      return false;
-    }
-    vtkNew<vtkIdList> ids;
-    this->Scene->GetCellPoints(cell, ids);
-    std::vector<V> corners;
-    for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
-    {
-      double p[3];
-      this->Scene->GetPoint(ids->GetId(i), p);
-      corners.push_back({ p[0], p[1], p[2] });
-    }
-    if (dot(areaVector(corners), this->Up) <= 0 || dot(point - hit, this->Up) <= this->Height)
+    if (cell < 0 || dot(this->normalOf(cell), this->Up) <= 0 ||
+      dot(point - hit, this->Up) <= this->Height)
     {
       return false;
     }
@@ -305,11 +294,12 @@ public:
   }
 
   /// Whether `point` is walled in: more than half of WallDirections horizontal rays from it
-  /// meet a polygon before they leave `extent`, the bounds of the floor or ceiling in question.
-  /// A room's walls stand at the edges of its floor and ceiling, within their bounds; a
-  /// neighbour's wall across the street lies beyond them and walls in no room of theirs.
-  /// More than half: a room's windows and doors let some rays out.
-  bool walledIn(const V& point, const Extent& extent) const
+  /// meet a polygon before they leave `extent`, the bounds of the floor or ceiling in question
+  /// (with `fromInside`, a polygon seen from behind, its normal pointing away). A room's walls
+  /// stand at the edges of its floor and ceiling, within their bounds; a neighbour's wall
+  /// across the street lies beyond them and walls in no room of theirs. More than half: a
+  /// room's windows and doors let some rays out.
+  bool walledIn(const V& point, const Extent& extent, bool fromInside = false) const
   {
     const double u = dot(point, this->T), v = dot(point, this->B);
     // The answer is known once more than half of the rays meet a wall, or half do not.
@@ -321,8 +311,10 @@ public:
       const double cu = std::cos(phi), cv = std::sin(phi);
       const double reach = std::min((cu > 0 ? extent.uHi - u : extent.uLo - u) / cu,
         (cv > 0 ? extent.vHi - v : extent.vLo - v) / cv);
-      const bool wall = reach > 0 &&
-        this->blocked(point, point + scaled(this->T, cu * reach) + scaled(this->B, cv * reach));
+      const V direction = scaled(this->T, cu) + scaled(this->B, cv);
+      const vtkIdType cell =
+        reach > 0 ? this->firstHit(point, point + scaled(direction, reach)) : vtkIdType(-1);
+      const bool wall = cell >= 0 && (!fromInside || dot(this->normalOf(cell), direction) > 0);
       (wall ? walls : open) += 1;
     }
     return 2 * walls > WallDirections;
@@ -371,13 +363,19 @@ public:
     return false;
   }
 
-  /// Nothing above `point` and, under lights, no light in sight from it: a roof. Daylight
-  /// reaches a roof, and a room's own faces up under its roof have something above them.
-  bool isRoof(const V& point) const
+  /// Whether `point`, on a polygon facing up over a floor found facing down (within
+  /// `floorExtent`), is that room's roof: nothing above it; under lights, no light in sight
+  /// (daylight reaches a roof; a room's lamps light its floor and what stands on it); and its
+  /// work plane not walled in by the room's walls. A roof stands on the walls, with the
+  /// outdoors around; a table under an opening in the roof, with nothing above it either,
+  /// stands within them, and sees them from inside: from behind, as the room's normals point
+  /// outward. A parapet or a taller part of the building around a roof shows it its front.
+  bool isRoof(const V& point, const Extent& floorExtent) const
   {
     const V from = this->above(point);
     return !this->blocked(from, from + scaled(this->Up, 2 * this->Size + 1)) &&
-      (this->Daylight || !this->seesALight(point));
+      (this->Daylight || !this->seesALight(point)) &&
+      !this->walledIn(point + scaled(this->Up, this->Height), floorExtent, true);
   }
 
 private:
@@ -400,13 +398,33 @@ private:
     return cell;
   }
 
-  bool blocked(const V& from, const V& to) const
+  /// The first cell between `from` and `to`; -1 when none.
+  vtkIdType firstHit(const V& from, const V& to) const
   {
     double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
     double t = 0, x[3], pcoords[3];
     int subId = 0;
     vtkIdType cell = -1;
-    return this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) != 0;
+    return this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) != 0
+      ? cell
+      : -1;
+  }
+
+  bool blocked(const V& from, const V& to) const { return this->firstHit(from, to) >= 0; }
+
+  /// Twice the area times the unit normal of a cell of the scene.
+  V normalOf(vtkIdType cell) const
+  {
+    vtkNew<vtkIdList> ids;
+    this->Scene->GetCellPoints(cell, ids);
+    std::vector<V> corners;
+    for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
+    {
+      double p[3];
+      this->Scene->GetPoint(ids->GetId(i), p);
+      corners.push_back({ p[0], p[1], p[2] });
+    }
+    return areaVector(corners);
   }
 
   V Up, T, B;
@@ -563,6 +581,7 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     std::sort(facingDown.begin(), facingDown.end(),
       [](const Face& f, const Face& g) { return f.level < g.level; });
     std::vector<Face> floors;
+    std::map<vtkIdType, Extent> floorExtents; ///< of each floor's cell: its group's bounds
     std::vector<std::vector<Face>> groups;
     for (const std::vector<Face>& level : levelsOf(facingDown, finder.levelTolerance()))
     {
@@ -604,6 +623,10 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       if (floor)
       {
         floors.insert(floors.end(), group.begin(), group.end());
+        for (const Face& face : group)
+        {
+          floorExtents[face.cell] = extent;
+        }
       }
     }
     floorsFacingDown = !floors.empty();
@@ -630,8 +653,9 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
         // standing on it, a lower roof's under the next storey's floor. Under a floor
         // standing higher (on stilts) the point is outdoors and stays. Otherwise the face
         // may be that room's roof.
-        sensor.keep =
-          floor < 0 || (level < sensor.w - finder.levelTolerance() && !finder.isRoof(sensor.point));
+        sensor.keep = floor < 0 ||
+          (level < sensor.w - finder.levelTolerance() &&
+            !finder.isRoof(sensor.point, floorExtents.at(floor)));
       }
       std::vector<Sensor> more;
       std::stable_sort(floors.begin(), floors.end(),

@@ -40,11 +40,12 @@ constexpr int SkyDirections = 32;
  * The lattice then loses the points of the polygons facing up whose point lies above such a
  * floor while they lie below it or at its level (the ground under a room standing on it),
  * and its points over the polygons facing up that have nothing above them, stand over such a
- * floor and, under lights, see no light (that room's roof). A correctly oriented room's
- * polygons facing down (ceilings, undersides, a shelf over a lit floor) find no floor, and its
- * work plane is the one of the polygons facing up alone, as without either. Warns when every
- * sensor lies above the scene while some polygon faces down and no floor was found among
- * them. Throws InputError when no polygon is a floor, and UsageError when the grid would have
+ * floor, are not walled in by that room's walls, seen from behind, `height` above them (a
+ * table under an opening in the roof is) and, under lights, see no light (that room's roof). A
+ * correctly oriented room's polygons facing down (ceilings, undersides, a shelf over a lit floor)
+ * find no floor, and its work plane is the one of the polygons facing up alone, as without either.
+ * Warns when every sensor lies above the scene while some polygon faces down and no floor was found
+ * among them. Throws InputError when no polygon is a floor, and UsageError when the grid would have
  * more sensors than a solve accepts.
  */
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& up, double height,
