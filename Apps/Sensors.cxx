@@ -346,6 +346,13 @@ public:
     return false;
   }
 
+  /// Whether nothing lies less than the work plane's height straight above `point`.
+  bool roomAbove(const V& point) const
+  {
+    const V from = this->above(point);
+    return !this->blocked(from, from + scaled(this->Up, this->Height));
+  }
+
   /// Whether a light above `point`'s level is in sight from just above it.
   bool seesALight(const V& point) const
   {
@@ -577,7 +584,9 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     // room (ceilingOverItsFloor).
     const FloorFinder finder(scene, lights, daylight, up, t, b, height);
     // Faces that touch at one height are one floor: a part in shadow goes with the parts
-    // that see the light; another building's floor at that height is decided by its own.
+    // that see the light, and a windowless unit of a terrace with its neighbour's (its floor
+    // is a floor with inward normals too, dark); another building's floor at that height is
+    // decided by its own.
     std::sort(facingDown.begin(), facingDown.end(),
       [](const Face& f, const Face& g) { return f.level < g.level; });
     std::vector<Face> floors;
@@ -622,10 +631,26 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       }
       if (floor)
       {
-        floors.insert(floors.end(), group.begin(), group.end());
+        // A face with no room for the work plane over any of its points is the bottom of a
+        // solid lower than it (a block, a bench, a step) that touches the floor or the
+        // building: no room's floor, as a room lower than the work plane holds none. It is
+        // left as the polygons facing up leave it, its top's sensors kept.
+        std::vector<Face> kept;
         for (const Face& face : group)
         {
-          floorExtents[face.cell] = extent;
+          const std::vector<Sensor> points = lattice({ face }, spacing);
+          if (points.empty() ||
+            std::any_of(points.begin(), points.end(),
+              [&](const Sensor& point) { return finder.roomAbove(point.point); }))
+          {
+            kept.push_back(face);
+          }
+        }
+        const Extent keptExtent = extentOf(kept, finder.levelTolerance());
+        for (const Face& face : kept)
+        {
+          floors.push_back(face);
+          floorExtents[face.cell] = keptExtent;
         }
       }
     }

@@ -286,14 +286,19 @@ def test_work_plane_finds_the_floor_of_a_room_with_outward_normals(tmp_path):
         assert numpy.all(array(a, "Illuminance") > 0)
 
 
-def write_windowed_room(directory, outward, ground=None):
+def write_windowed_room(directory, outward, ground=None, rooms=(), blocks=()):
     """The room of write_room closed by a ceiling, with a 1 x 1 window (x in [1, 2], z in
     [1, 2]) in its wall y = 0, its normals inward or outward; with `ground`, on a ground
-    (GROUND, facing up) at that height."""
+    (GROUND, facing up) at that height; with closed `rooms` (x0, x1, y0, y1, z0, z1) whose
+    normals face like the room's, and `blocks` whose normals face outward."""
     room = Polygons()
     if ground is not None:
         x0, x1, y0, y1 = GROUND
         room.add([(x0, y0, ground), (x1, y0, ground), (x1, y1, ground), (x0, y1, ground)])
+    for bounds in rooms:
+        add_block(room, *bounds, inward=not outward)
+    for bounds in blocks:
+        add_block(room, *bounds)
 
     def add(inward_corners):
         room.add(inward_corners[::-1] if outward else inward_corners)
@@ -352,16 +357,16 @@ def keys(points):
     return sorted(tuple(numpy.round(p, 6)) for p in points)
 
 
-def same_illuminance(a, b):
+def same_illuminance(a, b, lit=True):
     """Each of `a`'s sensors has the illuminance of `b`'s sensor at its point (the first, if
-    several) within 5 standard errors; both lit."""
+    several) within 5 standard errors; both lit, unless not `lit`."""
     first = {}
     for i, p in enumerate(vtk_to_numpy(b.GetPoints().GetData())):
         first.setdefault(tuple(numpy.round(p, 6)), i)
     at = [first[tuple(numpy.round(p, 6))] for p in vtk_to_numpy(a.GetPoints().GetData())]
     la, lb = array(a, "Illuminance"), array(b, "Illuminance")[at]
     sigma = numpy.hypot(array(a, "IlluminanceStdError"), array(b, "IlluminanceStdError")[at])
-    assert numpy.all(la > 0) and numpy.all(lb > 0)
+    assert not lit or (numpy.all(la > 0) and numpy.all(lb > 0))
     assert numpy.all(numpy.abs(la - lb) <= 5 * sigma + 1e-6 * lb), numpy.abs(la - lb) / sigma
 
 
@@ -400,14 +405,15 @@ def test_work_plane_finds_the_floor_of_an_outward_room_on_a_ground(tmp_path, gro
     same_illuminance(frames["outward"], frames["inward"])
 
 
-def add_block(polygons, x0, x1, y0, y1, z0, z1):
-    """A closed block, its normals outward."""
-    polygons.add([(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)])  # bottom
-    polygons.add([(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)])  # top
-    polygons.add([(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)])  # x = x0
-    polygons.add([(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)])  # x = x1
-    polygons.add([(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)])  # y = y0
-    polygons.add([(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)])  # y = y1
+def add_block(polygons, x0, x1, y0, y1, z0, z1, inward=False):
+    """A closed block, its normals outward (or inward: a closed room)."""
+    for corners in ([(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)],   # bottom
+                    [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],   # top
+                    [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],   # x = x0
+                    [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],   # x = x1
+                    [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)],   # y = y0
+                    [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)]):  # y = y1
+        polygons.add(corners[::-1] if inward else corners)
 
 
 def write_room_with_a_roof_opening(directory, outward):
@@ -463,6 +469,44 @@ def test_work_plane_keeps_a_table_under_an_opening_of_an_outward_room(tmp_path, 
         assert keys(vtk_to_numpy(inward.GetPoints().GetData())) == expected
         assert keys(vtk_to_numpy(outward.GetPoints().GetData())) == expected
         same_illuminance(outward, inward)
+
+
+@pytest.mark.parametrize("neighbour", ["unit", "bench"])
+def test_work_plane_of_an_outward_room_and_a_neighbour_touching_it(tmp_path, neighbour):
+    """The windowed room on a ground at -0.01, with a closed block touching it and standing on
+    the ground like it: a windowless unit of a terrace sharing its wall x = W (3 x 2, as high
+    as the room, its normals like the room's), or a bench at its corner (W, D) (1 x 1, 0.45
+    high, its normals outward; at a corner, as a block against a wall lit the room with
+    inward normals through the faces they share).
+    With outward normals the bottoms touching at one height are one floor, found by the room's
+    window: the unit's floor, dark, is a floor, as it is with inward normals. So was the
+    bench's bottom: its 4 sensors stood 0.8 above the bottom, not 0.8 above its top, and the
+    ground's beneath it went. A solid lower than the work plane holds none, and is left as with
+    inward normals: the grid is that of the room and unit with inward normals but for the
+    ground's sensors under them (in them), with the same illuminance within the noise."""
+    rooms, blocks = ([(W, 2 * W, 0, D, 0, H)], []) if neighbour == "unit" else (
+        [], [(W, W + 1, D, D + 1, 0, 0.45)])
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_windowed_room(tmp_path, outward, -0.01, rooms, blocks),
+                      "--work-plane", f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd"]
+                     + DAYLIGHT, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")[0][1]
+    x1 = 2 * W if neighbour == "unit" else W
+    inward = vtk_to_numpy(frames["inward"].GetPoints().GetData())
+    # The ground's sensors under the room (and the unit).
+    x, y, z = inward.T
+    under = (numpy.abs(z - (HEIGHT - 0.01)) < 1e-9) & (0 < x) & (x < x1) & (0 < y) & (y < D)
+    assert keys(inward[under]) == keys(
+        p for p in lattice(*GROUND, HEIGHT - 0.01) if 0 < p[0] < x1 and 0 < p[1] < D)
+    if neighbour == "bench":
+        assert keys(inward[inward[:, 2] > HEIGHT]) == keys(lattice(W, W + 1, D, D + 1, 0.45 + HEIGHT))
+    assert keys(vtk_to_numpy(frames["outward"].GetPoints().GetData())) == keys(inward[~under])
+    # The unit, closed, is dark.
+    same_illuminance(frames["outward"], frames["inward"], lit=neighbour == "bench")
 
 
 def test_work_plane_follows_up(tmp_path):
