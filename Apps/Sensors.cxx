@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -71,6 +72,9 @@ V areaVector(const std::vector<V>& corners)
   return sum;
 }
 
+/// Horizontal rays from a point that tell a room from the outdoors.
+constexpr int WallDirections = 16;
+
 /// A polygon of the scene across up, seen along up: its corners (u along t, v along b).
 struct Face
 {
@@ -80,6 +84,27 @@ struct Face
   double area = 0;
   vtkIdType cell = -1; ///< in the scene
 };
+
+/// Bounds across up (u along t, v along b).
+struct Extent
+{
+  double uLo, uHi, vLo, vHi;
+};
+
+/// The bounds of `faces` across up, widened by `margin` on every side.
+Extent extentOf(const std::vector<Face>& faces, double margin)
+{
+  Extent e{ std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+    std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity() };
+  for (const Face& face : faces)
+  {
+    const auto [uLo, uHi] = std::minmax_element(face.us.begin(), face.us.end());
+    const auto [vLo, vHi] = std::minmax_element(face.vs.begin(), face.vs.end());
+    e = { std::min(e.uLo, *uLo - margin), std::max(e.uHi, *uHi + margin),
+      std::min(e.vLo, *vLo - margin), std::max(e.vHi, *vHi + margin) };
+  }
+  return e;
+}
 
 /// UsageError when a lattice of `spacing` over `area` would have more sensors than a solve
 /// accepts.
@@ -116,16 +141,10 @@ std::vector<std::vector<Face>> levelsOf(const std::vector<Face>& sorted, double 
 /// apart from the next building's.
 std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, double tolerance)
 {
-  struct Extent
-  {
-    double uLo, uHi, vLo, vHi;
-  };
   std::vector<Extent> extents;
   for (const Face& face : level)
   {
-    const auto [uLo, uHi] = std::minmax_element(face.us.begin(), face.us.end());
-    const auto [vLo, vHi] = std::minmax_element(face.vs.begin(), face.vs.end());
-    extents.push_back({ *uLo - tolerance, *uHi + tolerance, *vLo - tolerance, *vHi + tolerance });
+    extents.push_back(extentOf({ face }, tolerance));
   }
   std::vector<std::size_t> parent(level.size());
   std::iota(parent.begin(), parent.end(), 0);
@@ -176,19 +195,20 @@ std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, do
 /**
  * What rays through the scene say of a horizontal polygon's upper side: whether it sees one of
  * the lights (at most 16 of their positions, spread over the frames) or the sky, what lies
- * straight below and above it, and whether it is a roof (nothing above it and, unless
- * daylight lights the scene, no light in sight).
+ * straight below and above it, whether the work plane over it is in a room (walled in) or
+ * outdoors, and whether it is a roof.
  */
 class FloorFinder
 {
 public:
-  /// `t` and `b`: two axes across `up`, for the sky's directions.
+  /// `t` and `b`: two axes across `up`, for the sky's directions; `height`: the work plane's.
   FloorFinder(vtkPolyData* scene, const std::vector<Triple>& lights, bool daylight, const V& up,
-    const V& t, const V& b)
+    const V& t, const V& b, double height)
     : Up(up)
     , T(t)
     , B(b)
     , Daylight(daylight)
+    , Height(height)
     , Scene(scene)
   {
     double bounds[6];
@@ -222,46 +242,82 @@ public:
     return this->firstBelow(point, hit) >= 0 && this->seesALight(hit);
   }
 
-  /// Whether the first polygon below `point` faces up, towards it: then a polygon facing down
-  /// at `point` is a correctly oriented room's ceiling (or an underside over its floor), where
-  /// the sky, seen from above the ceiling, says nothing.
-  bool facedFromBelow(const V& point) const
+  /// Whether `point`, on a polygon facing down of a group within `extent`, is on a correctly
+  /// oriented room's ceiling over its floor, where the sky seen from above the ceiling says
+  /// nothing. Seen from `point` alone, such a ceiling and the floor of a room modelled with
+  /// outward normals standing on a ground (or on the roof below, or on stilts over the ground)
+  /// look alike: a polygon facing down over one facing up at it. They differ in which side of
+  /// the polygon is a room: a space that holds the work plane and is walled in. The space
+  /// between the two polygons is a room when it is higher than the work plane (the floor's
+  /// work plane lies under the ceiling) and its work plane is walled in; lower, it is a gap
+  /// (under an outward room's floor on a ground), never a room. When it is high but open,
+  /// the space above `point` decides: walled in, it is the room of a floor raised over open
+  /// ground; open too, neither side is a room (a canopy, a pavilion's ceiling) and the normals
+  /// are taken as given: a ceiling.
+  bool ceilingOverItsFloor(const V& point, const Extent& extent) const
   {
     V hit;
     const vtkIdType cell = this->firstBelow(point, hit);
-    if (cell < 0)
+    if (cell < 0 || dot(this->normalOf(cell), this->Up) <= 0 ||
+      dot(point - hit, this->Up) <= this->Height)
     {
       return false;
     }
-    vtkNew<vtkIdList> ids;
-    this->Scene->GetCellPoints(cell, ids);
-    std::vector<V> corners;
-    for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
-    {
-      double p[3];
-      this->Scene->GetPoint(ids->GetId(i), p);
-      corners.push_back({ p[0], p[1], p[2] });
-    }
-    return dot(areaVector(corners), this->Up) > 0;
+    return this->walledIn(hit + scaled(this->Up, this->Height), extent) ||
+      !this->walledIn(point + scaled(this->Up, this->Height), extent);
   }
 
-  /// Whether one of `cells` lies straight below `point`.
-  bool standsOver(const V& point, const std::set<vtkIdType>& cells) const
+  /// The nearest of `cells` straight below `point` (-1 when none), and its height along up.
+  vtkIdType nearestBelow(const V& point, const std::set<vtkIdType>& cells, double& level) const
   {
     const V from = point - scaled(this->Up, this->Offset);
     const V to = from - scaled(this->Up, 2 * this->Size + 1);
     double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
+    vtkNew<vtkPoints> points;
     vtkNew<vtkIdList> hits;
     vtkNew<vtkGenericCell> cell;
-    this->Locator->IntersectWithLine(a, z, this->Tolerance, nullptr, hits, cell);
+    this->Locator->IntersectWithLine(a, z, this->Tolerance, points, hits, cell);
+    vtkIdType nearest = -1;
+    level = -std::numeric_limits<double>::infinity();
     for (vtkIdType i = 0; i < hits->GetNumberOfIds(); ++i)
     {
-      if (cells.count(hits->GetId(i)))
+      double x[3];
+      points->GetPoint(i, x);
+      const double h = dot({ x[0], x[1], x[2] }, this->Up);
+      if (cells.count(hits->GetId(i)) && h > level)
       {
-        return true;
+        nearest = hits->GetId(i);
+        level = h;
       }
     }
-    return false;
+    return nearest;
+  }
+
+  /// Whether `point` is walled in: more than half of WallDirections horizontal rays from it
+  /// meet a polygon before they leave `extent`, the bounds of the floor or ceiling in question
+  /// (with `fromInside`, a polygon seen from behind, its normal pointing away). A room's walls
+  /// stand at the edges of its floor and ceiling, within their bounds; a neighbour's wall
+  /// across the street lies beyond them and walls in no room of theirs. More than half: a
+  /// room's windows and doors let some rays out.
+  bool walledIn(const V& point, const Extent& extent, bool fromInside = false) const
+  {
+    const double u = dot(point, this->T), v = dot(point, this->B);
+    // The answer is known once more than half of the rays meet a wall, or half do not.
+    int walls = 0, open = 0;
+    for (int k = 0; 2 * walls <= WallDirections && 2 * open < WallDirections; ++k)
+    {
+      // Half a step off the axes: no ray runs along a wall.
+      const double phi = 2 * M_PI * (k + 0.5) / WallDirections;
+      const double cu = std::cos(phi), cv = std::sin(phi);
+      const double reach = std::min((cu > 0 ? extent.uHi - u : extent.uLo - u) / cu,
+        (cv > 0 ? extent.vHi - v : extent.vLo - v) / cv);
+      const V direction = scaled(this->T, cu) + scaled(this->B, cv);
+      const vtkIdType cell =
+        reach > 0 ? this->firstHit(point, point + scaled(direction, reach)) : vtkIdType(-1);
+      const bool wall = cell >= 0 && (!fromInside || dot(this->normalOf(cell), direction) > 0);
+      (wall ? walls : open) += 1;
+    }
+    return 2 * walls > WallDirections;
   }
 
   /// Whether the sky is in sight from just above `point`, along one of SkyDirections
@@ -290,6 +346,13 @@ public:
     return false;
   }
 
+  /// Whether nothing lies less than the work plane's height straight above `point`.
+  bool roomAbove(const V& point) const
+  {
+    const V from = this->above(point);
+    return !this->blocked(from, from + scaled(this->Up, this->Height));
+  }
+
   /// Whether a light above `point`'s level is in sight from just above it.
   bool seesALight(const V& point) const
   {
@@ -307,13 +370,19 @@ public:
     return false;
   }
 
-  /// Nothing above `point` and, under lights, no light in sight from it: a roof. Daylight
-  /// reaches a roof, and a room's own faces up under its roof have something above them.
-  bool isRoof(const V& point) const
+  /// Whether `point`, on a polygon facing up over a floor found facing down (within
+  /// `floorExtent`), is that room's roof: nothing above it; under lights, no light in sight
+  /// (daylight reaches a roof; a room's lamps light its floor and what stands on it); and its
+  /// work plane not walled in by the room's walls. A roof stands on the walls, with the
+  /// outdoors around; a table under an opening in the roof, with nothing above it either,
+  /// stands within them, and sees them from inside: from behind, as the room's normals point
+  /// outward. A parapet or a taller part of the building around a roof shows it its front.
+  bool isRoof(const V& point, const Extent& floorExtent) const
   {
     const V from = this->above(point);
     return !this->blocked(from, from + scaled(this->Up, 2 * this->Size + 1)) &&
-      (this->Daylight || !this->seesALight(point));
+      (this->Daylight || !this->seesALight(point)) &&
+      !this->walledIn(point + scaled(this->Up, this->Height), floorExtent, true);
   }
 
 private:
@@ -336,17 +405,38 @@ private:
     return cell;
   }
 
-  bool blocked(const V& from, const V& to) const
+  /// The first cell between `from` and `to`; -1 when none.
+  vtkIdType firstHit(const V& from, const V& to) const
   {
     double a[3] = { from.x, from.y, from.z }, z[3] = { to.x, to.y, to.z };
     double t = 0, x[3], pcoords[3];
     int subId = 0;
     vtkIdType cell = -1;
-    return this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) != 0;
+    return this->Locator->IntersectWithLine(a, z, this->Tolerance, t, x, pcoords, subId, cell) != 0
+      ? cell
+      : -1;
+  }
+
+  bool blocked(const V& from, const V& to) const { return this->firstHit(from, to) >= 0; }
+
+  /// Twice the area times the unit normal of a cell of the scene.
+  V normalOf(vtkIdType cell) const
+  {
+    vtkNew<vtkIdList> ids;
+    this->Scene->GetCellPoints(cell, ids);
+    std::vector<V> corners;
+    for (vtkIdType i = 0; i < ids->GetNumberOfIds(); ++i)
+    {
+      double p[3];
+      this->Scene->GetPoint(ids->GetId(i), p);
+      corners.push_back({ p[0], p[1], p[2] });
+    }
+    return areaVector(corners);
   }
 
   V Up, T, B;
   bool Daylight;
+  double Height;
   double Size = 0, Offset = 0, Tolerance = 0;
   std::vector<V> Lights;
   vtkPolyData* Scene;
@@ -490,13 +580,17 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
     // A floor whose normal points down (a room modelled with outward normals) is found by
     // the light it sees: its upper side, where the sensors go, sees a light or the sky. A
     // correctly oriented room's ceilings and undersides see no light from above; the sky
-    // they may see, but they lie over the room's floor, which faces up at them.
-    const FloorFinder finder(scene, lights, daylight, up, t, b);
+    // they may see, but they lie over the room's floor, which faces up at them across the
+    // room (ceilingOverItsFloor).
+    const FloorFinder finder(scene, lights, daylight, up, t, b, height);
     // Faces that touch at one height are one floor: a part in shadow goes with the parts
-    // that see the light; another building's floor at that height is decided by its own.
+    // that see the light, and a windowless unit of a terrace with its neighbour's (its floor
+    // is a floor with inward normals too, dark); another building's floor at that height is
+    // decided by its own.
     std::sort(facingDown.begin(), facingDown.end(),
       [](const Face& f, const Face& g) { return f.level < g.level; });
     std::vector<Face> floors;
+    std::map<vtkIdType, Extent> floorExtents; ///< of each floor's cell: its group's bounds
     std::vector<std::vector<Face>> groups;
     for (const std::vector<Face>& level : levelsOf(facingDown, finder.levelTolerance()))
     {
@@ -515,11 +609,12 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       // At most about 64 probes a group, and at least its lattice's points.
       const double probeStep = std::max(spacing, std::sqrt(groupArea / 64));
       const std::vector<Sensor> probes = lattice(group, probeStep);
+      const Extent extent = extentOf(group, finder.levelTolerance());
       bool floor = false;
       if (daylight)
       {
         floor = std::none_of(probes.begin(), probes.end(),
-          [&](const Sensor& probe) { return finder.facedFromBelow(probe.point); });
+          [&](const Sensor& probe) { return finder.ceilingOverItsFloor(probe.point, extent); });
         const std::size_t stride = (probes.size() + SkyProbes - 1) / SkyProbes;
         bool sky = false;
         for (std::size_t k = 0; floor && !sky && k < probes.size(); k += stride)
@@ -536,7 +631,27 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       }
       if (floor)
       {
-        floors.insert(floors.end(), group.begin(), group.end());
+        // A face with no room for the work plane over any of its points is the bottom of a
+        // solid lower than it (a block, a bench, a step) that touches the floor or the
+        // building: no room's floor, as a room lower than the work plane holds none. It is
+        // left as the polygons facing up leave it, its top's sensors kept.
+        std::vector<Face> kept;
+        for (const Face& face : group)
+        {
+          const std::vector<Sensor> points = lattice({ face }, spacing);
+          if (points.empty() ||
+            std::any_of(points.begin(), points.end(),
+              [&](const Sensor& point) { return finder.roomAbove(point.point); }))
+          {
+            kept.push_back(face);
+          }
+        }
+        const Extent keptExtent = extentOf(kept, finder.levelTolerance());
+        for (const Face& face : kept)
+        {
+          floors.push_back(face);
+          floorExtents[face.cell] = keptExtent;
+        }
       }
     }
     floorsFacingDown = !floors.empty();
@@ -548,8 +663,6 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
         floorArea += face.area;
       }
       checkSensorCount(area + floorArea, spacing);
-      // Such a room's roof faces up: above it nothing, below it its floor, and no lamp of
-      // the room reaches it.
       std::set<vtkIdType> floorCells;
       for (const Face& face : floors)
       {
@@ -557,7 +670,17 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
       }
       for (Sensor& sensor : sensors)
       {
-        sensor.keep = !(finder.isRoof(sensor.point) && finder.standsOver(sensor.point, floorCells));
+        double level = 0;
+        const vtkIdType floor =
+          finder.nearestBelow(sensor.point + scaled(up, height), floorCells, level);
+        // A floor between a face and its sensor's point, or at the face's level, puts the
+        // point in that floor's room, whose own lattice covers it: the ground's under a room
+        // standing on it, a lower roof's under the next storey's floor. Under a floor
+        // standing higher (on stilts) the point is outdoors and stays. Otherwise the face
+        // may be that room's roof.
+        sensor.keep = floor < 0 ||
+          (level < sensor.w - finder.levelTolerance() &&
+            !finder.isRoof(sensor.point, floorExtents.at(floor)));
       }
       std::vector<Sensor> more;
       std::stable_sort(floors.begin(), floors.end(),

@@ -29,19 +29,26 @@ constexpr int SkyDirections = 32;
  *
  * The floors are the polygons whose normal is within WorkPlaneToleranceDegrees of `up`. With
  * `lights` (where the lights are) or `daylight` (the sun or a sky light the scene) the floors
- * are also found by geometry, as the solve is two-sided: the polygons within that angle of
- * down that touch one another at one height are the floor of a room modelled with outward
- * normals when, under lights, one of their points sees a light from its upper side and has
- * nothing lit straight below it, and under daylight, one of their points sees the sky (along
- * one of SkyDirections directions from each of up to SkyProbes points) and none has a
- * polygon facing up at it straight below; the lattice then loses its points over the
- * polygons facing up that have nothing above them, stand over such a floor and, under
- * lights, see no light (that room's roof). A correctly oriented room's polygons facing down
- * (ceilings, undersides, a shelf over a lit floor) find no floor, and its work plane is the
- * one of the polygons facing up alone, as without either. Warns when every sensor lies above
- * the scene while some polygon faces down and no floor was found among them. Throws
- * InputError when no polygon is a floor, and UsageError when the grid would have more
- * sensors than a solve accepts.
+ * are also found by geometry, as the solve is two-sided: the polygons within that angle of down
+ * that touch one another at one height are the floor of a room modelled with outward normals
+ * when, under lights, one of their points sees a light from its upper side and has nothing lit
+ * straight below it, and under daylight, one of their points sees the sky (along one of
+ * SkyDirections directions from each of up to SkyProbes points) and none is a correctly
+ * oriented room's ceiling: a polygon facing up at it straight below, more than `height` below,
+ * with the work plane between them walled in or the space above the group open too (a ground
+ * just under a room, or open ground under a room on stilts, is no room). Of such a floor, a
+ * polygon with something less than `height` above each of its lattice points is the bottom of a
+ * low solid touching it, and no floor. The lattice then adds the floors' points, and loses the
+ * points of the polygons facing up whose point lies above such a floor while they lie below it
+ * or at its level (the ground under a room standing on it), and its points over the polygons
+ * facing up that have nothing above them, stand over such a floor, are not walled in by that
+ * room's walls, seen from behind, `height` above them (a table under an opening in the roof is)
+ * and, under lights, see no light (that room's roof). A correctly oriented room's polygons
+ * facing down (ceilings, undersides, a shelf over a lit floor) find no floor, and its work
+ * plane is the one of the polygons facing up alone, as without either. Warns when every sensor
+ * lies above the scene while some polygon faces down and no floor was found among them. Throws
+ * InputError when no polygon is a floor, and UsageError when the grid would have more sensors
+ * than a solve accepts.
  */
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& up, double height,
   double spacing, const std::vector<Triple>& lights = {}, bool daylight = false);

@@ -27,6 +27,7 @@ from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPolyDataWriter
 W, D, H = 3.0, 2.0, 2.5
 HEIGHT, SPACING = 0.8, 0.5
 EDH = 100.0
+GROUND = (-2.0, 5.0, -2.0, 4.0)  # x0, x1, y0, y1: a ground around the room's footprint
 FAST = ["--paths", "20000", "--threads", "2", "--patch-size", "0.5"]
 
 
@@ -285,10 +286,19 @@ def test_work_plane_finds_the_floor_of_a_room_with_outward_normals(tmp_path):
         assert numpy.all(array(a, "Illuminance") > 0)
 
 
-def write_windowed_room(directory, outward):
+def write_windowed_room(directory, outward, ground=None, rooms=(), blocks=()):
     """The room of write_room closed by a ceiling, with a 1 x 1 window (x in [1, 2], z in
-    [1, 2]) in its wall y = 0, its normals inward or outward."""
+    [1, 2]) in its wall y = 0, its normals inward or outward; with `ground`, on a ground
+    (GROUND, facing up) at that height; with closed `rooms` (x0, x1, y0, y1, z0, z1) whose
+    normals face like the room's, and `blocks` whose normals face outward."""
     room = Polygons()
+    if ground is not None:
+        x0, x1, y0, y1 = GROUND
+        room.add([(x0, y0, ground), (x1, y0, ground), (x1, y1, ground), (x0, y1, ground)])
+    for bounds in rooms:
+        add_block(room, *bounds, inward=not outward)
+    for bounds in blocks:
+        add_block(room, *bounds)
 
     def add(inward_corners):
         room.add(inward_corners[::-1] if outward else inward_corners)
@@ -333,6 +343,170 @@ def test_work_plane_under_daylight_does_not_depend_on_the_normals(tmp_path, dayl
                             array(outward, "IlluminanceStdError"))
         assert numpy.all(a > 0) and numpy.all(b > 0)
         assert numpy.all(numpy.abs(a - b) <= 5 * sigma + 1e-6 * a), numpy.abs(a - b) / sigma
+
+
+def lattice(x0, x1, y0, y1, z):
+    """--work-plane's points over [x0, x1] x [y0, y1] at height z, for bounds on its lattice
+    (multiples of SPACING): (i + 1/2) SPACING along x and y."""
+    xs = numpy.arange(x0 + SPACING / 2, x1, SPACING)
+    ys = numpy.arange(y0 + SPACING / 2, y1, SPACING)
+    return [(x, y, z) for x in xs for y in ys]
+
+
+def keys(points):
+    return sorted(tuple(numpy.round(p, 6)) for p in points)
+
+
+def same_illuminance(a, b, lit=True):
+    """Each of `a`'s sensors has the illuminance of `b`'s sensor at its point (the first, if
+    several) within 5 standard errors; both lit, unless not `lit`."""
+    first = {}
+    for i, p in enumerate(vtk_to_numpy(b.GetPoints().GetData())):
+        first.setdefault(tuple(numpy.round(p, 6)), i)
+    at = [first[tuple(numpy.round(p, 6))] for p in vtk_to_numpy(a.GetPoints().GetData())]
+    la, lb = array(a, "Illuminance"), array(b, "Illuminance")[at]
+    sigma = numpy.hypot(array(a, "IlluminanceStdError"), array(b, "IlluminanceStdError")[at])
+    assert not lit or (numpy.all(la > 0) and numpy.all(lb > 0))
+    assert numpy.all(numpy.abs(la - lb) <= 5 * sigma + 1e-6 * lb), numpy.abs(la - lb) / sigma
+
+
+SOLVE = ["--paths", "200000", "--threads", "2", "--patch-size", "0.25"]
+DAYLIGHT = ["--sky", "uniform", "--sky-diffuse-horizontal", str(EDH)] + SOLVE
+
+
+@pytest.mark.parametrize("ground", [-0.01, 0.0, -1.5])
+def test_work_plane_finds_the_floor_of_an_outward_room_on_a_ground(tmp_path, ground):
+    """The windowed room with outward normals on a ground facing up: just under its floor, at
+    its level, or 1.5 below it (on stilts). A ground under the floor made the floor a ceiling
+    over its floor (a polygon facing up at it straight below): the room's sensors stayed 0.8
+    above its roof in full daylight, without a warning; at the floor's level the ground's
+    sensors under the room doubled the floor's. Its grid is that of the same room with inward
+    normals, 24 sensors 0.8 above the floor with the same illuminance within the noise, and
+    the ground's outside the room; none above the roof. The ground's sensors under the room go
+    when the floor lies between the ground and them (they are in the room, whose grid covers
+    them); 1.5 below they stay, outdoors under the room."""
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_windowed_room(tmp_path, outward, ground), "--work-plane",
+                      f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd"] + DAYLIGHT, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")[0][1]
+    room = lattice(0, W, 0, D, HEIGHT)
+    outdoors = lattice(*GROUND, ground + HEIGHT)
+    # The polygons facing up alone: the floor's grid, and the ground's all over.
+    assert keys(vtk_to_numpy(frames["inward"].GetPoints().GetData())) == keys(room + outdoors)
+    if -ground < HEIGHT:
+        outdoors = [p for p in outdoors if not (0 < p[0] < W and 0 < p[1] < D)]
+    points = vtk_to_numpy(frames["outward"].GetPoints().GetData())
+    assert numpy.all(points[:, 2] < H)
+    assert keys(points) == keys(room + outdoors)
+    same_illuminance(frames["outward"], frames["inward"])
+
+
+def add_block(polygons, x0, x1, y0, y1, z0, z1, inward=False):
+    """A closed block, its normals outward (or inward: a closed room)."""
+    for corners in ([(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)],   # bottom
+                    [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],   # top
+                    [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],   # x = x0
+                    [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)],   # x = x1
+                    [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)],   # y = y0
+                    [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)]):  # y = y1
+        polygons.add(corners[::-1] if inward else corners)
+
+
+def write_room_with_a_roof_opening(directory, outward):
+    """The room of write_room closed by a ceiling with a 1 x 1 opening (x in [1, 2], y in
+    [0.5, 1.5]) over a table (a block 0.75 high standing on the floor, x in [1.1, 1.9], y in
+    [0.6, 1.4]), and a parapet 1.1 high and 0.1 thick round its top; the room's normals inward
+    or outward, the blocks' outward."""
+    room = Polygons()
+
+    def add(inward_corners):
+        room.add(inward_corners[::-1] if outward else inward_corners)
+
+    add([(0, 0, 0), (W, 0, 0), (W, D, 0), (0, D, 0)])              # floor
+    for x0, x1, y0, y1 in ((0, W, 0, 0.5), (0, W, 1.5, D), (0, 1, 0.5, 1.5), (2, W, 0.5, 1.5)):
+        add([(x0, y0, H), (x0, y1, H), (x1, y1, H), (x1, y0, H)])  # ceiling, around the opening
+    add([(0, 0, 0), (0, D, 0), (0, D, H), (0, 0, H)])              # x = 0
+    add([(W, 0, 0), (W, 0, H), (W, D, H), (W, D, 0)])              # x = W
+    add([(0, 0, 0), (0, 0, H), (W, 0, H), (W, 0, 0)])              # y = 0
+    add([(0, D, 0), (W, D, 0), (W, D, H), (0, D, H)])              # y = D
+    add_block(room, 1.1, 1.9, 0.6, 1.4, 0, 0.75)
+    for x0, x1, y0, y1 in ((0, W, 0, 0.1), (0, W, D - 0.1, D), (0, 0.1, 0.1, D - 0.1),
+                           (W - 0.1, W, 0.1, D - 0.1)):
+        add_block(room, x0, x1, y0, y1, H, H + 1.1)
+    return room.write(directory / ("outward.vtp" if outward else "inward.vtp"))
+
+
+@pytest.mark.parametrize("daylight", ["sky", "sun"])
+def test_work_plane_keeps_a_table_under_an_opening_of_an_outward_room(tmp_path, daylight):
+    """A table with the sky straight above it, through an opening in the roof of a room with
+    outward normals, was taken for a roof (nothing above it) over the room's floor, and lost
+    its sensors. It stands within the room's walls, seen from inside (from behind), where a
+    roof stands on them, its parapet seen from outside: the grid is that of the same room with
+    inward normals, the floor's 24 sensors and the table's 4 at 0.75 + 0.8, with the same
+    illuminance within the noise; the roof's go."""
+    # The sun through the opening onto the table, from two directions.
+    sun = write_points(tmp_path / "sun.vtp", [(0.1, 0.05, 1), (-0.1, 0, 1)])
+    # More rays per sensor than the default 512: the table sees the sky through a small opening.
+    light = (DAYLIGHT if daylight == "sky" else ["--sun-directions", sun] + SOLVE) + [
+        "--sensor-rays", "4096"]
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_room_with_a_roof_opening(tmp_path, outward),
+                      "--work-plane", f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd"]
+                     + light, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")
+    table = lattice(1.0, 2.0, 0.5, 1.5, 0.75 + HEIGHT)
+    expected = keys(lattice(0, W, 0, D, HEIGHT) + table)
+    assert len(frames["inward"]) == len(frames["outward"]) == (1 if daylight == "sky" else 2)
+    for (_, inward), (_, outward) in zip(frames["inward"], frames["outward"]):
+        assert keys(vtk_to_numpy(inward.GetPoints().GetData())) == expected
+        assert keys(vtk_to_numpy(outward.GetPoints().GetData())) == expected
+        same_illuminance(outward, inward)
+
+
+@pytest.mark.parametrize("neighbour", ["unit", "bench"])
+def test_work_plane_of_an_outward_room_and_a_neighbour_touching_it(tmp_path, neighbour):
+    """The windowed room on a ground at -0.01, with a closed block touching it and standing on
+    the ground like it: a windowless unit of a terrace sharing its wall x = W (3 x 2, as high
+    as the room, its normals like the room's), or a bench at its corner (W, D) (1 x 1, 0.45
+    high, its normals outward; at a corner, as a block against a wall lit the room with
+    inward normals through the faces they share).
+    With outward normals the bottoms touching at one height are one floor, found by the room's
+    window: the unit's floor, dark, is a floor, as it is with inward normals. So was the
+    bench's bottom: its 4 sensors stood 0.8 above the bottom, not 0.8 above its top, and the
+    ground's beneath it went. A solid lower than the work plane holds none, and is left as with
+    inward normals: the grid is that of the room and unit with inward normals but for the
+    ground's sensors under them (in them), with the same illuminance within the noise."""
+    rooms, blocks = ([(W, 2 * W, 0, D, 0, H)], []) if neighbour == "unit" else (
+        [], [(W, W + 1, D, D + 1, 0, 0.45)])
+    frames = {}
+    for outward in (False, True):
+        name = "outward" if outward else "inward"
+        result = run(["--scene", write_windowed_room(tmp_path, outward, -0.01, rooms, blocks),
+                      "--work-plane", f"{HEIGHT},{SPACING}", "--output", f"{name}/room.pvd"]
+                     + DAYLIGHT, tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert "--work-plane" not in result.stderr, result.stderr
+        frames[name] = read_sensor_series(tmp_path, f"{name}/room_sensors.pvd")[0][1]
+    x1 = 2 * W if neighbour == "unit" else W
+    inward = vtk_to_numpy(frames["inward"].GetPoints().GetData())
+    # The ground's sensors under the room (and the unit).
+    x, y, z = inward.T
+    under = (numpy.abs(z - (HEIGHT - 0.01)) < 1e-9) & (0 < x) & (x < x1) & (0 < y) & (y < D)
+    assert keys(inward[under]) == keys(
+        p for p in lattice(*GROUND, HEIGHT - 0.01) if 0 < p[0] < x1 and 0 < p[1] < D)
+    if neighbour == "bench":
+        assert keys(inward[inward[:, 2] > HEIGHT]) == keys(lattice(W, W + 1, D, D + 1, 0.45 + HEIGHT))
+    assert keys(vtk_to_numpy(frames["outward"].GetPoints().GetData())) == keys(inward[~under])
+    # The unit, closed, is dark.
+    same_illuminance(frames["outward"], frames["inward"], lit=neighbour == "bench")
 
 
 def test_work_plane_follows_up(tmp_path):
