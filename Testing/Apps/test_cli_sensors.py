@@ -503,7 +503,8 @@ def test_work_plane_of_an_outward_room_and_a_neighbour_touching_it(tmp_path, nei
     assert keys(inward[under]) == keys(
         p for p in lattice(*GROUND, HEIGHT - 0.01) if 0 < p[0] < x1 and 0 < p[1] < D)
     if neighbour == "bench":
-        assert keys(inward[inward[:, 2] > HEIGHT]) == keys(lattice(W, W + 1, D, D + 1, 0.45 + HEIGHT))
+        assert keys(inward[inward[:, 2] > HEIGHT]) == keys(
+            lattice(W, W + 1, D, D + 1, 0.45 + HEIGHT))
     assert keys(vtk_to_numpy(frames["outward"].GetPoints().GetData())) == keys(inward[~under])
     # The unit, closed, is dark.
     same_illuminance(frames["outward"], frames["inward"], lit=neighbour == "bench")
