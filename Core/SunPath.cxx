@@ -8,6 +8,7 @@
 #include <libnova/transform.h>
 
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -115,17 +116,18 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
     r.day > daysIn(r.year, r.month))
   {
     std::ostringstream s;
-    s << "the date " << r.year << "-" << r.month << "-" << r.day
-      << " does not exist: give YYYY-MM-DD";
+    s << "the date " << r.year << "-" << std::setfill('0') << std::setw(2) << r.month << "-"
+      << std::setw(2) << r.day << " does not exist: give YYYY-MM-DD";
     throw Error(s.str());
   }
   if (!(r.startHour >= 0 && r.startHour <= 24) || !(r.endHour >= 0 && r.endHour <= 24))
   {
     throw Error("the times of day must be from 00:00 to 24:00");
   }
-  if (!(r.endHour > r.startHour))
+  if (!(r.endHour >= r.startHour))
   {
-    throw Error("the end time is not after the start time: give the day's start first");
+    throw Error("the end time is before the start time: give the day's start first (or the "
+                "same time twice for one instant)");
   }
   if (!(r.stepMinutes > 0) || !std::isfinite(r.stepMinutes) ||
     (r.endHour - r.startHour) * 60 / r.stepMinutes > 100000)

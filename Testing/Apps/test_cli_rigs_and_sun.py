@@ -645,7 +645,7 @@ BAD = {
     "hour 25": (sun_path("0,0,2024-06-21,25:00,26:00,60"), 2, "has the time '25:00'"),
     "time 6h": (sun_path("0,0,2024-06-21,6h,08:00,60"), 2, "has the time '6h'"),
     "end before start": (sun_path("0,0,2024-06-21,08:00,06:00,60"), 2,
-                         "the end time is not after the start time"),
+                         "the end time is before the start time"),
     "zero sun direction": (sun_directions([(0, 0, 1), (0, 0, 0), (1, 0, 1)]), 1,
                            "direction 1 towards the light is (0, 0, 0)"),
     "irradiance -1": (paris("--sun-irradiance", "-1"), 2, "--sun-irradiance is -1"),

@@ -150,7 +150,15 @@ TEST(SunPath, BadRequestsSayWhatToFix)
   r = SunPathRequest();
   r.startHour = 18;
   r.endHour = 6;
-  expectError([&] { sunPath(r); }, "end time is not after the start");
+  expectError([&] { sunPath(r); }, "end time is before the start");
+  // One instant: the same time twice is one frame.
+  r.endHour = 18;
+  EXPECT_EQ(sunPath(r).size(), 1u);
+  r = SunPathRequest();
+  r.year = 2023;
+  r.month = 2;
+  r.day = 29;
+  expectError([&] { sunPath(r); }, "the date 2023-02-29 does not exist");
   r = SunPathRequest();
   r.stepMinutes = 0;
   expectError([&] { sunPath(r); }, "step");
