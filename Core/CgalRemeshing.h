@@ -38,7 +38,7 @@ struct CgalRemeshOutput
   std::size_t fallbackRegions = 0;
   std::size_t degenerateTriangles = 0;
   std::size_t duplicateTriangles = 0;
-  std::size_t foldedTriangles = 0; ///< dropped, overlapping an earlier one in its plane
+  std::size_t foldedTriangles = 0; ///< dropped, overlapping a larger one in its plane
   std::size_t splitPoints = 0;
   std::size_t contactSplitTriangles = 0; ///< repaired triangles cut along contact lines
   std::size_t contactEdges = 0;          ///< edges of the contact lines, once split

@@ -134,11 +134,13 @@ bool interiorsOverlap(const std::array<Point, 3>& s, const std::array<Point, 3>&
     !separates(a, b) && !separates(b, a);
 }
 
-/// Keeps the first of triangles that lie in one plane, face the same way and overlap with some
-/// area: two
-/// triangulations of one face, a face folded onto itself, or a polygon drawn over another.
-/// CGAL 5.5's autorefinement does not handle such coplanar overlaps (it binds references to
-/// null points, or never ends), and no surface can hold both.
+/// Keeps the larger of triangles that lie in one plane, face the same way and overlap with some
+/// area (the first of equal ones): two triangulations of one face, a face folded onto itself,
+/// a polygon drawn over another, or a block's face on a wall. CGAL 5.5's autorefinement does
+/// not handle such coplanar overlaps (it binds references to null points, or never ends), and
+/// no surface can hold both. The larger stays because the smaller is the one more likely to
+/// lie within it: a wall triangle dropped for the block face on it left half the wall open,
+/// and daylight poured into the room through it.
 std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& poll)
 {
   using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
@@ -149,13 +151,18 @@ std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& pol
     const CgalTriangle& t = soup.triangles[i];
     return std::array<Point, 3>{ soup.points[t[0]], soup.points[t[1]], soup.points[t[2]] };
   };
+  std::vector<double> area(soup.triangles.size());
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
     const std::array<Point, 3> c = corners(i);
     boxes.emplace_back(c[0].bbox() + c[1].bbox() + c[2].bbox(), i);
+    area[i] = CGAL::squared_area(c[0], c[1], c[2]);
   }
-  // The pairs (later, earlier), gathered in whatever order the boxes meet, then decided in
-  // triangle order: a triangle goes when it overlaps an earlier one that stays.
+  // Whether triangle i goes before j: the larger first, then the earlier.
+  const auto before = [&area](std::size_t i, std::size_t j)
+  { return area[i] != area[j] ? area[i] > area[j] : i < j; };
+  // The pairs (loser, winner), gathered in whatever order the boxes meet, then decided in
+  // the losers' order: a triangle goes when it overlaps one before it that stays.
   std::vector<std::pair<std::size_t, std::size_t>> overlapping;
   CGAL::box_self_intersection_d(boxes.begin(), boxes.end(),
     [&](const TriangleBox& x, const TriangleBox& y)
@@ -165,17 +172,20 @@ std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& pol
       if (CGAL::coplanar(s[0], s[1], s[2], t[0]) && CGAL::coplanar(s[0], s[1], s[2], t[1]) &&
         CGAL::coplanar(s[0], s[1], s[2], t[2]) && interiorsOverlap(s, t))
       {
-        overlapping.emplace_back(std::max(x.info(), y.info()), std::min(x.info(), y.info()));
+        overlapping.push_back(before(x.info(), y.info()) ? std::make_pair(y.info(), x.info())
+                                                         : std::make_pair(x.info(), y.info()));
       }
     });
-  std::sort(overlapping.begin(), overlapping.end());
+  std::sort(overlapping.begin(), overlapping.end(),
+    [&](const auto& a, const auto& b)
+    { return a.first != b.first ? before(a.first, b.first) : before(a.second, b.second); });
   std::vector<bool> keep(soup.triangles.size(), true);
   std::size_t removed = 0;
-  for (const auto& [later, earlier] : overlapping)
+  for (const auto& [loser, winner] : overlapping)
   {
-    if (keep[later] && keep[earlier])
+    if (keep[loser] && keep[winner])
     {
-      keep[later] = false;
+      keep[loser] = false;
       ++removed;
     }
   }
