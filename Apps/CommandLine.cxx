@@ -909,12 +909,12 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   }
   if (o.targetError)
   {
-    if (!(*o.targetError == 0 || (*o.targetError >= 1e-4 && std::isfinite(*o.targetError))))
+    if (!(*o.targetError == 0 || (*o.targetError >= 1e-4 && *o.targetError < 1)))
     {
       std::ostringstream s;
       s << "--target-error is " << *o.targetError
         << ": give the relative error to reach as a fraction, e.g. 0.02 for 2% (at least "
-           "0.0001), or 0 for none";
+           "0.0001 and below 1: the batches' relative error is at most 1), or 0 for none";
       throw UsageError(s.str());
     }
     if (*o.targetError > 0 && o.errorBatches && *o.errorBatches < 2)

@@ -320,14 +320,22 @@ void validateErrorOptions(const SolverOptions& options)
   if (!(options.targetRelativeError >= 0) || !std::isfinite(options.targetRelativeError))
   {
     throw Error("the target relative error (TargetRelativeError, --target-error) is " +
-      std::to_string(options.targetRelativeError) +
+      formatNumber(options.targetRelativeError) +
       ": give 0 (no target) or a fraction such as 0.02 (2%)");
   }
   if (options.targetRelativeError > 0 && options.targetRelativeError < MinimumTargetRelativeError)
   {
     throw Error("the target relative error (TargetRelativeError, --target-error) is " +
-      std::to_string(options.targetRelativeError) +
+      formatNumber(options.targetRelativeError) +
       ": below 0.0001 no solve would finish; give 0 (no target) or a fraction such as 0.02");
+  }
+  if (options.targetRelativeError >= 1)
+  {
+    // One batch holding all of an element's light gives SE = mean, its largest.
+    throw Error("the target relative error (TargetRelativeError, --target-error) is " +
+      formatNumber(options.targetRelativeError) +
+      ": the batches' relative error is at most 1 (100%), so every solve would meet it; give "
+      "a fraction below 1 such as 0.02 (2%), or 0 (no target)");
   }
   if (options.targetRelativeError > 0 && options.errorBatches < 2)
   {
@@ -337,7 +345,7 @@ void validateErrorOptions(const SolverOptions& options)
   if (!(options.timeLimitSeconds >= 0) || !std::isfinite(options.timeLimitSeconds))
   {
     throw Error("the time limit (TimeLimit, --time-limit) is " +
-      std::to_string(options.timeLimitSeconds) + " s: give 0 (no limit) or a number of seconds");
+      formatNumber(options.timeLimitSeconds) + " s: give 0 (no limit) or a number of seconds");
   }
 }
 
