@@ -44,7 +44,7 @@ namespace
 
 // Bump when the solver's output for the same inputs changes, so that cached references go
 // stale (the cache key covers the inputs and options, not the solver's code).
-constexpr std::uint64_t ReferenceVersion = 1;
+constexpr std::uint64_t ReferenceVersion = 2; // 2: lit sides per surface
 constexpr std::uint64_t ReferenceSeed = 12345;
 constexpr char CacheMagic[8] = { 'M', 'L', 'R', 'R', 'E', 'F', '1', '\n' };
 

@@ -796,7 +796,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   Solution& out = onFrames ? result : whole;
   if (!onFrames)
   {
-    whole.chooseLitSides(resolveThreadCount(options.threads));
+    whole.chooseLitSides(scene, resolveThreadCount(options.threads));
     summariseErrors(whole, errors);
   }
   else

@@ -468,7 +468,7 @@ std::uint64_t nextBatchCount(std::uint64_t batches, double p95, double target)
   return std::max(next, batches + 1);
 }
 
-void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
+void solveInBatches(const Scene& scene, const SolverOptions& options, const BatchSolve& solveBatch,
   const std::function<bool(double fraction)>& progress, std::uint64_t memoryBytes,
   double& secondsReducing, Solution& result)
 {
@@ -558,7 +558,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
       break;
     }
     spread.publish();
-    result.chooseLitSides(workers);
+    result.chooseLitSides(scene, workers);
     const auto [p95, frame] = worstFrame(result, spread);
     std::ostringstream s;
     s << "error estimate, round " << summary.rounds << ": " << spread.count() << " batches, "
@@ -594,7 +594,7 @@ void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
   }
 
   spread.publish();
-  result.chooseLitSides(workers);
+  result.chooseLitSides(scene, workers);
   summary.batches = spread.count();
   summary.stoppedBy = stoppedBy;
   spread.publishStdErrors();

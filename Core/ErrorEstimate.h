@@ -93,14 +93,14 @@ using BatchSolve = std::function<Solution&(
 
 /**
  * Runs the batches of `options` in batch order through `solveBatch` and leaves in `result`
- * (allocated, its reflectance and emission set) their mean, its lit sides, the standard error
- * of every element side and frame, and errorEstimate. With a target it adds rounds until
- * every frame's p95 is at most the target, or the time limit or the path limit stops it (a
- * warning then says so). Every rank runs the same batches and takes the same decisions: the
- * time limit is agreed over ranks. `memoryBytes` is the solve's memory estimate, for the
- * log. Throws mlr::Cancelled when `progress` returns false.
+ * (allocated, its reflectance and emission set) their mean, its lit sides (on `scene`'s
+ * surfaces), the standard error of every element side and frame, and errorEstimate. With a
+ * target it adds rounds until every frame's p95 is at most the target, or the time limit or
+ * the path limit stops it (a warning then says so). Every rank runs the same batches and
+ * takes the same decisions: the time limit is agreed over ranks. `memoryBytes` is the
+ * solve's memory estimate, for the log. Throws mlr::Cancelled when `progress` returns false.
  */
-void solveInBatches(const SolverOptions& options, const BatchSolve& solveBatch,
+void solveInBatches(const Scene& scene, const SolverOptions& options, const BatchSolve& solveBatch,
   const std::function<bool(double fraction)>& progress, std::uint64_t memoryBytes,
   double& secondsReducing, Solution& result);
 

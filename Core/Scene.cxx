@@ -2,7 +2,9 @@
 
 #include "Error.h"
 #include "MemoryBudget.h"
+#include "SurfaceRegions.h"
 
+#include <algorithm>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -51,8 +53,8 @@ std::uint64_t Scene::estimateMemory(
   std::size_t patches, std::size_t elements, std::size_t points, bool emits)
 {
   const std::uint64_t emission = emits ? sizeof(Rgb) : 0;
-  const std::uint64_t perPatch = sizeof(Triangle) + sizeof(Vec3) + sizeof(double) + sizeof(Rgb) +
-    sizeof(LinearStencil) + emission;
+  const std::uint64_t perPatch = sizeof(Triangle) + sizeof(Vec3) + sizeof(std::uint32_t) +
+    sizeof(double) + sizeof(Rgb) + sizeof(LinearStencil) + emission;
   const std::uint64_t perElement = sizeof(Triangle) + sizeof(double);
   // The patch mesh: its corners (fewer than the scene's points), triangles and materials.
   const std::uint64_t mesh = sizeof(Triangle) + sizeof(Rgb) + emission;
@@ -66,8 +68,9 @@ std::uint64_t Scene::memoryBytes() const
   auto bytes = [](const auto& v) -> std::uint64_t
   { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
   return bytes(this->Points) + bytes(this->PatchTriangles) + bytes(this->ElementTriangles) +
-    bytes(this->PatchNormals) + bytes(this->PatchAreas) + bytes(this->ElementAreas) +
-    bytes(this->Reflectance) + bytes(this->PatchStencils) + bytes(this->Emission);
+    bytes(this->PatchNormals) + bytes(this->PatchRegions) + bytes(this->PatchAreas) +
+    bytes(this->ElementAreas) + bytes(this->Reflectance) + bytes(this->PatchStencils) +
+    bytes(this->Emission);
 }
 
 Scene Scene::fromPatchMesh(const PatchMesh& mesh)
@@ -197,6 +200,9 @@ Scene Scene::fromPatchMesh(const PatchMesh& mesh)
         length(triangleAreaVector(scene.Points[e[0]], scene.Points[e[1]], scene.Points[e[2]])));
     }
   }
+  scene.PatchRegions = surfaceRegions(scene.PatchTriangles, scene.PatchNormals);
+  scene.RegionCount =
+    std::size_t(*std::max_element(scene.PatchRegions.begin(), scene.PatchRegions.end())) + 1;
   scene.PatchStencils =
     linearStencils(scene.Points, scene.PatchTriangles, scene.PatchNormals, scene.Reflectance);
   return scene;

@@ -83,6 +83,10 @@ public:
   const std::vector<Triangle>& elementTriangles() const { return this->ElementTriangles; }
 
   const Vec3& patchNormal(std::size_t p) const { return this->PatchNormals[p]; }
+  /// The smooth connected surface patch p belongs to (surfaceRegions in SurfaceRegions.h):
+  /// all of a surface's elements and patches show the one side it chooses (Solution).
+  std::uint32_t patchRegion(std::size_t p) const { return this->PatchRegions[p]; }
+  std::size_t regionCount() const { return this->RegionCount; }
   double patchArea(std::size_t p) const { return this->PatchAreas[p]; }
   const Rgb& patchReflectance(std::size_t p) const { return this->Reflectance[p]; }
   /// How final gathering reads patch p's bounced light as a linear function (Reconstruction.h).
@@ -121,6 +125,8 @@ private:
   std::vector<Triangle> PatchTriangles;
   std::vector<Triangle> ElementTriangles;
   std::vector<Vec3> PatchNormals;
+  std::vector<std::uint32_t> PatchRegions;
+  std::size_t RegionCount = 0;
   std::vector<double> PatchAreas;
   std::vector<double> ElementAreas;
   std::vector<Rgb> Reflectance;

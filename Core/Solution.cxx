@@ -1,9 +1,11 @@
 #include "Solution.h"
 
+#include "Error.h"
 #include "Parallel.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace mlr
 {
@@ -38,50 +40,86 @@ void Solution::clearRadiosity()
   StoredArray().swap(this->Indirect);
 }
 
-void Solution::chooseLitSides(int workers)
+Solution::SideTotals Solution::elementTotals(std::size_t element) const
 {
-  // Every element and patch decides alone, over all its frames: blocks of them run on every
-  // worker (the choice does not depend on which).
-  constexpr std::size_t PerTask = 2048;
-  parallelFor((this->Elements + PerTask - 1) / PerTask, workers,
-    [&](std::size_t task, int)
+  SideTotals t;
+  for (std::size_t f = 0; f < this->Frames; ++f)
+  {
+    t.front += this->total(f, element, Side::Front).sum();
+    t.back += this->total(f, element, Side::Back).sum();
+  }
+  // The irradiance decides only for a surface black on both sides, whose every element is:
+  // the others skip reading it again.
+  if (t.front == 0 && t.back == 0)
+  {
+    for (std::size_t f = 0; f < this->Frames; ++f)
     {
-      for (std::size_t e = task * PerTask; e < std::min(this->Elements, (task + 1) * PerTask); ++e)
-      {
-        double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
-        for (std::size_t f = 0; f < this->Frames; ++f)
-        {
-          front += this->total(f, e, Side::Front).sum();
-          back += this->total(f, e, Side::Back).sum();
-        }
-        if (front == 0 && back == 0)
-        {
-          // A black element: the side light arrives on is the one its irradiance is shown for.
-          for (std::size_t f = 0; f < this->Frames; ++f)
-          {
-            irradianceFront += this->irradiance(f, e, Side::Front).sum();
-            irradianceBack += this->irradiance(f, e, Side::Back).sum();
-          }
-        }
-        this->LitSide[e] = litSideOf(front, back, irradianceFront, irradianceBack);
-      }
-    },
-    [](std::size_t) { return true; });
+      t.irradianceFront += this->irradiance(f, element, Side::Front).sum();
+      t.irradianceBack += this->irradiance(f, element, Side::Back).sum();
+    }
+  }
+  return t;
+}
+
+void Solution::chooseLitSides(const Scene& scene, int workers)
+{
+  this->chooseLitSides(
+    scene, [this](std::size_t e) { return this->elementTotals(e); }, workers);
+}
+
+void Solution::chooseLitSides(
+  const Scene& scene, const std::function<SideTotals(std::size_t element)>& totals, int workers)
+{
+  if (scene.elementCount() != this->Elements || scene.patchCount() != this->Patches)
+  {
+    throw Error("internal error: lit sides chosen for a scene of " +
+      std::to_string(scene.patchCount()) + " patches and a solution of " +
+      std::to_string(this->Patches));
+  }
+  // One element's estimate is noisy: where its two sides' totals are comparable, choosing
+  // per element would follow the noise, speckle the surface and keep the elements whose
+  // shown side came out high (a biased mean). A surface's pooled sums hardly move with any
+  // one element. Each patch's sum is added in element order on one worker, and the
+  // surfaces' sums in patch order on this thread: the same bits for any worker count.
+  std::vector<SideTotals> patchTotals(this->Patches);
+  constexpr std::size_t PerTask = 2048;
   parallelFor((this->Patches + PerTask - 1) / PerTask, workers,
     [&](std::size_t task, int)
     {
       for (std::size_t p = task * PerTask; p < std::min(this->Patches, (task + 1) * PerTask); ++p)
       {
-        double front = 0, back = 0;
-        for (std::size_t f = 0; f < this->Frames; ++f)
+        SideTotals sum;
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
+             ++e)
         {
-          front += this->patchRadiosity(f, p, Side::Front).sum();
-          back += this->patchRadiosity(f, p, Side::Back).sum();
+          const SideTotals t = totals(e);
+          const double area = scene.elementArea(e);
+          sum.front += area * t.front;
+          sum.back += area * t.back;
+          sum.irradianceFront += area * t.irradianceFront;
+          sum.irradianceBack += area * t.irradianceBack;
         }
-        this->PatchLitSide[p] = back > front ? Side::Back : Side::Front;
+        patchTotals[p] = sum;
       }
     },
     [](std::size_t) { return true; });
+  std::vector<SideTotals> surfaces(scene.regionCount());
+  for (std::size_t p = 0; p < this->Patches; ++p)
+  {
+    SideTotals& sum = surfaces[scene.patchRegion(p)];
+    sum.front += patchTotals[p].front;
+    sum.back += patchTotals[p].back;
+    sum.irradianceFront += patchTotals[p].irradianceFront;
+    sum.irradianceBack += patchTotals[p].irradianceBack;
+  }
+  for (std::size_t p = 0; p < this->Patches; ++p)
+  {
+    const SideTotals& sum = surfaces[scene.patchRegion(p)];
+    const Side side = litSideOf(sum.front, sum.back, sum.irradianceFront, sum.irradianceBack);
+    this->PatchLitSide[p] = side;
+    std::fill_n(this->LitSide.begin() + static_cast<std::ptrdiff_t>(p * Scene::ElementsPerPatch),
+      Scene::ElementsPerPatch, side);
+  }
 }
 
 } // namespace mlr

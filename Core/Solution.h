@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -109,7 +110,7 @@ using StoredArray = std::vector<PackedRgb, ZeroedAllocator<PackedRgb>>;
  * B_direct = rho_e E_direct, B_indirect = rho_e E_indirect, so that a black element has its
  * irradiance too, at no memory per frame beyond the radiosity's (Documentation/Method.md,
  * section 15). Both sides are kept; litSide() and patchLitSide() pick the one to show,
- * chosen once when the solve ends.
+ * chosen once when the solve ends, one per surface.
  */
 class Solution
 {
@@ -180,17 +181,32 @@ public:
   {
     return this->load(this->Patch[this->patchIndex(frame, patch, side)]);
   }
-  /// The side of an element that received more power over the whole animation.
+  /// The side of an element that is shown: its surface's (chooseLitSides).
   Side litSide(std::size_t element) const { return this->LitSide[element]; }
-  /// The same for a patch, from its shooting solution: the side whose radiosity (rho/A
-  /// times the power it received) has the larger sum over frames and channels.
+  /// The same for a patch: its surface's side, the side its elements show.
   Side patchLitSide(std::size_t patch) const { return this->PatchLitSide[patch]; }
-  /// Chooses litSide() and patchLitSide() from the radiosity, once it is complete, on
-  /// `workers` threads.
-  void chooseLitSides(int workers);
-  /// The rule chooseLitSides applies to an element's totals over the frames on its two sides
-  /// (its irradiance's, for a black element whose totals are both 0): the larger, front on a
-  /// tie. For callers that sum the frames elsewhere (ranks holding frames apart).
+  /// Sums over frames of the light on an element's two sides (W/m^2, channels summed): its
+  /// radiosity's total() and its irradiance's.
+  struct SideTotals
+  {
+    double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
+  };
+  /// Element `element`'s sums over the frames held, added in frame order; its irradiance's
+  /// only when its radiosity's are both 0 (else 0: chooseLitSides reads them only then).
+  SideTotals elementTotals(std::size_t element) const;
+  /**
+   * Chooses litSide() and patchLitSide() from the radiosity, once it is complete: every
+   * surface of `scene` (Scene::patchRegion) shows one side, which litSideOf picks from the
+   * area-weighted sums of its elements' totals (Documentation/Method.md, section 10). On
+   * `workers` threads, the same sides for any count.
+   */
+  void chooseLitSides(const Scene& scene, int workers);
+  /// The same from every element's totals given by `totals`, for callers that sum the frames
+  /// elsewhere (ranks holding frames apart sum elementTotals over the ranks).
+  void chooseLitSides(
+    const Scene& scene, const std::function<SideTotals(std::size_t element)>& totals, int workers);
+  /// The rule chooseLitSides applies to a surface's totals on its two sides (its irradiance's,
+  /// for a black surface whose totals are both 0): the larger, front on a tie.
   static Side litSideOf(double front, double back, double irradianceFront, double irradianceBack)
   {
     const bool black = front == 0 && back == 0;

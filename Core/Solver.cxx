@@ -383,7 +383,7 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
     batch.emissionData() = solution.emissionData();
     std::uint64_t batchIndex = 0;
     solveInBatches(
-      options,
+      scene, options,
       [&](
         const SolverOptions& batchOptions, const std::function<bool(double)>& fraction) -> Solution&
       {
@@ -415,7 +415,7 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
   stats.secondsReducing = secondsReducing;
   if (!batched)
   {
-    solution.chooseLitSides(workers);
+    solution.chooseLitSides(scene, workers);
   }
   finish(scene, options, frames, plan, workers, counts[4], counts[5], solution);
   stats.secondsTotal = secondsSince(start);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "MovingLightRadiosityOutputs.h"
+#include "SurfaceRegions.h"
 
 #include <array>
 #include <cstdint>
@@ -62,8 +63,9 @@ struct SmoothShading
   std::vector<double> elementAreas;
 };
 
-/// Creases sharper than this (degrees between lit-side normals) split the points.
-constexpr double FeatureAngle = 30.0;
+/// Creases sharper than this (degrees between lit-side normals) split the points: the angle
+/// that ends the surfaces whose elements show one side (Scene::patchRegion).
+constexpr double FeatureAngle = CreaseAngleDegrees;
 
 SmoothShading smoothShading(const Scene& scene, const Solution& solution);
 

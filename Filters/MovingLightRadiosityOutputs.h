@@ -80,8 +80,8 @@ void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, s
 /// `ErrorRounds`, `TargetRelativeError` and the string `StoppedBy`; nothing without one.
 void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution);
 
-/// The side of each patch that received more power over the animation, as the solve chose
-/// it (Solution::patchLitSide), for every patch.
+/// The side each patch shows, its surface's, as the solve chose it (Solution::patchLitSide),
+/// for every patch.
 std::vector<Side> patchLitSides(const Solution& solution);
 
 /// Adds `Radiosity`, the patch shooting solution of each patch's lit side in `frame`.

@@ -3,6 +3,7 @@
 #include "Error.h"
 #include "ErrorEstimate.h"
 #include "MovingLightRadiosityDisplay.h"
+#include "Parallel.h"
 
 #include "vtkCellData.h"
 #include "vtkCharArray.h"
@@ -472,8 +473,8 @@ void rendezvous(vtkMultiProcessController* controller, double limitSeconds,
 /// Sums go in chunks: MPI counts are ints.
 constexpr std::size_t Chunk = std::size_t(1) << 24;
 
-RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t frames,
-  const Solution& statistics, const SolverOptions& options)
+RankFramesDisplay combineRankFrames(const Scene& scene, std::vector<FrameBlock>& blocks,
+  std::size_t frames, const Solution& statistics, const SolverOptions& options)
 {
   RankFramesDisplay display;
   if (blocks.empty())
@@ -489,9 +490,10 @@ RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t
   const Solution& like = blocks.front().frames;
   const std::size_t elements = like.elementCount(), patches = like.patchCount();
 
-  // The lit sides: each element's totals on both sides over every frame (and its irradiance,
-  // for a black element), and each patch's, summed frame by frame as chooseLitSides does.
-  std::vector<double> sums(4 * elements + 2 * patches, 0.0);
+  // The lit sides: each element's totals on both sides over every frame (and its
+  // irradiance's), summed frame by frame as Solution::elementTotals does, over the ranks,
+  // then pooled per surface by chooseLitSides.
+  std::vector<double> sums(4 * elements, 0.0);
   for (const FrameBlock& b : blocks)
   {
     const Solution& s = b.frames;
@@ -505,14 +507,6 @@ RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t
         sums[4 * e + 3] += s.irradiance(f, e, Side::Back).sum();
       }
     }
-    for (std::size_t p = 0; p < patches; ++p)
-    {
-      for (std::size_t f = 0; f < s.frameCount(); ++f)
-      {
-        sums[4 * elements + 2 * p] += s.patchRadiosity(f, p, Side::Front).sum();
-        sums[4 * elements + 2 * p + 1] += s.patchRadiosity(f, p, Side::Back).sum();
-      }
-    }
   }
   if (display.apart)
   {
@@ -520,16 +514,12 @@ RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t
   }
   Solution& summary = display.summary;
   summary = Solution(0, elements, patches);
-  for (std::size_t e = 0; e < elements; ++e)
-  {
-    summary.litSideData()[e] =
-      Solution::litSideOf(sums[4 * e], sums[4 * e + 1], sums[4 * e + 2], sums[4 * e + 3]);
-  }
-  for (std::size_t p = 0; p < patches; ++p)
-  {
-    summary.patchLitSideData()[p] =
-      sums[4 * elements + 2 * p + 1] > sums[4 * elements + 2 * p] ? Side::Back : Side::Front;
-  }
+  summary.chooseLitSides(
+    scene,
+    [&sums](std::size_t e) {
+      return Solution::SideTotals{ sums[4 * e], sums[4 * e + 1], sums[4 * e + 2], sums[4 * e + 3] };
+    },
+    resolveThreadCount(options.threads));
   for (FrameBlock& b : blocks)
   {
     b.frames.litSideData() = summary.litSideData();

@@ -86,15 +86,15 @@ struct RankFramesDisplay
 /**
  * The frames of an animation of `frames` frames streamed to this rank (Core's ranks take
  * whole chunks when there are at least as many as ranks; otherwise every rank gets every
- * frame). Chooses every element's and patch's lit side over the whole animation, as
+ * frame). Chooses the lit side of every surface of `scene` over the whole animation, as
  * Solution::chooseLitSides does, and sets it in every block; gives every frame's error
- * figures and one auto exposure over every frame. With the frames apart, their sums go over
- * the ranks (`options`' sums: a collective call), so that every rank shows the same; the
- * lit sides then match the serial choice but for elements whose two sides' totals agree to
- * the rounding of the sum.
+ * figures and one auto exposure over every frame. With the frames apart, the elements' sums
+ * go over the ranks (`options`' sums: a collective call) before they are pooled per
+ * surface, so that every rank shows the same; the lit sides then match the serial choice
+ * but for surfaces whose two sides' totals agree to the rounding of the sum.
  */
-RankFramesDisplay combineRankFrames(std::vector<FrameBlock>& blocks, std::size_t frames,
-  const Solution& statistics, const SolverOptions& options);
+RankFramesDisplay combineRankFrames(const Scene& scene, std::vector<FrameBlock>& blocks,
+  std::size_t frames, const Solution& statistics, const SolverOptions& options);
 
 /// What the ranks agreed on: whether any failed or was cancelled, and the message to report
 /// (this rank's own, or the first failed rank's, named).

@@ -1657,8 +1657,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     std::optional<mlr::vtkparallel::RankFramesDisplay> apart;
     if (keepsRankFrames)
     {
-      apart = mlr::vtkparallel::combineRankFrames(
-        rankFrames, static_cast<std::size_t>(solution.statistics.frames), solution, solverOptions);
+      apart = mlr::vtkparallel::combineRankFrames(scene, rankFrames,
+        static_cast<std::size_t>(solution.statistics.frames), solution, solverOptions);
       solution = std::move(apart->summary);
     }
     if (streamed)

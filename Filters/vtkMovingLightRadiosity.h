@@ -53,8 +53,10 @@
  * - port 0, Elements: the element mesh (triangles, four per patch) with the cell arrays
  *   `Radiosity` (= `EmittedRadiosity` + `DirectRadiosity` + `IndirectRadiosity`),
  *   `DirectRadiosity`, `IndirectRadiosity`, `EmittedRadiosity` (3 components, W/m^2, of the
- *   element's lit side: the side that received more power over the whole animation, so
- *   that a room made of outward-facing polygons still shows its lit walls), `RadiosityFront`
+ *   element's lit side: the side on which its surface, the patches joined by edges across
+ *   which it bends by at most 30 degrees, received more power over the whole animation, so
+ *   that a room made of outward-facing polygons still shows its lit walls, and a surface
+ *   one side, not each element's noisier choice), `RadiosityFront`
  *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
  *   display colour of `Radiosity` (see Exposure). For smooth shading its points are split
  *   along creases (lit-side normals more than 30 degrees apart), between materials and

@@ -59,6 +59,8 @@ TEST_P(Determinism, ThreadCountDoesNotChangeABit)
   EXPECT_TRUE(checks::sameBits(one.patchData(), two.patchData()));
   EXPECT_TRUE(checks::sameBits(one.directData(), three.directData()));
   EXPECT_TRUE(checks::sameBits(one.indirectData(), three.indirectData()));
+  EXPECT_EQ(one.litSideData(), three.litSideData());
+  EXPECT_EQ(one.patchLitSideData(), three.patchLitSideData());
   EXPECT_EQ(one.statistics.shootingRays, two.statistics.shootingRays);
   EXPECT_EQ(one.statistics.shadowRays, two.statistics.shadowRays);
   EXPECT_EQ(one.statistics.gatheringRays, two.statistics.gatheringRays);

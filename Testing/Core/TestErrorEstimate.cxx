@@ -236,8 +236,12 @@ TEST(ErrorEstimate, ASideFirstLitInALaterBatchGetsTheWholeMeanAndSpread)
   options.threads = 3;
   std::size_t done = 0;
   double secondsReducing = 0;
+  PatchMesh onePatch;
+  onePatch.points = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } };
+  onePatch.triangles = { { 0, 1, 2 } };
+  onePatch.reflectance = { Rgb(0.5) };
   solveInBatches(
-    options,
+    Scene::fromPatchMesh(onePatch), options,
     [&](const SolverOptions&, const std::function<bool(double)>&) -> Solution&
     {
       batch.clearRadiosity();

@@ -112,6 +112,8 @@ TEST_P(Ranks, EveryRankHoldsTheSerialSolutionBitForBit)
       EXPECT_TRUE(checks::sameBits(serial.directData(), s.directData()));
       EXPECT_TRUE(checks::sameBits(serial.indirectData(), s.indirectData()));
       EXPECT_TRUE(checks::sameBits(serial.patchData(), s.patchData()));
+      EXPECT_EQ(serial.litSideData(), s.litSideData());
+      EXPECT_EQ(serial.patchLitSideData(), s.patchLitSideData());
       EXPECT_EQ(serial.statistics.shootingRays, s.statistics.shootingRays);
       EXPECT_EQ(serial.statistics.shadowRays, s.statistics.shadowRays);
       EXPECT_EQ(serial.statistics.gatheringRays, s.statistics.gatheringRays);
