@@ -141,8 +141,12 @@ void prepareDirectory(OutputTransaction& output, const fs::path& directory)
     std::ofstream file(probe);
     if (!file || !(file << "probe") || !(file.flush()))
     {
-      const std::string reason = std::strerror(errno);
+      const int code = errno;
       std::error_code error;
+      // A directory that exists and refuses new files (/proc, /sys) reports ENOENT.
+      const std::string reason = code == ENOENT && fs::is_directory(where, error)
+        ? "it accepts no new files (a system directory?): give a directory of your own"
+        : std::strerror(code);
       fs::remove(probe, error);
       throw InputError("cannot write in the directory '" + where.string() + "': " + reason);
     }

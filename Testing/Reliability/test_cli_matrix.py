@@ -386,6 +386,16 @@ def test_unwritable_output_folder_fails_before_solving(tmp_path):
     assert all_files(tmp_path) == [] or directory.startswith(str(tmp_path))
 
 
+def test_a_system_directory_is_not_said_to_be_missing(tmp_path):
+    # /proc exists and refuses new files with "No such file or directory", which the message
+    # passed on as if the directory were missing.
+    result = run(["--paths", "20000", "--output", "/proc/series.pvd"], tmp_path)
+    assert result.returncode == 1
+    assert ("cannot write in the directory '/proc': it accepts no new files (a system "
+            "directory?): give a directory of your own") in result.stderr, result.stderr
+    assert all_files(tmp_path) == []
+
+
 def test_output_folder_that_cannot_be_created(tmp_path):
     (tmp_path / "file").write_text("in the way\n")
     result = run(scene_args(SCENE) + ["--output", "file/sub/series.pvd"], tmp_path)
