@@ -361,8 +361,8 @@ void addRepairWarnings(CgalRemeshOutput& out)
   if (out.foldedTriangles > 0)
   {
     out.warnings.push_back("removed " + countOf(out.foldedTriangles, "triangle") +
-      " overlapping a larger one in its plane, facing the same way (two triangulations of one "
-      "face, a polygon drawn over another, a block's face on a wall; the larger was kept)");
+      " overlapping a larger polygon in its plane, facing the same way (two triangulations of "
+      "one face, a polygon drawn over another, a block's face on a wall; the larger was kept)");
   }
   if (out.splitPoints > 0)
   {

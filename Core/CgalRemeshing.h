@@ -21,6 +21,8 @@ struct TriangleSoup
 {
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> material;
+  /// The input polygon each triangle was cut from (empty: each triangle its own).
+  std::vector<std::uint32_t> polygon;
 };
 
 /// Patches CGAL produced, plus the triangles it refused (to be refined only).
@@ -38,7 +40,7 @@ struct CgalRemeshOutput
   std::size_t fallbackRegions = 0;
   std::size_t degenerateTriangles = 0;
   std::size_t duplicateTriangles = 0;
-  std::size_t foldedTriangles = 0; ///< dropped, overlapping a larger one in its plane
+  std::size_t foldedTriangles = 0; ///< dropped, overlapping a larger polygon in its plane
   std::size_t splitPoints = 0;
   std::size_t contactSplitTriangles = 0; ///< repaired triangles cut along contact lines
   std::size_t contactEdges = 0;          ///< edges of the contact lines, once split

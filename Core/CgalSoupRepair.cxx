@@ -134,14 +134,17 @@ bool interiorsOverlap(const std::array<Point, 3>& s, const std::array<Point, 3>&
     !separates(a, b) && !separates(b, a);
 }
 
-/// Keeps the larger of triangles that lie in one plane, face the same way and overlap with some
-/// area (the first of equal ones): two triangulations of one face, a face folded onto itself,
-/// a polygon drawn over another, or a block's face on a wall. CGAL 5.5's autorefinement does
-/// not handle such coplanar overlaps (it binds references to null points, or never ends), and
-/// no surface can hold both. The larger stays because the smaller is the one more likely to
-/// lie within it: a wall triangle dropped for the block face on it left half the wall open,
-/// and daylight poured into the room through it.
-std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& poll)
+/// Of triangles that lie in one plane, face the same way and overlap with some area (two
+/// triangulations of one face, a face folded onto itself, a polygon drawn over another, a
+/// block's face on a wall), keeps those of the larger input polygon (of the first of equal
+/// ones). CGAL 5.5's autorefinement does not handle such coplanar overlaps (it binds
+/// references to null points, or never ends), and no surface can hold both. The smaller
+/// polygon is the one likely to lie within the other: keeping the first instead dropped a
+/// wall's triangle for the block face given before it, half the wall, and daylight poured
+/// into the room. Whole polygons are compared, not their triangles, so that of two
+/// triangulations of one polygon one stays whole, not a mixture with gaps.
+std::size_t removeOverlappingTriangles(
+  RepairedSoup& soup, const TriangleSoup& input, CancellationPoll& poll)
 {
   using TriangleBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t>;
   std::vector<TriangleBox> boxes;
@@ -151,16 +154,26 @@ std::size_t removeOverlappingTriangles(RepairedSoup& soup, CancellationPoll& pol
     const CgalTriangle& t = soup.triangles[i];
     return std::array<Point, 3>{ soup.points[t[0]], soup.points[t[1]], soup.points[t[2]] };
   };
-  std::vector<double> area(soup.triangles.size());
+  const auto polygonOf = [&](std::size_t i) -> std::size_t
+  { return input.polygon.empty() ? soup.input[i] : input.polygon[soup.input[i]]; };
+  std::vector<double> polygonArea;
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
     const std::array<Point, 3> c = corners(i);
     boxes.emplace_back(c[0].bbox() + c[1].bbox() + c[2].bbox(), i);
-    area[i] = CGAL::squared_area(c[0], c[1], c[2]);
+    const std::size_t polygon = polygonOf(i);
+    polygonArea.resize(std::max(polygonArea.size(), polygon + 1), 0.0);
+    polygonArea[polygon] += std::sqrt(CGAL::squared_area(c[0], c[1], c[2]));
   }
-  // Whether triangle i goes before j: the larger first, then the earlier.
-  const auto before = [&area](std::size_t i, std::size_t j)
-  { return area[i] != area[j] ? area[i] > area[j] : i < j; };
+  // Whether triangle i goes before j: that of the larger polygon, then of the earlier one,
+  // then the earlier triangle.
+  const auto before = [&](std::size_t i, std::size_t j)
+  {
+    const std::size_t p = polygonOf(i), q = polygonOf(j);
+    return polygonArea[p] != polygonArea[q] ? polygonArea[p] > polygonArea[q]
+      : p != q                              ? p < q
+                                            : i < j;
+  };
   // The pairs (loser, winner), gathered in whatever order the boxes meet, then decided in
   // the losers' order: a triangle goes when it overlaps one before it that stays.
   std::vector<std::pair<std::size_t, std::size_t>> overlapping;
@@ -268,7 +281,7 @@ RepairedSoup repairAndOrient(const std::vector<Vec3>& points, const TriangleSoup
   poll.check();
   out.degenerateTriangles = removeDegenerateTriangles(soup);
   out.duplicateTriangles = removeDuplicateTriangles(soup, poll);
-  out.foldedTriangles = removeOverlappingTriangles(soup, poll);
+  out.foldedTriangles = removeOverlappingTriangles(soup, input, poll);
   PMP::remove_isolated_points_in_polygon_soup(soup.points, soup.triangles);
   poll.check();
   // A soup that already is an oriented manifold mesh (most are) would come out of

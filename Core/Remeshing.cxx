@@ -316,6 +316,7 @@ Triangulation triangulate(const PolygonSoup& soup,
       const Triangle triangle{ polygon[t[0]], polygon[t[1]], polygon[t[2]] };
       out.soup.triangles.push_back(triangle);
       out.soup.material.push_back(materialOfPolygon[i]);
+      out.soup.polygon.push_back(static_cast<std::uint32_t>(i));
       out.area += triangleArea(soup.points, triangle);
     }
   }

@@ -419,7 +419,7 @@ TEST(RemeshingMessyInput, APolygonDrawnOverAnotherInItsPlaneIsDropped)
   soup.polygons = { { 0, 1, 2, 3 }, { 4, 5, 6 }, { 1, 7, 8, 2 } };
   soup.materials = { Material{ Rgb(0.5) }, Material{ Rgb(0.3) }, Material{ Rgb(0.5) } };
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "removed 1 triangle overlapping a larger one"))
+  EXPECT_TRUE(contains(result.warnings, "removed 1 triangle overlapping a larger polygon"))
     << joined(result.warnings);
   EXPECT_NEAR(totalArea(result.mesh), 6.0, 0.005 * 6.0);
   for (std::size_t p = 0; p < result.mesh.triangles.size(); ++p)
@@ -455,7 +455,7 @@ TEST(RemeshingMessyInput, ABlockFaceOnAWallLeavesTheWallWhole)
   addPolygon(soup, { { 0, D, 0 }, { W, D, 0 }, { W, D, H }, { 0, D, H } }, Rgb(0.5));
   addPolygon(soup, { { 0, 0, 0 }, { 0, 0, H }, { W, 0, H }, { W, 0, 0 } }, Rgb(0.5));
   const RemeshResult result = remesh(soup, withEdgeLength(0.25));
-  EXPECT_TRUE(contains(result.warnings, "overlapping a larger one in its plane"))
+  EXPECT_TRUE(contains(result.warnings, "overlapping a larger polygon in its plane"))
     << joined(result.warnings);
   // What lies in the plane x = 3: the wall, whole, and no piece of the block's face beyond it.
   double wall = 0, wallOfTheRoom = 0;
@@ -486,7 +486,7 @@ TEST(RemeshingMessyInput, TwoTriangulationsOfOneFaceKeepTheFirst)
   soup.materials = { Material{ Rgb(0.5) }, Material{ Rgb(0.5) }, Material{ Rgb(0.3) },
     Material{ Rgb(0.3) }, Material{ Rgb(0.3) } };
   const RemeshResult result = remesh(soup, withEdgeLength(0.1));
-  EXPECT_TRUE(contains(result.warnings, "overlapping a larger one in its plane"))
+  EXPECT_TRUE(contains(result.warnings, "overlapping a larger polygon in its plane"))
     << joined(result.warnings);
   const double quadArea = 1.5, wallArea = 0.5 * std::sqrt(3.0);
   EXPECT_NEAR(totalArea(result.mesh), quadArea + wallArea, 0.005 * (quadArea + wallArea));
