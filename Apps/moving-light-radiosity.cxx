@@ -11,6 +11,7 @@
 #include "Sensors.h"
 #include "SeriesWriter.h"
 
+#include "vtkAbstractArray.h"
 #include "vtkCallbackCommand.h"
 #include "vtkCellData.h"
 #include "vtkCommand.h"
@@ -428,7 +429,12 @@ void darkenSunBelowHorizon(vtkPolyData* directions, const Triple& up, const std:
   {
     return;
   }
-  vtkDataArray* power = directions->GetPointData()->GetArray("Power");
+  vtkAbstractArray* given = directions->GetPointData()->GetAbstractArray("Power");
+  vtkDataArray* power = vtkDataArray::SafeDownCast(given);
+  if (given && (!power || power->GetNumberOfTuples() != directions->GetNumberOfPoints()))
+  {
+    return; // the filter refuses such a Power array, naming it
+  }
   if (!power)
   {
     vtkNew<vtkDoubleArray> ones;

@@ -421,11 +421,15 @@ void accumulate(const ErrorEstimateSummary& c, bool first, ErrorEstimateSummary&
     s = c;
     return;
   }
-  // The batches and N of the animation are those of its least solved chunk, as each frame's
-  // result and error bar come from its own chunk's; a limit that stopped one says so.
-  s.batches = std::min(s.batches, c.batches);
-  s.rounds = std::max(s.rounds, c.rounds);
-  s.pathsPerFrame = std::min(s.pathsPerFrame, c.pathsPerFrame);
+  // The batches, rounds and N of the animation are those of its least solved chunk (the
+  // first of equal ones), together, as each frame's result and error bar come from its own
+  // chunk's; a limit that stopped one says so.
+  if (c.pathsPerFrame < s.pathsPerFrame)
+  {
+    s.batches = c.batches;
+    s.rounds = c.rounds;
+    s.pathsPerFrame = c.pathsPerFrame;
+  }
   if (c.stoppedBy == "time limit" || c.stoppedBy == "path limit")
   {
     s.stoppedBy = c.stoppedBy;

@@ -617,7 +617,8 @@ public:
    * elements' relative error is at most this (0.02 is 2%), or TimeLimit stops it (field data
    * `StoppedBy`, and a warning when the target was not reached). The result stays
    * reproducible for a seed and thread count-independent, unless TimeLimit stops it. Needs
-   * ErrorBatches of 2 or more. 0 (off) or from 0.0001; negative values and NaN make the update
+   * ErrorBatches of 2 or more. 0 (off) or from 0.0001 to below 1 (the batches' relative error is
+   * at most 1, so a larger target is met at once); negative values and NaN make the update
    * fail with an error naming TargetRelativeError. Default 0.
    */
   vtkSetMacro(TargetRelativeError, double);

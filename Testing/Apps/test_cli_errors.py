@@ -92,6 +92,7 @@ def test_target_error_is_reached_in_every_frame(tmp_path):
     (["--target-error", "nan"], "--target-error needs a number, not 'nan'"),
     (["--target-error", "0.000001"], "--target-error is 1e-06: give the relative error"),
     (["--target-error", "1.5"], "--target-error is 1.5: give the relative error"),
+    (["--target-error", "1"], "--target-error is 1: give the relative error"),
     (["--target-error", "0.02", "--error-batches", "1"],
      "--target-error needs an error estimate: give --error-batches 2 or more"),
     (["--target-error", "0.02", "--time-limit", "-1"], "--time-limit is -1: give a number"),

@@ -461,6 +461,8 @@ TEST(ErrorEstimate, BadOptionsAreRefusedWithTheOptionNamed)
   // No spread of non-negative batches exceeds their mean: a target of 1 or more is met at once.
   o.targetRelativeError = 1.5;
   expectError(run(o), "is 1.5: the batches' relative error is at most 1 (100%)");
+  o.targetRelativeError = 1;
+  expectError(run(o), "is 1: the batches' relative error is at most 1 (100%)");
   o = batched(16000, 1, 0);
   o.targetRelativeError = 0.02;
   expectError(run(o), "needs an error estimate");

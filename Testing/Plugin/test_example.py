@@ -84,13 +84,16 @@ def test_example_under_pvbatch_without_a_display_ends(tmp_path):
     everything. It exits 0, and nothing it started outlives it."""
     if not shutil.which("Xvfb"):
         pytest.skip("Xvfb is not installed")
+    pvbatch = os.environ.get("MLR_PVBATCH") or shutil.which("pvbatch")
+    if not pvbatch:
+        pytest.skip("pvbatch is not installed")
     plugin = os.environ.get("MLR_PLUGIN")
     assert plugin and os.path.isfile(plugin), f"set MLR_PLUGIN to the built plugin ({plugin!r})"
     env = {k: v for k, v in os.environ.items()
            if k not in ("PV_PLUGIN_PATH", "PYTHONPATH", "DISPLAY")}
     output = tmp_path / "animation"
     process = subprocess.Popen(
-        [os.environ.get("MLR_PVBATCH", "pvbatch"), "--force-offscreen-rendering",
+        [pvbatch, "--force-offscreen-rendering",
          os.path.join(ROOT, "Examples", "cornell_box_animation.py"), "--plugin", plugin,
          "--output", str(output), "--paths", "20000", "--size", "64"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,

@@ -80,7 +80,8 @@ def display_for_this_process(attempts=20):
     the process ends, however it ends (PR_SET_PDEATHSIG). For scripts run by pvbatch, whose
     ParaView closes its X connection after Python's exit handlers have run: a server stopped
     by such a handler made that close fail (an X I/O error, then a double free whose abort
-    handler hangs pvbatch for ever)."""
+    handler hangs pvbatch for ever). Call it from the main thread: the kernel stops the server
+    when the thread that started it ends."""
     parent = os.getpid()
     libc = ctypes.CDLL(None, use_errno=True)
 
