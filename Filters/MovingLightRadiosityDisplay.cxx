@@ -1,5 +1,7 @@
 #include "MovingLightRadiosityDisplay.h"
 
+#include "SurfaceRegions.h"
+
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -150,52 +152,28 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
       dot(litNormals[a], litNormals[b]) >= cosFeature;
   };
 
-  // Every edge once per element, keyed by its two scene points (lower first), with the
-  // corners of the element at those points; sorted so that an edge's elements are adjacent.
-  struct EdgeUse
+  // The corners of an element at the lower and the higher point of its edge.
+  const auto lowAndHigh = [&triangles](const EdgeUse& u)
   {
-    std::uint64_t key;
-    std::size_t lowCorner, highCorner;
+    std::size_t low = 3 * u.triangle + u.corner, high = 3 * u.triangle + (u.corner + 1) % 3;
+    if (triangles[u.triangle][u.corner] > triangles[u.triangle][(u.corner + 1) % 3])
+    {
+      std::swap(low, high);
+    }
+    return std::make_pair(low, high);
   };
-  std::vector<EdgeUse> uses;
-  uses.reserve(corners);
-  for (std::size_t e = 0; e < triangles.size(); ++e)
-  {
-    for (std::size_t k = 0; k < 3; ++k)
+  // Usually 2 uses of an edge; more only at non-manifold edges, where every smooth pair joins.
+  forEachSharedEdge(triangles,
+    [&](const EdgeUse& u, const EdgeUse& v)
     {
-      std::size_t a = 3 * e + k, b = 3 * e + (k + 1) % 3;
-      if (triangles[e][k] > triangles[e][(k + 1) % 3])
+      if (smooth(u.triangle, v.triangle))
       {
-        std::swap(a, b);
+        const auto [uLow, uHigh] = lowAndHigh(u);
+        const auto [vLow, vHigh] = lowAndHigh(v);
+        join(uLow, vLow);
+        join(uHigh, vHigh);
       }
-      const std::uint64_t key =
-        (static_cast<std::uint64_t>(triangles[a / 3][a % 3]) << 32) | triangles[b / 3][b % 3];
-      uses.push_back({ key, a, b });
-    }
-  }
-  std::sort(
-    uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
-  for (std::size_t first = 0; first < uses.size();)
-  {
-    std::size_t last = first + 1;
-    while (last < uses.size() && uses[last].key == uses[first].key)
-    {
-      ++last;
-    }
-    // Usually 2 uses; more only at non-manifold edges, where every smooth pair joins.
-    for (std::size_t i = first; i < last; ++i)
-    {
-      for (std::size_t j = i + 1; j < last; ++j)
-      {
-        if (smooth(uses[i].lowCorner / 3, uses[j].lowCorner / 3))
-        {
-          join(uses[i].lowCorner, uses[j].lowCorner);
-          join(uses[i].highCorner, uses[j].highCorner);
-        }
-      }
-    }
-    first = last;
-  }
+    });
 
   SmoothShading shading;
   shading.elementAreas.resize(triangles.size());
