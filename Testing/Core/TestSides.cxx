@@ -1,5 +1,6 @@
 // Two-sided surfaces: a box built with outward normals lights up like one built inward;
 // one-sided surfaces absorb on their back faces and say so.
+#include "CoreChecks.h"
 #include "GeneratedScenes.h"
 #include "Solver.h"
 
@@ -158,19 +159,6 @@ LightRig sunFrom(const std::vector<Vec3>& directions, double irradiance)
   return rig;
 }
 
-/// Classic shooting: each frame's paths come from that frame's direction alone, so that a
-/// frame's mean over a surface is a binomial count of its own paths.
-SolverOptions classic(std::uint64_t paths, std::uint64_t seed)
-{
-  SolverOptions o;
-  o.pathsPerFrame = paths;
-  o.reuseShooting = false;
-  o.reuseGathering = false;
-  o.seed = seed;
-  o.threads = 2;
-  return o;
-}
-
 /// The area-weighted mean over elements [begin, end) of what the outputs show in `frame`:
 /// the irradiance (one channel) of each element's lit side.
 double shownMean(
@@ -225,7 +213,8 @@ TEST(Sides, AFloorLitMoreOnItsFrontShowsItsFrontEverywhereUnbiased)
   ASSERT_EQ(scene.regionCount(), 1u);
   const double E = 800;
   const LightRig rig = sunFrom({ { 0, 0, 1 }, { 1, 0, 1 }, { 0, 0, -1 } }, E);
-  const SolverOptions options = classic(20000, 5);
+  // Classic shooting: a frame's mean over a surface is a binomial count of its own paths.
+  const SolverOptions options = checks::modeOptions(false, 20000, 5);
   const Solution s = solve(scene, rig, options);
   const std::size_t n = scene.elementCount();
   EXPECT_EQ(showing(s, Side::Front, 0, n), n);
@@ -249,7 +238,7 @@ TEST(Sides, AThinPanelLitAlikeOnBothSidesShowsOneSide)
   const Rgb rho(0.5);
   const Scene scene = floorScene(rho);
   const double E = 800;
-  const SolverOptions options = classic(20000, 9);
+  const SolverOptions options = checks::modeOptions(false, 20000, 9);
   const Solution s = solve(scene, sunFrom({ { 0, 0, 1 }, { 0, 0, -1 } }, E), options);
   const std::size_t n = scene.elementCount();
   const Side side = s.litSide(0);
@@ -293,7 +282,7 @@ TEST(Sides, SurfacesMeetingAtACreaseChooseApart)
   const Scene scene = Scene::fromPatchMesh(mesh);
   EXPECT_EQ(scene.regionCount(), 2u);
   const double E = 800;
-  const SolverOptions options = classic(20000, 11);
+  const SolverOptions options = checks::modeOptions(false, 20000, 11);
   const Solution s = solve(scene, sunFrom({ { 0, 0, 1 }, { -1, 0, 1 }, { 0, 0, -1 } }, E), options);
   const std::size_t floor = 4 * floorPatches, n = scene.elementCount();
   EXPECT_EQ(showing(s, Side::Front, 0, floor), floor);
