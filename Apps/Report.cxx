@@ -97,21 +97,17 @@ std::string worstFrameText(const char* what, vtkDataArray* median, vtkDataArray*
 
 namespace
 {
-/// The light as solved: its kind, files and settings, and its power, from the filter's Light
-/// output, which holds every area light's polygons and every point light's vertex with their
-/// Power and LuminousFlux in one frame. Nothing is derived here: lumens, a file's flux, TILT
-/// factors and the Trajectory's Power are the filter's to apply.
-nlohmann::ordered_json lightingJson(
-  const Options& o, vtkMovingLightRadiosity* filter, const PosedLight& posed)
+/// The light as solved: its kind, files and settings, and its power, from the filter's field
+/// data per frame (`LightPower`, `LightLuminousFlux`: every light's Power and flux in that
+/// frame) and its Light output (whether a luminaire emits from an opening). Nothing is derived
+/// here: lumens, a file's flux, TILT factors and the Trajectory's Power are the filter's to
+/// apply.
+nlohmann::ordered_json lightingJson(const Options& o, vtkMovingLightRadiosity* filter,
+  const PosedLight& posed, const std::vector<FrameRecord>& frames)
 {
   nlohmann::ordered_json j;
   const bool sky = o.sky.has_value();
   const bool areaKinds = !o.usesSun() && !o.sceneLightsItself() && !o.pointLight;
-  vtkDataArray* powers = posed.light ? posed.light->GetCellData()->GetArray("Power") : nullptr;
-  vtkDataArray* fluxes =
-    posed.light ? posed.light->GetCellData()->GetArray("LuminousFlux") : nullptr;
-  const bool fromOutput = powers && fluxes && powers->GetNumberOfComponents() == 3 &&
-    powers->GetNumberOfTuples() > 0 && fluxes->GetNumberOfTuples() == powers->GetNumberOfTuples();
   j["kind"] = o.usesSun()   ? "sun"
     : sky                   ? "sky"
     : o.sceneLightsItself() ? "scene emission"
@@ -153,23 +149,22 @@ nlohmann::ordered_json lightingJson(
 
   if (!o.usesSun() && !sky && !o.sceneLightsItself())
   {
-    if (fromOutput)
+    if (!frames.empty())
     {
-      double power[3] = { 0, 0, 0 };
-      double lumens = 0;
-      for (vtkIdType c = 0; c < powers->GetNumberOfTuples(); ++c)
+      // The brightest frame (the first of equals): a light dimmed, switched off or tilted
+      // away in some frames is reported at what it emits at its brightest, and each frame
+      // at its own (frames[].powerW).
+      std::size_t brightest = 0;
+      for (std::size_t f = 1; f < frames.size(); ++f)
       {
-        for (int k = 0; k < 3; ++k)
+        if (frames[f].lightLuminousFlux > frames[brightest].lightLuminousFlux)
         {
-          power[k] += powers->GetComponent(c, k);
+          brightest = f;
         }
-        lumens += fluxes->GetComponent(c, 0);
       }
-      j["powerW"] = jsonTriple(power);
-      // The Light output poses the lights in one frame, with that frame's Power factor and
-      // TILT factor.
-      j["powerFrame"] = posed.frame;
-      j["lumens"] = jsonNumber(lumens);
+      j["powerW"] = jsonTriple(frames[brightest].lightPower.data());
+      j["powerFrame"] = brightest;
+      j["lumens"] = jsonNumber(frames[brightest].lightLuminousFlux);
     }
     j["powerFrom"] = o.lightLumens     ? "--light-lumens"
       : filter->GetLightFluxFromFile() ? "the distribution file's flux"
@@ -324,7 +319,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   const std::string builtIn = "built-in Cornell box";
   nlohmann::ordered_json json;
   json["scene"] = options.scene.empty() ? builtIn : options.scene;
-  const nlohmann::ordered_json lighting = lightingJson(options, filter, posedLight);
+  const nlohmann::ordered_json lighting = lightingJson(options, filter, posedLight, frames);
   // What lit the scene: a light file, a material of the scene, a luminaire, the sun, the sky,
   // or the scene's own emissive surfaces ("lighting" says more).
   const std::string kind = lighting["kind"].get<std::string>();
@@ -398,7 +393,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
 
   // Every statistic the filter reports, except those that describe one frame.
   static const std::set<std::string> perFrame = { "FrameIndex", "LightPosition", "LightTranslation",
-    "SolveCount", "TimeValue" };
+    "LightPower", "LightLuminousFlux", "SolveCount", "TimeValue" };
   nlohmann::ordered_json values = nlohmann::ordered_json::object();
   for (int i = 0; statistics && i < statistics->GetNumberOfArrays(); ++i)
   {
@@ -458,6 +453,8 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
     else if (!options.sky && !options.sceneLightsItself())
     {
       record["lightPosition"] = jsonTriple(frame.lightPosition.data());
+      record["powerW"] = jsonTriple(frame.lightPower.data());
+      record["lumens"] = jsonNumber(frame.lightLuminousFlux);
     }
     if (options.sky || options.usesSun())
     {

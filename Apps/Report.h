@@ -28,6 +28,8 @@ struct FrameRecord
   std::array<double, 3> lightPosition{}; ///< field data LightPosition: the first light's
   std::array<double, 3> sunDirection{};  ///< field data SunDirection, towards the sun
   double luminousEfficacy = 0;           ///< field data LuminousEfficacy, lm/W
+  std::array<double, 3> lightPower{};    ///< field data LightPower: every light's, W per channel
+  double lightLuminousFlux = 0;          ///< field data LightLuminousFlux, lm
 };
 
 /// Wall-clock seconds of the stages of a run.
@@ -63,7 +65,6 @@ std::string errorLine(vtkFieldData* statistics);
 struct PosedLight
 {
   vtkSmartPointer<vtkPolyData> light; ///< null or empty without area lights
-  std::size_t frame = 0;
 };
 
 /// Writes the inputs, the light as solved, the sensors, the filter's settings, the

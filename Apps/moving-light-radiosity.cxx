@@ -301,15 +301,21 @@ void tripleOf(vtkFieldData* data, const char* name, double out[3])
   }
 }
 
+double valueOf(vtkFieldData* data, const char* name)
+{
+  vtkDataArray* array = data->GetArray(name);
+  return array && array->GetNumberOfTuples() > 0 ? array->GetComponent(0, 0) : 0.0;
+}
+
 /// What a frame's field data says of its lights: where the first light is, where the sun is,
-/// and the luminous efficacy of its Illuminance.
+/// what the lights emit, and the luminous efficacy of its Illuminance.
 void recordLights(FrameRecord& record, vtkFieldData* data)
 {
   tripleOf(data, "LightPosition", record.lightPosition.data());
   tripleOf(data, "SunDirection", record.sunDirection.data());
-  vtkDataArray* efficacy = data->GetArray("LuminousEfficacy");
-  record.luminousEfficacy =
-    efficacy && efficacy->GetNumberOfTuples() > 0 ? efficacy->GetComponent(0, 0) : 0.0;
+  tripleOf(data, "LightPower", record.lightPower.data());
+  record.lightLuminousFlux = valueOf(data, "LightLuminousFlux");
+  record.luminousEfficacy = valueOf(data, "LuminousEfficacy");
 }
 
 /// Runs the Sun Path source with the scene's north and up; its error, without VTK's location
@@ -574,8 +580,9 @@ std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double
     failure = failureOf([&] { writer->finish(); });
   }
   agreeOnFramesWritten(job, failure, static_cast<long long>(mine.size()), times.size());
-  // Per frame: the light's position, the sun's direction and the luminous efficacy.
-  constexpr std::size_t Values = 7;
+  // Per frame: the light's position, the sun's direction, the luminous efficacy and what the
+  // lights emit.
+  constexpr std::size_t Values = 11;
   std::vector<double> lights(Values * times.size(), 0.0);
   for (std::size_t i = 0; i < mine.size(); ++i)
   {
@@ -583,6 +590,8 @@ std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double
     std::copy(mine[i].lightPosition.begin(), mine[i].lightPosition.end(), at);
     std::copy(mine[i].sunDirection.begin(), mine[i].sunDirection.end(), at + 3);
     at[6] = mine[i].luminousEfficacy;
+    std::copy(mine[i].lightPower.begin(), mine[i].lightPower.end(), at + 7);
+    at[10] = mine[i].lightLuminousFlux;
   }
   job.sum(lights);
   std::vector<FrameRecord> records(times.size());
@@ -594,6 +603,8 @@ std::vector<FrameRecord> finishRankStream(RankJob& job, const std::vector<double
     std::copy(at, at + 3, records[f].lightPosition.begin());
     std::copy(at + 3, at + 6, records[f].sunDirection.begin());
     records[f].luminousEfficacy = at[6];
+    std::copy(at + 7, at + 10, records[f].lightPower.begin());
+    records[f].lightLuminousFlux = at[10];
   }
   return records;
 }
@@ -856,7 +867,6 @@ int run(int argc, char** argv, RankJob& job)
   PosedLight posedLight;
   posedLight.light = vtkSmartPointer<vtkPolyData>::New();
   posedLight.light->DeepCopy(filter->GetOutput(vtkMovingLightRadiosity::LIGHT_OUTPUT_PORT));
-  posedLight.frame = streaming ? times.size() - 1 : 0;
   vtkDataArray* remeshing = statistics->GetArray("SecondsRemeshing");
   stages.remeshing = remeshing ? std::min(remeshing->GetComponent(0, 0), update) : 0.0;
   // Streamed frames were converted and handed to the writers during the solve: writing.

@@ -1107,6 +1107,27 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
       translation = position - light.position(0);
     }
     mlr::vtkoutputs::addFrameFieldData(fieldData, frame, position, translation, this->SolveCount);
+    if (!cache.Rig.areaLights.empty() || !cache.Rig.pointLights.empty())
+    {
+      // What the lights emit in this frame, in all: the Light output's Power summed, so that
+      // a series says which frames a dimmed or switched light was solved at.
+      mlr::Rgb power;
+      for (const mlr::MovingLight& light : cache.Rig.areaLights)
+      {
+        power += light.power() * light.pose(light.frameCount() > 1 ? frame : 0).power;
+      }
+      for (const mlr::PointLight& light : cache.Rig.pointLights)
+      {
+        power += light.power() * light.pose(light.frameCount() > 1 ? frame : 0).power;
+      }
+      vtkNew<vtkDoubleArray> total;
+      total->SetName("LightPower");
+      total->SetNumberOfComponents(3);
+      total->InsertNextTuple3(power.r, power.g, power.b);
+      fieldData->AddArray(total);
+      mlr::vtkoutputs::addValue<vtkDoubleArray>(
+        fieldData, "LightLuminousFlux", this->LuminousEfficacy * mlr::luminance(power));
+    }
     if (cache.ChunkScene)
     {
       mlr::vtkoutputs::addValue<vtkIntArray>(

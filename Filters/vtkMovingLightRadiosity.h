@@ -75,7 +75,9 @@
  *   points and cells. Its field data holds the solver statistics (paths, rays by kind,
  *   seconds by phase, patches, elements, frames, reuse modes, predicted speed-up), the frame
  *   shown (`FrameIndex`), where the light is in it (`LightPosition`, its centroid, and
- *   `LightTranslation`, from the Light input), `SolveCount`, the exposure (`AutoExposure`,
+ *   `LightTranslation`, from the Light input), what the area and point lights emit in it
+ *   (`LightPower`, RGB W, the Light output's `Power` summed, and `LightLuminousFlux`, lm),
+ *   `SolveCount`, the exposure (`AutoExposure`,
  *   `Exposure`, `ExposureScale`) and `LuminousEfficacy`; with an error estimate, one value per
  *   frame of `RelativeErrorMedian`, `RelativeErrorP95` and `LitElements` (the relative error
  *   over the lit elements, see ErrorBatches), `ErrorBatches` (batches run), `ErrorRounds`,

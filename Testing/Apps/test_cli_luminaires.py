@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support")
 sys.path.insert(0, os.path.dirname(__file__))
 from cli_support import all_files, run  # noqa: E402
 from test_cli_rigs_and_sun import (  # noqa: E402
-    DISCRETISATION, LAMP, RHO, SIGMAS, disc, solve, write_floor)
+    DISCRETISATION, LAMP, RHO, SIGMAS, disc, read_series, solve, write_floor, write_points)
 
 PATHS = 100000
 HEIGHT = 1.0
@@ -198,10 +198,41 @@ def test_stats_take_the_point_light_from_the_filter(tmp_path):
     scale = 0.4 * 50 / (0.2126 * 2 + 0.7152 * 1)
     assert lighting["powerW"] == pytest.approx([2 * scale, scale, 0], rel=1e-12, abs=1e-12)
     assert lighting["lumens"] == pytest.approx(0.4 * 8950, rel=1e-12)
-    # Either frame (the last when streamed): the light is tilted alike in both.
-    assert lighting["powerFrame"] in (0, 1) and lighting["powerFrom"] == "--light-lumens"
+    # The light is tilted alike in both frames: the first of the brightest.
+    assert lighting["powerFrame"] == 0 and lighting["powerFrom"] == "--light-lumens"
     assert stats["settings"]["lightPower"] == lighting["powerW"]
     assert [f["lightPosition"] for f in stats["frames"]] == [[0, 0, HEIGHT], [0.5, 0, HEIGHT]]
+    assert [f["powerW"] for f in stats["frames"]] == [lighting["powerW"]] * 2
+
+
+def test_stats_give_each_frames_power_and_the_brightest(tmp_path):
+    """--stats posed the light in one frame (the first, or the last when streamed), so a light
+    off there reported 0 W and 0 lm. Each frame now has its own power, the trajectory's Power
+    factor applied, as the frames' field data LightPower and LightLuminousFlux give it, and the
+    light's powerW is its brightest frame's."""
+    trajectory = write_points(tmp_path / "dims.vtp", [(0, 0, HEIGHT), (0.2, 0, HEIGHT),
+                                                      (0.4, 0, HEIGHT)], Power=[0.0, 1.0, 0.25])
+    for streamed in ([], ["--frames-per-chunk", "2", "--chunk-overlap", "0"]):
+        out = "chunked" if streamed else "whole"
+        result = run(["--scene", write_floor(tmp_path), "--point-light", "--trajectory",
+                      trajectory, "--light-lumens", "1790", "--paths", "2000", "--output",
+                      f"{out}/s.pvd", "--stats", f"{out}/s.json"] + streamed, tmp_path)
+        assert result.returncode == 0, result.stderr
+        stats = json.loads((tmp_path / out / "s.json").read_text())
+        watts = 1790 / 179  # of luminance, white: 10 W per channel
+        numpy.testing.assert_allclose([f["powerW"] for f in stats["frames"]],
+                                      [[0] * 3, [watts] * 3, [watts / 4] * 3], rtol=1e-12,
+                                      err_msg=out)
+        assert [f["lumens"] for f in stats["frames"]] == pytest.approx(
+            [0, 1790, 1790 / 4], rel=1e-12), out
+        lighting = stats["lighting"]
+        assert lighting["powerFrame"] == 1, out
+        assert lighting["powerW"] == pytest.approx([watts] * 3, rel=1e-12), out
+        assert lighting["lumens"] == pytest.approx(1790, rel=1e-12), out
+        # The series' own field data says the same.
+        last = read_series(tmp_path, f"{out}/s.pvd")[2][1]
+        assert last.field("LightPower") == pytest.approx([watts / 4] * 3, rel=1e-12), out
+        assert last.field("LightLuminousFlux") == pytest.approx(1790 / 4, rel=1e-12), out
 
 
 def test_light_lumens_set_the_power_through_the_efficacy(tmp_path):
