@@ -1,5 +1,6 @@
 #include "Sensors.h"
 
+#include "DisjointSets.h"
 #include "InputFiles.h"
 #include "Messages.h"
 
@@ -146,16 +147,7 @@ std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, do
   {
     extents.push_back(extentOf({ face }, tolerance));
   }
-  std::vector<std::size_t> parent(level.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&](std::size_t i)
-  {
-    while (parent[i] != i)
-    {
-      i = parent[i] = parent[parent[i]];
-    }
-    return i;
-  };
+  mlr::DisjointSets touching(level.size());
   // A sweep along u: each face meets the faces whose u extent still reaches it.
   std::vector<std::size_t> order(level.size());
   std::iota(order.begin(), order.end(), 0);
@@ -172,7 +164,7 @@ std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, do
     {
       if (extents[j].vLo <= e.vHi && e.vLo <= extents[j].vHi)
       {
-        parent[root(j)] = root(i);
+        touching.join(i, j);
       }
     }
     reaching.push_back(i);
@@ -181,7 +173,7 @@ std::vector<std::vector<Face>> touchingGroups(const std::vector<Face>& level, do
   std::vector<std::size_t> groupOfRoot(level.size(), level.size());
   for (std::size_t i = 0; i < level.size(); ++i)
   {
-    std::size_t& group = groupOfRoot[root(i)];
+    std::size_t& group = groupOfRoot[touching.find(i)];
     if (group == level.size())
     {
       group = groups.size();

@@ -5,6 +5,7 @@
 // lines become remeshing constraints.
 #include "CgalRemeshingInternal.h"
 
+#include "DisjointSets.h"
 #include "Error.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
@@ -73,25 +74,13 @@ struct Surfaces
 
 Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
 {
-  // Union-find over points.
-  std::vector<std::size_t> parent(soup.points.size());
-  std::iota(parent.begin(), parent.end(), std::size_t(0));
-  auto root = [&parent](std::size_t p)
-  {
-    while (parent[p] != p)
-    {
-      parent[p] = parent[parent[p]];
-      p = parent[p];
-    }
-    return p;
-  };
+  DisjointSets connected(soup.points.size());
   for (const CgalTriangle& t : soup.triangles)
   {
     poll.tick();
     for (int k = 1; k < 3; ++k)
     {
-      const std::size_t a = root(t[0]), b = root(t[static_cast<std::size_t>(k)]);
-      parent[std::max(a, b)] = std::min(a, b);
+      connected.join(t[0], t[static_cast<std::size_t>(k)]);
     }
   }
   Surfaces s;
@@ -99,7 +88,7 @@ Surfaces findSurfaces(const RepairedSoup& soup, CancellationPoll& poll)
   s.of.resize(soup.triangles.size());
   for (std::size_t i = 0; i < soup.triangles.size(); ++i)
   {
-    std::size_t& surface = index[root(soup.triangles[i][0])];
+    std::size_t& surface = index[connected.find(soup.triangles[i][0])];
     if (surface == NoOrigin)
     {
       surface = s.count++;

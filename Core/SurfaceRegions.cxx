@@ -1,4 +1,5 @@
 #include "SurfaceRegions.h"
+#include "DisjointSets.h"
 
 #include <algorithm>
 #include <cmath>
@@ -55,19 +56,8 @@ std::vector<std::uint32_t> surfaceRegions(
   const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<Vec3>& normals)
 {
   const std::size_t n = triangles.size();
-  // Joining the larger root under the smaller makes every root its set's first triangle,
-  // whatever order the edges join in.
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), std::size_t(0));
-  auto find = [&parent](std::size_t t)
-  {
-    while (parent[t] != t)
-    {
-      parent[t] = parent[parent[t]];
-      t = parent[t];
-    }
-    return t;
-  };
+  // Every set's root is its first triangle, whatever order the edges join in.
+  DisjointSets surfaces(n);
 
   const double cosCrease = std::cos(CreaseAngleDegrees * M_PI / 180.0);
   const auto ascending = [&triangles](const EdgeUse& u)
@@ -81,8 +71,7 @@ std::vector<std::uint32_t> surfaceRegions(
       if (ascending(u) != ascending(v) &&
         dot(normals[u.triangle], normals[v.triangle]) >= cosCrease)
       {
-        const std::size_t ra = find(u.triangle), rb = find(v.triangle);
-        parent[std::max(ra, rb)] = std::min(ra, rb);
+        surfaces.join(u.triangle, v.triangle);
       }
     });
 
@@ -90,7 +79,7 @@ std::vector<std::uint32_t> surfaceRegions(
   std::uint32_t count = 0;
   for (std::size_t t = 0; t < n; ++t)
   {
-    const std::size_t root = find(t);
+    const std::size_t root = surfaces.find(t);
     region[t] = root == t ? count++ : region[root];
   }
   return region;

@@ -1,5 +1,6 @@
 #include "MovingLightRadiosityDisplay.h"
 
+#include "DisjointSets.h"
 #include "SurfaceRegions.h"
 
 #include "vtkCellData.h"
@@ -119,26 +120,7 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
 
   // Union-find over element corners: two corners at the same scene point join when their
   // elements share an edge through that point and meet smoothly there.
-  std::vector<std::size_t> parent(corners);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&parent](std::size_t c)
-  {
-    while (parent[c] != c)
-    {
-      parent[c] = parent[parent[c]];
-      c = parent[c];
-    }
-    return c;
-  };
-  auto join = [&](std::size_t a, std::size_t b)
-  {
-    a = find(a);
-    b = find(b);
-    if (a != b)
-    {
-      parent[std::max(a, b)] = std::min(a, b);
-    }
-  };
+  DisjointSets corner(corners);
 
   std::vector<Vec3> litNormals(triangles.size());
   for (std::size_t e = 0; e < triangles.size(); ++e)
@@ -170,8 +152,8 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
       {
         const auto [uLow, uHigh] = lowAndHigh(u);
         const auto [vLow, vHigh] = lowAndHigh(v);
-        join(uLow, vLow);
-        join(uHigh, vHigh);
+        corner.join(uLow, vLow);
+        corner.join(uHigh, vHigh);
       }
     });
 
@@ -185,7 +167,7 @@ SmoothShading smoothShading(const Scene& scene, const Solution& solution)
   std::vector<double> area;
   for (std::size_t c = 0; c < corners; ++c)
   {
-    const std::size_t root = find(c);
+    const std::size_t root = corner.find(c);
     if (shading.cornerPoints[root] < 0)
     {
       shading.cornerPoints[root] = static_cast<vtkIdType>(shading.scenePoints.size());
