@@ -829,13 +829,24 @@ int vtkMovingLightRadiosity::RequestUpdateExtent(
   // of 0: an abort silences the update it stopped, not the next one.
   this->ProgressStopped = false;
   // Our time is the light's position, not the inputs' time: a new time must not make the
-  // scene, the light or the trajectory execute again.
+  // scene, the light or the trajectory execute again. An input with time steps of its own (a
+  // file series) is asked for its first: left to whatever time another consumer of the same
+  // output last asked for (ParaView's view of the reader), the scene solved would follow the
+  // time bar, one step late.
   for (int port = 0; port < this->GetNumberOfInputPorts(); ++port)
   {
     for (int i = 0; i < inputVector[port]->GetNumberOfInformationObjects(); ++i)
     {
-      inputVector[port]->GetInformationObject(i)->Remove(
-        vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+      vtkInformation* input = inputVector[port]->GetInformationObject(i);
+      const auto steps = vtkStreamingDemandDrivenPipeline::TIME_STEPS();
+      if (input->Length(steps) > 0)
+      {
+        input->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), input->Get(steps)[0]);
+      }
+      else
+      {
+        input->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+      }
     }
   }
   return 1;
@@ -856,12 +867,17 @@ int vtkMovingLightRadiosity::RequestData(
     return 0;
   }
   vtkInternals& cache = *this->Internals;
-  // Whether anything that decides the result changed since the last solve or attempt.
+  // Whether anything that decides the result changed since the last solve or attempt: a
+  // property, or anything upstream (an algorithm, or data given with SetInputData). Not the
+  // inputs' own modification times: an input shared with another consumer executes again for
+  // that consumer's time steps, the same content at our fixed time.
   bool unchanged = this->GetMTime() <= cache.PropertiesTime.GetMTime();
   for (int port = 0; unchanged && port < this->GetNumberOfInputPorts(); ++port)
   {
-    vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
-    unchanged = !input || input->GetMTime() <= cache.SolveTime.GetMTime();
+    auto* upstream = this->GetNumberOfInputConnections(port) > 0
+      ? vtkDemandDrivenPipeline::SafeDownCast(this->GetInputExecutive(port, 0))
+      : nullptr;
+    unchanged = !upstream || upstream->GetPipelineMTime() <= cache.SolveTime.GetMTime();
   }
   if (unchanged && cache.Failed)
   {

@@ -116,8 +116,10 @@
  * are served from it without solving again, until an input or a property other than
  * Exposure changes. A time between two steps shows the step at or below it. All the outputs
  * show the time requested on the port being updated. The filter's time is not passed
- * upstream: the inputs are used as they are. The outputs share their unchanging arrays
- * (points, cells, `Reflectance`, ...) with the kept result: edit a DeepCopy of an output,
+ * upstream: an input with time steps of its own (a file series) is taken at its first time
+ * step whatever time is shown, and re-executions of an input for another consumer's time
+ * (ParaView's view of the same reader) do not solve again. The outputs share their unchanging
+ * arrays (points, cells, `Reflectance`, ...) with the kept result: edit a DeepCopy of an output,
  * not the output itself, or the other time steps show the edit.
  *
  * Progress is reported through UpdateProgress; setting AbortExecute (or aborting an upstream

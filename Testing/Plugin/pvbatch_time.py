@@ -6,9 +6,16 @@ Plane as Light, a Line with resolution 9 as Trajectory):
   the lit spot under the light on the floor, Radiosity different from the other frames; a
   time between two steps gives the step below; the Patches output follows too;
 - going back and forth in time solves nothing again (SolveCount and the arrays unchanged);
-- changing a property (Seed, then NumberOfPaths) or an input (the trajectory) solves again.
+- changing a property (Seed, then NumberOfPaths) or an input (the trajectory) solves again;
+- disconnecting the Trajectory (Trajectory = None) puts the light back on Path Start to Path
+  End, and disconnecting the Sensors empties the Sensors output;
+- a Scene with time steps of its own (a .pvd series whose floor rises) is solved once, at its
+  first time step, whatever time another consumer of the reader asks it for.
 
     pvbatch --force-offscreen-rendering pvbatch_time.py --plugin MovingLightRadiosity.so"""
+import os
+import tempfile
+
 import numpy
 
 import plugin_test_support as support
@@ -137,5 +144,68 @@ if len(frames) == 3:
     check(field(data, "SolveCount") == before + 1, "a new trajectory did not solve again")
     check(numpy.allclose(field(data, "LightPosition"), support.PATH_END),
           f"the last of 5 positions is {field(data, 'LightPosition')}, expected {support.PATH_END}")
+
+    # Disconnected optional inputs reach the filter (null_on_empty): the Trajectory's 5 positions
+    # give way to Path Start to Path End.
+    radiosity.NumberOfPositions = 3
+    radiosity.Trajectory = None
+    radiosity.UpdatePipelineInformation()
+    check(list(radiosity.TimestepValues) == [0.0, 1.0, 2.0],
+          f"without a Trajectory the time steps are {list(radiosity.TimestepValues)}, expected "
+          "the 3 of Path Start to Path End")
+    data = fetch(2.0)
+    check(numpy.allclose(field(data, "LightPosition"), radiosity.PathEnd),
+          f"without a Trajectory the last position is {field(data, 'LightPosition')}, expected "
+          f"Path End {list(radiosity.PathEnd)}")
+    radiosity.Sensors = Plane(Origin=[-0.2, -0.2, 0.0], Point1=[0.2, -0.2, 0.0],
+                              Point2=[-0.2, 0.2, 0.0])
+    check(fetch(0.0, port=3).GetNumberOfPoints() == 4, "the Plane's 4 sensors are not in the output")
+    radiosity.Sensors = None
+    check(fetch(0.0, port=3).GetNumberOfPoints() == 0,
+          "after Sensors = None the Sensors output still has points")
+
+
+def write_rising_floor(directory, steps):
+    """A .pvd series of a 2 x 2 floor at z = 0.2 t, t = 0 ... steps - 1."""
+    from vtkmodules.vtkFiltersSources import vtkPlaneSource
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+    entries = []
+    for t in range(steps):
+        plane = vtkPlaneSource()
+        plane.SetOrigin(-1, -1, 0.2 * t)
+        plane.SetPoint1(1, -1, 0.2 * t)
+        plane.SetPoint2(-1, 1, 0.2 * t)
+        writer = vtkXMLPolyDataWriter()
+        writer.SetInputConnection(plane.GetOutputPort())
+        writer.SetFileName(os.path.join(directory, f"floor_{t}.vtp"))
+        writer.Write()
+        entries.append(f'<DataSet timestep="{t}" file="floor_{t}.vtp"/>')
+    path = os.path.join(directory, "floor.pvd")
+    with open(path, "w") as out:
+        out.write('<?xml version="1.0"?><VTKFile type="Collection" version="0.1"><Collection>' +
+                  "".join(entries) + "</Collection></VTKFile>")
+    return path
+
+
+# A temporal Scene whose reader another consumer (a view, here a script) updates at each time:
+# the filter solved again at every step, with the scene of the time the reader ran last.
+with tempfile.TemporaryDirectory() as directory:
+    reader = PVDReader(FileName=write_rising_floor(directory, 5))
+    x, y, z = -0.1, -0.1, 2.5
+    lamp = Plane(Origin=[x, y, z], Point1=[x, y + 0.2, z], Point2=[x + 0.2, y, z])
+    moving = MovingLightRadiosity(Scene=reader, Light=lamp, NumberOfPaths=support.TEST_PATHS,
+                                  PathStart=[-0.5, 0, z], PathEnd=[0.5, 0, z], NumberOfPositions=5)
+    solves = set()
+    for time in (0.0, 2.0, 4.0, 1.0):
+        reader.UpdatePipeline(time=time)
+        moving.UpdatePipeline(time=time)
+        data = servermanager.Fetch(moving)
+        solves.add(field(data, "SolveCount"))
+        check(abs(data.GetBounds()[4]) < 1e-9 and abs(data.GetBounds()[5]) < 1e-9,
+              f"at time {time} the solved floor spans z {data.GetBounds()[4:]}, expected the "
+              "series' first step at z = 0")
+        check(field(data, "FrameIndex") == int(time),
+              f"at time {time} the filter shows frame {field(data, 'FrameIndex')}")
+    check(len(solves) == 1, f"stepping through a temporal Scene solved again: SolveCount {solves}")
 
 checks.finish()
