@@ -792,10 +792,10 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     filter->SetLightTypeToLuminaire();
   }
-  const Triple zenith = o.zenith();
-  if (!o.lightDistribution.empty())
+  // Up decides a TILT table's angles, the sky's zenith and which suns are below the horizon.
+  if (!o.lightDistribution.empty() || o.usesSun() || o.sky)
   {
-    filter->SetUp(zenith.data());
+    filter->SetUp(o.zenith().data());
   }
   if (!o.lightDistribution.empty())
   {
@@ -827,7 +827,6 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     filter->SetSkyModel(skyModelIndex(*o.sky));
     filter->SetSkyDiffuseHorizontal(o.skyDiffuseHorizontal.value_or(100.0));
-    filter->SetUp(zenith.data());
   }
   if (o.paths)
   {

@@ -416,61 +416,6 @@ private:
 };
 
 /// What `step` threw, as a message; empty when it succeeded.
-/// The frames of a sun-directions file whose sun is below the horizon (a direction under the
-/// plane across `up`) are night, dark as --sun-path's: their Power becomes 0, where the solve,
-/// whose surfaces are two-sided, would light the scene from below. Warns once, naming them.
-void darkenSunBelowHorizon(vtkPolyData* directions, const Triple& up, const std::string& file)
-{
-  std::vector<vtkIdType> below;
-  for (vtkIdType i = 0; i < directions->GetNumberOfPoints(); ++i)
-  {
-    double d[3];
-    directions->GetPoint(i, d);
-    if (d[0] * up[0] + d[1] * up[1] + d[2] * up[2] < 0)
-    {
-      below.push_back(i);
-    }
-  }
-  if (below.empty())
-  {
-    return;
-  }
-  vtkAbstractArray* given = directions->GetPointData()->GetAbstractArray("Power");
-  vtkDataArray* power = vtkDataArray::SafeDownCast(given);
-  if (given && (!power || power->GetNumberOfTuples() != directions->GetNumberOfPoints()))
-  {
-    return; // the filter refuses such a Power array, naming it
-  }
-  if (!power)
-  {
-    vtkNew<vtkDoubleArray> ones;
-    ones->SetName("Power");
-    ones->SetNumberOfTuples(directions->GetNumberOfPoints());
-    ones->Fill(1.0);
-    directions->GetPointData()->AddArray(ones);
-    power = ones;
-  }
-  const vtkIdType count = directions->GetNumberOfPoints();
-  std::ostringstream s;
-  s << "--sun-directions " << file << ": " << below.size() << " of " << count
-    << (count == 1 ? " direction points" : " directions point") << " below the horizon (--up "
-    << up[0] << "," << up[1] << "," << up[2] << "), frame" << (below.size() == 1 ? " " : "s ");
-  for (std::size_t k = 0; k < below.size(); ++k)
-  {
-    for (int c = 0; c < power->GetNumberOfComponents(); ++c)
-    {
-      power->SetComponent(below[k], c, 0.0);
-    }
-    if (k < 8)
-    {
-      s << (k ? ", " : "") << below[k];
-    }
-  }
-  s << (below.size() > 8 ? ", ..." : "")
-    << (below.size() == 1 ? ": that frame is night, dark" : ": those frames are night, dark");
-  printWarning(s.str());
-}
-
 std::string failureOf(const std::function<void()>& step)
 {
   try
@@ -665,7 +610,6 @@ int run(int argc, char** argv, RankJob& job)
   else if (!options.sunDirections.empty())
   {
     trajectory = readSurfaceFile(options.sunDirections, "sun directions", memoryLimit);
-    darkenSunBelowHorizon(trajectory, options.zenith(), options.sunDirections);
   }
   else if (!options.trajectory.empty())
   {

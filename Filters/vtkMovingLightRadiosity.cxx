@@ -537,9 +537,11 @@ std::vector<mlr::SkyFrame> daylightFrames(vtkMovingLightRadiosity* self,
   }
   for (std::size_t f = 0; f < frames.size(); ++f)
   {
+    // SkyDiffuseHorizontal is a daylight sky's: under a sun below the horizon it is night. A
+    // frame's own value (a weather file's) is a measurement, twilight included.
     frames[f].diffuseHorizontal = f < trajectory.skyDiffuseHorizontal.size()
       ? trajectory.skyDiffuseHorizontal[f]
-      : self->GetSkyDiffuseHorizontal();
+      : (mlr::dot(frames[f].sun, up) < 0 ? 0.0 : self->GetSkyDiffuseHorizontal());
     if (f < trajectory.directNormal.size())
     {
       frames[f].directNormal = trajectory.directNormal[f];
@@ -550,6 +552,45 @@ std::vector<mlr::SkyFrame> daylightFrames(vtkMovingLightRadiosity* self,
     }
   }
   return frames;
+}
+
+/// A sun below the horizon (across `up`) is night: its frames go dark, where the solve would
+/// light the scene from below (its surfaces may be two-sided) and give those frames a share
+/// of the mixture's paths. Returns the frames whose sun this turned off (the Sun Path source
+/// already gives its night frames Power 0).
+std::vector<std::size_t> darkenNight(mlr::vtkinputs::Trajectory& trajectory, const mlr::Vec3& up)
+{
+  std::vector<std::size_t> darkened;
+  std::vector<mlr::PoseInput>& sun = trajectory.lights.front();
+  for (std::size_t f = 0; f < sun.size(); ++f)
+  {
+    if (mlr::dot(sun[f].position, up) < 0)
+    {
+      if (sun[f].power != mlr::Rgb())
+      {
+        darkened.push_back(f);
+      }
+      sun[f].power = mlr::Rgb();
+    }
+  }
+  return darkened;
+}
+
+std::string nightWarning(
+  const std::vector<std::size_t>& frames, std::size_t count, const double* up)
+{
+  std::ostringstream s;
+  s << "the sun is below the horizon (across Up " << mlr::formatNumber(up[0]) << ", "
+    << mlr::formatNumber(up[1]) << ", " << mlr::formatNumber(up[2]) << ") in " << frames.size()
+    << " of " << count << (count == 1 ? " frame" : " frames") << ", frame"
+    << (frames.size() == 1 ? " " : "s ");
+  for (std::size_t k = 0; k < frames.size() && k < 8; ++k)
+  {
+    s << (k ? ", " : "") << frames[k];
+  }
+  s << (frames.size() > 8 ? ", ..." : "")
+    << (frames.size() == 1 ? ": that frame is night, dark" : ": those frames are night, dark");
+  return s.str();
 }
 
 void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& trajectory,
@@ -1299,8 +1340,17 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
                         .centroid();
       }
     }
-    const mlr::vtkinputs::Trajectory trajectory =
+    mlr::vtkinputs::Trajectory trajectory =
       trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]), lampInScene);
+    if (directional)
+    {
+      const std::vector<std::size_t> night =
+        darkenNight(trajectory, mlr::Vec3(this->Up[0], this->Up[1], this->Up[2]));
+      if (!night.empty())
+      {
+        warnings.push_back(nightWarning(night, trajectory.lights.front().size(), this->Up));
+      }
+    }
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,
       this->EmissionArrayName, materialLight.materialId);

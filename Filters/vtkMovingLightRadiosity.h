@@ -35,7 +35,8 @@
  *   wins over `Normal`); `Power` (1 or 3 components: a factor >= 0 on the light's power in
  *   that frame, 0 is off). With LightType Directional the points are the directions towards
  *   the light (the sun), one per frame, of any length but 0; `Power` scales SunIrradiance
- *   (clouds, night); `SunAzimuth` and `SunElevation` (degrees), if present, are passed to the
+ *   (clouds, night); a direction below the horizon (across Up) is night: that frame is dark,
+ *   with a warning; `SunAzimuth` and `SunElevation` (degrees), if present, are passed to the
  *   outputs' field data; `DirectNormalIrradiance` (W/m^2) replaces SunIrradiance per frame,
  *   and `SkyDiffuseHorizontal` (W/m^2) and `DayOfYear` (1 to 366, the Perez sky's date) set
  *   the sky per frame. Without this input the light moves in a straight line from
@@ -408,7 +409,9 @@ public:
 
   ///@{
   /// The sky's diffuse horizontal irradiance E_dh, W/m^2, when the Trajectory has no
-  /// SkyDiffuseHorizontal array; 0 or more. Default 100.
+  /// SkyDiffuseHorizontal array; 0 or more. A daylight sky's: in a frame whose sun (LightType
+  /// Directional) is below the horizon the sky is dark, where a Trajectory's per-frame value
+  /// (a weather file's, twilight included) is used as given. Default 100.
   vtkSetMacro(SkyDiffuseHorizontal, double);
   vtkGetMacro(SkyDiffuseHorizontal, double);
   ///@}

@@ -446,8 +446,8 @@ def test_sun_directions_below_the_horizon_are_dark_frames_with_a_warning(tmp_pat
     scene = write_town(tmp_path, boxes)
     directions = write_points(tmp_path / "sun.vtp", [(0, 0, 1), (0, 0, -1), (0, -1, 1)])
     frames = solve(tmp_path, ["--scene", scene, "--sun-directions", directions])
-    assert ("1 of 3 directions point below the horizon (--up 0,0,1), frame 1: that frame is "
-            "night, dark") in frames.stderr, frames.stderr
+    assert ("the sun is below the horizon (across Up 0, 0, 1) in 1 of 3 frames, frame 1: that "
+            "frame is night, dark") in frames.stderr, frames.stderr
     assert not frames[1][1].cells("Radiosity").any()
     for (_, frame), elevation in ((frames[0], 90.0), (frames[2], 45.0)):
         region = sun_region(frame, elevation, boxes)
@@ -458,7 +458,7 @@ def test_sun_directions_below_the_horizon_are_dark_frames_with_a_warning(tmp_pat
     result = run(["--scene", scene, "--sun-directions", directions, "--up", "0,1,0",
                   "--output", "y/s.pvd"] + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "1 of 3 directions point below the horizon (--up 0,1,0), frame 2:" in result.stderr
+    assert "below the horizon (across Up 0, 1, 0) in 1 of 3 frames, frame 2:" in result.stderr
 
 
 # --- Area lights: aim, Normal, Orientation, Power --------------------------------------------

@@ -68,6 +68,22 @@ def test_clear_sky_follows_the_sun_path_without_direct_sun(tmp_path):
             assert channel == pytest.approx(RHO * EDH, rel=2 * SIGMAS * relative_sigma() * 1.5)
 
 
+@pytest.mark.parametrize("model", ["uniform", "cie-clear", "perez"])
+def test_the_sky_is_dark_at_night(tmp_path, model):
+    """--sky-diffuse-horizontal is a daylight sky's. It lit the ground at midnight, with the sun
+    13 to 18 degrees below the horizon (QA: about 10,000 lx), and counted night as daylight in
+    the sensors' metrics. A frame whose sun is below the horizon is now night, sky included."""
+    frames = solve(tmp_path, ["--scene", write_ground(tmp_path), "--sun-path",
+                              PARIS + ",00:00,12:00,360", "--time-zone", "2", "--sky", model,
+                              "--sky-diffuse-horizontal", str(EDH)])
+    (_, night), _, (_, noon) = frames
+    assert night.field("SunElevation") < -10 and noon.field("SunElevation") > 50
+    for name in ("Radiosity", "Irradiance", "Illuminance"):
+        assert not night.cells(name).any(), name
+    # By day the sky still gives E_dh, the sun the rest.
+    assert min(noon.mean("Irradiance", noon.area > 0)) > EDH
+
+
 def test_up_turns_the_sky(tmp_path):
     # With the zenith along -z the ground's underside faces the sky and gets E_dh (100 by
     # default): the Irradiance of a two-sided surface counts both sides.

@@ -62,6 +62,13 @@ def trajectory():
     for t in HOURS:
         time.InsertNextValue(t)
     data.GetPointData().AddArray(time)
+    # Each frame's own diffuse irradiance, as a weather file gives it: used as given, twilight
+    # included, where the constant SkyDiffuseHorizontal is dark under a sun below the horizon.
+    diffuse = vtkDoubleArray()
+    diffuse.SetName("SkyDiffuseHorizontal")
+    for _ in HOURS:
+        diffuse.InsertNextValue(EDH)
+    data.GetPointData().AddArray(diffuse)
     return data
 
 
