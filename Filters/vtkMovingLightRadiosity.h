@@ -425,8 +425,9 @@ public:
 
   ///@{
   /**
-   * Aim every area light at AimPoint in every frame: its emission direction is turned to
-   * point from its centroid to AimPoint (a Trajectory's Orientation still wins). Default off.
+   * Aim every light at AimPoint in every frame: an area light's emission direction is turned
+   * to point from its centroid to AimPoint, a point light's nadir from its position (a
+   * Trajectory's Orientation still wins). Default off.
    */
   vtkSetMacro(AimAtPoint, vtkTypeBool);
   vtkGetMacro(AimAtPoint, vtkTypeBool);
