@@ -3,6 +3,7 @@
 #include "CgalRemeshingInternal.h"
 
 #include "Error.h"
+#include "Plural.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/boost/graph/helpers.h>
@@ -32,11 +33,6 @@ constexpr std::size_t MaximumRegionWarnings = 10;
 
 /// What a remeshing outcome is short of to be kept; empty when it is fine.
 using Refusal = std::string;
-
-std::string countOf(std::size_t n, const std::string& noun)
-{
-  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
-}
 
 std::string describe(const Rgb& c)
 {

@@ -4,6 +4,7 @@
 #include "CgalRemeshing.h"
 #include "Error.h"
 #include "MemoryBudget.h"
+#include "Plural.h"
 #include "PolygonTriangulation.h"
 
 #include <algorithm>
@@ -73,11 +74,6 @@ void refineTriangle(
 double triangleArea(const std::vector<Vec3>& points, const Triangle& t)
 {
   return 0.5 * length(triangleAreaVector(points[t[0]], points[t[1]], points[t[2]]));
-}
-
-std::string countOf(std::size_t n, const std::string& noun, const std::string& nouns = {})
-{
-  return std::to_string(n) + " " + (n == 1 ? noun : (nouns.empty() ? noun + "s" : nouns));
 }
 
 void checkProgress(const RemeshProgress& progress, double fraction)
@@ -549,9 +545,23 @@ RemeshResult remesh(
     triangulation.zeroArea + triangulation.selfCrossing;
   if (triangles.triangles.empty())
   {
-    throw Error("the scene has no polygon with an area (" + std::to_string(soup.polygons.size()) +
-      " polygons, all degenerate or too large to measure): give at least one triangle or "
-      "polygon that encloses area");
+    // Say why, as the warnings of a scene with some area do: a self-crossing polygon wants
+    // splitting, not the "degenerate" a user would look for in vain.
+    const Triangulation& t = triangulation;
+    std::string why;
+    const std::pair<std::size_t, std::string> reasons[] = {
+      { t.selfCrossing, countOf(t.selfCrossing, "self-crossing polygon") },
+      { t.zeroArea, countOf(t.zeroArea, "polygon") + " with zero area (all points on one line)" },
+      { t.linesAndPoints, countOf(t.linesAndPoints, "line or vertex", "lines or vertices") },
+      { t.duplicates, countOf(t.duplicates, "duplicate polygon") },
+    };
+    for (const auto& [count, text] : reasons)
+    {
+      why += count > 0 ? (why.empty() ? "" : ", ") + text : "";
+    }
+    throw Error("the scene has no polygon with an area (" + why +
+      "): give at least one triangle or polygon that encloses area" +
+      (t.selfCrossing > 0 ? ", and split self-crossing polygons into simple ones" : ""));
   }
   addTriangulationWarnings(triangulation, result.warnings);
 

@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "MemoryBudget.h"
+#include "Plural.h"
 #include "PolygonTriangulation.h"
 
 #include "vtkAppendPolyData.h"
@@ -11,9 +12,12 @@
 #include "vtkCompositeDataIterator.h"
 #include "vtkCompositeDataSet.h"
 #include "vtkDataArray.h"
+#include "vtkDataObjectTreeIterator.h"
 #include "vtkDataSet.h"
 #include "vtkFieldData.h"
 #include "vtkGeometryFilter.h"
+#include "vtkInformation.h"
+#include "vtkIntArray.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
@@ -23,8 +27,10 @@
 #include "vtkStringArray.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -33,6 +39,50 @@ namespace mlr::vtkinputs
 
 namespace
 {
+// What surfaceOf adds to the surface of an input that is not a vtkPolyData, so that messages
+// name the cells and points the user sees in the spreadsheet: the input's own ids, and the
+// block of a composite input.
+const char* const InputCellIds = "MovingLightRadiosityInputCellId";
+const char* const InputPointIds = "MovingLightRadiosityInputPointId";
+const char* const InputBlock = "MovingLightRadiosityInputBlock";
+const char* const InputBlockNames = "MovingLightRadiosityInputBlockNames";
+
+/// Element `id` of the id array `name` of `data`, or `id` itself without it.
+vtkIdType inputIdOf(vtkDataSetAttributes* data, const char* name, vtkIdType id)
+{
+  auto* ids = vtkDataArray::SafeDownCast(data->GetAbstractArray(name));
+  return ids && id < ids->GetNumberOfTuples() ? static_cast<vtkIdType>(ids->GetComponent(id, 0))
+                                              : id;
+}
+
+/// "block 1 " for the surface's cell `cellId` from a composite input's block 1, else "".
+std::string blockOf(vtkPolyData* surface, vtkIdType cellId)
+{
+  auto* names =
+    vtkStringArray::SafeDownCast(surface->GetFieldData()->GetAbstractArray(InputBlockNames));
+  auto* blocks = vtkDataArray::SafeDownCast(surface->GetCellData()->GetAbstractArray(InputBlock));
+  if (!names || !blocks || cellId >= blocks->GetNumberOfTuples())
+  {
+    return "";
+  }
+  const auto block = static_cast<vtkIdType>(blocks->GetComponent(cellId, 0));
+  return block >= 0 && block < names->GetNumberOfValues() ? names->GetValue(block) + " " : "";
+}
+
+/// The surface's cell `cellId` as the input has it: "cell 7" of a vtkPolyData (its own id),
+/// else the input cell it is a face of, in its block ("block 1 cell 3").
+std::string cellPlace(vtkPolyData* surface, vtkIdType cellId)
+{
+  return blockOf(surface, cellId) + "cell " +
+    std::to_string(inputIdOf(surface->GetCellData(), InputCellIds, cellId));
+}
+
+/// The surface's point `pointId` as the input (its block, for a composite) numbers it.
+std::string pointPlace(vtkPolyData* surface, vtkIdType pointId)
+{
+  return "point " + std::to_string(inputIdOf(surface->GetPointData(), InputPointIds, pointId));
+}
+
 /// Calls visit(cellId, pointIds) for every polygon of `data`, then for every triangle of its
 /// strips, with the cell ids vtkPolyData gives them (vertices, lines, polygons, strips).
 void forEachSurfaceCell(
@@ -116,6 +166,46 @@ vtkDataArray* colourArray(vtkPolyData* scene, const std::string& name, const cha
   return numbers;
 }
 
+/// What the Scene has instead of its cell array `name`: a point array of that name, or an
+/// array whose name differs only in case; "" when nothing like it.
+std::string lookalikeOf(vtkPolyData* scene, const std::string& name, const std::string& property)
+{
+  if (name.empty())
+  {
+    return "";
+  }
+  if (scene->GetPointData()->GetAbstractArray(name.c_str()))
+  {
+    return ": it has a point array " + name +
+      ", but values are per cell: convert it with Point Data to Cell Data "
+      "(vtkPointDataToCellData)";
+  }
+  auto lower = [](std::string text)
+  {
+    std::transform(text.begin(), text.end(), text.begin(),
+      [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return text;
+  };
+  for (vtkDataSetAttributes* data : { static_cast<vtkDataSetAttributes*>(scene->GetCellData()),
+         static_cast<vtkDataSetAttributes*>(scene->GetPointData()) })
+  {
+    for (int a = 0; a < data->GetNumberOfArrays(); ++a)
+    {
+      const char* other = data->GetArrayName(a);
+      if (other && lower(other) == lower(name))
+      {
+        return std::string(": it has a ") + (data == scene->GetCellData() ? "cell" : "point") +
+          " array '" + other + "' (names differ in case): rename it " + name + ", or set " +
+          property + " to '" + other + "'" +
+          (data == scene->GetCellData()
+              ? ""
+              : ", and convert it with Point Data to Cell Data (vtkPointDataToCellData)");
+      }
+    }
+  }
+  return "";
+}
+
 Rgb colourOfCell(vtkDataArray* array, vtkIdType cellId)
 {
   if (array->GetNumberOfComponents() == 1)
@@ -126,7 +216,8 @@ Rgb colourOfCell(vtkDataArray* array, vtkIdType cellId)
     array->GetComponent(cellId, 0), array->GetComponent(cellId, 1), array->GetComponent(cellId, 2));
 }
 
-Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& name)
+Rgb reflectanceOfCell(
+  vtkPolyData* scene, vtkDataArray* array, vtkIdType cellId, const std::string& name)
 {
   const Rgb rho = colourOfCell(array, cellId);
   for (int c = 0; c < 3; ++c)
@@ -134,22 +225,29 @@ Rgb reflectanceOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& 
     if (!(rho[c] >= 0.0 && rho[c] < 1.0))
     {
       std::ostringstream s;
-      s << "Scene cell " << cellId << " has " << name << " (" << rho.r << ", " << rho.g << ", "
-        << rho.b << "): every value must be >= 0 and < 1";
+      s << "Scene " << cellPlace(scene, cellId) << " has " << name << " (" << rho.r << ", " << rho.g
+        << ", " << rho.b << "): every value must be >= 0 and < 1";
+      if (array->GetDataType() == VTK_UNSIGNED_CHAR && rho.maxComponent() >= 1)
+      {
+        // Colours read from images and PLY files come as bytes.
+        s << "; it is an unsigned char array, colours from 0 to 255: divide it by 255 (a "
+          << "Calculator on Cell Data: " << name << "/255) to give fractions";
+      }
       throw Error(s.str());
     }
   }
   return rho;
 }
 
-Rgb emissionOfCell(vtkDataArray* array, vtkIdType cellId, const std::string& name)
+Rgb emissionOfCell(
+  vtkPolyData* scene, vtkDataArray* array, vtkIdType cellId, const std::string& name)
 {
   const Rgb e = colourOfCell(array, cellId);
   if (!e.isFinite() || e.minComponent() < 0)
   {
     std::ostringstream s;
-    s << "Scene cell " << cellId << " has " << name << " (" << e.r << ", " << e.g << ", " << e.b
-      << ") W/m^2: every value must be finite and >= 0";
+    s << "Scene " << cellPlace(scene, cellId) << " has " << name << " (" << e.r << ", " << e.g
+      << ", " << e.b << ") W/m^2: every value must be finite and >= 0";
     throw Error(s.str());
   }
   return e;
@@ -243,7 +341,7 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
     if (!std::isfinite(v) || v != std::floor(v))
     {
       std::ostringstream s;
-      s << "the Light's cell array LightId has " << v << " at cell " << c
+      s << "the Light's cell array LightId has " << v << " at " << cellPlace(light, c)
         << ": give integers (0, 1, ...) that group polygons into lights";
       throw Error(s.str());
     }
@@ -252,6 +350,51 @@ std::vector<long long> distinctLightIds(vtkPolyData* light, vtkDataArray* ids)
   std::sort(values.begin(), values.end());
   values.erase(std::unique(values.begin(), values.end()), values.end());
   return values;
+}
+
+/// Every leaf of `data` with its label, null and empty ones included so that a leaf's number
+/// is the same on every rank. The label is the block's index, as the Multiblock Inspector and
+/// the spreadsheet's unnamed_block_N give it ("block 1"; block 2 of block 1 is "block 1/2"),
+/// and its name when it has one.
+std::vector<std::pair<vtkDataObject*, std::string>> leavesOf(
+  vtkCompositeDataSet* data, const std::string& path = "")
+{
+  std::vector<std::pair<vtkDataObject*, std::string>> leaves;
+  vtkSmartPointer<vtkCompositeDataIterator> child;
+  child.TakeReference(data->NewIterator());
+  auto* tree = vtkDataObjectTreeIterator::SafeDownCast(child);
+  if (!tree)
+  {
+    // Not a tree (AMR): its leaves have no block index, but a flat one.
+    for (child->InitTraversal(); !child->IsDoneWithTraversal(); child->GoToNextItem())
+    {
+      leaves.emplace_back(
+        child->GetCurrentDataObject(), "block " + std::to_string(child->GetCurrentFlatIndex()));
+    }
+    return leaves;
+  }
+  tree->VisitOnlyLeavesOff();
+  tree->TraverseSubTreeOff();
+  tree->SkipEmptyNodesOff();
+  int index = 0;
+  for (tree->InitTraversal(); !tree->IsDoneWithTraversal(); tree->GoToNextItem(), ++index)
+  {
+    const std::string label = (path.empty() ? "block " : path + "/") + std::to_string(index);
+    vtkDataObject* object = tree->GetCurrentDataObject();
+    if (auto* inner = vtkCompositeDataSet::SafeDownCast(object))
+    {
+      for (auto& leaf : leavesOf(inner, label))
+      {
+        leaves.push_back(std::move(leaf));
+      }
+      continue;
+    }
+    const char* name = tree->HasCurrentMetaData()
+      ? tree->GetCurrentMetaData()->Get(vtkCompositeDataSet::NAME())
+      : nullptr;
+    leaves.emplace_back(object, name && *name ? label + " '" + name + "'" : label);
+  }
+  return leaves;
 }
 }
 
@@ -270,6 +413,10 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
   {
     vtkNew<vtkGeometryFilter> surface;
     surface->SetInputData(data);
+    surface->PassThroughCellIdsOn();
+    surface->SetOriginalCellIdsName(InputCellIds);
+    surface->PassThroughPointIdsOn();
+    surface->SetOriginalPointIdsName(InputPointIds);
     surface->Update();
     return vtkSmartPointer<vtkPolyData>(surface->GetOutput());
   };
@@ -292,11 +439,12 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
   vtkNew<vtkStringArray> materialNames;
   materialNames->SetName("MaterialNames");
   std::map<std::string, int> materialIndex;
-  vtkSmartPointer<vtkCompositeDataIterator> leaf;
-  leaf.TakeReference(composite->NewIterator());
-  for (leaf->InitTraversal(); !leaf->IsDoneWithTraversal(); leaf->GoToNextItem())
+  vtkNew<vtkStringArray> blockNames;
+  blockNames->SetName(InputBlockNames);
+  for (const auto& [leaf, label] : leavesOf(composite))
   {
-    auto* data = vtkDataSet::SafeDownCast(leaf->GetCurrentDataObject());
+    const auto block = static_cast<int>(blockNames->InsertNextValue(label));
+    auto* data = vtkDataSet::SafeDownCast(leaf);
     if (!data || data->GetNumberOfCells() == 0)
     {
       continue;
@@ -332,6 +480,11 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
       renumbered->GetCellData()->AddArray(merged);
       surface = renumbered;
     }
+    vtkNew<vtkIntArray> blockOfCell;
+    blockOfCell->SetName(InputBlock);
+    blockOfCell->SetNumberOfTuples(surface->GetNumberOfCells());
+    blockOfCell->FillValue(block);
+    surface->GetCellData()->AddArray(blockOfCell);
     vtkCellData* cells = surface->GetCellData();
     for (int a = 0; a < cells->GetNumberOfArrays(); ++a)
     {
@@ -363,6 +516,7 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
     whole->GetFieldData()->RemoveArray("MaterialNames");
     whole->GetFieldData()->AddArray(materialNames);
   }
+  whole->GetFieldData()->AddArray(blockNames);
   return whole;
 }
 
@@ -376,15 +530,15 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     return soup;
   }
   {
-    // Per point 24 bytes; per polygon its index vector (~56 bytes with the allocator's
-    // overhead) and material (24), and 4 bytes per index. Strips become one polygon per
-    // triangle.
+    // Per point 24 bytes and 4 for its new number; per polygon its index vector (~56 bytes
+    // with the allocator's overhead) and material (24), and 4 bytes per index. Strips become
+    // one polygon per triangle.
     // The Scene is in memory, so these sums of its sizes cannot overflow.
     const auto count = [](vtkIdType n) { return static_cast<std::uint64_t>(n); };
     const std::uint64_t stripIds = count(scene->GetStrips()->GetNumberOfConnectivityIds());
     const std::uint64_t cells = count(scene->GetNumberOfPolys()) + stripIds;
     const std::uint64_t ids = count(scene->GetPolys()->GetNumberOfConnectivityIds()) + 3 * stripIds;
-    const std::uint64_t estimate = 24 * count(scene->GetNumberOfPoints()) + 80 * cells + 4 * ids;
+    const std::uint64_t estimate = 28 * count(scene->GetNumberOfPoints()) + 80 * cells + 4 * ids;
     MemoryBudget(memoryLimitBytes)
       .check(estimate,
         "the Scene has " + std::to_string(scene->GetNumberOfCells()) + " cells on " +
@@ -394,9 +548,10 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   const vtkIdType ignored = scene->GetNumberOfVerts() + scene->GetNumberOfLines();
   if (ignored > 0)
   {
-    warnings.push_back("ignored " + std::to_string(scene->GetNumberOfVerts()) + " vertices and " +
-      std::to_string(scene->GetNumberOfLines()) +
-      " lines of the Scene: only polygons and triangle strips are surfaces");
+    warnings.push_back("ignored " +
+      countOf(static_cast<std::size_t>(scene->GetNumberOfVerts()), "vertex", "vertices") + " and " +
+      countOf(static_cast<std::size_t>(scene->GetNumberOfLines()), "line") +
+      " of the Scene: only polygons and triangle strips are surfaces");
   }
   if (scene->GetNumberOfPolys() + scene->GetNumberOfStrips() == 0)
   {
@@ -410,10 +565,79 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
     std::ostringstream s;
     s << "the Scene has no cell array "
       << (reflectanceName.empty() ? "for reflectance" : reflectanceName)
-      << ": every surface is grey " << Material{}.reflectance.g;
+      << ": every surface is grey " << Material{}.reflectance.g
+      << lookalikeOf(scene, reflectanceName, "ReflectanceArrayName");
     warnings.push_back(s.str());
   }
-  soup.points = pointsOf(scene);
+  if (!emission)
+  {
+    const std::string lookalike = lookalikeOf(scene, emissionName, "EmissionArrayName");
+    if (!lookalike.empty())
+    {
+      warnings.push_back(
+        "the Scene has no cell array " + emissionName + ": nothing in it emits" + lookalike);
+    }
+  }
+
+  // Only the points that polygons use, in their order: a point no surface uses (an unused
+  // point, an interior point of a volume, a vertex cell's) neither fails the solve with its
+  // NaN nor stretches the scene's extent.
+  const vtkIdType pointCount = scene->GetNumberOfPoints();
+  constexpr std::uint32_t Unused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> newId(static_cast<std::size_t>(pointCount), Unused);
+  forEachSurfaceCell(scene,
+    [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids)
+    {
+      for (std::uint32_t id : ids)
+      {
+        if (id >= static_cast<std::uint64_t>(pointCount))
+        {
+          throw Error("Scene " + cellPlace(scene, cellId) + " uses point " + std::to_string(id) +
+            " but the Scene has " + std::to_string(pointCount) + " points: fix its connectivity");
+        }
+        newId[id] = 0;
+      }
+    });
+  std::size_t nonFinite = 0;
+  vtkIdType firstNonFinite = -1;
+  for (vtkIdType i = 0; i < pointCount; ++i)
+  {
+    if (newId[static_cast<std::size_t>(i)] == Unused)
+    {
+      continue;
+    }
+    double p[3];
+    scene->GetPoint(i, p);
+    const Vec3 point(p[0], p[1], p[2]);
+    if (!isFinite(point) && nonFinite++ == 0)
+    {
+      firstNonFinite = i;
+    }
+    newId[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(soup.points.size());
+    soup.points.push_back(point);
+  }
+  if (nonFinite > 0)
+  {
+    // Named with a cell that uses it, which names the block of a composite input.
+    vtkIdType user = -1;
+    forEachSurfaceCell(scene,
+      [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids)
+      {
+        if (user < 0 && std::find(ids.begin(), ids.end(), firstNonFinite) != ids.end())
+        {
+          user = cellId;
+        }
+      });
+    double p[3];
+    scene->GetPoint(firstNonFinite, p);
+    std::ostringstream s;
+    s << "the Scene has " << countOf(nonFinite, "point")
+      << " with NaN or infinite coordinates in its polygons; the first is "
+      << pointPlace(scene, firstNonFinite) << " (" << p[0] << ", " << p[1] << ", " << p[2]
+      << ") of " << cellPlace(scene, user) << ": fix them or remove the cells that use them";
+    throw Error(s.str());
+  }
+
   vtkDataArray* materialIds = skipMaterial >= 0 ? materialIdArray(scene) : nullptr;
   forEachSurfaceCell(scene,
     [&](vtkIdType cellId, const std::vector<std::uint32_t>& ids)
@@ -422,15 +646,18 @@ PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
       {
         return;
       }
-      soup.polygons.push_back(ids);
+      std::vector<std::uint32_t> polygon(ids.size());
+      std::transform(
+        ids.begin(), ids.end(), polygon.begin(), [&](std::uint32_t id) { return newId[id]; });
+      soup.polygons.push_back(std::move(polygon));
       Material material;
       if (reflectance)
       {
-        material.reflectance = reflectanceOfCell(reflectance, cellId, reflectanceName);
+        material.reflectance = reflectanceOfCell(scene, reflectance, cellId, reflectanceName);
       }
       if (emission)
       {
-        material.emission = emissionOfCell(emission, cellId, emissionName);
+        material.emission = emissionOfCell(scene, emission, cellId, emissionName);
       }
       soup.materials.push_back(material);
     });
@@ -488,8 +715,8 @@ MaterialLight materialLight(
       }
       if (emission)
       {
-        power +=
-          emissionOfCell(emission, cellId, emissionName) * (0.5 * length(newellNormal(polygon)));
+        power += emissionOfCell(scene, emission, cellId, emissionName) *
+          (0.5 * length(newellNormal(polygon)));
       }
       result.light.polygons.push_back(std::move(polygon));
     });
@@ -718,6 +945,20 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
   }
   // The point ids of each light's positions.
   std::vector<std::vector<vtkIdType>> perLight;
+  auto* poly = vtkPolyData::SafeDownCast(trajectory);
+  const vtkIdType lines = poly ? poly->GetNumberOfLines() : 0;
+  if (lights <= 1 && lines > 1)
+  {
+    // One light would run through every polyline's points in turn, as if they were frames:
+    // the second light that was meant never appears.
+    throw Error("the Trajectory has " + std::to_string(lines) +
+      " polylines but it moves one light (a point light, a luminaire, the sun, a "
+      "LightMaterial or a Light whose cell array LightId has one value or none), which takes "
+      "one polyline "
+      "(or points, one per frame): join them into one, or give several area lights a Light "
+      "cell array LightId (one value per light) with one polyline per light in LightId "
+      "order; point lights are solved one at a time (their Irradiance arrays add up)");
+  }
   if (lights <= 1)
   {
     perLight.emplace_back(static_cast<std::size_t>(n));
@@ -728,16 +969,13 @@ Trajectory trajectoryFromPoints(vtkPointSet* trajectory, std::size_t lights)
   }
   else
   {
-    auto* poly = vtkPolyData::SafeDownCast(trajectory);
-    const vtkIdType lines = poly ? poly->GetNumberOfLines() : 0;
     if (static_cast<std::size_t>(lines) != lights)
     {
       throw Error("the Light holds " + std::to_string(lights) +
-        " lights (LightId) but the "
-        "Trajectory has " +
-        std::to_string(lines) +
-        " polylines: give one polyline per light, "
-        "in LightId order (a single point for a light that does not move)");
+        " lights (LightId) but the Trajectory has " +
+        countOf(static_cast<std::size_t>(lines), "polyline") +
+        ": give one polyline per light, in LightId order (a single point for a light that "
+        "does not move)");
     }
     auto it = vtkSmartPointer<vtkCellArrayIterator>::Take(poly->GetLines()->NewIterator());
     for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())

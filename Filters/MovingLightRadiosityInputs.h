@@ -24,7 +24,8 @@ namespace mlr::vtkinputs
 /// their cell and field data); the surfaces of a composite data set's leaves, appended, their
 /// materials (MaterialId, MaterialNames) matched by name, and a cell array that not every leaf
 /// has dropped with a warning in `warnings`. Null for no input. Throws mlr::Error, naming the
-/// port, for data that has no surface (a table).
+/// port, for data that has no surface (a table). A surface made here carries the input's cell
+/// and point ids and its leaves' blocks, which the messages of the functions below give.
 vtkSmartPointer<vtkPolyData> surfaceOf(
   vtkDataObject* data, const std::string& port, std::vector<std::string>& warnings);
 
@@ -32,10 +33,10 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
 /// from the cell array named `reflectanceName` (1 or 3 components, each in [0, 1)) and
 /// emission from the one named `emissionName` (1 or 3 components, W/m^2, >= 0), if present.
 /// Recoverable oddities (ignored vertices and lines, no reflectance) are appended to
-/// `warnings`. An empty soup means there is nothing to light. Throws mlr::Error, before
-/// copying anything, when the copy is estimated to need more than `memoryLimitBytes` (0: half
-/// the physical memory).
-/// Cells whose `MaterialId` is `skipMaterial` (>= 0) are left out: they are the light.
+/// `warnings`. Points that no polygon or strip uses are left out of the soup. An empty soup means
+/// there is nothing to light. Throws mlr::Error, before copying anything, when the copy is
+/// estimated to need more than `memoryLimitBytes` (0: half the physical memory). Cells whose
+/// `MaterialId` is `skipMaterial` (>= 0) are left out: they are the light.
 PolygonSoup sceneSoup(vtkPolyData* scene, std::vector<std::string>& warnings,
   std::uint64_t memoryLimitBytes = 0, const std::string& reflectanceName = "Reflectance",
   const std::string& emissionName = "Emission", int skipMaterial = -1);

@@ -624,6 +624,7 @@ def lamp_path(points, lines=None, lamp_kwargs=None, **arrays):
 
 
 TWO_LAMPS = {"centres": ((0, 0, 1), (0, 1, 1)), "LightId": [0, 1]}
+TWO_PATHS = [(-1, 0, 1), (-1, 0.5, 1), (1, 0, 1), (1, 0.5, 1)]  # two polylines of 2 points
 
 
 def emissive_scene(emission):
@@ -663,7 +664,15 @@ BAD = {
                   "point array Power has (nan, nan, nan) at point 1"),
     "light id without polyline": (
         lamp_path([(0, 0, 1), (0.5, 0, 1)], lines=[[0, 1]], lamp_kwargs=TWO_LAMPS), 1,
-        "the Light holds 2 lights (LightId) but the Trajectory has 1 polylines"),
+        "the Light holds 2 lights (LightId) but the Trajectory has 1 polyline:"),
+    # One light would have run through both polylines as frames, the second lamp never shown.
+    "point light with two polylines": (
+        lambda d: ["--scene", write_floor(d), "--point-light", "--trajectory",
+                   write_points(d / "path.vtp", TWO_PATHS, [[0, 1], [2, 3]])], 1,
+        "the Trajectory has 2 polylines but it moves one light"),
+    "one area light with two polylines": (
+        lamp_path(TWO_PATHS, lines=[[0, 1], [2, 3]]), 1,
+        "the Trajectory has 2 polylines but it moves one light"),
     "negative emission": (emissive_scene((1.0, -2.0, 0.0)), 1,
                           "Scene cell 1 has Emission (1, -2, 0) W/m^2"),
     "sun path and sun directions": (

@@ -507,6 +507,15 @@ TEST(RemeshingMessyInput, SelfCrossingPolygonIsIgnoredWithAWarning)
   EXPECT_NEAR(totalArea(result.mesh), 1.0, 0.005);
 }
 
+TEST(RemeshingMessyInput, ALoneSelfCrossingPolygonIsCalledSo)
+{
+  PolygonSoup soup;
+  addPolygon(soup, { { 0, 0, 0 }, { 1, 1, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, Rgb(0.5)); // a bow tie
+  expectError([&] { remesh(soup, RemeshOptions{}); },
+    "no polygon with an area (1 self-crossing polygon): give at least one triangle or polygon "
+    "that encloses area, and split self-crossing polygons into simple ones");
+}
+
 TEST(RemeshingMessyInput, ConcaveAndNonPlanarPolygonsAreKept)
 {
   PolygonSoup soup;

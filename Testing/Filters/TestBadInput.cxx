@@ -253,7 +253,7 @@ TEST(FilterBadInput, VerticesAndLinesAreIgnoredWithAWarning)
   setReflectance(setup.scene, rho);
   const FilterRun run = runFilter(fastFilter(setup));
   EXPECT_TRUE(run.succeeded);
-  EXPECT_NE(run.messages->allWarnings().find("ignored 1 vertices and 0 lines"), std::string::npos);
+  EXPECT_NE(run.messages->allWarnings().find("ignored 1 vertex and 0 lines"), std::string::npos);
   EXPECT_GT(run.elements, 0);
 }
 

@@ -521,7 +521,7 @@ TEST(FilterRigs, LightIdWithoutItsPolylineIsAnError)
   BoxSetup setup = closedBoxSetup(3);
   setup.light = twoLights({ 1, 1, 1 }, { 1, 1, 1 });
   setup.trajectory = polylines({ { { 0.25, 0.3, 0.9 }, { 0.5, 0.5, 0.9 }, { 0.75, 0.7, 0.9 } } });
-  expectError(boxFilter(setup), "2 lights (LightId) but the Trajectory has 1 polylines");
+  expectError(boxFilter(setup), "2 lights (LightId) but the Trajectory has 1 polyline:");
   // Points without polylines are no rig either.
   setup.trajectory = trajectoryPolyData({ { 0.25, 0.3, 0.9 }, { 0.5, 0.5, 0.9 } });
   expectError(boxFilter(setup), "polylines");

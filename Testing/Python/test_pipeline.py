@@ -252,6 +252,117 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     assert elements.GetNumberOfCells() == 0
 
 
+def with_reflectance(data, values, array=None):
+    """`data` with the cell array Reflectance holding `values` (one grey value per cell)."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    array = array or vtkDoubleArray()
+    array.SetName(array.GetName() or "Reflectance")
+    for value in values:
+        array.InsertNextTuple(value if isinstance(value, tuple) else (value,))
+    data.GetCellData().AddArray(array)
+    return data
+
+
+def test_messages_name_the_cell_as_the_input_numbers_it():
+    # The surface of a grid or a multiblock numbers its faces otherwise: a message must give
+    # the cell the spreadsheet shows, with its block.
+    from vtkmodules.vtkCommonDataModel import (VTK_HEXAHEDRON, VTK_TETRA, vtkCompositeDataSet,
+                                               vtkMultiBlockDataSet, vtkUnstructuredGrid)
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkFiltersSources import vtkCubeSource
+    grid = vtkUnstructuredGrid()
+    points = vtkPoints()
+    for z in (0, 1):
+        for y in (0, 1):
+            for x in (0, 1):
+                points.InsertNextPoint(x, y, z)
+    for p in ((3, 0, 0), (4, 0, 0), (3, 1, 0), (3, 0, 1)):
+        points.InsertNextPoint(*p)
+    grid.SetPoints(points)
+    grid.InsertNextCell(VTK_TETRA, 4, [8, 9, 10, 11])
+    grid.InsertNextCell(VTK_HEXAHEDRON, 8, [0, 1, 3, 2, 4, 5, 7, 6])
+    with_reflectance(grid, [0.5, 1.5])
+    _, messages = lit(grid)
+    assert any("Scene cell 1 has Reflectance (1.5, 1.5, 1.5)" in e
+               for e in messages["ErrorEvent"]), messages
+
+    def cube(bad_cell):
+        source = vtkCubeSource()
+        source.Update()
+        return with_reflectance(source.GetOutput(), [2.0 if c == bad_cell else 0.5
+                                                     for c in range(6)])
+
+    blocks = vtkMultiBlockDataSet()
+    blocks.SetBlock(0, grey_plane((-2, -2, 0), (2, -2, 0), (-2, 2, 0), 0.5))
+    blocks.SetBlock(1, cube(3))
+    _, messages = lit(blocks)
+    assert any("Scene block 1 cell 3 has Reflectance (2, 2, 2)" in e
+               for e in messages["ErrorEvent"]), messages
+
+    # Nested, after an empty block, and named: block 2 of block 1, as the Multiblock Inspector
+    # shows it.
+    inner = vtkMultiBlockDataSet()
+    inner.SetBlock(0, cube(-1))
+    inner.SetBlock(2, cube(5))
+    inner.GetMetaData(2).Set(vtkCompositeDataSet.NAME(), "box")
+    blocks.SetBlock(1, inner)
+    _, messages = lit(blocks)
+    assert any("Scene block 1/2 'box' cell 5 has Reflectance (2, 2, 2)" in e
+               for e in messages["ErrorEvent"]), messages
+
+
+def test_points_no_polygon_uses_are_ignored_and_a_used_nan_is_named():
+    import math
+    from vtkmodules.vtkCommonCore import vtkPoints
+    scene = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5)
+    points = vtkPoints()
+    points.DeepCopy(scene.GetPoints())
+    points.InsertNextPoint(math.nan, 0, 0)  # point 4: no cell uses it
+    scene.SetPoints(points)
+    elements, messages = lit(scene)
+    assert not messages["ErrorEvent"], messages
+    assert surface_area(elements) == pytest.approx(1.0, rel=1e-9)
+
+    points.SetPoint(2, 0, math.inf, 0)
+    scene.Modified()
+    _, messages = lit(scene)
+    assert any("the Scene has 1 point with NaN or infinite coordinates in its polygons; the "
+               "first is point 2 (0, inf, 0) of cell 0" in e
+               for e in messages["ErrorEvent"]), messages
+
+
+def test_a_reflectance_array_of_the_wrong_kind_says_what_to_do():
+    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkUnsignedCharArray
+    scene = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+    values = vtkDoubleArray()
+    values.SetName("Reflectance")
+    for _ in range(scene.GetNumberOfPoints()):
+        values.InsertNextValue(0.3)
+    scene.GetPointData().AddArray(values)
+    _, messages = lit(scene)
+    assert any("no cell array Reflectance: every surface is grey 0.5: it has a point array "
+               "Reflectance, but values are per cell: convert it with Point Data to Cell Data"
+               in w for w in messages["WarningEvent"]), messages
+
+    scene = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+    lower = vtkDoubleArray()
+    lower.SetName("reflectance")
+    with_reflectance(scene, [0.3], lower)
+    _, messages = lit(scene)
+    assert any("it has a cell array 'reflectance' (names differ in case): rename it "
+               "Reflectance, or set ReflectanceArrayName to 'reflectance'" in w
+               for w in messages["WarningEvent"]), messages
+
+    scene = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0))
+    colours = vtkUnsignedCharArray()
+    colours.SetNumberOfComponents(3)
+    with_reflectance(scene, [(200, 100, 50)], colours)
+    _, messages = lit(scene)
+    assert any("Scene cell 0 has Reflectance (200, 100, 50): every value must be >= 0 and < 1; "
+               "it is an unsigned char array, colours from 0 to 255: divide it by 255" in e
+               for e in messages["ErrorEvent"]), messages
+
+
 def material_block(quads, names):
     """Quads [(origin, point1, point2, material id)] with MaterialId and MaterialNames, as the
     scene reader gives a file's materials."""

@@ -134,7 +134,7 @@ def test_rig_without_its_polyline_is_an_error(rig):
     radiosity.SetTrajectoryData(output(line))  # one polyline for two lights
     errors = recorded(radiosity, "ErrorEvent")
     assert not radiosity.UpdateTimeStep(0.0)
-    assert any("2 lights (LightId) but the Trajectory has 1 polylines" in e for e in errors), errors
+    assert any("2 lights (LightId) but the Trajectory has 1 polyline:" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
 
 

@@ -131,7 +131,7 @@ std::vector<Row> rows()
         scene->SetLines(lines);
         c.setup.scene = scene;
       },
-      Outcome::EmptyResult, "ignored 1 vertices and 1 lines" },
+      Outcome::EmptyResult, "ignored 1 vertex and 1 line" },
     { "OneTriangle",
       [](Case& c) {
         c.setup.scene = polyData({ { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, { { 0, 1, 2 } });
