@@ -629,7 +629,7 @@ int run(int argc, char** argv, RankJob& job)
     sensors =
       workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1],
         lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()),
-        options.usesSun() || options.sky.has_value());
+        options.usesSun() || options.sky.has_value(), memoryLimit);
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);

@@ -108,10 +108,14 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     const std::size_t kept = streamed ? options.keptStreamedChunks : 0;
     framesPerChunk = chooseFramesPerChunk(patches, elements, points, frames, options.solver,
       lightCount, outputs, streamed, kept, reachable, firstHits);
+    const std::size_t sensors = options.sensors.size();
     checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
                        options.solver, lightCount, outputs, streamed, kept, reachable, firstHits),
       streamed ? std::min(frames, framesPerChunk) : frames, patches, elements, options.solver,
-      approximate);
+      approximate, sensors,
+      saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
+                      options.solver, options.sensorOptions),
+        saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
   };
 
   RemeshOptions remeshing = options.remeshing;

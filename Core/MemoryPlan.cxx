@@ -6,6 +6,7 @@
 #include "Gathering.h"
 
 #include "Parallel.h"
+#include "Plural.h"
 #include "Reachability.h"
 #include "Rgb.h"
 
@@ -360,14 +361,24 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options)
 }
 
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
-  std::size_t elements, const SolverOptions& options, bool approximate)
+  std::size_t elements, const SolverOptions& options, bool approximate, std::size_t sensors,
+  std::uint64_t sensorBytes)
 {
   const std::string about = approximate ? "about " : "";
-  MemoryBudget(options.memoryLimitBytes)
-    .check(estimate, "the solve",
-      std::to_string(frames) + " frames x (" + about + std::to_string(patches) + " patches + " +
-        about + std::to_string(elements) + " elements) x 2 sides x RGB, plus per-thread buffers",
-      "use fewer frames or a larger patch size, or raise the limit");
+  std::string detail = countOf(frames, "frame") + " x (" + about + std::to_string(patches) +
+    " patches + " + about + std::to_string(elements) +
+    " elements) x 2 sides x RGB, plus per-thread buffers";
+  std::string advice = "use fewer frames or a larger patch size, or raise the limit";
+  if (sensors > 0)
+  {
+    detail += ", and " + countOf(sensors, "sensor") + " (" + gibibytes(sensorBytes) + ")";
+    if (sensorBytes > estimate / 2)
+    {
+      advice = "use fewer sensors (a coarser grid) or fewer sensor rays (SensorRays, "
+               "--sensor-rays), or raise the limit";
+    }
+  }
+  MemoryBudget(options.memoryLimitBytes).check(estimate, "the solve", detail, advice);
 }
 
 } // namespace mlr

@@ -115,9 +115,11 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options);
 /**
  * Throws mlr::Error when `estimate` bytes exceed the memory limit of `options`; the message
  * gives the estimate, the limit and what it is made of (`frames`, `patches`, `elements`;
- * `approximate` says the counts are expected ones, before remeshing).
+ * `approximate` says the counts are expected ones, before remeshing; `sensorBytes` of the
+ * estimate are the `sensors`', and when they are most of it the advice is about them).
  */
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
-  std::size_t elements, const SolverOptions& options, bool approximate = false);
+  std::size_t elements, const SolverOptions& options, bool approximate = false,
+  std::size_t sensors = 0, std::uint64_t sensorBytes = 0);
 
 } // namespace mlr

@@ -205,6 +205,11 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
     (["--work-plane", "0.8,0.5", "--sensors", "s.vtp"], 2, "give one of them"),
     (["--da-threshold", "300"], 2, "--da-threshold is for the sensors"),
     (["--work-plane", "0.8,1e-7"], 2, "over the maximum"),
+    # Refused before the grid is built (it took 2.5 times the limit, then blamed the frames).
+    (["--work-plane", "0.8,0.001", "--memory-limit", "100"], 2,
+     "the work plane needs an estimated"),
+    (["--work-plane", "0.8,0.01", "--memory-limit", "100"], 1,
+     "use fewer sensors (a coarser grid) or fewer sensor rays"),
     (["--sensor-rays", "64"], 2, "--sensor-rays is for the sensors"),
     (["--work-plane", "0.8,0.5", "--sensor-rays", "0"], 2,
      "--sensor-rays is 0: give a value from 1 to 1000000"),
