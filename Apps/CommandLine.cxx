@@ -7,6 +7,7 @@
 
 #include "Chunks.h"
 #include "Error.h"
+#include "Photometry.h"
 
 #include <vtk_cli11.h>
 
@@ -582,10 +583,11 @@ Options parseCommandLine(int argc, const char* const* argv)
       mlr::formatNumber((*o.spot)[1]) +
       ": give a half angle above 0 and at most 180 degrees and a soft edge from 0 to 180");
   }
-  if (o.lightLumens && !(*o.lightLumens > 0))
+  if (o.lightLumens && !(*o.lightLumens > 0 && *o.lightLumens <= mlr::MaximumLightPower))
   {
     throw UsageError("--light-lumens is " + mlr::formatNumber(*o.lightLumens) +
-      ": give the luminaire's luminous flux in lumens, above 0");
+      ": give the luminaire's luminous flux in lumens, above 0 and at most " +
+      mlr::formatNumber(mlr::MaximumLightPower));
   }
   if (!o.sunDirections.empty() && o.sunPath)
   {
@@ -774,7 +776,7 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
   {
     for (double p : *o.lightPower)
     {
-      checkRange("--light-power", p, 0.0, 1e30);
+      checkRange("--light-power", p, 0.0, mlr::MaximumLightPower);
     }
     filter->SetLightPower(o.lightPower->data());
   }
@@ -1003,10 +1005,10 @@ Scene and light:
                         --light-power its power is the material's emission, pi Ke area
                         (Ke read as radiance, as path tracers do). Other emissive
                         materials stay in the scene and emit in every frame
-  --light-power R,G,B   total power of the light in W, per channel, or one number for all
-                        (default 100,100,100)
-                        A cell array LightId groups the polygons into several lights, and
-                        a cell array LightPower (RGB, W) gives each its power.
+  --light-power R,G,B   power of each light in W, per channel, or one number for all
+                        (default 100,100,100), at most 1e30
+                        A cell array LightId groups the polygons into several lights, each
+                        of this power unless a cell array LightPower (RGB, W) gives its own.
   --point-light         a point light instead of --light's polygons: it sits at the
                         trajectory's points (or moves from --from to --to), of power
                         --light-power, its nadir -z unless a Normal or Orientation turns it
@@ -1024,9 +1026,9 @@ Scene and light:
   --spot HALF_ANGLE_DEG[,SOFT_EDGE_DEG]
                         a spot instead: uniform within the half angle of the nadir, falling
                         to zero over the soft edge beyond it (default soft edge 0)
-  --light-lumens LM     the luminous flux of every light in lumens, instead of the watts of
-                        --light-power, whose colour it keeps: watts of luminance = LM over
-                        the luminous efficacy (179 lm/W by default)
+  --light-lumens LM     the luminous flux of every light in lumens (at most 1e30), instead of
+                        the watts of --light-power, whose colour it keeps: watts of
+                        luminance = LM over the luminous efficacy (179 lm/W by default)
                         Scene cells with a cell array Emission (RGB or grey, W/m^2) emit
                         from their front side in every frame, and reflect too.
 Light path (the positions of the light's area centroid, one per frame):

@@ -157,7 +157,7 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
     // No luminous area: the luminaire's own outline is the nearest thing to it.
     areaLength = bodyLength;
     areaWidth = bodyWidth;
-    luminaire.warnings.push_back(
+    luminaire.openingWarnings.push_back(
       name + ": no luminous area is given; an area luminaire emits from the luminaire's outline");
   }
   luminaire.length = std::abs(areaLength) / 1000;
@@ -170,7 +170,7 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
     if (areaHeight > 0)
     {
       luminaire.openingName += " with luminous sides";
-      luminaire.warnings.push_back(
+      luminaire.openingWarnings.push_back(
         name + ": the luminous area has luminous sides, emitted from its outline seen from below");
     }
   }
@@ -201,11 +201,14 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
     const double flux = fields.number("the total luminous flux of lamps of " + set + " (lm)");
     if (i == 0)
     {
-      lampFlux = std::abs(flux);
+      // Only the number of lamps is negative for absolute photometry; the flux is then the
+      // luminaire's own, still positive.
+      lampFlux = flux;
       if (!(lampFlux > 0))
       {
         fields.fail("the total luminous flux of lamps of set 1 is " + formatNumber(flux) +
-          " lm: the cd/klm intensities need it above 0");
+          " lm: the cd/klm intensities need it above 0 (for absolute photometry, give the "
+          "luminaire's flux and a negative number of lamps)");
       }
     }
     fields.text("the colour appearance of " + set);
@@ -254,7 +257,7 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
       " intensities per plane need more lines than the file has: a count is wrong or the file is "
       "truncated");
   }
-  auto readAngles = [&](std::size_t n, const char* what, double highest)
+  auto readAngles = [&](std::size_t n, const char* what, const char* count, double highest)
   {
     std::vector<double> angles(n);
     for (std::size_t i = 0; i < n; ++i)
@@ -269,15 +272,17 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
       }
       if (i > 0 && !(angles[i] > angles[i - 1]))
       {
+        // A count too large reads the next block's values as angles, and they seldom ascend.
         fields.fail(field() + " is " + formatNumber(angles[i]) +
           " degrees, not above the previous " + formatNumber(angles[i - 1]) +
-          ": the angles must ascend strictly");
+          ": the angles must ascend strictly (if they end at " + formatNumber(angles[i - 1]) +
+          ", " + count + " is " + std::to_string(i) + ", not " + std::to_string(n) + ")");
       }
     }
     return angles;
   };
   const std::size_t cLine = fields.line() + 1;
-  const std::vector<double> cAngles = readAngles(mc, "C angle", 360);
+  const std::vector<double> cAngles = readAngles(mc, "C angle", "the number of C-planes Mc", 360);
   auto expect = [&](std::size_t index, double angle)
   {
     if (std::abs(cAngles[index] - angle) > 1e-6)
@@ -304,7 +309,8 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
   {
     expect(3 * mc / 4, 270);
   }
-  const std::vector<double> gammas = readAngles(ng, "gamma angle", 180);
+  const std::vector<double> gammas =
+    readAngles(ng, "gamma angle", "the number of intensities per C-plane Ng", 180);
 
   std::vector<double> planes(stored), candela(stored * ng);
   for (std::size_t p = 0; p < stored; ++p)

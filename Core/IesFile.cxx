@@ -148,9 +148,10 @@ private:
   const std::string& Name;
 };
 
-/// Reads `n` strictly ascending angles within [lowest, highest] degrees.
-std::vector<double> readAngles(
-  Tokens& tokens, std::size_t n, const std::string& what, double lowest, double highest)
+/// Reads `n` strictly ascending angles within [lowest, highest] degrees; `count` names the
+/// field that gave `n`.
+std::vector<double> readAngles(Tokens& tokens, std::size_t n, const std::string& what,
+  const std::string& count, double lowest, double highest)
 {
   std::vector<double> angles(n);
   for (std::size_t i = 0; i < n; ++i)
@@ -164,8 +165,11 @@ std::vector<double> readAngles(
     }
     if (i > 0 && !(angles[i] > angles[i - 1]))
     {
+      // A count too large reads the next block's values as angles, and they seldom ascend.
       tokens.fail(field() + " is " + formatNumber(angles[i]) + " degrees, not above the previous " +
-        formatNumber(angles[i - 1]) + ": the angles must ascend strictly");
+        formatNumber(angles[i - 1]) + ": the angles must ascend strictly (if they end at " +
+        formatNumber(angles[i - 1]) + ", " + count + " is " + std::to_string(i) + ", not " +
+        std::to_string(n) + ")");
     }
   }
   return angles;
@@ -196,11 +200,13 @@ void mirrorLaterally(std::vector<double>& horizontal, std::vector<double>& cande
 
 /**
  * A type B table (angles in degrees, candela[h * vertical + v]) in the light's frame. Type B's
- * polar axis is the luminaire's lateral axis, C = 90 (+y): the horizontal angle H turns a
- * half-plane about it from the nadir (H = 0) towards C = 0 (+x), and the vertical angle V
- * rises within that half-plane towards +y. So the direction of (H, V) is
- * cos V (sin H, 0, cos H) + sin V (0, 1, 0), and the table is a C-gamma table in its own axes:
- * gamma' = 90 - V from +y, C' = H - H0 from the half-plane H0. Interpolation stays bilinear in
+ * polar axis is the photometric horizontal, C = 0 (+x, along the opening's length), where
+ * Radiance's ies2rad and source.cal put it (srcB_horiz = atan2(Dy, Dz), srcB_vert =
+ * atan2(-Dx, Dz), D pointing into the source): the horizontal angle H turns a half-plane about
+ * that axis from the nadir (H = 0) towards C = 270 (-y), and the vertical angle V rises within
+ * that half-plane towards +x. So the direction of (H, V) is
+ * cos V (0, -sin H, cos H) + sin V (1, 0, 0), and the table is a C-gamma table in its own axes:
+ * gamma' = 90 - V from +x, C' = H - H0 from the half-plane H0. Interpolation stays bilinear in
  * the file's own angles.
  */
 IntensityDistribution typeB(
@@ -252,10 +258,11 @@ IntensityDistribution typeB(
     }
   }
   const double s = std::sin(h0 * Degree), c = std::cos(h0 * Degree);
-  const PhotometricFrame axes{ { s, 0, c }, { c, 0, -s }, { 0, 1, 0 } };
+  const PhotometricFrame axes{ { 0, -s, c }, { 0, -c, -s }, { 1, 0, 0 } };
   return IntensityDistribution::tabulatedInAxes(
     std::move(gammas), std::move(planes), std::move(values), axes, near(span, 360));
 }
+
 /**
  * A type A table (angles in degrees, candela[h * vertical + v]) in the light's frame. LM-63-2002
  * puts type A's planes through the vertical axis, as type C's, but counts its horizontal
@@ -331,7 +338,7 @@ void readOpening(Luminaire& luminaire, double width, double length, double heigh
   };
   auto outline = [&](const char* what, const char* from)
   {
-    luminaire.warnings.push_back(name + ": the luminous opening is a " + std::string(what) +
+    luminaire.openingWarnings.push_back(name + ": the luminous opening is a " + std::string(what) +
       ", emitted from its outline seen from below (" + from + ")");
   };
   luminaire.opening = OpeningShape::None;
@@ -357,7 +364,7 @@ void readOpening(Luminaire& luminaire, double width, double length, double heigh
     else
     {
       luminaire.openingName = "vertical rectangle";
-      luminaire.warnings.push_back(name +
+      luminaire.openingWarnings.push_back(name +
         ": the luminous opening is a vertical rectangle, which has no extent seen from below: "
         "the luminaire is a point");
     }
@@ -406,16 +413,17 @@ void readOpening(Luminaire& luminaire, double width, double length, double heigh
   else if (edition == 2002 && is(0, -1, -1))
   {
     luminaire.openingName = "vertical disc facing the photometric horizontal";
-    luminaire.warnings.push_back(name +
+    luminaire.openingWarnings.push_back(name +
       ": the luminous opening is a vertical disc, which has no extent seen from below: the "
       "luminaire is a point");
   }
   else
   {
     luminaire.openingName = "unknown shape";
-    luminaire.warnings.push_back(name + ": the luminous opening (width " + formatNumber(width) +
-      ", length " + formatNumber(length) + ", height " + formatNumber(height) +
-      " m) is none of LM-63-" + std::to_string(edition) + "'s shapes: the luminaire is a point");
+    luminaire.openingWarnings.push_back(name + ": the luminous opening (width " +
+      formatNumber(width) + ", length " + formatNumber(length) + ", height " +
+      formatNumber(height) + " m) is none of LM-63-" + std::to_string(edition) +
+      "'s shapes: the luminaire is a point");
   }
 }
 } // namespace
@@ -492,7 +500,8 @@ Luminaire parseIes(const std::string& text, const std::string& name)
       1, 3);
     luminaire.tilt.geometry = static_cast<TiltTable::Geometry>(geometry);
     const std::size_t n = tokens.count("the number of tilt angles", 1, MaximumAngles);
-    luminaire.tilt.angles = readAngles(tokens, n, "tilt angle", -360, 360);
+    luminaire.tilt.angles =
+      readAngles(tokens, n, "tilt angle", "the number of tilt angles", -360, 360);
     luminaire.tilt.factors.resize(n);
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -553,26 +562,30 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   {
     tokens.fail("the ballast factor is " + formatNumber(ballast) + ": it must be above 0");
   }
-  // The ballast-lamp photometric factor of the 1986 and 1991 editions, 1 since; the 2019
-  // edition puts its file generation type there.
-  double photometricFactor = tokens.number("the ballast-lamp photometric factor (future use)");
-  if (year == 2019)
+  double photometricFactor = 1;
+  // The ballast-lamp photometric factor scales the candela in the 1986 and 1991 editions only:
+  // 1995 and 2002 keep the field for future use, 2019 gives the file generation type there
+  // (ies2rad likewise ignores it from 1995 on).
+  if (year <= 1991)
   {
-    photometricFactor = 1;
+    photometricFactor = tokens.number("the ballast-lamp photometric factor");
+    if (!(photometricFactor > 0))
+    {
+      tokens.fail("the ballast-lamp photometric factor is " + formatNumber(photometricFactor) +
+        ": it must be above 0 (1 usually)");
+    }
   }
-  else if (!(photometricFactor > 0))
+  else
   {
-    tokens.fail("the ballast-lamp photometric factor is " + formatNumber(photometricFactor) +
-      ": it must be above 0 (1 since LM-63-1995)");
+    tokens.number(year == 2019 ? "the file generation type" : "the future use field");
   }
   tokens.number("the input watts");
 
   const bool typeC = !typeBFile && !typeAFile;
-  const std::vector<double> vertical = typeC ? readAngles(tokens, nV, "vertical angle", 0, 180)
-                                             : readAngles(tokens, nV, "vertical angle", -90, 90);
-  const std::vector<double> horizontal = typeC
-    ? readAngles(tokens, nH, "horizontal angle", 0, 360)
-    : readAngles(tokens, nH, "horizontal angle", -180, 360);
+  const std::vector<double> vertical = readAngles(tokens, nV, "vertical angle",
+    "the number of vertical angles", typeC ? 0 : -90, typeC ? 180 : 90);
+  const std::vector<double> horizontal = readAngles(
+    tokens, nH, "horizontal angle", "the number of horizontal angles", typeC ? 0 : -180, 360);
   photometry::PlaneSymmetry symmetry = photometry::PlaneSymmetry::None;
   const double h0 = horizontal.front(), h1 = horizontal.back();
   if (!typeC)

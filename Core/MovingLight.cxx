@@ -34,11 +34,12 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
 
 void checkLightPower(const Rgb& power)
 {
-  if (!power.isFinite() || power.minComponent() < 0)
+  if (!power.isFinite() || power.minComponent() < 0 ||
+    std::max({ power.r, power.g, power.b }) > MaximumLightPower)
   {
     std::ostringstream s;
     s << "the light power (" << power.r << ", " << power.g << ", " << power.b
-      << ") must be finite and not negative";
+      << ") W must be finite and not negative, at most " << MaximumLightPower << " W per channel";
     throw Error(s.str());
   }
 }

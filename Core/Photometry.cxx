@@ -494,9 +494,12 @@ IntensityDistribution IntensityDistribution::tabulatedInAxes(std::vector<double>
   {
     throw Error("the intensity table emits no flux: give some positive candela values");
   }
-  if (!std::isfinite(sum))
+  if (!(sum <= MaximumLightPower))
   {
-    throw Error("the intensity table's flux overflows: its candela values are far too large");
+    std::ostringstream s;
+    s << "the intensity table emits " << sum << " lm, more than " << MaximumLightPower
+      << " lm: its candela values (times the multiplier) are far too large";
+    throw Error(s.str());
   }
   table->Flux = sum;
   table->MaximumDensity = largest / sum;

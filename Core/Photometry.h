@@ -11,6 +11,12 @@
 namespace mlr
 {
 
+/// The largest light power (W per channel) and luminous flux (lm) taken, however given:
+/// LightPower, LightFluxLumens or a photometric file's own flux. The outputs are single
+/// precision (at most 3.4e38), which leaves them 8 orders of magnitude for a surface near a
+/// light of this power.
+constexpr double MaximumLightPower = 1e30;
+
 /**
  * A light's own photometric frame. z is the nadir (gamma = 0): the emission normal of an area
  * light, minus the up direction for a point light. x is C = 0: the light's first edge, +x for
@@ -175,9 +181,12 @@ struct Luminaire
   /// TILT=INCLUDE's table (empty for TILT=NONE and EULUMDAT).
   TiltTable tilt;
   /// What was read but not applied (values after the table, an unknown edition, several lamp
-  /// sets, an opening shape emitted from its outline seen from below), one sentence each naming
-  /// the file.
+  /// sets), one sentence each naming the file.
   std::vector<std::string> warnings;
+  /// What the opening leaves out (a shape emitted from its outline seen from below, one with no
+  /// extent from below, a missing luminous area): for a light that emits from the opening
+  /// only.
+  std::vector<std::string> openingWarnings;
 };
 
 /**

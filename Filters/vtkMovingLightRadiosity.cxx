@@ -260,7 +260,8 @@ const PropertyRange PropertyRanges[] = {
     [](Self* f) { return f->GetSpotHalfAngle(); } },
   { "SpotSoftEdge", 0, 180, "0 (a hard edge) up to 180 degrees",
     [](Self* f) { return f->GetSpotSoftEdge(); } },
-  { "LightFluxLumens", 0, Most, "0 (LightPower's watts) or a luminous flux in lm",
+  { "LightFluxLumens", 0, mlr::MaximumLightPower,
+    "0 (LightPower's watts) or a luminous flux in lm, at most 1e30",
     [](Self* f) { return f->GetLightFluxLumens(); } },
   { "MemoryLimit", 0, VTK_INT_MAX, "0 (half of the physical memory) or a limit in MiB",
     [](Self* f) { return static_cast<double>(f->GetMemoryLimit()); } },
@@ -1463,8 +1464,11 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           throw mlr::Error("LightType Luminaire emits from a photometric file's luminous "
                            "opening: give its LightDistributionFile (.ies or .ldt)");
         }
+        // Only here does the light emit from the opening, so only here do its limits matter.
+        warnings.insert(
+          warnings.end(), luminaire->openingWarnings.begin(), luminaire->openingWarnings.end());
         fromOpening = luminaire->opening != mlr::OpeningShape::None;
-        if (!fromOpening)
+        if (!fromOpening && luminaire->openingWarnings.empty())
         {
           warnings.push_back(this->LightDistributionFile + " gives no luminous opening (its " +
             luminaire->openingName + "): the luminaire is a point light");

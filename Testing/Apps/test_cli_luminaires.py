@@ -305,6 +305,8 @@ def test_tilt_table_scales_the_light_by_the_tilt_from_up(tmp_path):
     (["--spot", "30,5,1"], "--spot"),
     (["--light-lumens", "-5"], "--light-lumens"),
     (["--light-lumens", "0"], "--light-lumens"),
+    (["--light-lumens", "1e45"], "--light-lumens is 1e+45: give the luminaire's luminous flux in "
+                                 "lumens, above 0 and at most 1e+30"),
     (["--light-distribution", "lamp.txt"], "--light-distribution"),
     (["--light-distribution", "a.ies", "--spot", "30"], "--light-distribution"),
     (["--point-light=yes"], "--point-light"),
@@ -322,7 +324,10 @@ def test_bad_luminaire_options_are_refused_naming_them(tmp_path, args, words):
 def test_missing_or_bad_photometric_file_names_it(tmp_path):
     floor = write_floor(tmp_path)
     (tmp_path / "broken.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1\n")
-    for name in ("missing.ies", "broken.ies"):
+    # Finite candela of an infinite irradiance in single precision: 1e300 cd over a hemisphere.
+    (tmp_path / "huge.ies").write_text("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n"
+                                       "1 1 0\n0 45 90\n0\n1e300 1e300 1e300\n")
+    for name in ("missing.ies", "broken.ies", "huge.ies"):
         result = run(["--scene", floor, "--point-light", "--from", "0,0,1", "--to", "0,0,1",
                       "--frames", "1", "--light-distribution", name, "--output", "out/s.pvd"],
                      tmp_path)

@@ -384,6 +384,10 @@ TEST(Luminaires, PointLightRefusesBadInput)
 {
   mlr::checks::expectError(
     [] { PointLight(Rgb(-1), { LightPose() }); }, "must be finite and not negative");
+  // Beyond MaximumLightPower the single-precision outputs would overflow.
+  mlr::checks::expectError(
+    [] { PointLight(Rgb(1, 2e30, 1), { LightPose() }); }, "at most 1e+30 W per channel");
+  EXPECT_NO_THROW(PointLight(Rgb(1e30), { LightPose() }));
   mlr::checks::expectError([] { PointLight(Rgb(1), {}); }, "zero frames");
 }
 

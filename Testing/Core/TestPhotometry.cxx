@@ -664,6 +664,34 @@ TEST(Photometry, IesCosinePowerGivesTheAnalyticFlux)
   EXPECT_DOUBLE_EQ(l.tilt.factor(30), 1);
 }
 
+TEST(Photometry, IesBallastLampFactorScalesOnly1986And1991Files)
+{
+  // The ballast line "ballast factor, ballast-lamp photometric factor, watts": the second
+  // field multiplies the candela in LM-63-1986/1991; 1995 and 2002 keep it for future use and
+  // 2019 puts the file generation type there, which must change nothing (as in ies2rad).
+  const auto f = [](double g, double) { return 100 * cosPower(g, 1); };
+  const std::string base = iesFile(degrees(0, 90, 5), { 0 }, f);
+  auto edition = [&](const std::string& header, const std::string& factor)
+  {
+    std::string text = base;
+    text.replace(0, text.find('\n'), header);
+    text.replace(text.find("\n1 1 40\n"), 8, "\n1 " + factor + " 40\n");
+    return parseIes(text, "edition.ies");
+  };
+  const double flux = parseIes(base, "base.ies").lumens;
+  EXPECT_NEAR(flux, 100 * Pi, 1e-3 * 100 * Pi);
+  EXPECT_NEAR(edition("an old file without edition", "2").lumens, 2 * flux, 1e-12 * flux);
+  EXPECT_NEAR(edition("IESNA91", "2").lumens, 2 * flux, 1e-12 * flux);
+  for (const char* later : { "IESNA:LM-63-1995", "IESNA:LM-63-2002", "IES:LM-63-2019" })
+  {
+    EXPECT_NEAR(edition(later, "2").lumens, flux, 1e-12 * flux) << later;
+    EXPECT_NEAR(edition(later, "0").lumens, flux, 1e-12 * flux) << later;
+    EXPECT_NEAR(edition(later, "1.00001").lumens, flux, 1e-12 * flux) << later;
+  }
+  checks::expectError([&] { edition("IESNA91", "0"); },
+    "edition.ies, line 5: the ballast-lamp photometric factor is 0");
+}
+
 TEST(Photometry, IesSymmetricFormsEqualTheFullTable)
 {
   const std::vector<double> vertical = degrees(0, 180, 5);
@@ -825,6 +853,15 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   EXPECT_NE(
     e.find("line 6: tilt angle 3 of 3 is 30 degrees, not above the previous 45"), std::string::npos)
     << e;
+  // A count too large reads the factors as angles: the message offers the count they end at.
+  e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n5\n0 90\n1 0.5"));
+  EXPECT_NE(
+    e.find("line 7: tilt angle 3 of 5 is 1 degrees, not above the previous 90"), std::string::npos)
+    << e;
+  EXPECT_NE(e.find("(if they end at 90, the number of tilt angles is 2, not 5)"), std::string::npos)
+    << e;
+  e = error(with("1 -1 1 3 1", "1 -1 1 4 1"));
+  EXPECT_NE(e.find("the number of vertical angles is 3, not 4"), std::string::npos) << e;
   e = error(with("TILT=NONE", "TILT=INCLUDE\n1\n2\n0 400\n1 1"));
   EXPECT_NE(e.find("line 6: tilt angle 2 of 2 is 400 degrees"), std::string::npos) << e;
   e = error(with("TILT=NONE", "TILT=INCLUDE\n2\n2\n0 90\n1 x"));
@@ -833,6 +870,16 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
     << e;
   e = error("IESNA:LM-63-2002\nTILT=INCLUDE\n1\n3\n0 45 90\n1 0.9");
   EXPECT_NE(e.find("bad.ies: the file ends (after line 6) before tilt multiplying factor 3 of 3"),
+    std::string::npos)
+    << e;
+  // The flux is bounded by MaximumLightPower, 1e30 lm, which keeps the single-precision outputs
+  // finite: a uniform sphere of 1e28 cd emits 4 pi 1e28 lm and is read, one of 1e29 cd is not.
+  auto sphere = [](double cd) {
+    return iesFile({ 0, 90, 180 }, { 0 }, [=](double, double) { return cd; });
+  };
+  EXPECT_NEAR(parseIes(sphere(1e28), "sphere.ies").lumens, 4 * Pi * 1e28, 1e-12 * 4 * Pi * 1e28);
+  e = error(sphere(1e29));
+  EXPECT_NE(e.find("bad.ies: the intensity table emits 1.25664e+30 lm, more than 1e+30 lm"),
     std::string::npos)
     << e;
   // Horizontal angles that are no LM-63 symmetry.
@@ -889,15 +936,25 @@ std::string typeBFile(const std::vector<double>& vertical, const std::vector<dou
   return s.str();
 }
 
-/// The light-frame direction of type B angles (degrees): the half-plane H about the lateral
-/// axis +y, from the nadir towards +x, and V within it towards +y.
+/// The light-frame direction of type B angles (degrees): the half-plane H about the
+/// photometric horizontal +x, from the nadir towards -y, and V within it towards +x.
 Vec3 typeBDirection(double h, double v)
 {
   const double hr = h * Pi / 180, vr = v * Pi / 180;
-  return Vec3(std::cos(vr) * std::sin(hr), std::sin(vr), std::cos(vr) * std::cos(hr));
+  return Vec3(std::sin(vr), -std::cos(vr) * std::sin(hr), std::cos(vr) * std::cos(hr));
 }
 
-TEST(Photometry, IesTypeBFollowsItsLateralAxis)
+/// Radiance's type B angles (degrees) of a light-frame emission direction, as lib/source.cal
+/// computes them from the ray direction D into the source (D = -emission, in a world where the
+/// light's nadir is -z): srcB_horiz = atan2(Dy, Dz), srcB_vert = atan2(-Dx, Dz).
+void radianceTypeB(const Vec3& emission, double& h, double& v)
+{
+  const Vec3 d(-emission.x, -emission.y, emission.z);
+  h = std::atan2(d.y, d.z) * 180 / Pi;
+  v = std::atan2(-d.x, d.z) * 180 / Pi;
+}
+
+TEST(Photometry, IesTypeBTurnsAboutThePhotometricHorizontal)
 {
   // An asymmetric floodlight: every table point must come back, times the multiplier, in the
   // direction the analytic conversion gives it, and its density integrates to 1.
@@ -914,21 +971,48 @@ TEST(Photometry, IesTypeBFollowsItsLateralAxis)
     {
       if (std::abs(v) == 90)
       {
-        continue; // the poles of the lateral axis are one direction for every H
+        continue; // the poles of the photometric horizontal are one direction for every H
       }
       EXPECT_NEAR(b.distribution.intensity(typeBDirection(h, v)), 2 * f(h, v), 1e-9 * f(h, v))
         << "H " << h << ", V " << v;
+      // The same angles as Radiance's: H everywhere, V in the plane H = 0 (elsewhere
+      // source.cal's V is a projection, atan(tan V / cos H)).
+      double rh, rv;
+      radianceTypeB(typeBDirection(h, v), rh, rv);
+      EXPECT_NEAR(rh, h, 1e-9) << "H " << h << ", V " << v;
+      if (std::abs(h) < 90)
+      {
+        EXPECT_NEAR(std::tan(rv * Pi / 180) * std::cos(h * Pi / 180), std::tan(v * Pi / 180), 1e-9)
+          << "H " << h << ", V " << v;
+      }
     }
   }
   EXPECT_NEAR(sphereIntegral(b.distribution), 1, 2e-3);
   EXPECT_NEAR(b.lumens, b.distribution.flux(), 1e-12 * b.lumens);
-  // Positive H leans towards C = 0 (+x), positive V towards C = 90 (+y).
-  EXPECT_GT(b.distribution.intensity(typeBDirection(30, 0)),
-    b.distribution.intensity(typeBDirection(-30, 0)));
-  EXPECT_GT(b.distribution.intensity(typeBDirection(0, 30)),
-    b.distribution.intensity(typeBDirection(0, -30)));
-  EXPECT_NEAR(b.distribution.intensity(Vec3(0.3, 0, 0.95) / length(Vec3(0.3, 0, 0.95))),
-    b.distribution.intensity(typeBDirection(std::atan2(0.3, 0.95) * 180 / Pi, 0)), 1e-9);
+
+  // A narrow lobe at (H, V) = (30, 0) lights -y and one at (0, 30) lights +x, below a point
+  // light 2 m up, as Radiance's ies2rad model of the same file does; the old reading turned
+  // both by 90 degrees about the nadir (to +x and +y).
+  auto lobe = [&](double h0, double v0)
+  {
+    return parseIes(
+      typeBFile(degrees(-90, 90, 10), degrees(-90, 90, 10),
+        [&](double h, double v)
+        { return 10 + 1000 * std::exp(-((h - h0) * (h - h0) + (v - v0) * (v - v0)) / 50); }),
+      "lobe.ies");
+  };
+  const double t = std::tan(30 * Pi / 180);
+  const Vec3 plusX = normalize(Vec3(t, 0, 1)), minusY = normalize(Vec3(0, -t, 1));
+  const Luminaire lobeH = lobe(30, 0), lobeV = lobe(0, 30);
+  EXPECT_NEAR(lobeH.distribution.intensity(minusY), 1010, 1e-9);
+  EXPECT_NEAR(lobeV.distribution.intensity(plusX), 1010, 1e-9);
+  for (const Vec3& elsewhere : { normalize(Vec3(-t, 0, 1)), normalize(Vec3(0, t, 1)) })
+  {
+    EXPECT_NEAR(lobeH.distribution.intensity(elsewhere), 10, 1e-6);
+    EXPECT_NEAR(lobeV.distribution.intensity(elsewhere), 10, 1e-6);
+  }
+  EXPECT_NEAR(lobeH.distribution.intensity(plusX), 10, 1e-6);
+  EXPECT_NEAR(lobeV.distribution.intensity(minusY), 10, 1e-6);
   // Behind the luminaire (|H| > 90) the file says nothing: no light there.
   EXPECT_EQ(b.distribution.intensity(typeBDirection(120, 10)), 0);
   EXPECT_EQ(b.distribution.intensity(Vec3(0, 0, -1)), 0);
@@ -1090,7 +1174,9 @@ TEST(Photometry, IesLuminousOpeningShapes)
       EXPECT_NEAR(l.length, c.alongX, 1e-15) << c.name;
       EXPECT_NEAR(l.width, c.alongY, 1e-15) << c.name;
     }
-    EXPECT_EQ(!l.warnings.empty(), c.warns) << c.name;
+    // Apart, for the light that emits from the opening alone.
+    EXPECT_EQ(!l.openingWarnings.empty(), c.warns) << c.name;
+    EXPECT_TRUE(l.warnings.empty()) << c.name;
   }
   // Feet: a 2 by 4 foot troffer.
   std::string feet = iesFile({ 0, 45, 90 }, { 0 }, f);
@@ -1116,6 +1202,7 @@ TEST(Photometry, IesLuminousOpeningShapes)
   EXPECT_NEAR(circle.length, 0.25, 1e-15);
   EXPECT_NEAR(circle.width, 0.25, 1e-15);
   EXPECT_TRUE(circle.warnings.empty());
+  EXPECT_TRUE(circle.openingWarnings.empty());
   // No luminous area: the luminaire's own outline (600 mm round), with a warning.
   std::string body = ldt;
   const std::string sizes = "\n600\n0\n80\n500\n300\n";
@@ -1123,8 +1210,9 @@ TEST(Photometry, IesLuminousOpeningShapes)
   const Luminaire outline = parseEulumdat(body, "b.ldt");
   EXPECT_EQ(outline.opening, OpeningShape::Ellipse);
   EXPECT_NEAR(outline.length, 0.6, 1e-15);
-  ASSERT_EQ(outline.warnings.size(), 1u);
-  EXPECT_NE(outline.warnings[0].find("no luminous area"), std::string::npos);
+  EXPECT_TRUE(outline.warnings.empty());
+  ASSERT_EQ(outline.openingWarnings.size(), 1u);
+  EXPECT_NE(outline.openingWarnings[0].find("no luminous area"), std::string::npos);
 }
 
 TEST(Photometry, OpeningPolygonsFaceTheNadirWithTheirAreas)
@@ -1218,6 +1306,11 @@ TEST(Photometry, BadEulumdatFilesNameTheLineAndField)
   EXPECT_NE(e.find("need more lines than the file has"), std::string::npos) << e;
   e = error(line(29, "0"));
   EXPECT_NE(e.find("line 29: the total luminous flux of lamps of set 1 is 0"), std::string::npos)
+    << e;
+  // A negative flux is no absolute photometry (that is a negative number of lamps).
+  e = error(line(29, "-2000"));
+  EXPECT_NE(
+    e.find("line 29: the total luminous flux of lamps of set 1 is -2000 lm"), std::string::npos)
     << e;
   e = error(line(45, "80"));
   EXPECT_NE(

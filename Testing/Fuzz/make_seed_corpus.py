@@ -265,6 +265,8 @@ def photometric_seeds():
         vertical, [0], [row(0)], tilt="TILT=INCLUDE\n1\n3\n0 45 30\n1 1 1")
     yield "ies_vertical_cylinder", 6, ies_text(
         vertical, [0], [row(0)], lamp_line=f"1 -1 1 {len(vertical)} 1 1 2 -0.2 -0.2 0.3")
+    # Finite candela whose flux is beyond MaximumLightPower (1e30 lm): refused.
+    yield "ies_flux_beyond_the_bound", 6, ies_text(vertical, [0], [[1e300] * len(vertical)])
 
     gammas = [0, 30, 60, 90, 120, 150, 180]
 
@@ -279,6 +281,7 @@ def photometric_seeds():
     yield "ldt_truncated", 7, good[:len(good) // 2]
     yield "ldt_negative_intensity", 7, good.replace(b"\r\n240\r\n", b"\r\n-240\r\n", 1)
     yield "ldt_bad_symmetry", 7, good.replace(b"Seed\r\n1\r\n0\r\n", b"Seed\r\n1\r\n7\r\n", 1)
+    yield "ldt_negative_flux", 7, good.replace(b"\r\nLED\r\n1000\r\n", b"\r\nLED\r\n-1000\r\n", 1)
 
 
 def gltf_seeds():

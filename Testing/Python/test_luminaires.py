@@ -199,6 +199,27 @@ def test_area_light_of_another_size_than_the_opening_is_warned_of(tmp_path):
     assert not any("luminous opening" in w for w in warnings), warnings
 
 
+def test_opening_warnings_come_only_where_the_light_emits_from_the_opening(tmp_path):
+    # A rectangle with luminous sides (height 0.1 m) is kept as its bottom rectangle: that
+    # concerns the Luminaire light, which emits from it, not the point light, which has no
+    # extent. The same for a EULUMDAT file without a luminous area.
+    sides = ies_file(tmp_path / "sides.ies", "0.4 0.8 0.1")
+    ldt = tmp_path / "body.ldt"
+    ldt.write_text("\n".join(
+        ["body", "1", "1", "1", "0", "3", "45", "r", "l", "n", "body.ldt", "d", "600", "0", "80",
+         "0", "0", "0", "0", "0", "0", "100", "100", "1", "0", "1", "1", "LED", "1000", "3000",
+         "1B", "10"] + ["0.5"] * 10 + ["0", "0", "45", "90", "100", "100", "100"]) + "\n")
+    for path, words in ((sides, "emitted from its outline seen from below"),
+                        (str(ldt), "emits from the luminaire's outline")):
+        for light, warned in ((vtkMovingLightRadiosity.POINT_LIGHT, False),
+                              (vtkMovingLightRadiosity.LUMINAIRE_LIGHT, True)):
+            radiosity = radiosity_filter(LightType=light, LightDistributionFile=path,
+                                         NumberOfPaths=2000)
+            warnings = warnings_of(radiosity)
+            radiosity.UpdateTimeStep(0.0)
+            assert any(words in w for w in warnings) == warned, (path, light, warnings)
+
+
 def two_point_trajectory(normals=None, power=None):
     """(0, 0, 1) then (0.5, 0, 1), with the point arrays Normal and Power when given."""
     points = vtkPoints()
