@@ -119,6 +119,11 @@ void perezIndices(
 }
 
 constexpr double PrecipitableWater = 2.0; // cm
+
+/// cos t at 6 degrees of elevation, the lowest at which Radiance evaluates the Perez model:
+/// gendaylit normalises the sky on the centres of the 145 Tregenza patches, whose lowest ring
+/// is there, and gendaymtx's default sky takes each patch's value at its centre.
+const double LowestEvaluatedCosine = std::sin(6 * M_PI / 180);
 }
 
 SkyDistribution::SkyDistribution(
@@ -166,7 +171,14 @@ double SkyDistribution::gradation(double z) const
       break;
   }
   const double* k = this->Coefficients;
-  return cosZ > 0 ? 1.0 + k[0] * std::exp(k[1] / cosZ) : 1.0 + 0.0 * k[0];
+  // With b > 0, a e^(b / cos t) grows without bound towards the horizon (e^97 in the table's
+  // lowest ring at b = 0.3): normalised to E_dh, most of the sky's light lay in the last 1.5
+  // degrees and a wall facing away from a sun at 1 degree got ten times E_dh. Radiance
+  // evaluates no such sky below 6 degrees (gendaylit refuses it), so below there the
+  // gradation keeps its value at 6 degrees. With b <= 0 it tends to 1 on its own, as
+  // perezlum.cal renders it.
+  const double c = k[1] > 0 ? std::max(cosZ, LowestEvaluatedCosine) : cosZ;
+  return c > 0 ? 1.0 + k[0] * std::exp(k[1] / c) : 1.0;
 }
 
 double SkyDistribution::operator()(const Vec3& v, double gradation) const
