@@ -87,6 +87,9 @@ double perezSunZenith(const Vec3& sunLocal)
   return std::acos(std::clamp(sunLocal.z, 0.0, 1.0));
 }
 
+/// The top of the clearness range the model was fitted on.
+constexpr double MaxClearness = 12;
+
 /// The day gendaylit assumes when it is given none.
 constexpr int DefaultDayOfYear = 150;
 
@@ -98,7 +101,9 @@ void perezIndices(
 {
   if (!(diffuse > 0))
   {
-    epsilon = 1;
+    // Direct light and no diffuse light is the clearest sky (gendaylit's division gives
+    // infinity, then clamped), not an overcast one.
+    epsilon = direct > 0 ? MaxClearness : 1;
     delta = 0.01;
     return;
   }
@@ -114,7 +119,7 @@ void perezIndices(
     0.00128 * std::sin(dayAngle) + 0.000719 * std::cos(2 * dayAngle) +
     0.000077 * std::sin(2 * dayAngle);
   delta = diffuse * airMass / (1367.0 * eccentricity);
-  epsilon = std::clamp(epsilon, 1.0, 12.0);
+  epsilon = std::clamp(epsilon, 1.0, MaxClearness);
   delta = std::clamp(delta, 0.01, 0.6);
 }
 

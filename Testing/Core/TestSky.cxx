@@ -150,6 +150,19 @@ TEST(Sky, PerezIndicesAndEfficacyFollowGendaylit)
   EXPECT_LT(e.direct, 110);
 }
 
+TEST(Sky, AnHourWithDirectSunAndNoDiffuseLightIsTheClearestSky)
+{
+  // E_dh = 0 with E_dn > 0: epsilon's (E_dh + E_dn) / E_dh is infinite, clamped to the top
+  // of the range, as in gendaylit; the direct efficacy is then that of any vanishing E_dh
+  // (104 lm/W here, where the overcast bin gave 49).
+  const SkyFrame noDiffuse{ sunDirection(60, 0), 0, 800 };
+  EXPECT_DOUBLE_EQ(SkyDistribution(SkyModel::Perez, noDiffuse.sun, 0, 800).clearness(), 12.0);
+  EXPECT_DOUBLE_EQ(perezEfficacy(noDiffuse, { 0, 0, 1 }).direct,
+    perezEfficacy({ noDiffuse.sun, 1e-9, 800 }, { 0, 0, 1 }).direct);
+  // Neither: no sky to speak of, the overcast bin.
+  EXPECT_DOUBLE_EQ(SkyDistribution(SkyModel::Perez, noDiffuse.sun, 0, 0).clearness(), 1.0);
+}
+
 TEST(Sky, APerezSkyOfALowClearSunKeepsItsLightOffTheHorizon)
 {
   // A low sun in a clear sky gives many frames a Perez gradation b > 0, whose a e^(b/cos t)
