@@ -87,6 +87,9 @@ double perezSunZenith(const Vec3& sunLocal)
   return std::acos(std::clamp(sunLocal.z, 0.0, 1.0));
 }
 
+/// The top of the clearness range the model was fitted on.
+constexpr double MaxClearness = 12;
+
 /// The day gendaylit assumes when it is given none.
 constexpr int DefaultDayOfYear = 150;
 
@@ -98,7 +101,9 @@ void perezIndices(
 {
   if (!(diffuse > 0))
   {
-    epsilon = 1;
+    // Direct light and no diffuse light is the clearest sky (gendaylit's division gives
+    // infinity, then clamped), not an overcast one.
+    epsilon = direct > 0 ? MaxClearness : 1;
     delta = 0.01;
     return;
   }
@@ -114,11 +119,16 @@ void perezIndices(
     0.00128 * std::sin(dayAngle) + 0.000719 * std::cos(2 * dayAngle) +
     0.000077 * std::sin(2 * dayAngle);
   delta = diffuse * airMass / (1367.0 * eccentricity);
-  epsilon = std::clamp(epsilon, 1.0, 12.0);
+  epsilon = std::clamp(epsilon, 1.0, MaxClearness);
   delta = std::clamp(delta, 0.01, 0.6);
 }
 
 constexpr double PrecipitableWater = 2.0; // cm
+
+/// cos t at 6 degrees of elevation, the lowest at which Radiance evaluates the Perez model:
+/// gendaylit normalises the sky on the centres of the 145 Tregenza patches, whose lowest ring
+/// is there, and gendaymtx's default sky takes each patch's value at its centre.
+const double LowestEvaluatedCosine = std::sin(6 * M_PI / 180);
 }
 
 SkyDistribution::SkyDistribution(
@@ -166,7 +176,14 @@ double SkyDistribution::gradation(double z) const
       break;
   }
   const double* k = this->Coefficients;
-  return cosZ > 0 ? 1.0 + k[0] * std::exp(k[1] / cosZ) : 1.0 + 0.0 * k[0];
+  // With b > 0, a e^(b / cos t) grows without bound towards the horizon (e^97 in the table's
+  // lowest ring at b = 0.3): normalised to E_dh, most of the sky's light lay in the last 1.5
+  // degrees and a wall facing away from a sun at 1 degree got ten times E_dh. Radiance
+  // evaluates no such sky below 6 degrees (gendaylit refuses it), so below there the
+  // gradation keeps its value at 6 degrees. With b <= 0 it tends to 1 on its own, as
+  // perezlum.cal renders it.
+  const double c = k[1] > 0 ? std::max(cosZ, LowestEvaluatedCosine) : cosZ;
+  return c > 0 ? 1.0 + k[0] * std::exp(k[1] / c) : 1.0;
 }
 
 double SkyDistribution::operator()(const Vec3& v, double gradation) const
