@@ -254,6 +254,80 @@ bool sameSky(SkyModel model, const SkyFrame& a, const SkyFrame& b)
   return a.sun.x == b.sun.x && a.sun.y == b.sun.y && a.sun.z == b.sun.z &&
     (model != SkyModel::Perez || (a.directNormal == b.directNormal && a.dayOfYear == b.dayOfYear));
 }
+
+/// The subsamples' directions, the same for every position: cos and sin of each azimuth, and
+/// the cosine and sine of each zenith angle.
+struct CellDirections
+{
+  std::vector<double> cosPhi, sinPhi, ringCos, ringSin;
+
+  CellDirections()
+    : cosPhi(std::size_t(Sky::Sectors) * SubSamples)
+    , sinPhi(std::size_t(Sky::Sectors) * SubSamples)
+    , ringCos(std::size_t(Sky::Rings) * SubSamples)
+    , ringSin(std::size_t(Sky::Rings) * SubSamples)
+  {
+    for (int s = 0; s < Sky::Sectors; ++s)
+    {
+      for (int j = 0; j < SubSamples; ++j)
+      {
+        const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
+        this->cosPhi[std::size_t(s) * SubSamples + j] = std::cos(phi);
+        this->sinPhi[std::size_t(s) * SubSamples + j] = std::sin(phi);
+      }
+    }
+    for (int r = 0; r < Sky::Rings; ++r)
+    {
+      const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
+      for (int i = 0; i < SubSamples; ++i)
+      {
+        const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
+        this->ringCos[std::size_t(r) * SubSamples + i] = cz;
+        this->ringSin[std::size_t(r) * SubSamples + i] = std::sqrt(std::max(0.0, 1 - cz * cz));
+      }
+    }
+  }
+};
+
+/// Each cell's mean of `f` into `mean`, and the sky's integrals over the horizontal (cosine
+/// weighted) and over the solid angle.
+void tabulate(const SkyDistribution& f, const CellDirections& d, std::vector<double>& mean,
+  double& horizontal, double& total)
+{
+  horizontal = total = 0;
+  double gradation[SubSamples];
+  for (int r = 0; r < Sky::Rings; ++r)
+  {
+    const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
+    const double solidAngle = SectorStep * (c0 - c1);
+    const double cosine = SectorStep * (c0 * c0 - c1 * c1) / 2;
+    const double* cz = d.ringCos.data() + std::size_t(r) * SubSamples;
+    const double* sz = d.ringSin.data() + std::size_t(r) * SubSamples;
+    for (int i = 0; i < SubSamples; ++i)
+    {
+      gradation[i] = f.gradation(cz[i]);
+    }
+    for (int s = 0; s < Sky::Sectors; ++s)
+    {
+      // The cell's mean by the midpoint rule in cos(theta) and phi, which is uniform in
+      // solid angle: the paths draw directions uniformly within the cell.
+      double sum = 0;
+      const double* cp = d.cosPhi.data() + std::size_t(s) * SubSamples;
+      const double* sp = d.sinPhi.data() + std::size_t(s) * SubSamples;
+      for (int i = 0; i < SubSamples; ++i)
+      {
+        for (int j = 0; j < SubSamples; ++j)
+        {
+          sum += f({ sz[i] * cp[j], sz[i] * sp[j], cz[i] }, gradation[i]);
+        }
+      }
+      const double m = sum / (SubSamples * SubSamples);
+      mean[std::size_t(r) * Sky::Sectors + s] = m;
+      horizontal += m * cosine;
+      total += m * solidAngle;
+    }
+  }
+}
 }
 
 Sky Sky::slice(std::size_t first, std::size_t count) const
@@ -325,30 +399,8 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, in
   std::vector<std::uint8_t> dark(positions, 0);
   const int workers = resolveThreadCount(threads);
   std::vector<std::vector<double>> means(static_cast<std::size_t>(workers));
-  // The subsamples' directions, the same for every position: cos and sin of each azimuth,
-  // and the cosine and sine of each zenith angle.
-  std::vector<double> cosPhi(std::size_t(Sectors) * SubSamples),
-    sinPhi(std::size_t(Sectors) * SubSamples), ringCos(std::size_t(Rings) * SubSamples),
-    ringSin(std::size_t(Rings) * SubSamples);
-  for (int s = 0; s < Sectors; ++s)
-  {
-    for (int j = 0; j < SubSamples; ++j)
-    {
-      const double phi = (s + (j + 0.5) / SubSamples) * SectorStep;
-      cosPhi[std::size_t(s) * SubSamples + j] = std::cos(phi);
-      sinPhi[std::size_t(s) * SubSamples + j] = std::sin(phi);
-    }
-  }
-  for (int r = 0; r < Rings; ++r)
-  {
-    const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
-    for (int i = 0; i < SubSamples; ++i)
-    {
-      const double cz = c0 + (c1 - c0) * (i + 0.5) / SubSamples;
-      ringCos[std::size_t(r) * SubSamples + i] = cz;
-      ringSin[std::size_t(r) * SubSamples + i] = std::sqrt(std::max(0.0, 1 - cz * cz));
-    }
-  }
+  const CellDirections directions;
+  this->UniformInstead.assign(positions, 0);
   parallelFor(
     positions, workers,
     [&](std::size_t k, int worker)
@@ -356,40 +408,15 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, in
       std::vector<double>& mean = means[static_cast<std::size_t>(worker)];
       mean.resize(Cells);
       const SkyFrame& frame = this->Frames[k];
-      const SkyDistribution f(model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
-        frame.directNormal, frame.dayOfYear);
       double horizontal = 0, total = 0;
-      double gradation[SubSamples];
-      for (int r = 0; r < Rings; ++r)
+      tabulate(this->distribution(k), directions, mean, horizontal, total);
+      if (!(horizontal > 0) && model == SkyModel::Perez)
       {
-        const double c0 = std::cos(r * RingStep), c1 = std::cos((r + 1) * RingStep);
-        const double solidAngle = SectorStep * (c0 - c1);
-        const double cosine = SectorStep * (c0 * c0 - c1 * c1) / 2;
-        const double* cz = ringCos.data() + std::size_t(r) * SubSamples;
-        const double* sz = ringSin.data() + std::size_t(r) * SubSamples;
-        for (int i = 0; i < SubSamples; ++i)
-        {
-          gradation[i] = f.gradation(cz[i]);
-        }
-        for (int s = 0; s < Sectors; ++s)
-        {
-          // The cell's mean by the midpoint rule in cos(theta) and phi, which is uniform in
-          // solid angle: the paths draw directions uniformly within the cell.
-          double sum = 0;
-          const double* cp = cosPhi.data() + std::size_t(s) * SubSamples;
-          const double* sp = sinPhi.data() + std::size_t(s) * SubSamples;
-          for (int i = 0; i < SubSamples; ++i)
-          {
-            for (int j = 0; j < SubSamples; ++j)
-            {
-              sum += f({ sz[i] * cp[j], sz[i] * sp[j], cz[i] }, gradation[i]);
-            }
-          }
-          const double m = sum / (SubSamples * SubSamples);
-          mean[std::size_t(r) * Sectors + s] = m;
-          horizontal += m * cosine;
-          total += m * solidAngle;
-        }
+        // The Perez fit is negative over the whole sky (a high sun, little diffuse light and
+        // two to three times as much direct): Radiance's gendaymtx draws such an hour as a
+        // uniform sky, and so does this table, rather than stop a weather year there.
+        this->UniformInstead[k] = 1;
+        tabulate(this->distribution(k), directions, mean, horizontal, total);
       }
       if (!(horizontal > 0))
       {
@@ -456,6 +483,27 @@ double Sky::radiance(std::size_t position, const Vec3& towardsSky) const
   return c == Cells ? 0.0 : this->density(position, c) * this->Lambda[position];
 }
 
+SkyDistribution Sky::distribution(std::size_t position) const
+{
+  const SkyFrame& frame = this->Frames[position];
+  return SkyDistribution(this->UniformInstead[position] ? SkyModel::Uniform : this->Model,
+    this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal, frame.directNormal,
+    frame.dayOfYear);
+}
+
+std::vector<std::size_t> Sky::uniformInsteadFrames() const
+{
+  std::vector<std::size_t> frames;
+  for (std::size_t k = 0; k < this->UniformInstead.size(); ++k)
+  {
+    if (this->UniformInstead[k])
+    {
+      frames.push_back(k);
+    }
+  }
+  return frames;
+}
+
 double Sky::modelRadiance(std::size_t position, const Vec3& towardsSky) const
 {
   const Vec3 v = this->toLocal(normalize(towardsSky));
@@ -463,10 +511,7 @@ double Sky::modelRadiance(std::size_t position, const Vec3& towardsSky) const
   {
     return 0;
   }
-  const SkyFrame& frame = this->Frames[position];
-  const SkyDistribution f(this->Model, this->toLocal(normalize(frame.sun)), frame.diffuseHorizontal,
-    frame.directNormal, frame.dayOfYear);
-  return this->Scale[position] * f(v);
+  return this->Scale[position] * this->distribution(position)(v);
 }
 
 Vec3 Sky::sample(std::size_t position, double u0, double u1, double u2) const

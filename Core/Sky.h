@@ -124,6 +124,9 @@ public:
   Vec3 sample(std::size_t position, double u0, double u1, double u2) const;
   /// The model's own radiance, not tabulated, normalised the same way (for checks).
   double modelRadiance(std::size_t position, const Vec3& towardsSky) const;
+  /// The positions whose Perez fit is negative over the whole sky, drawn as a uniform sky of
+  /// the same E_dh instead (as Radiance's gendaymtx does).
+  std::vector<std::size_t> uniformInsteadFrames() const;
   /// The bytes of the tables: about 115 KB per position.
   std::uint64_t allocatedBytes() const;
 
@@ -132,15 +135,18 @@ private:
   {
     return { dot(v, this->T), dot(v, this->B), dot(v, this->Up) };
   }
+  /// The model `position` is drawn with: Model, or Uniform where UniformInstead says so.
+  SkyDistribution distribution(std::size_t position) const;
 
   SkyModel Model;
   Vec3 Up, T, B;
   std::size_t FrameCount = 0;
   std::vector<SkyFrame> Frames; ///< one per position
   std::vector<double> Lambda;
-  std::vector<double> Scale;   ///< radiance per unit of the model's relative luminance
-  std::vector<double> Density; ///< cell-major: all positions of a cell side by side
-  std::vector<double> Cdf;     ///< position-major
+  std::vector<double> Scale;                ///< radiance per unit of the model's relative luminance
+  std::vector<double> Density;              ///< cell-major: all positions of a cell side by side
+  std::vector<double> Cdf;                  ///< position-major
+  std::vector<std::uint8_t> UniformInstead; ///< per position
 };
 
 } // namespace mlr

@@ -13,6 +13,7 @@
 #include "LuminaireTilt.h"
 #include "MovingLight.h"
 #include "Photometry.h"
+#include "Plural.h"
 #include "PointLight.h"
 #include "Remeshing.h"
 #include "Scene.h"
@@ -596,7 +597,7 @@ std::string nightWarning(
 
 void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& trajectory,
   bool directional, mlr::LightRig& rig, std::vector<double>& efficacy,
-  std::vector<double>& sunEfficacy)
+  std::vector<double>& sunEfficacy, std::vector<std::string>& warnings)
 {
   static const mlr::SkyModel models[] = { mlr::SkyModel::Uniform, mlr::SkyModel::CieOvercast,
     mlr::SkyModel::CieClear, mlr::SkyModel::Perez };
@@ -611,6 +612,24 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
   }
   const std::vector<mlr::SkyFrame> frames = daylightFrames(self, trajectory, directional, up);
   rig.skies.emplace_back(model, up, frames, self->GetNumberOfThreads());
+  const std::vector<std::size_t> uniform = rig.skies.back().uniformInsteadFrames();
+  if (!uniform.empty())
+  {
+    std::ostringstream s;
+    s << "the Perez sky is negative everywhere (its fit for a high sun with little diffuse "
+         "light) in ";
+    if (rig.skies.back().positions() == 1)
+    {
+      s << "every frame";
+    }
+    else
+    {
+      s << mlr::countOf(uniform.size(), "frame") << ", " << uniform.front()
+        << (uniform.size() > 1 ? " first" : "");
+    }
+    s << ": drawn as a uniform sky of the same diffuse irradiance, as Radiance's gendaymtx does";
+    warnings.push_back(s.str());
+  }
   for (const mlr::SkyFrame& frame : frames)
   {
     const mlr::DaylightEfficacy k = mlr::perezEfficacy(frame, up);
@@ -1428,7 +1447,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     cache.SunEfficacy.clear();
     if (this->SkyModel != NO_SKY)
     {
-      addSky(this, trajectory, directional, rig, cache.DaylightEfficacy, cache.SunEfficacy);
+      addSky(
+        this, trajectory, directional, rig, cache.DaylightEfficacy, cache.SunEfficacy, warnings);
     }
     else if (directional)
     {

@@ -207,6 +207,28 @@ TEST(Sky, APerezSkyOfALowClearSunKeepsItsLightOffTheHorizon)
   }
 }
 
+TEST(Sky, APerezSkyNegativeEverywhereIsDrawnAsAUniformSky)
+{
+  // A high sun with little diffuse light and two to three times as much direct: the Perez fit
+  // is negative over the whole sky. That stopped the run ("dark everywhere"), a weather year
+  // at its first such hour; Radiance's gendaymtx draws such an hour as a uniform sky.
+  const SkyFrame negative{ sunDirection(70, 0), 40, 100, 172 };
+  const SkyFrame clear{ sunDirection(70, 0), 100, 800, 172 };
+  const SkyDistribution f(SkyModel::Perez, negative.sun, 40, 100, 172);
+  EXPECT_EQ(hemisphere([&](const Vec3& w) { return f(w, f.gradation(w.z)); }), 0.0);
+  const Sky sky(SkyModel::Perez, { 0, 0, 1 }, { clear, negative });
+  EXPECT_EQ(sky.uniformInsteadFrames(), std::vector<std::size_t>{ 1 });
+  for (const Vec3& w : { Vec3(0, 0, 1), normalize(Vec3(1, 2, 0.3)), negative.sun })
+  {
+    EXPECT_NEAR(sky.radiance(1, w), 40 / M_PI, 1e-9);
+    EXPECT_NEAR(sky.modelRadiance(1, w), 40 / M_PI, 1e-9);
+  }
+  EXPECT_NEAR(hemisphere([&](const Vec3& w) { return sky.radiance(1, w) * w.z; }), 40, 1e-6);
+  // The other frame is the Perez sky it was.
+  const Sky alone(SkyModel::Perez, { 0, 0, 1 }, { clear });
+  EXPECT_EQ(sky.radiance(0, negative.sun), alone.radiance(0, negative.sun));
+}
+
 TEST(Sky, TheTableMeetsTheModelAndDrawsItsOwnDensity)
 {
   for (SkyModel model :
