@@ -64,6 +64,9 @@ struct vtkMovingLightRadiosity::vtkInternals
   /// Taken just before the inputs and properties were read for the solve.
   vtkTimeStamp SolveTime;
   std::vector<double> Times;
+  /// The hours one frame stands for (DirectSunHours): the Trajectory's field data
+  /// TimeStepHours, else the frames' median spacing.
+  double HoursPerStep = 1;
   /// The lights with their poses, for the Light output and the frame's field data.
   mlr::LightRig Rig;
   /// Per frame, passed on from the Trajectory when it has them (degrees).
@@ -1386,6 +1389,14 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
                          "and North 0, 0, -1)");
     }
     cache.Times = trajectory.times;
+    // A weather file's frames may skip hours (one per day at noon), a sun path's not: its
+    // source says how long a frame lasts.
+    vtkDataObject* path = vtkDataObject::GetData(inputs[TRAJECTORY_PORT], 0);
+    vtkDataArray* step = path ? path->GetFieldData()->GetArray("TimeStepHours") : nullptr;
+    cache.HoursPerStep = step && step->GetNumberOfTuples() > 0 &&
+        std::isfinite(step->GetComponent(0, 0)) && step->GetComponent(0, 0) > 0
+      ? step->GetComponent(0, 0)
+      : mlr::hoursPerTimeStep(cache.Times);
     cache.SunAzimuth = trajectory.sunAzimuth;
     cache.SunElevation = trajectory.sunElevation;
     if (soup.polygons.empty() && fromMaterial && !materialLight.light.polygons.empty())
@@ -1809,7 +1820,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       // The metrics count every time step, each showing its solved frame (one for a scene
       // lit by static lights), with the efficacy its Illuminance takes.
       mlr::vtksensors::MetricSteps steps;
-      steps.hoursPerStep = mlr::hoursPerTimeStep(cache.Times);
+      steps.hoursPerStep = cache.HoursPerStep;
       steps.autonomyThreshold = this->DaylightAutonomyThreshold;
       for (std::size_t t = 0; t < cache.Times.size(); ++t)
       {

@@ -100,8 +100,9 @@
  *   the daylight metrics over all the time steps (constant over time): `DaylightAutonomy`
  *   (share of steps with at least DaylightAutonomyThreshold), `UDILow` (below 100 lx),
  *   `UDIUseful` (100 to 2000 lx), `UDIHigh` (above 2000 lx) and `DirectSunHours` (hours
- *   whose direct sun alone gives over 1000 lx; a step lasts the median spacing of the
- *   Trajectory's `Time`, in hours as vtkSunPathSource gives it, 1 hour with one step). With
+ *   whose direct sun alone gives over 1000 lx; a step lasts the Trajectory's field data
+ *   `TimeStepHours`, as vtkSunPathSource gives it, else the median spacing of its `Time` in
+ *   hours, 1 hour with one step). With
  *   ErrorBatches above 1, `IrradianceStdError` (3 components, W/m^2) and
  *   `IlluminanceStdError` (lx, the efficacy times the luminance of IrradianceStdError): the
  *   sensor's own sampling and the noise of the solution its rays read, from every batch. Its

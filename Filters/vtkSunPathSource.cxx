@@ -6,6 +6,7 @@
 
 #include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -124,6 +125,12 @@ int vtkSunPathSource::RequestData(
   {
     data->AddArray(array);
   }
+  // How long a frame lasts, for the filter's DirectSunHours: the frames' times need not be
+  // evenly spaced (a weather file's chosen hours skip the nights, or all but noon).
+  vtkNew<vtkDoubleArray> stepHours;
+  stepHours->SetName("TimeStepHours");
+  stepHours->InsertNextValue(hours.empty() ? this->StepMinutes / 60.0 : 1.0);
+  output->GetFieldData()->AddArray(stepHours);
   if (!hours.empty())
   {
     const std::pair<const char*, double mlr::WeatherFrame::*> perHour[] = {

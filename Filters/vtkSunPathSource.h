@@ -24,7 +24,9 @@
  * `SkyDiffuseHorizontal` (W/m^2, the file's hourly means), and `GlobalHorizontalIrradiance`
  * (W/m^2, the file's, NaN where it is missing), `ClockHour` (0 to 23, the clock time the
  * hour starts at) beside them. Both modes give `DayOfYear` (1 to 366), the date of the Perez
- * sky's extraterrestrial irradiance.
+ * sky's extraterrestrial irradiance, and the field data `TimeStepHours`, the hours a frame
+ * stands for (StepMinutes / 60, or 1 for a weather file's hour), which the filter's
+ * `DirectSunHours` counts.
  *
  * Bad input (a latitude outside +-90, a date that does not exist, an end before the start, a
  * north that is not horizontal, a weather file that cannot be read, naming its line, ...)

@@ -87,6 +87,21 @@ def test_a_horizontal_roof_gets_dni_sin_elevation_plus_dhi(tmp_path):
             assert channel == pytest.approx(expected, rel=tolerance), (time, dni, dhi)
 
 
+def test_direct_sun_hours_count_an_hour_per_weather_frame(tmp_path):
+    """A weather file's frame is an hour, however far apart the frames chosen are: one noon
+    hour on each of 10 days counted 24 hours each (the median spacing), 240 direct-sun hours
+    for 10 sunny noons (QA)."""
+    from test_cli_sensors import read_sensor_series, write_sensors
+    sensors = write_sensors(tmp_path, [(0, 0, 0.1)], [(0, 0, 1)])
+    result = run(["--scene", write_ground(tmp_path), "--weather", WEATHER, "--dates",
+                  "06-01,06-10", "--hours", "12-12", "--sensors", sensors, "--paths", "2000",
+                  "--output", "out/room.pvd"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    # Every one of those noons is sunny in the file (DNI 459 to 897 W/m^2).
+    last = read_sensor_series(tmp_path)[-1][1]
+    assert last.GetPointData().GetArray("DirectSunHours").GetValue(0) == 10
+
+
 @pytest.mark.parametrize("args, words", [
     (["--weather", WEATHER, "--sun-path", "48.85,2.35,2024-06-21,06:00,07:00,60"],
      "without --sun-directions and --sun-path"),
