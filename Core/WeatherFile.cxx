@@ -1,10 +1,10 @@
 #include "WeatherFile.h"
 
 #include "Error.h"
+#include "PhotometricParsing.h"
 #include "RegularFile.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -119,12 +119,10 @@ struct Where
         << ") is needed: give every field of the EPW format, separated by commas";
       this->fail(s.str());
     }
-    const std::string text(fields[index]);
-    errno = 0;
-    char* end = nullptr;
-    const double value = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE ||
-      !std::isfinite(value))
+    // The one number syntax of the project's readers: decimal only ("0x1F4" is text), and the
+    // same in every locale, where strtod took hexadecimal and a locale's decimal comma.
+    double value = 0;
+    if (!photometry::parseNumber(photometry::trim(fields[index]), value))
     {
       std::ostringstream s;
       s << "field " << index + 1 << " (" << what << ") is '" << shown(fields[index])

@@ -184,6 +184,11 @@ TEST(WeatherFile, MalformedFilesAreRefusedAtTheirLine)
   expectLineError(withField(106, 3, "7.5"), 106, "hour is 7.5");
   expectLineError(withField(107, 3, "99"), 107, "hour is 99");
   expectLineError(withField(108, 0, "1995x"), 108, "field 1 (year) is '1995x'");
+  // Hexadecimal and infinity are text (strtod took them as 500 and inf).
+  expectLineError(
+    withField(109, 14, "0x1F4"), 109, "field 15 (direct normal irradiance) is '0x1F4'");
+  expectLineError(
+    withField(110, 15, "inf"), 110, "field 16 (diffuse horizontal irradiance) is 'inf'");
   {
     std::vector<std::string> lines = year(false);
     lines[500] = "2023,1,21,9,60\n";
