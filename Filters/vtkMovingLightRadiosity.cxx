@@ -304,9 +304,10 @@ bool vtkMovingLightRadiosity::GetPropertyRange(const char* name, double range[2]
 }
 
 //------------------------------------------------------------------------------
-void vtkMovingLightRadiosity::SetExposure(double exposure)
+template <typename T>
+void vtkMovingLightRadiosity::SetKeepingTheSolve(T& property, T value)
 {
-  if (exposure == this->Exposure)
+  if (value == property)
   {
     return;
   }
@@ -314,7 +315,7 @@ void vtkMovingLightRadiosity::SetExposure(double exposure)
   // the solve before this change, they still do after it.
   vtkInternals& cache = *this->Internals;
   const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
-  this->Exposure = exposure;
+  property = value;
   this->Modified();
   if (current)
   {
@@ -323,21 +324,24 @@ void vtkMovingLightRadiosity::SetExposure(double exposure)
 }
 
 //------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetExposure(double exposure)
+{
+  this->SetKeepingTheSolve(this->Exposure, exposure);
+}
+
+//------------------------------------------------------------------------------
 void vtkMovingLightRadiosity::SetDaylightAutonomyThreshold(double threshold)
 {
-  if (threshold == this->DaylightAutonomyThreshold)
-  {
-    return;
-  }
-  // As Exposure: the metrics are recomputed from the cached solve when the output is built.
-  vtkInternals& cache = *this->Internals;
-  const bool current = cache.HasResult && this->GetMTime() <= cache.PropertiesTime.GetMTime();
-  this->DaylightAutonomyThreshold = threshold;
-  this->Modified();
-  if (current)
-  {
-    cache.PropertiesTime.Modified();
-  }
+  // The metrics are recomputed from the cached solve when the output is built.
+  this->SetKeepingTheSolve(this->DaylightAutonomyThreshold, threshold);
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetNumberOfThreads(int threads)
+{
+  // The solution is the same bits for any thread count: a solve kept is still the one asked
+  // for. A solve that failed (its memory depends on the workers) runs again.
+  this->SetKeepingTheSolve(this->NumberOfThreads, threads);
 }
 
 //------------------------------------------------------------------------------

@@ -294,10 +294,10 @@ public:
 
   ///@{
   /**
-   * Threads of the solve, up to 1024; 0 uses every core. The result does not depend on it.
-   * Default 0.
+   * Threads of the solve, up to 1024; 0 uses every core. The result does not depend on it,
+   * so changing it keeps a solve already made. Default 0.
    */
-  vtkSetMacro(NumberOfThreads, int);
+  void SetNumberOfThreads(int threads);
   vtkGetMacro(NumberOfThreads, int);
   ///@}
 
@@ -795,6 +795,10 @@ private:
   vtkMovingLightRadiosity(const vtkMovingLightRadiosity&) = delete;
   void operator=(const vtkMovingLightRadiosity&) = delete;
 
+  /// Sets a property that does not change the solve (Exposure, the autonomy threshold, the
+  /// threads): a kept solve still serves the outputs.
+  template <typename T>
+  void SetKeepingTheSolve(T& property, T value);
   /// Solves every frame and caches the result; returns false (after an error) on failure.
   bool Solve(vtkInformationVector** inputVector);
   /// Fills output port `port` with frame `frame` of the cache; false (after an error) when

@@ -8,8 +8,10 @@ import os
 import sys
 import xml.etree.ElementTree as ElementTree
 
+import numpy
 import pytest
 
+from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkFiltersCore import vtkAppendFilter
 from vtkmodules.vtkFiltersSources import vtkLineSource, vtkPlaneSource
@@ -106,6 +108,21 @@ def test_property_change_solves_again(pipeline):
     radiosity.SetSeed(radiosity.GetSeed() + 1)
     radiosity.UpdateTimeStep(0.0)
     assert radiosity.GetSolveCount() == solves + 1
+
+
+def test_threads_and_exposure_keep_the_solve(pipeline):
+    """The solution is the same bits for any thread count: changing the threads solved the
+    whole animation again for nothing (QA)."""
+    radiosity = pipeline["filter"]
+    radiosity.UpdateTimeStep(0.0)
+    solves = radiosity.GetSolveCount()
+    before = vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")).copy()
+    radiosity.SetNumberOfThreads(1 if radiosity.GetNumberOfThreads() != 1 else 2)
+    radiosity.SetExposure(radiosity.GetExposure() + 1)
+    radiosity.UpdateTimeStep(0.0)
+    assert radiosity.GetSolveCount() == solves
+    assert numpy.array_equal(
+        vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")), before)
 
 
 def test_pvd_series_written_and_read_back(pipeline, tmp_path):
