@@ -94,4 +94,14 @@ struct WeatherFrame
  */
 std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSelection& selection);
 
+/**
+ * A warning when the chosen hours' irradiances disagree with their sun: over the hours whose
+ * sun stands above 10 degrees and whose global horizontal irradiance is known (10 at least),
+ * the global departs from the direct normal times the sine of the elevation plus the diffuse
+ * horizontal by more than 15% of it, as when the file's time zone or longitude is wrong (a
+ * sign flipped shifts every hour's sun by hours). Empty when they agree or too few hours count.
+ */
+std::string irradianceClosureWarning(
+  const WeatherFile& file, const std::vector<WeatherFrame>& frames);
+
 } // namespace mlr

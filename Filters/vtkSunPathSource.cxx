@@ -67,7 +67,13 @@ int vtkSunPathSource::RequestData(
       selection.includeNight = this->IncludeNight;
       selection.north = { this->North[0], this->North[1], this->North[2] };
       selection.up = { this->Up[0], this->Up[1], this->Up[2] };
-      hours = mlr::weatherFrames(mlr::readWeatherFile(this->WeatherFile), selection);
+      const mlr::WeatherFile file = mlr::readWeatherFile(this->WeatherFile);
+      hours = mlr::weatherFrames(file, selection);
+      const std::string closure = mlr::irradianceClosureWarning(file, hours);
+      if (!closure.empty())
+      {
+        vtkWarningMacro(<< closure);
+      }
       for (const mlr::WeatherFrame& h : hours)
       {
         path.push_back(h.sun);

@@ -403,12 +403,43 @@ TEST(WeatherFile, TheDayOfTheYearSetsThePerezExtraterrestrialIrradiance)
     perezEfficacy(SkyFrame{ sun, 150, 600, 185 }, zenith).diffuse);
 }
 
+TEST(WeatherFile, IrradiancesThatDisagreeWithTheirSunAreWarnedOf)
+{
+  // The sun at 30 degrees with 600 W/m^2 direct and 100 diffuse closes at 400 global; the
+  // same hours under a sun at 60 degrees (a time zone of the wrong sign puts the sun hours
+  // off) depart by 55%.
+  WeatherFile file;
+  file.name = "t.epw";
+  file.longitude = 2.35;
+  file.timeZoneHours = -1;
+  auto hours = [](double elevation, double global, std::size_t count)
+  {
+    WeatherFrame f;
+    f.sun.elevationDegrees = elevation;
+    f.directNormal = 600;
+    f.diffuseHorizontal = 100;
+    f.globalHorizontal = global;
+    return std::vector<WeatherFrame>(count, f);
+  };
+  EXPECT_EQ(irradianceClosureWarning(file, hours(30, 400, 20)), "");
+  const std::string warning = irradianceClosureWarning(file, hours(60, 400, 20));
+  EXPECT_NE(warning.find("t.epw: over 20 chosen hours"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("departs by 55%"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("time zone (-1 h, east of Greenwich positive)"), std::string::npos)
+    << warning;
+  // Too few hours, a low sun, or an unknown global: nothing to judge by.
+  EXPECT_EQ(irradianceClosureWarning(file, hours(60, 400, 9)), "");
+  EXPECT_EQ(irradianceClosureWarning(file, hours(8, 100, 20)), "");
+  EXPECT_EQ(irradianceClosureWarning(file, hours(60, std::nan(""), 20)), "");
+}
+
 TEST(WeatherFile, TheShippedYearReads)
 {
   const WeatherFile file = readWeatherFile(MLR_SOURCE_DIR "/Data/paris_synthetic.epw");
   EXPECT_EQ(file.hours.size(), 8760u);
   EXPECT_DOUBLE_EQ(file.timeZoneHours, 1.0);
   const std::vector<WeatherFrame> frames = weatherFrames(file, WeatherSelection());
+  EXPECT_EQ(irradianceClosureWarning(file, frames), "");
   for (const WeatherFrame& f : frames)
   {
     // Its model has light whenever the sun at the middle of the hour is up (NOAA's formulas
