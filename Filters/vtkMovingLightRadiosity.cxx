@@ -1592,6 +1592,28 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       warnings.push_back("the Light input is connected but empty (no cells; an upstream filter "
                          "gave nothing?): it lights nothing");
     }
+    // Inputs and properties that would change nothing: the user meant something by them.
+    if (lightData && lightData->GetNumberOfCells() > 0 &&
+      (directional || this->LightType == POINT_LIGHT || fromMaterial))
+    {
+      warnings.push_back(std::string("the Light input is not used: ") +
+        (directional                         ? "LightType Directional is the sun"
+            : this->LightType == POINT_LIGHT ? "LightType Point emits from the Trajectory's points"
+                                             : "the LightMaterial's surfaces are the light") +
+        "; disconnect it, or choose LightType Area for its polygons");
+    }
+    if (rig.areaLights.empty() && rig.pointLights.empty() && rig.directionalLights.empty() &&
+      rig.skies.empty() && this->GetNumberOfInputConnections(TRAJECTORY_PORT) > 0)
+    {
+      warnings.push_back("the Trajectory moves no light: without a Light or a LightMaterial the "
+                         "Scene's own emissive surfaces light it, and they stay where they are "
+                         "in every time step");
+    }
+    if (this->TimeLimit > 0 && !(this->TargetRelativeError > 0))
+    {
+      warnings.push_back("TimeLimit stops the rounds of a TargetRelativeError, and there is "
+                         "none: the solve runs its NumberOfPaths whatever the time");
+    }
     for (const std::string& warning : warnings)
     {
       vtkWarningMacro(<< warning);

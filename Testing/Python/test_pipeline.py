@@ -520,6 +520,77 @@ def test_an_empty_light_is_named_before_nothing_emits():
     assert any("nothing emits light" in m for m in messages), messages
 
 
+def test_inputs_and_properties_that_change_nothing_are_warned_of():
+    """A Light input beside LightType Point or Directional, a Trajectory with only the Scene's
+    own emitters, a TimeLimit without a target: accepted silently, where the command line
+    refuses the like (QA)."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    floor = grey_plane((-1, -1, 0), (1, -1, 0), (-1, 1, 0), 0.5)
+    lamp = grey_plane((-0.1, -0.1, 1), (-0.1, 0.1, 1), (0.1, -0.1, 1))
+    line = vtkLineSource()
+    line.SetPoint1(-0.5, 0, 1)
+    line.SetPoint2(0.5, 0, 1)
+    line.SetResolution(2)
+    line.Update()
+
+    def warnings(configure):
+        radiosity = vtkMovingLightRadiosity()
+        radiosity.SetSceneData(floor)
+        radiosity.SetNumberOfPaths(2000)
+        radiosity.SetNumberOfThreads(2)
+        configure(radiosity)
+        messages = recorded(radiosity, "WarningEvent", "ErrorEvent")
+        assert radiosity.UpdateTimeStep(0.0), messages
+        return messages
+
+    def point(r):
+        r.SetLightTypeToPoint()
+        r.SetLightData(lamp)
+        r.SetTrajectoryData(line.GetOutput())
+    assert any("the Light input is not used: LightType Point" in m for m in warnings(point))
+
+    def sun(r):
+        r.SetLightTypeToDirectional()
+        r.SetLightData(lamp)
+        r.SetPathStart(0, 0, 1)
+        r.SetPathEnd(1, 0, 1)
+    assert any("the Light input is not used: LightType Directional" in m for m in warnings(sun))
+
+    # Both blocks carry both arrays, which vtkAppendPolyData keeps only when all have them.
+    glowing = grey_plane((-0.1, -0.1, 1), (-0.1, 0.1, 1), (0.1, -0.1, 1), 0.5)
+    dark = grey_plane((-1, -1, 0), (1, -1, 0), (-1, 1, 0), 0.5)
+    for data, value in ((glowing, 100), (dark, 0)):
+        emission = vtkDoubleArray()
+        emission.SetName("Emission")
+        emission.SetNumberOfComponents(3)
+        emission.InsertNextTuple3(value, value, value)
+        data.GetCellData().AddArray(emission)
+    from vtkmodules.vtkFiltersCore import vtkAppendPolyData
+    both = vtkAppendPolyData()
+    both.AddInputData(dark)
+    both.AddInputData(glowing)
+    both.Update()
+
+    def emitters(r):
+        r.SetSceneData(both.GetOutput())
+        r.SetTrajectoryData(line.GetOutput())
+    assert any("the Trajectory moves no light" in m for m in warnings(emitters))
+
+    def limit(r):
+        r.SetLightData(lamp)
+        r.SetTimeLimit(60)
+    assert any("TimeLimit stops the rounds of a TargetRelativeError" in m
+               for m in warnings(limit))
+    # An area light, its Trajectory and a target with its limit: nothing to say.
+    def plain(r):
+        r.SetLightData(lamp)
+        r.SetTrajectoryData(line.GetOutput())
+        r.SetTargetRelativeError(0.5)
+        r.SetTimeLimit(60)
+    assert not any("not used" in m or "moves no light" in m or "TimeLimit" in m
+                   for m in warnings(plain))
+
+
 def test_a_light_material_that_takes_the_whole_scene_is_an_error():
     radiosity = vtkMovingLightRadiosity()
     radiosity.SetSceneData(material_block([((0, 0, 0), (1, 0, 0), (0, 1, 0), 0)], ["lamp"]))
