@@ -115,7 +115,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       approximate, sensors,
       saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
                       options.solver, options.sensorOptions),
-        saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })));
+        saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })),
+      !streamed && sensors == 0 && options.solver.ranks <= 1 && frames > 2 * MinimumFramesPerChunk);
   };
 
   RemeshOptions remeshing = options.remeshing;

@@ -362,13 +362,16 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options)
 
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate, std::size_t sensors,
-  std::uint64_t sensorBytes)
+  std::uint64_t sensorBytes, bool couldStream)
 {
   const std::string about = approximate ? "about " : "";
   std::string detail = countOf(frames, "frame") + " x (" + about + std::to_string(patches) +
     " patches + " + about + std::to_string(elements) +
     " elements) x 2 sides x RGB, plus per-thread buffers";
-  std::string advice = "use fewer frames or a larger patch size, or raise the limit";
+  std::string advice = couldStream
+    ? "use fewer frames or a larger patch size, keep fewer frames in memory (the filter's "
+      "CachedChunks: the others are solved again when shown), or raise the limit"
+    : "use fewer frames or a larger patch size, or raise the limit";
   if (sensors > 0)
   {
     detail += ", and " + countOf(sensors, "sensor") + " (" + gibibytes(sensorBytes) + ")";

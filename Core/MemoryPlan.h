@@ -116,10 +116,12 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options);
  * Throws mlr::Error when `estimate` bytes exceed the memory limit of `options`; the message
  * gives the estimate, the limit and what it is made of (`frames`, `patches`, `elements`;
  * `approximate` says the counts are expected ones, before remeshing; `sensorBytes` of the
- * estimate are the `sensors`', and when they are most of it the advice is about them).
+ * estimate are the `sensors`', and when they are most of it the advice is about them;
+ * `couldStream`: every frame is kept where the frames could be kept a few chunks at a time,
+ * which the advice then offers).
  */
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate = false,
-  std::size_t sensors = 0, std::uint64_t sensorBytes = 0);
+  std::size_t sensors = 0, std::uint64_t sensorBytes = 0, bool couldStream = false);
 
 } // namespace mlr

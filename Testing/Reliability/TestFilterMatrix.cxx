@@ -230,6 +230,19 @@ std::vector<Row> rows()
       // "about": refused on the patch count expected before remeshing, not after it.
       Outcome::Error, "(10000 frames x (about", 5,
       [](Case& c) { EXPECT_EQ(c.filter->GetPatchSize(), 0.02); } },
+    { "ManyFramesOverTheMemoryLimitSuggestKeepingFewer",
+      [](Case& c)
+      {
+        // Every frame is kept unless CachedChunks says otherwise: the refusal names it.
+        std::vector<Vec3> positions;
+        for (int i = 0; i < 20000; ++i)
+        {
+          positions.emplace_back(0.2 + 0.6 * i / 19999.0, 0.5, 0.9);
+        }
+        c.setup.trajectory = trajectoryPolyData(positions);
+        c.filter->SetMemoryLimit(64);
+      },
+      Outcome::Error, "keep fewer frames in memory (the filter's CachedChunks", 5 },
     { "LargeSceneOverTheMemoryLimitIsRefusedBeforeCopying",
       [](Case& c)
       {
