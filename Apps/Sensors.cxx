@@ -109,8 +109,6 @@ Extent extentOf(const std::vector<Face>& faces, double margin)
   return e;
 }
 
-/// UsageError when a lattice of `spacing` over `area` would have more sensors than a solve
-/// accepts.
 /// Bytes one work-plane sensor takes before the solve checks its own memory: the lattice
 /// (with the set that finds a point in several faces) and the sensors' VTK points, normals
 /// and vertices. Measured at 1.21 million sensors: 135 bytes each over the run without them
@@ -125,8 +123,8 @@ void checkSensorCount(double area, double spacing, std::size_t frames, std::uint
   const double count = area / (spacing * spacing);
   std::ostringstream s;
   s << "--work-plane spacing " << mlr::formatNumber(spacing) << " gives about "
-    << static_cast<std::uint64_t>(std::ceil(std::min(count, 1e19))) << " sensors over " << mlr::formatNumber(area)
-    << " square units of floor";
+    << static_cast<std::uint64_t>(std::ceil(std::min(count, 1e19))) << " sensors over "
+    << mlr::formatNumber(area) << " square units of floor";
   if (count > MaximumSensors)
   {
     s << ", over the maximum of 1e8: give a larger spacing";
@@ -477,7 +475,7 @@ bool inside(const std::vector<double>& us, const std::vector<double>& vs, double
 
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& upGiven,
   double height, double spacing, const std::vector<Triple>& lights, bool daylight,
-  std::uint64_t memoryLimit)
+  std::size_t frames, std::uint64_t memoryLimit)
 {
   const V up = unit({ upGiven[0], upGiven[1], upGiven[2] });
   // The lattice's axes: the world axis least along up, made orthogonal to it, and up x it.
@@ -550,7 +548,6 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
   {
     throw noFloor();
   }
-  const std::size_t frames = std::max<std::size_t>(lights.size(), 1);
   checkSensorCount(area, spacing, frames, memoryLimit);
 
   struct Sensor

@@ -49,11 +49,11 @@ constexpr int SkyDirections = 32;
  * lies above the scene while some polygon faces down and no floor was found among them. Throws
  * InputError when no polygon is a floor, and UsageError when the grid would have more sensors
  * than a solve accepts or than fit in `memoryLimit` bytes (0: the default limit) with their
- * results over the frames of `lights` (one without).
+ * results over `frames` frames.
  */
 vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& up, double height,
   double spacing, const std::vector<Triple>& lights = {}, bool daylight = false,
-  std::uint64_t memoryLimit = 0);
+  std::size_t frames = 1, std::uint64_t memoryLimit = 0);
 
 /// Writes the Sensors output of one frame (points as vertices and their arrays) to `path`,
 /// a .vtp file. Throws std::runtime_error when it cannot be written.

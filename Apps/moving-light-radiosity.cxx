@@ -629,7 +629,14 @@ int run(int argc, char** argv, RankJob& job)
     sensors =
       workPlaneSensors(scene, options.zenith(), (*options.workPlane)[0], (*options.workPlane)[1],
         lightPositions(options, trajectory, scene, filter->GetEmissionArrayName()),
-        options.usesSun() || options.sky.has_value(), memoryLimit);
+        options.usesSun() || options.sky.has_value(),
+        // A weather year's 8760 frames of results: the trajectory's points (per light, when
+        // there are several: an upper bound), the straight path's frames, or one (a sky, the
+        // scene's own emitters).
+        trajectory       ? static_cast<std::size_t>(trajectory->GetNumberOfPoints())
+          : options.from ? static_cast<std::size_t>(std::max(filter->GetNumberOfPositions(), 1))
+                         : std::size_t(1),
+        memoryLimit);
   }
   StageTimes stages;
   stages.reading = secondsSince(readingStarted);

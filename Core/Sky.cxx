@@ -179,8 +179,8 @@ double SkyDistribution::gradation(double z) const
   // With b > 0, a e^(b / cos t) grows without bound towards the horizon (e^97 in the table's
   // lowest ring at b = 0.3): normalised to E_dh, most of the sky's light lay in the last 1.5
   // degrees and a wall facing away from a sun at 1 degree got ten times E_dh. Radiance
-  // evaluates no such sky below 6 degrees (gendaylit refuses it), so below there the
-  // gradation keeps its value at 6 degrees. With b <= 0 it tends to 1 on its own, as
+  // evaluates no such sky below 6 degrees (gendaylit writes a dark error sky for b > 0), so below
+  // there the gradation keeps its value at 6 degrees. With b <= 0 it tends to 1 on its own, as
   // perezlum.cal renders it.
   const double c = k[1] > 0 ? std::max(cosZ, LowestEvaluatedCosine) : cosZ;
   return c > 0 ? 1.0 + k[0] * std::exp(k[1] / c) : 1.0;
@@ -410,11 +410,14 @@ Sky::Sky(SkyModel model, const Vec3& up, const std::vector<SkyFrame>& frames, in
       const SkyFrame& frame = this->Frames[k];
       double horizontal = 0, total = 0;
       tabulate(this->distribution(k), directions, mean, horizontal, total);
-      if (!(horizontal > 0) && model == SkyModel::Perez)
+      // A uniform sky of relative luminance 1 gives pi: a Perez sky left with a thousandth
+      // of that is negative but for a sliver, which normalised to E_dh would blaze.
+      constexpr double Sliver = 1e-3 * M_PI;
+      if (!(horizontal > Sliver) && model == SkyModel::Perez)
       {
-        // The Perez fit is negative over the whole sky (a high sun, little diffuse light and
-        // two to three times as much direct): Radiance's gendaymtx draws such an hour as a
-        // uniform sky, and so does this table, rather than stop a weather year there.
+        // The Perez fit is negative over (nearly) the whole sky (a high sun, little diffuse
+        // light and two to three times as much direct): Radiance's gendaymtx draws such an
+        // hour as a uniform sky, and so does this table, rather than stop a weather year there.
         this->UniformInstead[k] = 1;
         tabulate(this->distribution(k), directions, mean, horizontal, total);
       }

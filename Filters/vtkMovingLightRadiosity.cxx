@@ -340,7 +340,18 @@ void vtkMovingLightRadiosity::SetDaylightAutonomyThreshold(double threshold)
 void vtkMovingLightRadiosity::SetNumberOfThreads(int threads)
 {
   // The solution is the same bits for any thread count: a solve kept is still the one asked
-  // for. A solve that failed (its memory depends on the workers) runs again.
+  // for. A solve that failed (its memory depends on the workers) runs again; so does one
+  // whose rounds a TimeLimit cut (more threads run more of them), and one of kept chunks,
+  // whose chunks solved again when shown take the threads of the solve.
+  if (this->TimeLimit > 0 || this->CachedChunks > 0)
+  {
+    if (threads != this->NumberOfThreads)
+    {
+      this->NumberOfThreads = threads;
+      this->Modified();
+    }
+    return;
+  }
   this->SetKeepingTheSolve(this->NumberOfThreads, threads);
 }
 
@@ -515,9 +526,82 @@ std::size_t lightsOf(vtkMovingLightRadiosity* self, vtkInformationVector* lightI
     mlr::vtkinputs::surfaceOf(vtkDataObject::GetData(lightInput, 0), "Light", ignored));
 }
 
-/// The sky of SkyModel in `rig`: one frame per sun direction of a directional light (or one
-/// frame), E_dh and E_dn from the Trajectory's arrays or the properties, and per frame the
-/// Perez luminous efficacy of the daylight a horizontal surface receives into `efficacy`.
+/// What an area or point light emits in `frame` (one pose for a light that does not move):
+/// its power times the pose's factor, the Trajectory's Power and a TILT table's.
+template <typename Light>
+mlr::Rgb emittedPower(const Light& light, std::size_t frame)
+{
+  return light.power() * light.pose(light.frameCount() > 1 ? frame : 0).power;
+}
+
+/// "frame 5" or "frames 3, 5, 8", the first 8 and "..." after them.
+std::string framesNamed(const std::vector<std::size_t>& frames)
+{
+  std::ostringstream s;
+  s << (frames.size() == 1 ? "frame " : "frames ");
+  for (std::size_t k = 0; k < frames.size() && k < 8; ++k)
+  {
+    s << (k ? ", " : "") << frames[k];
+  }
+  s << (frames.size() > 8 ? ", ..." : "");
+  return s.str();
+}
+
+/// Whether the sun of frame `f` is below the horizon: by the Trajectory's SunElevation when
+/// it has one (the Sun Path source's, whose Up may differ from the filter's: a Y-up scene's
+/// source set to Up 0, 1, 0 beside the filter's default), else across `up`.
+bool sunBelowHorizon(
+  const mlr::vtkinputs::Trajectory& trajectory, std::size_t f, const mlr::Vec3& up)
+{
+  return f < trajectory.sunElevation.size()
+    ? trajectory.sunElevation[f] < 0
+    : mlr::dot(trajectory.lights.front()[f].position, up) < 0;
+}
+
+/// A sun below the horizon is night: its frames go dark, where the solve would light the
+/// scene from below (its surfaces may be two-sided) and give those frames a share of the
+/// mixture's paths. Warns of the frames whose sun this turned off (the Sun Path source
+/// already gives its night frames Power 0), and of frames whose SunElevation disagrees with
+/// `up`.
+void darkenNight(
+  mlr::vtkinputs::Trajectory& trajectory, const double* up, std::vector<std::string>& warnings)
+{
+  const mlr::Vec3 zenith(up[0], up[1], up[2]);
+  std::vector<std::size_t> darkened, disagree;
+  std::vector<mlr::PoseInput>& sun = trajectory.lights.front();
+  for (std::size_t f = 0; f < sun.size(); ++f)
+  {
+    const bool below = sunBelowHorizon(trajectory, f, zenith);
+    if (below != (mlr::dot(sun[f].position, zenith) < 0))
+    {
+      disagree.push_back(f);
+    }
+    if (below)
+    {
+      if (sun[f].power != mlr::Rgb())
+      {
+        darkened.push_back(f);
+      }
+      sun[f].power = mlr::Rgb();
+    }
+  }
+  const std::string upText =
+    mlr::formatNumber(up[0]) + ", " + mlr::formatNumber(up[1]) + ", " + mlr::formatNumber(up[2]);
+  if (!darkened.empty())
+  {
+    warnings.push_back("the sun is below the horizon (across Up " + upText + ") in " +
+      std::to_string(darkened.size()) + " of " + mlr::countOf(sun.size(), "frame") + ", " +
+      framesNamed(darkened) + ": " + (darkened.size() == 1 ? "that frame is" : "those frames are") +
+      " night, dark");
+  }
+  if (!disagree.empty())
+  {
+    warnings.push_back("the Trajectory's SunElevation and the filter's Up (" + upText +
+      ") disagree on which side of the horizon the sun is in " + framesNamed(disagree) +
+      ": set Up to the Sun Path source's Up (0, 1, 0 for a Y-up scene)");
+  }
+}
+
 /// Each frame's daylight as a sky sees it: the sun (the zenith without a directional light),
 /// its direct normal irradiance, the diffuse horizontal irradiance and the day, from the
 /// Trajectory's arrays or else the properties.
@@ -548,9 +632,10 @@ std::vector<mlr::SkyFrame> daylightFrames(vtkMovingLightRadiosity* self,
   {
     // SkyDiffuseHorizontal is a daylight sky's: under a sun below the horizon it is night. A
     // frame's own value (a weather file's) is a measurement, twilight included.
+    const bool night = directional && sunBelowHorizon(trajectory, f, up);
     frames[f].diffuseHorizontal = f < trajectory.skyDiffuseHorizontal.size()
       ? trajectory.skyDiffuseHorizontal[f]
-      : (mlr::dot(frames[f].sun, up) < 0 ? 0.0 : self->GetSkyDiffuseHorizontal());
+      : (night ? 0.0 : self->GetSkyDiffuseHorizontal());
     if (f < trajectory.directNormal.size())
     {
       frames[f].directNormal = trajectory.directNormal[f];
@@ -563,45 +648,9 @@ std::vector<mlr::SkyFrame> daylightFrames(vtkMovingLightRadiosity* self,
   return frames;
 }
 
-/// A sun below the horizon (across `up`) is night: its frames go dark, where the solve would
-/// light the scene from below (its surfaces may be two-sided) and give those frames a share
-/// of the mixture's paths. Returns the frames whose sun this turned off (the Sun Path source
-/// already gives its night frames Power 0).
-std::vector<std::size_t> darkenNight(mlr::vtkinputs::Trajectory& trajectory, const mlr::Vec3& up)
-{
-  std::vector<std::size_t> darkened;
-  std::vector<mlr::PoseInput>& sun = trajectory.lights.front();
-  for (std::size_t f = 0; f < sun.size(); ++f)
-  {
-    if (mlr::dot(sun[f].position, up) < 0)
-    {
-      if (sun[f].power != mlr::Rgb())
-      {
-        darkened.push_back(f);
-      }
-      sun[f].power = mlr::Rgb();
-    }
-  }
-  return darkened;
-}
-
-std::string nightWarning(
-  const std::vector<std::size_t>& frames, std::size_t count, const double* up)
-{
-  std::ostringstream s;
-  s << "the sun is below the horizon (across Up " << mlr::formatNumber(up[0]) << ", "
-    << mlr::formatNumber(up[1]) << ", " << mlr::formatNumber(up[2]) << ") in " << frames.size()
-    << " of " << count << (count == 1 ? " frame" : " frames") << ", frame"
-    << (frames.size() == 1 ? " " : "s ");
-  for (std::size_t k = 0; k < frames.size() && k < 8; ++k)
-  {
-    s << (k ? ", " : "") << frames[k];
-  }
-  s << (frames.size() > 8 ? ", ..." : "")
-    << (frames.size() == 1 ? ": that frame is night, dark" : ": those frames are night, dark");
-  return s.str();
-}
-
+/// The sky of SkyModel in `rig`: one frame per sun direction of a directional light (or one
+/// frame), E_dh and E_dn from the Trajectory's arrays or the properties, and per frame the
+/// Perez luminous efficacy of the daylight a horizontal surface receives into `efficacy`.
 void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& trajectory,
   bool directional, mlr::LightRig& rig, std::vector<double>& efficacy,
   std::vector<double>& sunEfficacy, std::vector<std::string>& warnings)
@@ -631,8 +680,7 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
     }
     else
     {
-      s << mlr::countOf(uniform.size(), "frame") << ", " << uniform.front()
-        << (uniform.size() > 1 ? " first" : "");
+      s << framesNamed(uniform);
     }
     s << ": drawn as a uniform sky of the same diffuse irradiance, as Radiance's gendaymtx does";
     warnings.push_back(s.str());
@@ -942,10 +990,16 @@ int vtkMovingLightRadiosity::RequestData(
   bool unchanged = this->GetMTime() <= cache.PropertiesTime.GetMTime();
   for (int port = 0; unchanged && port < this->GetNumberOfInputPorts(); ++port)
   {
-    auto* upstream = this->GetNumberOfInputConnections(port) > 0
-      ? vtkDemandDrivenPipeline::SafeDownCast(this->GetInputExecutive(port, 0))
-      : nullptr;
-    unchanged = !upstream || upstream->GetPipelineMTime() <= cache.SolveTime.GetMTime();
+    if (this->GetNumberOfInputConnections(port) == 0)
+    {
+      continue;
+    }
+    auto* upstream = vtkDemandDrivenPipeline::SafeDownCast(this->GetInputExecutive(port, 0));
+    vtkDataObject* input = vtkDataObject::GetData(inputVector[port], 0);
+    const vtkMTimeType changed = upstream ? upstream->GetPipelineMTime()
+      : input                             ? input->GetMTime()
+                                          : 0;
+    unchanged = changed <= cache.SolveTime.GetMTime();
   }
   if (unchanged && cache.Failed)
   {
@@ -1157,14 +1211,14 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
         mlr::vtkoutputs::LightTransform transform;
         transform.rotation = light.pose(k).rotation.rows();
         transform.translation = light.rigidTranslation(k);
-        lights->AddInputData(mlr::vtkoutputs::posedLight(
-          light.polygons(), transform, light.power() * light.pose(k).power));
+        lights->AddInputData(
+          mlr::vtkoutputs::posedLight(light.polygons(), transform, emittedPower(light, frame)));
       }
       for (const mlr::PointLight& light : cache.Rig.pointLights)
       {
         const std::size_t k = light.frameCount() > 1 ? frame : 0;
         lights->AddInputData(
-          mlr::vtkoutputs::posedPointLight(light.position(k), light.power() * light.pose(k).power));
+          mlr::vtkoutputs::posedPointLight(light.position(k), emittedPower(light, frame)));
       }
       if (lights->GetNumberOfInputConnections(0) > 0)
       {
@@ -1198,11 +1252,11 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
       mlr::Rgb power;
       for (const mlr::MovingLight& light : cache.Rig.areaLights)
       {
-        power += light.power() * light.pose(light.frameCount() > 1 ? frame : 0).power;
+        power += emittedPower(light, frame);
       }
       for (const mlr::PointLight& light : cache.Rig.pointLights)
       {
-        power += light.power() * light.pose(light.frameCount() > 1 ? frame : 0).power;
+        power += emittedPower(light, frame);
       }
       vtkNew<vtkDoubleArray> total;
       total->SetName("LightPower");
@@ -1371,12 +1425,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       trajectoryOf(this, inputs[TRAJECTORY_PORT], lightsOf(this, inputs[LIGHT_PORT]), lampInScene);
     if (directional)
     {
-      const std::vector<std::size_t> night =
-        darkenNight(trajectory, mlr::Vec3(this->Up[0], this->Up[1], this->Up[2]));
-      if (!night.empty())
-      {
-        warnings.push_back(nightWarning(night, trajectory.lights.front().size(), this->Up));
-      }
+      darkenNight(trajectory, this->Up, warnings);
     }
     const mlr::PolygonSoup soup = mlr::vtkinputs::sceneSoup(sceneData, warnings,
       static_cast<std::uint64_t>(this->MemoryLimit) << 20, this->ReflectanceArrayName,

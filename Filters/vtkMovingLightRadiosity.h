@@ -120,7 +120,10 @@
  * show the time requested on the port being updated. The filter's time is not passed
  * upstream: an input with time steps of its own (a file series) is taken at its first time
  * step whatever time is shown, and re-executions of an input for another consumer's time
- * (ParaView's view of the same reader) do not solve again. The outputs share their unchanging
+ * (ParaView's view of the same reader) do not solve again: a solve follows the modification
+ * times of the upstream algorithms and of data given with SetInputData, so a source whose
+ * output changes without them (a script reading a file it was not told changed) needs
+ * Modified() on it or on this filter. The outputs share their unchanging
  * arrays (points, cells, `Reflectance`, ...) with the kept result: edit a DeepCopy of an output,
  * not the output itself, or the other time steps show the edit.
  *
@@ -295,7 +298,8 @@ public:
   ///@{
   /**
    * Threads of the solve, up to 1024; 0 uses every core. The result does not depend on it,
-   * so changing it keeps a solve already made. Default 0.
+   * so changing it keeps a solve already made (not with a TimeLimit, whose rounds depend on
+   * the speed, nor with CachedChunks, whose chunks are solved again when shown). Default 0.
    */
   void SetNumberOfThreads(int threads);
   vtkGetMacro(NumberOfThreads, int);
@@ -418,8 +422,10 @@ public:
   ///@}
 
   ///@{
-  /// The zenith of the sky, and the vertical a LightDistributionFile's TILT=INCLUDE table
-  /// measures each pose's tilt from; any length but 0. Default 0, 0, 1.
+  /// The zenith of the sky, the vertical a LightDistributionFile's TILT=INCLUDE table
+  /// measures each pose's tilt from, and with LightType Directional the horizon below which a
+  /// sun is night when the Trajectory gives no SunElevation (with one, the elevation decides
+  /// and a disagreement with Up is warned of); any length but 0. Default 0, 0, 1.
   vtkSetVector3Macro(Up, double);
   vtkGetVector3Macro(Up, double);
   ///@}

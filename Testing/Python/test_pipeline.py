@@ -123,6 +123,18 @@ def test_threads_and_exposure_keep_the_solve(pipeline):
     assert radiosity.GetSolveCount() == solves
     assert numpy.array_equal(
         vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")), before)
+    # Under a TimeLimit the rounds run depend on the speed: the threads then solve again.
+    radiosity.SetTargetRelativeError(0.5)
+    radiosity.SetTimeLimit(600)
+    radiosity.UpdateTimeStep(0.0)
+    solves = radiosity.GetSolveCount()
+    radiosity.SetNumberOfThreads(1 if radiosity.GetNumberOfThreads() != 1 else 2)
+    radiosity.UpdateTimeStep(0.0)
+    assert radiosity.GetSolveCount() == solves + 1
+    # Back to the fixture's settings, solved, for the tests that follow.
+    radiosity.SetTimeLimit(0)
+    radiosity.SetTargetRelativeError(0)
+    radiosity.UpdateTimeStep(0.0)
 
 
 def test_pvd_series_written_and_read_back(pipeline, tmp_path):

@@ -10,7 +10,8 @@ import sys
 
 import pytest
 
-from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray
+from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 from vtkmodules.vtkFiltersCore import vtkAppendPolyData
 from vtkmodules.vtkFiltersSources import vtkCubeSource, vtkLineSource, vtkPlaneSource
@@ -161,6 +162,41 @@ def sun():
     radiosity.SetPatchSize(0.25)
     radiosity.SetNumberOfThreads(2)
     return radiosity
+
+
+def test_night_follows_the_sun_paths_elevation_whatever_the_filters_up():
+    """A Y-up scene: the Sun Path source set to Up 0, 1, 0 gives directions whose z is
+    negative in the northern half of the sky, while the filter's Up stays +z. Judged across
+    the filter's Up those suns were night; the Trajectory's SunElevation decides, and the
+    disagreement is named."""
+    ground = vtkPlaneSource()  # in the x-z plane, facing +y: a Y-up scene's ground
+    ground.SetOrigin(-0.5, 0, 0.5)
+    ground.SetPoint1(0.5, 0, 0.5)
+    ground.SetPoint2(-0.5, 0, -0.5)
+    trajectory = vtkPolyData()
+    points = vtkPoints()
+    for direction in ((0, 1, 0.5), (0, 1, -0.5), (0, -1, 0.5)):  # the last: below, y < 0
+        points.InsertNextPoint(*direction)
+    trajectory.SetPoints(points)
+    trajectory.GetPointData().AddArray(cell_array("SunElevation", (63.4, 63.4, -63.4)))
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(output(ground))
+    radiosity.SetTrajectoryData(trajectory)
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetNumberOfPaths(20000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetNumberOfThreads(2)
+    messages = recorded(radiosity, "WarningEvent")
+    lit = []
+    for frame in range(3):
+        assert radiosity.UpdateTimeStep(float(frame))
+        direct = radiosity.GetOutput(0).GetCellData().GetArray("DirectRadiosity")
+        lit.append(max(direct.GetRange(1)[1], direct.GetRange(0)[1]))
+    # Frame 1's sun has z < 0 but stands 63 degrees high: lit, as frame 0; frame 2 is night.
+    assert lit[0] > 0 and lit[1] == pytest.approx(lit[0], rel=0.1) and lit[2] == 0, lit
+    assert any("SunElevation and the filter's Up (0, 0, 1) disagree" in m and "frames 1, 2" in m
+               for m in messages), messages
+    assert any("in 1 of 3 frames, frame 2: that frame is night" in m for m in messages), messages
 
 
 def test_sun_time_steps_and_field_data(sun):
