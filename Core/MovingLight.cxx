@@ -44,7 +44,7 @@ void checkLightPower(const Rgb& power)
   }
 }
 
-void checkPoses(const std::vector<LightPose>& poses)
+void checkPoses(const std::vector<LightPose>& poses, const Rgb& power)
 {
   if (poses.empty())
   {
@@ -73,6 +73,16 @@ void checkPoses(const std::vector<LightPose>& poses)
         << "light off)";
       throw Error(s.str());
     }
+    // The outputs are single precision: a pose's power over the bound would write infinities.
+    const Rgb emitted = power * pose.power;
+    if (!(emitted.maxComponent() <= MaximumLightPower))
+    {
+      std::ostringstream s;
+      s << "the power factor of light position " << k << " takes the light to (" << emitted.r
+        << ", " << emitted.g << ", " << emitted.b << ") W, over " << MaximumLightPower
+        << " W per channel: give factors around 1 (a dimmer, 0 is off)";
+      throw Error(s.str());
+    }
     const Rotation& r = pose.rotation;
     const double orthogonality =
       std::max({ std::abs(dot(r.row0, r.row0) - 1), std::abs(dot(r.row1, r.row1) - 1),
@@ -88,7 +98,7 @@ void checkPoses(const std::vector<LightPose>& poses)
 
 void MovingLight::setPoses(const std::vector<LightPose>& poses)
 {
-  checkPoses(poses);
+  checkPoses(poses, this->Power);
   this->Rotates = false;
   for (const LightPose& pose : poses)
   {

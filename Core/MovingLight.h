@@ -128,8 +128,9 @@ private:
 void checkLightPower(const Rgb& power);
 
 /// Throws mlr::Error naming the first pose that is not finite, out of the coordinate range,
-/// not a rotation or of a negative power factor, or when there is no pose.
-void checkPoses(const std::vector<LightPose>& poses);
+/// not a rotation, of a negative power factor or of one that takes the light's `power` over
+/// MaximumLightPower, or when there is no pose.
+void checkPoses(const std::vector<LightPose>& poses, const Rgb& power);
 
 /// What users give for a light in one frame (a Trajectory point and its arrays).
 struct PoseInput

@@ -36,7 +36,7 @@ public:
   /// mlr::Error for bad poses.
   void setPoses(const std::vector<LightPose>& poses)
   {
-    checkPoses(poses);
+    checkPoses(poses, this->Power);
     this->Poses = poses;
   }
   const Vec3& position(std::size_t frame) const { return this->Poses[frame].position; }

@@ -2,6 +2,7 @@
 // emissive scene surfaces.
 #include "CoreChecks.h"
 #include "GeneratedScenes.h"
+#include "PointLight.h"
 #include "Solver.h"
 
 #include <gtest/gtest.h>
@@ -552,6 +553,14 @@ TEST(LightRigs, BadInputIsRefusedWithWhatToFix)
     "power factor of light position 1");
   expectError(withPose(2, [](LightPose& p) { p.power = Rgb(std::nan("")); }),
     "power factor of light position 2");
+  // Finite, but over the bound on a light's power: the outputs would hold infinities.
+  expectError(withPose(1, [](LightPose& p) { p.power = Rgb(1, 2e30, 1); }),
+    "power factor of light position 1 takes the light to (1, 2e+30, 1) W, over 1e+30 W");
+  expectError(
+    [] {
+      PointLight(Rgb(1e29), { LightPose{ Vec3(), Rotation(), Rgb(100) } });
+    },
+    "power factor of light position 0 takes the light to (1e+31, 1e+31, 1e+31) W");
   expectError(withPose(0, [](LightPose& p) { p.position.y = std::nan(""); }), "light position 0");
   // Scaled, sheared, mirrored, NaN: none is a rotation.
   expectError(withPose(1,
