@@ -7,12 +7,15 @@
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
+#include "vtkGenericCell.h"
+#include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
 #include "vtkIntArray.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkStaticCellLocator.h"
 #include "vtkStringArray.h"
 #include "vtkUnsignedCharArray.h"
 
@@ -93,6 +96,91 @@ vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCou
   }
   mesh->GetCellData()->AddArray(reflectance);
   return mesh;
+}
+
+std::vector<vtkIdType> nearestCells(
+  vtkPolyData* scene, const std::vector<Vec3>& points, const std::vector<Triangle>& triangles)
+{
+  std::vector<vtkIdType> nearest(triangles.size(), -1);
+  if (!scene || scene->GetNumberOfCells() == 0)
+  {
+    return nearest;
+  }
+  vtkNew<vtkStaticCellLocator> locator;
+  locator->SetDataSet(scene);
+  locator->BuildLocator();
+  vtkNew<vtkGenericCell> cell;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+  {
+    const Triangle& tri = triangles[t];
+    const Vec3 c = (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0;
+    const double x[3] = { c.x, c.y, c.z };
+    double closest[3];
+    int subId = 0;
+    double distance2 = 0;
+    locator->FindClosestPoint(x, closest, cell, nearest[t], subId, distance2);
+  }
+  return nearest;
+}
+
+void passSceneCellArrays(
+  vtkPolyData* input, const Scene& scene, vtkPolyData* elements, vtkPolyData* patches)
+{
+  static const char* const FrameArrays[] = { "Radiosity", "DirectRadiosity", "IndirectRadiosity",
+    "EmittedRadiosity", "RadiosityFront", "RadiosityBack", "Color", "Irradiance", "Illuminance",
+    "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError" };
+  if (!input)
+  {
+    return;
+  }
+  std::vector<vtkAbstractArray*> passed;
+  vtkCellData* from = input->GetCellData();
+  for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+  {
+    vtkAbstractArray* array = from->GetAbstractArray(a);
+    const std::string name = array && array->GetName() ? array->GetName() : "";
+    if (!name.empty() && !elements->GetCellData()->HasArray(name.c_str()) &&
+      !patches->GetCellData()->HasArray(name.c_str()) &&
+      name.rfind("MovingLightRadiosity", 0) != 0 && name.rfind("vtk", 0) != 0 &&
+      std::find(std::begin(FrameArrays), std::end(FrameArrays), name) == std::end(FrameArrays))
+    {
+      passed.push_back(array);
+    }
+  }
+  if (passed.empty())
+  {
+    return;
+  }
+  for (auto [mesh, triangles] : { std::make_pair(elements, &scene.elementTriangles()),
+         std::make_pair(patches, &scene.patchTriangles()) })
+  {
+    const std::vector<vtkIdType> nearest = nearestCells(input, scene.points(), *triangles);
+    vtkNew<vtkIdList> sourceIds;
+    vtkNew<vtkIdList> targetIds;
+    for (std::size_t t = 0; t < nearest.size(); ++t)
+    {
+      if (nearest[t] >= 0)
+      {
+        sourceIds->InsertNextId(nearest[t]);
+        targetIds->InsertNextId(static_cast<vtkIdType>(t));
+      }
+    }
+    for (vtkAbstractArray* array : passed)
+    {
+      vtkSmartPointer<vtkAbstractArray> copy;
+      copy.TakeReference(array->NewInstance());
+      copy->SetName(array->GetName());
+      copy->SetNumberOfComponents(array->GetNumberOfComponents());
+      copy->SetNumberOfTuples(static_cast<vtkIdType>(triangles->size()));
+      copy->InsertTuples(targetIds, sourceIds, array);
+      mesh->GetCellData()->AddArray(copy);
+    }
+    vtkAbstractArray* names = input->GetFieldData()->GetAbstractArray("MaterialNames");
+    if (names && mesh->GetCellData()->HasArray("MaterialId"))
+    {
+      mesh->GetFieldData()->AddArray(names);
+    }
+  }
 }
 
 void addElementRadiosity(

@@ -59,6 +59,25 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points);
 /// with `Reflectance`.
 vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCount);
 
+/// The cell of `scene` nearest each triangle's centroid (given by `triangles` on `points`):
+/// the input cell a patch or an element was remeshed from, -1 for an empty scene.
+std::vector<vtkIdType> nearestCells(
+  vtkPolyData* scene, const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
+
+/**
+ * Gives each element of `elements` and patch of `patches` (the meshes of `scene`) the values
+ * of the user's own cell arrays on its nearest cell of `input` (a zone, a MaterialId with its
+ * field data MaterialNames), as vtkProbeFilter passes a source's arrays: remeshing merges
+ * input cells, so an element has no input cell of its own. Left out: arrays the meshes
+ * already have (their Reflectance), those a frame writes (a scene that is an earlier output
+ * would keep a stale Radiosity), the filter's own MovingLightRadiosity* arrays and VTK's vtk*
+ * ones (vtkOriginalCellIds, vtkGhostType: how the input was split, not what it is, so that
+ * any number of ranks gives the serial arrays). Nothing is located when there is nothing to
+ * pass.
+ */
+void passSceneCellArrays(
+  vtkPolyData* input, const Scene& scene, vtkPolyData* elements, vtkPolyData* patches);
+
 /// Adds `Radiosity`, `DirectRadiosity` and `IndirectRadiosity` of each element's lit side in
 /// `frame`, and `RadiosityFront`/`RadiosityBack` when `twoSided` (see addDisplayArrays for the
 /// rest of a frame's Elements).

@@ -3,6 +3,7 @@
 #include "Error.h"
 #include "ErrorEstimate.h"
 #include "MovingLightRadiosityDisplay.h"
+#include "MovingLightRadiosityOutputs.h"
 #include "Parallel.h"
 
 #include "vtkCellData.h"
@@ -10,7 +11,6 @@
 #include "vtkCommunicator.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkFieldData.h"
-#include "vtkGenericCell.h"
 #include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
 #include "vtkMultiProcessController.h"
@@ -18,7 +18,6 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkStaticCellLocator.h"
 #include "vtkUnsignedCharArray.h"
 
 #if VTK_MODULE_ENABLE_VTK_ParallelMPI
@@ -687,23 +686,12 @@ std::vector<int> owners(vtkPolyData* scene, const std::vector<int>& cellRanks,
   {
     return owner;
   }
-  vtkNew<vtkStaticCellLocator> locator;
-  locator->SetDataSet(scene);
-  locator->BuildLocator();
-  vtkNew<vtkGenericCell> cell;
+  const std::vector<vtkIdType> nearest = mlr::vtkoutputs::nearestCells(scene, points, triangles);
   for (std::size_t t = 0; t < triangles.size(); ++t)
   {
-    const Triangle& tri = triangles[t];
-    const Vec3 c = (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0;
-    const double x[3] = { c.x, c.y, c.z };
-    double closest[3];
-    vtkIdType cellId = -1;
-    int subId = 0;
-    double distance2 = 0;
-    locator->FindClosestPoint(x, closest, cell, cellId, subId, distance2);
-    if (cellId >= 0 && static_cast<std::size_t>(cellId) < cellRanks.size())
+    if (nearest[t] >= 0 && static_cast<std::size_t>(nearest[t]) < cellRanks.size())
     {
-      owner[t] = cellRanks[static_cast<std::size_t>(cellId)];
+      owner[t] = cellRanks[static_cast<std::size_t>(nearest[t])];
     }
   }
   return owner;

@@ -1305,6 +1305,14 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
           : "Perez (1990) efficacy of the direct sun");
       fieldData->AddArray(model);
     }
+    // The meshes' own field data: the scene's MaterialNames beside a MaterialId passed on.
+    vtkPolyData* mesh = port == ELEMENTS_PORT ? cache.Elements.Get()
+      : port == PATCHES_PORT                  ? cache.Patches.Get()
+                                              : nullptr;
+    for (int a = 0; mesh && a < mesh->GetFieldData()->GetNumberOfArrays(); ++a)
+    {
+      fieldData->AddArray(mesh->GetFieldData()->GetAbstractArray(a));
+    }
     output->SetFieldData(fieldData);
   }
   output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), cache.Times[frame]);
@@ -1789,6 +1797,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
           cache.AutoExposure =
             firstChunkExposure ? *firstChunkExposure : mlr::vtkoutputs::autoExposure(frames);
           cache.Patches = mlr::vtkoutputs::patchMesh(solving.scene, solving.patches.points.size());
+          mlr::vtkoutputs::passSceneCellArrays(
+            sceneData, solving.scene, cache.Elements, cache.Patches);
           cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(frames);
           cache.TwoSided = solverOptions.twoSided;
           cache.FirstChunkLitSides = frames.litSideData();
@@ -1886,6 +1896,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
       cache.AutoExposure = apart ? apart->exposure : mlr::vtkoutputs::autoExposure(solution);
       cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
+      mlr::vtkoutputs::passSceneCellArrays(sceneData, scene, cache.Elements, cache.Patches);
       cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
       mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
       cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);

@@ -59,7 +59,10 @@
  *   that a room made of outward-facing polygons still shows its lit walls, and a surface
  *   one side, not each element's noisier choice), `RadiosityFront`
  *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
- *   display colour of `Radiosity` (see Exposure). For smooth shading its points are split
+ *   display colour of `Radiosity` (see Exposure). The Scene's own cell arrays (a zone, a
+ *   `MaterialId` with the field data `MaterialNames`) are passed on to the elements and
+ *   patches, each taking the values of the Scene cell nearest its centre, since remeshing
+ *   merges coplanar cells. For smooth shading its points are split
  *   along creases (lit-side normals more than 30 degrees apart), between materials and
  *   between the lit sides of thin walls, and carry `Radiosity` (area-weighted mean of the
  *   cells around the point), `Color` (its display colour) and `ScenePointId` (the remeshed

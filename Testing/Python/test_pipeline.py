@@ -442,6 +442,72 @@ def test_a_multiblock_matches_materials_by_name():
         assert radiosity.GetOutput(2).GetNumberOfCells() == polygons, material
 
 
+def test_the_scenes_own_cell_arrays_reach_every_element_and_patch():
+    # Remeshing merges coplanar cells, so an element takes the values of the input cell under
+    # its centroid: a zone, a label, a material and its name. A Radiosity the scene carries (an
+    # earlier output read back) is not passed: the frame's own is the solver's.
+    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkStringArray
+    from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet
+    from vtkmodules.vtkFiltersCore import vtkAppendPolyData
+
+    def zoned(quads, materials):
+        data = material_block([(o, p1, p2, m) for (o, p1, p2, _), m in zip(quads, materials)],
+                              ["plaster", "oak"])
+        zone, label, stale = vtkIntArray(), vtkStringArray(), vtkDoubleArray()
+        zone.SetName("Zone")
+        label.SetName("Label")
+        stale.SetName("Radiosity")
+        stale.SetNumberOfComponents(3)
+        for *_, z in quads:
+            zone.InsertNextValue(z)
+            label.InsertNextValue(f"zone {z}")
+            stale.InsertNextTuple3(1e6, 1e6, 1e6)
+        for array in (zone, label, stale):
+            data.GetCellData().AddArray(array)
+        return data
+
+    blocks = vtkMultiBlockDataSet()
+    # One floor in two coplanar halves, which remeshing merges, and a wall.
+    blocks.SetBlock(0, zoned([((0, 0, 0), (0.5, 0, 0), (0, 1, 0), 1),
+                              ((0.5, 0, 0), (1, 0, 0), (0.5, 1, 0), 2)], [0, 1]))
+    blocks.SetBlock(1, zoned([((0, 0, 0), (0, 0, 1), (0, 1, 0), 3)], [0]))
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(blocks)
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetPathStart(0, 0, 1)
+    radiosity.SetPathEnd(0, 0, 1)
+    radiosity.SetNumberOfPositions(1)
+    radiosity.SetNumberOfPaths(4000)
+    radiosity.SetPatchSize(0.2)
+    radiosity.SetNumberOfThreads(2)
+    radiosity.SetErrorBatches(1)
+    messages = {event: recorded(radiosity, event) for event in ("ErrorEvent", "WarningEvent")}
+    radiosity.Update()
+    assert not messages["ErrorEvent"], messages
+    for port in (0, 1):
+        mesh = radiosity.GetOutput(port)
+        zone = mesh.GetCellData().GetArray("Zone")
+        label = mesh.GetCellData().GetAbstractArray("Label")
+        material = mesh.GetCellData().GetArray("MaterialId")
+        names = mesh.GetFieldData().GetAbstractArray("MaterialNames")
+        assert zone and label and material and names, port
+        seen = set()
+        for c in range(mesh.GetNumberOfCells()):
+            cell = mesh.GetCell(c).GetPoints()
+            x, _, z = numpy.mean([cell.GetPoint(i) for i in range(3)], axis=0)
+            if abs(x - 0.5) < 1e-6:
+                continue  # on the line between the halves: either is right
+            expected = 3 if z > 1e-6 else (1 if x < 0.5 else 2)
+            assert zone.GetValue(c) == expected, (port, c, x, z)
+            assert label.GetValue(c) == f"zone {expected}", (port, c)
+            assert names.GetValue(int(material.GetValue(c))) == \
+                ("oak" if expected == 2 else "plaster"), (port, c)
+            seen.add(expected)
+        assert seen == {1, 2, 3}, port
+    radiosity_array = vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity"))
+    assert radiosity_array.max() < 1e5  # the solver's, not the stale 1e6
+
+
 def lamp_scene():
     """A floor and, 1.5 above it, a lamp material of two quads facing down: area centroid
     (0.4333, 1.4167, 1.5), not the mean of its points (x 0.55)."""
