@@ -12,7 +12,9 @@ namespace mlr
 {
 
 /// The logical lines of an OBJ or MTL file: a line ending in a backslash continues on the
-/// next, and a CR before the LF is dropped. number() is the physical line last read, as
+/// next, a CR before the LF is dropped, and so is the UTF-8 byte order mark that Windows
+/// editors put first (left in, it hid the first line's keyword, and a first 'v' line lost
+/// shifted every vertex index after it). number() is the physical line last read, as
 /// messages give it.
 class LogicalLines
 {
@@ -31,6 +33,10 @@ public:
     {
       any = true;
       ++this->Number;
+      if (this->Number == 1 && part.rfind("\xEF\xBB\xBF", 0) == 0)
+      {
+        part.erase(0, 3);
+      }
       if (!part.empty() && part.back() == '\r')
       {
         part.pop_back();

@@ -178,9 +178,11 @@ std::map<std::string, MtlMaterial> readMtl(
 }
 
 /// The material library files an mtllib line names: the whole rest of the line when that is a
-/// file (names with spaces), else each word.
-std::vector<std::string> mtllibFiles(const std::string& rest, const std::filesystem::path& folder)
+/// file (names with spaces), else each word. Backslashes separate folders, as in map_Kd:
+/// files written on Windows name "sub\room.mtl".
+std::vector<std::string> mtllibFiles(std::string rest, const std::filesystem::path& folder)
 {
+  std::replace(rest.begin(), rest.end(), '\\', '/');
   std::error_code error;
   const auto whole = folder / rest;
   if (std::filesystem::is_regular_file(whole, error))

@@ -356,6 +356,42 @@ TEST(SceneReader, MissingMtlFallsBackToGreyWithAWarningNamingTheFile)
   EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "red" }));
 }
 
+TEST(SceneReader, ObjWrittenOnWindowsKeepsItsFirstLineAndFindsItsLibrary)
+{
+  // Notepad's byte order mark, CRLF line ends, and the library in a subfolder named with a
+  // backslash: a mark left in shifted every vertex index after a first 'v' line (a tilted
+  // quad of area 1.225 for the unit square) and hid a first 'newmtl'.
+  const TestFolder scratch("windows-obj");
+  const fs::path& folder = scratch.path;
+  fs::create_directories(folder / "mats");
+  const std::string mark = "\xEF\xBB\xBF";
+  writeFile(folder / "mats" / "scene.mtl",
+    mark + "newmtl white\r\nKd 0.725 0.71 0.68\r\nnewmtl red\r\nKd 0.63 0.065 0.05\r\n");
+  std::string obj = twoMaterialObj("mats\\scene.mtl");
+  // The vertices first, the library after them: the mark sits on a 'v' line.
+  const std::size_t firstVertex = obj.find("v ");
+  obj = mark + obj.substr(firstVertex, obj.find("usemtl") - firstVertex) +
+    obj.substr(0, firstVertex) + obj.substr(obj.find("usemtl"));
+  std::string crlf;
+  for (char c : obj)
+  {
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  }
+  writeFile(folder / "scene.obj", crlf);
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_EQ(result.warnings(), "");
+  ASSERT_EQ(result.output->GetNumberOfCells(), 4);
+  double first[3];
+  result.output->GetPoint(0, first);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    EXPECT_EQ(first[axis], Corners[0][axis]) << axis;
+  }
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.63, 0.065, 0.05, 1e-12);
+}
+
 TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
 {
   const TestFolder scratch("undefined-material");
