@@ -1,6 +1,7 @@
 #include "FrameRenderer.h"
 
 #include "Rgb.h"
+#include "SeriesWriter.h"
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
@@ -15,6 +16,7 @@
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkStaticCellLocator.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkWindowToImageFilter.h"
 
 #include <algorithm>
@@ -405,12 +407,17 @@ void FrameRenderer::render(
   grab->ShouldRerenderOff(); // rendered just above: a second render cost as much again
   vtkNew<vtkPNGWriter> writer;
   writer->SetInputConnection(grab->GetOutputPort());
-  writer->SetFileName(png.string().c_str());
+  writer->WriteToMemoryOn();
   writer->Write();
-  if (writer->GetErrorCode() != 0)
+  vtkUnsignedCharArray* bytes = writer->GetResult();
+  if (writer->GetErrorCode() != 0 || !bytes)
   {
-    throw std::runtime_error("cannot write the picture '" + png.string() + "'");
+    throw std::runtime_error("cannot encode the picture '" + png.string() + "'");
   }
+  writeFileBytes(png,
+    std::string(reinterpret_cast<const char*>(bytes->GetPointer(0)),
+      static_cast<std::size_t>(bytes->GetNumberOfValues())),
+    "the picture");
 }
 
 namespace

@@ -1,10 +1,13 @@
 #include "Messages.h"
 
+#include "Error.h"
+
 #include "vtkLogger.h"
 #include "vtkObjectFactory.h"
 #include "vtkOutputWindow.h"
 #include "vtkSmartPointer.h"
 
+#include <atomic>
 #include <iostream>
 
 namespace mlr::cli
@@ -16,6 +19,7 @@ std::string Program = "moving-light-radiosity";
 std::size_t Errors = 0;
 std::string LastError;
 bool Quiet = false;
+std::atomic<bool> Aborting{ false };
 
 /// "ERROR: In file.cxx, line 12\nvtkSomething (0x1234): what went wrong\n\n" -> "what went wrong"
 std::string condensed(std::string text)
@@ -55,7 +59,8 @@ public:
     }
     // The executive repeats every failed request with a dump of its pipeline information;
     // the algorithm's own error already said what is wrong.
-    if (message.find("returned failure for request") == std::string::npos)
+    if (message.find("returned failure for request") == std::string::npos &&
+      !(Aborting && message.find(mlr::Cancelled().what()) != std::string::npos))
     {
       printError(message);
     }
@@ -104,6 +109,11 @@ const std::string& lastVtkError()
 void quietMessages()
 {
   Quiet = true;
+}
+
+void abortingTheFilter()
+{
+  Aborting = true;
 }
 
 void printError(const std::string& message)

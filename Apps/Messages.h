@@ -20,6 +20,10 @@ const std::string& lastVtkError();
 /// From now on nothing is printed: under mpiexec, on the ranks other than 0.
 void quietMessages();
 
+/// The program aborts the filter itself (an interrupt, a frame it could not write): the
+/// filter's error that it was cancelled is not printed, since the program's own reason follows.
+void abortingTheFilter();
+
 /// Prints "program: error: message" on stderr.
 void printError(const std::string& message);
 

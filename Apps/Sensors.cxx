@@ -5,6 +5,7 @@
 #include "InputFiles.h"
 #include "MemoryBudget.h"
 #include "Messages.h"
+#include "SeriesWriter.h"
 
 #include "vtkCellArray.h"
 #include "vtkFloatArray.h"
@@ -769,13 +770,14 @@ void writeSensorFrame(vtkPolyData* sensors, const std::filesystem::path& path)
 {
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetInputData(sensors);
-  writer->SetFileName(path.c_str());
+  writer->WriteToOutputStringOn();
   writer->SetDataModeToAppended();
   writer->SetCompressorTypeToLZ4();
   if (!writer->Write())
   {
-    throw std::runtime_error("could not write the sensors to " + path.string());
+    throw std::runtime_error("cannot encode the sensors of '" + path.string() + "'");
   }
+  writeFileBytes(path, writer->GetOutputString(), "the sensors");
 }
 
 } // namespace mlr::cli

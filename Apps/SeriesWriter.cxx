@@ -239,6 +239,7 @@ void FrameWriter::work()
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToLZ4();
+  writer->WriteToOutputStringOn();
   std::unique_lock<std::mutex> lock(this->Mutex);
   for (;;)
   {
@@ -262,12 +263,11 @@ void FrameWriter::work()
       grid->GetPointData()->ShallowCopy(job.pointData);
       grid->GetCellData()->ShallowCopy(job.cellData);
       grid->GetFieldData()->ShallowCopy(job.fieldData);
-      writer->SetFileName(job.path.string().c_str());
       if (!writer->Write() || writer->GetErrorCode() != 0)
       {
-        throw std::runtime_error("cannot write '" + job.path.string() +
-          "': check the disk space and the permissions of its directory");
+        throw std::runtime_error("cannot encode the frame '" + job.path.string() + "'");
       }
+      writeFileBytes(job.path, writer->GetOutputString(), "the frame");
     }
     catch (...)
     {
@@ -311,6 +311,19 @@ std::string xmlEscaped(const std::string& text)
   }
   return escaped;
 }
+}
+
+void writeFileBytes(
+  const std::filesystem::path& path, const std::string& bytes, const std::string& what)
+{
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out)
+  {
+    throw std::runtime_error("cannot write " + what + " '" + path.string() +
+      "': check the disk space and the permissions of its directory");
+  }
 }
 
 void writeCollection(

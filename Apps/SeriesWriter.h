@@ -99,6 +99,14 @@ private:
   std::vector<std::thread> Threads;
 };
 
+/**
+ * Writes `bytes` to `path` (created or truncated), or throws naming `what` and the path when
+ * any of them cannot be written. The VTK writers write through this, from memory: VTK 9.2's
+ * XML writers crash on a full disk instead of returning their error.
+ */
+void writeFileBytes(
+  const std::filesystem::path& path, const std::string& bytes, const std::string& what);
+
 /// Writes the .pvd collection: (time, file name relative to the .pvd) per frame.
 void writeCollection(
   const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);

@@ -395,6 +395,7 @@ public:
           {
             if (Interrupted)
             {
+              abortingTheFilter();
               filter->SetAbortExecuteAndUpdateTime();
               return;
             }
@@ -669,6 +670,7 @@ int run(int argc, char** argv, RankJob& job)
       auto* algorithm = static_cast<vtkMovingLightRadiosity*>(caller);
       if (Interrupted)
       {
+        abortingTheFilter();
         algorithm->SetAbortExecute(1);
       }
       // The error estimate's messages (rounds, estimates) as lines above the bar.
@@ -766,6 +768,7 @@ int run(int argc, char** argv, RankJob& job)
         catch (...)
         {
           streamFailure = std::current_exception();
+          abortingTheFilter();
           filter->SetAbortExecute(1);
         }
       });
