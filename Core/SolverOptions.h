@@ -18,8 +18,8 @@ struct SolverOptions
   /// k: gathering rays per frame = k * N, shared over the element sides that gather.
   double gatheringRatio = 1.0;
   /// lambda: probability that a path continues after its first hit, in [0.001, 1]. A walk
-  /// that survives carries 1/lambda of its power; the bound keeps the fixed-point sums (2^23
-  /// times the light's power per slot) far from overflow.
+  /// that survives carries 1/lambda of its power; the bound keeps the fixed-point sums (a slot
+  /// holds at least 2^13 times the light's power: quantumFor in Shooting.cxx) far from overflow.
   double firstBounceSurvival = 0.25;
   /// Cast M = N/n paths from each position and weight them for every frame.
   bool reuseShooting = true;

@@ -22,8 +22,10 @@
  *   other data set or a composite, its surface, as for the Scene. The
  *   integer cell array `LightId` groups them into several lights (one light without it); the
  *   cell array `LightPower` (3 components, W) gives each light its power, else each gets the
- *   LightPower property. A light's area centroid is its reference point. Lights do not cast
- *   shadows.
+ *   LightPower property. A light's area centroid is its reference point. The Light's polygons
+ *   only emit; they are not part of the scene's geometry: no ray stops at them (they shadow
+ *   neither this light, nor another, nor light the scene reflects) and they receive no
+ *   light. Emitting cells of the Scene are surfaces, and occlude like any other.
  * - port 2, Trajectory (optional): with one light, the points, in order, are the positions
  *   of the light's centroid, one per frame; with several, one polyline per light in LightId
  *   order (a polyline of one point is a light that does not move; moving lights must have one
