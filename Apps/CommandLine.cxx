@@ -95,15 +95,21 @@ std::vector<std::string> split(const std::string& text)
   return fields;
 }
 
-Triple parseTriple(const std::string& option, const std::string& text)
+/// Three numbers, as `shape` ("X,Y,Z", "R,G,B") names them.
+Triple parseThree(const std::string& option, const std::string& text, const std::string& shape)
 {
   const std::vector<std::string> fields = split(text);
   if (fields.size() != 3)
   {
-    throw UsageError(option + " needs three numbers X,Y,Z, not '" + text + "'");
+    throw UsageError(option + " needs three numbers " + shape + ", not '" + text + "'");
   }
   return { parseNumber(option, fields[0]), parseNumber(option, fields[1]),
     parseNumber(option, fields[2]) };
+}
+
+Triple parseTriple(const std::string& option, const std::string& text)
+{
+  return parseThree(option, text, "X,Y,Z");
 }
 
 /// HH:MM (00:00 to 24:00) as hours.
@@ -221,7 +227,7 @@ Triple parsePower(const std::string& option, const std::string& text)
 {
   if (text.find(',') != std::string::npos)
   {
-    return parseTriple(option, text);
+    return parseThree(option, text, "R,G,B");
   }
   const double power = parseNumber(option, text);
   return { power, power, power };
@@ -778,6 +784,14 @@ void configureFilter(const Options& o, vtkMovingLightRadiosity* filter)
     {
       checkRange("--light-power", p, 0.0, mlr::MaximumLightPower);
     }
+    if (o.lightLumens &&
+      mlr::luminance(mlr::Rgb((*o.lightPower)[0], (*o.lightPower)[1], (*o.lightPower)[2])) <= 0)
+    {
+      throw UsageError("--light-lumens takes the light's colour from --light-power, which is " +
+        mlr::formatNumber((*o.lightPower)[0]) + "," + mlr::formatNumber((*o.lightPower)[1]) + "," +
+        mlr::formatNumber((*o.lightPower)[2]) +
+        ", black: give a colour (1,1,1 for white) or leave --light-power out");
+    }
     filter->SetLightPower(o.lightPower->data());
   }
   if (o.lightMaterial)
@@ -1016,8 +1030,9 @@ Scene and light:
                         every light emits with this luminous intensity distribution (IES
                         LM-63 or EULUMDAT), its nadir along an area light's normal (C = 0
                         along its first edge) or a point light's -z (C = 0 along +x);
-                        without --light-lumens or --light-power the light emits the file's
-                        own flux, else only its shape is used (default: diffuse, Lambertian).
+                        without --light-lumens, --light-power or --light-material the light
+                        emits the file's own flux, else only its shape is used (default:
+                        diffuse, Lambertian).
                         An IES TILT=INCLUDE table scales each position's power by its factor
                         at that position's tilt from straight down (-up, see --up)
   --luminaire           the --light-distribution file's luminaire as an area light of its

@@ -196,7 +196,7 @@ std::string lookalikeOf(vtkPolyData* scene, const std::string& name, const std::
       {
         return std::string(": it has a ") + (data == scene->GetCellData() ? "cell" : "point") +
           " array '" + other + "' (names differ in case): rename it " + name + ", or set " +
-          property + " to '" + other + "'" +
+          property + " to '" + other + "' (in ParaView or Python)" +
           (data == scene->GetCellData()
               ? ""
               : ", and convert it with Point Data to Cell Data (vtkPointDataToCellData)");

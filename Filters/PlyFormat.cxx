@@ -567,7 +567,8 @@ Scene readPly(
       }
       if (value > 1.0 + 1e-9)
       {
-        fail("has a colour above 1: float colours must be from 0 to 1");
+        fail("has a colour above 1: give float colours from 0 to 1, 8-bit ones from 0 to 255 "
+             "and 16-bit ones from 0 to 65535");
       }
       clamped += value > MaxReflectance ? 1 : 0;
       value = std::min(value, MaxReflectance);

@@ -1597,6 +1597,14 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       if (fromMaterial)
       {
         lights.push_back(materialLight.light);
+        if (this->LightPowerFromMaterial && !materialLight.light.hasPower &&
+          !(this->LightFluxLumens > 0) && !this->LightFluxFromFile)
+        {
+          warnings.push_back("the LightMaterial '" + this->LightMaterial +
+            "' emits nothing of its own (no emission): the light emits LightPower, " +
+            mlr::formatNumber(this->LightPower[0]) + ", " + mlr::formatNumber(this->LightPower[1]) +
+            ", " + mlr::formatNumber(this->LightPower[2]) + " W");
+        }
         lights.back().hasPower = lights.back().hasPower && this->LightPowerFromMaterial;
       }
       else

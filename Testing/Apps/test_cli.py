@@ -169,6 +169,9 @@ def test_bad_option_fails_with_a_message_and_writes_nothing(tmp_path, args, mess
     (["--gather-ratio", "1e999"], "--gather-ratio needs a number, not '1e999'"),
     (["--from", "1,2"], "--from needs three numbers X,Y,Z, not '1,2'"),
     (["--aim", "1,2,3,"], "--aim needs three numbers X,Y,Z, not '1,2,3,'"),
+    (["--light-power", "1,2"], "--light-power needs three numbers R,G,B, not '1,2'"),
+    (["--light-lumens", "1000", "--light-power", "0,0,0"],
+     "--light-lumens takes the light's colour from --light-power, which is 0,0,0, black"),
     # CLI11 takes the next word as the value: these solved and wrote a file named --help.
     (["--stats", "--help"], "--stats needs a value: --stats FILE.json, not the option '--help'"),
     (["--png", "--help"], "--png needs a value: --png DIR, not the option '--help'"),

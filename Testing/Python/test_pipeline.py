@@ -508,6 +508,28 @@ def test_the_scenes_own_cell_arrays_reach_every_element_and_patch():
     assert radiosity_array.max() < 1e5  # the solver's, not the stale 1e6
 
 
+def test_a_light_material_that_emits_nothing_says_what_it_emits_instead():
+    # A material with no emission cannot give the light's power: LightPower does, said once.
+    blocks = material_block([((0, 0, 0), (2, 0, 0), (0, 2, 0), 0),
+                             ((0.8, 1.2, 1.5), (1.2, 1.2, 1.5), (0.8, 0.8, 1.5), 1)],
+                            ["floor", "lamp"])
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(blocks)
+    radiosity.SetLightMaterial("lamp")
+    radiosity.SetLightPower(30, 20, 10)
+    radiosity.SetNumberOfPositions(1)
+    radiosity.SetNumberOfPaths(2000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetErrorBatches(1)
+    messages = {event: recorded(radiosity, event) for event in ("ErrorEvent", "WarningEvent")}
+    assert radiosity.UpdateTimeStep(0.0)
+    assert not messages["ErrorEvent"], messages
+    assert sum("the LightMaterial 'lamp' emits nothing of its own (no emission): the light "
+               "emits LightPower, 30, 20, 10 W" in w for w in messages["WarningEvent"]) == 1, \
+        messages
+    assert field(radiosity.GetOutput(3), "LightPower") == pytest.approx((30, 20, 10))
+
+
 def lamp_scene():
     """A floor and, 1.5 above it, a lamp material of two quads facing down: area centroid
     (0.4333, 1.4167, 1.5), not the mean of its points (x 0.55)."""
