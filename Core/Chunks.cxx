@@ -3,6 +3,7 @@
 #include "Error.h"
 #include "ErrorEstimate.h"
 #include "Parallel.h"
+#include "Plural.h"
 #include "Ranks.h"
 
 #include <algorithm>
@@ -11,6 +12,8 @@
 #include <cmath>
 #include <numeric>
 #include <optional>
+#include <set>
+#include <sstream>
 #include <string>
 #include <type_traits>
 
@@ -601,6 +604,14 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   ErrorEstimateSummary errors;
   std::vector<Side> litSides, patchLitSides;
   std::vector<std::string> warnings;
+  struct
+  {
+    std::size_t count = 0;
+    double worst = 0;
+    std::size_t frame = 0;
+    std::set<std::string> by;
+    std::string first;
+  } missed;
   if (options.chunkOverlap > plan.overlap)
   {
     warnings.push_back("the chunk overlap of " + std::to_string(options.chunkOverlap) +
@@ -634,6 +645,15 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         { return progress(base + share * f); };
       }
       progressBase += share;
+      if (options.timeLimitSeconds > 0)
+      {
+        // The limit is the whole solve's: what is left of it is shared among this rank's
+        // chunks still to solve (each alone ran up to the whole limit, 100 chunks 100 times).
+        const double left = options.timeLimitSeconds -
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const std::size_t chunksLeft = (chunkCount - 1 - k) / ranks + 1;
+        chunkOptions.timeLimitSeconds = std::max(1e-3, left / static_cast<double>(chunksLeft));
+      }
       if (options.log)
       {
         options.log("chunk " + std::to_string(k + 1) + " of " + std::to_string(chunkCount) +
@@ -643,6 +663,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       }
       // Over ranks a chunk is solved alone; a failure or cancel on any rank stops every rank
       // here, before the exchange.
+      chunkOptions.firstFrame = c.solveBegin;
       auto solveChunk = [&]
       {
         current =
@@ -658,7 +679,20 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       }
       for (const std::string& w : current.warnings)
       {
-        if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
+        if (w.rfind(TargetNotReached, 0) == 0)
+        {
+          // One warning for the chunks that missed the target, after them all.
+          const std::vector<double>& p95 = current.errorEstimate.relativeErrorP95;
+          const auto worst = std::max_element(p95.begin(), p95.end());
+          if (!missed.count || (worst != p95.end() && *worst > missed.worst))
+          {
+            missed.worst = worst != p95.end() ? *worst : 0.0;
+            missed.frame = c.solveBegin + static_cast<std::size_t>(worst - p95.begin());
+          }
+          missed.by.insert(current.errorEstimate.stoppedBy);
+          missed.first = missed.count++ == 0 ? w : missed.first;
+        }
+        else if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
         {
           warnings.push_back(w);
         }
@@ -796,6 +830,24 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
                      [](const std::string& w) { return w.rfind("no light reached", 0) == 0; }),
       warnings.end());
+  }
+  if (missed.count == 1)
+  {
+    warnings.push_back(missed.first);
+  }
+  else if (missed.count > 1)
+  {
+    std::string by;
+    for (const std::string& reason : missed.by)
+    {
+      by += (by.empty() ? "the " : " and the ") + reason;
+    }
+    std::ostringstream s;
+    s << TargetNotReached << " " << percent(options.targetRelativeError) << " was not reached in "
+      << missed.count << " of " << countOf(chunkCount, "chunk") << ": " << by
+      << " stopped them, the worst with a p95 relative error of " << percent(missed.worst)
+      << " in frame " << missed.frame;
+    warnings.push_back(s.str());
   }
   Solution& out = onFrames ? result : whole;
   if (!onFrames)

@@ -268,14 +268,6 @@ private:
   std::vector<std::uint8_t> ElementRowSeen, PatchRowSeen;
 };
 
-std::string percent(double fraction)
-{
-  std::ostringstream s;
-  s.precision(3);
-  s << 100 * fraction << "%";
-  return s.str();
-}
-
 std::string seconds(double value)
 {
   std::ostringstream s;
@@ -299,6 +291,14 @@ std::pair<double, std::size_t> worstFrame(const Solution& result, const BatchSpr
   }
   return worst;
 }
+}
+
+std::string percent(double fraction)
+{
+  std::ostringstream s;
+  s.precision(3);
+  s << 100 * fraction << "%";
+  return s.str();
 }
 
 void validateErrorOptions(const SolverOptions& options)
@@ -563,7 +563,7 @@ void solveInBatches(const Scene& scene, const SolverOptions& options, const Batc
     std::ostringstream s;
     s << "error estimate, round " << summary.rounds << ": " << spread.count() << " batches, "
       << summary.pathsPerFrame << " paths per frame, p95 relative error " << percent(p95)
-      << " (frame " << frame << "), target " << percent(target);
+      << " (frame " << options.firstFrame + frame << "), target " << percent(target);
     if (p95 <= target)
     {
       log(s.str() + ": reached");
@@ -616,10 +616,10 @@ void solveInBatches(const Scene& scene, const SolverOptions& options, const Batc
   if (target > 0 && stoppedBy != "target")
   {
     std::ostringstream s;
-    s << "the target relative error " << percent(target) << " was not reached: the " << stoppedBy
+    s << TargetNotReached << " " << percent(target) << " was not reached: the " << stoppedBy
       << " stopped the solve after " << summary.batches << " batches (" << summary.pathsPerFrame
       << " paths per frame), with a p95 relative error of " << percent(worst) << " in frame "
-      << worstAt;
+      << options.firstFrame + worstAt;
     result.warnings.push_back(s.str());
   }
 }

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace mlr
@@ -85,6 +86,12 @@ FrameError relativeErrorFigures(std::vector<double>& relative);
 /// the round lands under the target, clamped to [MinimumRoundGrowth, MaximumRoundGrowth]
 /// times `batches` and rounded up.
 std::uint64_t nextBatchCount(std::uint64_t batches, double p95, double target);
+
+/// A relative error as the messages give it: "12.5%" (3 significant digits).
+std::string percent(double fraction);
+
+/// How the warning that a solve stopped short of its target begins.
+constexpr const char* TargetNotReached = "the target relative error";
 
 /// Solves one batch with `batchOptions` (its paths per frame and seed) into a Solution it
 /// returns; `fraction` gets the share of the batch done, false cancels.

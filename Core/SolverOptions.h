@@ -58,13 +58,17 @@ struct SolverOptions
   /// percentile of the lit elements' relative error is at most this, or a limit stops it.
   double targetRelativeError = 0;
   /// With a target: start no more batches once this many seconds have passed (0: no limit).
-  /// The round count then depends on the machine's speed: the result is no longer
-  /// reproducible.
+  /// In chunks it is the whole solve's, what is left of it shared among the chunks still to
+  /// solve, each of which completes its first round. The round count then depends on the
+  /// machine's speed: the result is no longer reproducible.
   double timeLimitSeconds = 0;
   /// The unit the results are stored in (Solution::storageScale), a power of two; 0 takes
   /// it from the scene and the rig solved (storageScaleFor). Solves whose results are
   /// blended, as the chunks of one animation, set the one of the whole rig.
   double storageScale = 0;
+  /// The animation's frame number of the first position solved, for the messages only: a
+  /// chunk's messages name the frames as the animation numbers them, not as the chunk does.
+  std::size_t firstFrame = 0;
 
   /// A solve shared by `ranks` processes (MPI ranks of pvbatch or pvserver), this one being
   /// `rank`. Every rank gives the same scene, rig and options; each traces a disjoint share
@@ -124,8 +128,8 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
     reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, chunkOverlap,
-    errorBatches, targetRelativeError, timeLimitSeconds, storageScale, rank, ranks, sumAcrossRanks,
-    sumDoublesAcrossRanks, log, batchSolved] = options;
+    errorBatches, targetRelativeError, timeLimitSeconds, storageScale, firstFrame, rank, ranks,
+    sumAcrossRanks, sumDoublesAcrossRanks, log, batchSolved] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -147,6 +151,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   // the limit.
   visit("timeLimitSeconds", timeLimitSeconds, OptionRole::Result);
   visit("storageScale", storageScale, OptionRole::Result);
+  visit("firstFrame", firstFrame, OptionRole::PerRank);
   visit("rank", rank, OptionRole::PerRank);
   visit("ranks", ranks, OptionRole::Result);
   visit("sumAcrossRanks", sumAcrossRanks, OptionRole::Hook);

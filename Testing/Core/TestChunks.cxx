@@ -4,6 +4,7 @@
 #include "Animation.h"
 #include "Chunks.h"
 #include "CoreChecks.h"
+#include "ErrorEstimate.h"
 #include "GeneratedScenes.h"
 #include "MemoryPlan.h"
 #include "ThreadRanks.h"
@@ -156,6 +157,51 @@ TEST(Chunks, ThreadCountDoesNotChangeABit)
   // Chunks differ from the plain solve: each reuses paths over its own positions only.
   Solution plain = solve(scene, rig(), o);
   EXPECT_FALSE(checks::sameBits(one.directData(), plain.directData()));
+}
+
+TEST(Chunks, ATimeLimitIsTheWholeSolvesAndItsMessagesNameTheAnimationsFrames)
+{
+  // A limit too short for any round after the first: every chunk stops after its first
+  // round. Each chunk alone ran up to the whole limit before; its messages named the
+  // chunk's own positions ("frame 0" in every chunk), and each chunk warned apart.
+  const Scene scene = box();
+  SolverOptions o = options(4000, 3);
+  o.errorBatches = 2;
+  o.targetRelativeError = 1e-4;
+  o.timeLimitSeconds = 1e-6;
+  std::vector<std::string> log;
+  o.log = [&](const std::string& line) { log.push_back(line); };
+  const Solution s = solveInChunks(scene, rig(), o, 4);
+  ASSERT_EQ(s.statistics.chunks, 3u);
+  EXPECT_EQ(s.errorEstimate.stoppedBy, "time limit");
+  std::vector<std::size_t> roundFrames;
+  for (const std::string& line : log)
+  {
+    const std::size_t at = line.find("(frame ");
+    if (line.rfind("error estimate, round 1", 0) == 0 && at != std::string::npos)
+    {
+      roundFrames.push_back(std::stoul(line.substr(at + 7)));
+    }
+  }
+  ASSERT_EQ(roundFrames.size(), 3u);
+  // Chunk k solves the positions from 4k - 1 (its overlap) to 4k + 4.
+  for (std::size_t k = 0; k < 3; ++k)
+  {
+    EXPECT_GE(roundFrames[k] + 1, 4 * k) << k;
+    EXPECT_LT(roundFrames[k], 4 * k + 5) << k;
+  }
+  std::size_t notReached = 0;
+  for (const std::string& w : s.warnings)
+  {
+    if (w.rfind(TargetNotReached, 0) == 0)
+    {
+      ++notReached;
+      EXPECT_NE(
+        w.find("was not reached in 3 of 3 chunks: the time limit stopped them"), std::string::npos)
+        << w;
+    }
+  }
+  EXPECT_EQ(notReached, 1u);
 }
 
 TEST(Chunks, TheSidesLightCanReachAreProbedOnceForEveryChunk)

@@ -52,6 +52,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.batchSolved = [](std::uint64_t, std::size_t, const Solution&) {};
   else if (name == "rank")
     options.rank = 1;
+  else if (name == "firstFrame")
+    options.firstFrame = 8;
   else if (name == "ranks")
     options.ranks = 2;
   else if (name == "sumAcrossRanks")
@@ -79,7 +81,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 22u);
+  EXPECT_EQ(names.size(), 23u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)
