@@ -604,6 +604,9 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   ErrorEstimateSummary errors;
   std::vector<Side> litSides, patchLitSides;
   std::vector<std::string> warnings;
+  // Streamed, every frame shows the side the first chunk chose; the sums of every chunk say
+  // whether the whole animation would have chosen another (a warning).
+  std::vector<Solution::SideTotals> animationTotals;
   struct
   {
     std::size_t count = 0;
@@ -700,6 +703,19 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       if (overRanks && shape.elementCount() == 0)
       {
         shape = shapedLike(current, 1);
+      }
+      if (onFrames)
+      {
+        const std::vector<Solution::SideTotals> totals =
+          current.surfaceTotals(scene, resolveThreadCount(options.threads));
+        animationTotals.resize(totals.size());
+        for (std::size_t r = 0; r < totals.size(); ++r)
+        {
+          animationTotals[r].front += totals[r].front;
+          animationTotals[r].back += totals[r].back;
+          animationTotals[r].irradianceFront += totals[r].irradianceFront;
+          animationTotals[r].irradianceBack += totals[r].irradianceBack;
+        }
       }
     }
     else
@@ -830,6 +846,52 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
                      [](const std::string& w) { return w.rfind("no light reached", 0) == 0; }),
       warnings.end());
+  }
+  if (onFrames && chunkCount > 1)
+  {
+    if (overRanks)
+    {
+      std::vector<double> sums(4 * scene.regionCount(), 0.0);
+      for (std::size_t r = 0; r < animationTotals.size(); ++r)
+      {
+        const Solution::SideTotals& t = animationTotals[r];
+        std::copy_n(
+          std::array<double, 4>{ t.front, t.back, t.irradianceFront, t.irradianceBack }.begin(), 4,
+          sums.begin() + static_cast<std::ptrdiff_t>(4 * r));
+      }
+      options.sumDoublesAcrossRanks(sums.data(), sums.size());
+      animationTotals.assign(scene.regionCount(), Solution::SideTotals());
+      for (std::size_t r = 0; r < animationTotals.size(); ++r)
+      {
+        animationTotals[r] = { sums[4 * r], sums[4 * r + 1], sums[4 * r + 2], sums[4 * r + 3] };
+      }
+    }
+    std::vector<bool> flipped(animationTotals.size(), false);
+    double flippedArea = 0, area = 0;
+    for (std::size_t p = 0; p < scene.patchCount() && !animationTotals.empty(); ++p)
+    {
+      const Solution::SideTotals& t = animationTotals[scene.patchRegion(p)];
+      area += scene.patchArea(p);
+      if (Solution::litSideOf(t.front, t.back, t.irradianceFront, t.irradianceBack) !=
+        patchLitSides[p])
+      {
+        flipped[scene.patchRegion(p)] = true;
+        flippedArea += scene.patchArea(p);
+      }
+    }
+    const auto surfaces =
+      static_cast<std::size_t>(std::count(flipped.begin(), flipped.end(), true));
+    if (surfaces > 0)
+    {
+      warnings.push_back(countOf(surfaces, "surface") + " (" +
+        percent(area > 0 ? flippedArea / area : 0) + " of the scene's area) " +
+        (surfaces == 1 ? "shows" : "show") +
+        " the side the first chunk lit more, while over the whole animation the other side "
+        "received more light: Radiosity, Color, Irradiance and their standard errors are of "
+        "that first chunk's side in every frame" +
+        (options.twoSided ? " (RadiosityFront and RadiosityBack hold both sides)" : "") +
+        ". Solved in one chunk (more memory, or fewer frames), the animation's side is shown");
+    }
   }
   if (missed.count == 1)
   {

@@ -61,6 +61,51 @@ Solution::SideTotals Solution::elementTotals(std::size_t element) const
   return t;
 }
 
+namespace
+{
+std::vector<Solution::SideTotals> surfaceTotalsOf(const Scene& scene, std::size_t patches,
+  const std::function<Solution::SideTotals(std::size_t element)>& totals, int workers)
+{
+  // One element's estimate is noisy: where its two sides' totals are comparable, choosing
+  // per element would follow the noise, speckle the surface and keep the elements whose
+  // shown side came out high (a biased mean). A surface's pooled sums hardly move with any
+  // one element. Each patch's sum is added in element order on one worker, and the
+  // surfaces' sums in patch order on this thread: the same bits for any worker count.
+  std::vector<Solution::SideTotals> patchTotals(patches);
+  constexpr std::size_t PerTask = 2048;
+  parallelFor((patches + PerTask - 1) / PerTask, workers,
+    [&](std::size_t task, int)
+    {
+      for (std::size_t p = task * PerTask; p < std::min(patches, (task + 1) * PerTask); ++p)
+      {
+        Solution::SideTotals sum;
+        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
+             ++e)
+        {
+          const Solution::SideTotals t = totals(e);
+          const double area = scene.elementArea(e);
+          sum.front += area * t.front;
+          sum.back += area * t.back;
+          sum.irradianceFront += area * t.irradianceFront;
+          sum.irradianceBack += area * t.irradianceBack;
+        }
+        patchTotals[p] = sum;
+      }
+    },
+    [](std::size_t) { return true; });
+  std::vector<Solution::SideTotals> surfaces(scene.regionCount());
+  for (std::size_t p = 0; p < patches; ++p)
+  {
+    Solution::SideTotals& sum = surfaces[scene.patchRegion(p)];
+    sum.front += patchTotals[p].front;
+    sum.back += patchTotals[p].back;
+    sum.irradianceFront += patchTotals[p].irradianceFront;
+    sum.irradianceBack += patchTotals[p].irradianceBack;
+  }
+  return surfaces;
+}
+}
+
 void Solution::chooseLitSides(const Scene& scene, int workers)
 {
   this->chooseLitSides(
@@ -76,42 +121,7 @@ void Solution::chooseLitSides(
       std::to_string(scene.patchCount()) + " patches and a solution of " +
       std::to_string(this->Patches));
   }
-  // One element's estimate is noisy: where its two sides' totals are comparable, choosing
-  // per element would follow the noise, speckle the surface and keep the elements whose
-  // shown side came out high (a biased mean). A surface's pooled sums hardly move with any
-  // one element. Each patch's sum is added in element order on one worker, and the
-  // surfaces' sums in patch order on this thread: the same bits for any worker count.
-  std::vector<SideTotals> patchTotals(this->Patches);
-  constexpr std::size_t PerTask = 2048;
-  parallelFor((this->Patches + PerTask - 1) / PerTask, workers,
-    [&](std::size_t task, int)
-    {
-      for (std::size_t p = task * PerTask; p < std::min(this->Patches, (task + 1) * PerTask); ++p)
-      {
-        SideTotals sum;
-        for (std::size_t e = p * Scene::ElementsPerPatch; e < (p + 1) * Scene::ElementsPerPatch;
-             ++e)
-        {
-          const SideTotals t = totals(e);
-          const double area = scene.elementArea(e);
-          sum.front += area * t.front;
-          sum.back += area * t.back;
-          sum.irradianceFront += area * t.irradianceFront;
-          sum.irradianceBack += area * t.irradianceBack;
-        }
-        patchTotals[p] = sum;
-      }
-    },
-    [](std::size_t) { return true; });
-  std::vector<SideTotals> surfaces(scene.regionCount());
-  for (std::size_t p = 0; p < this->Patches; ++p)
-  {
-    SideTotals& sum = surfaces[scene.patchRegion(p)];
-    sum.front += patchTotals[p].front;
-    sum.back += patchTotals[p].back;
-    sum.irradianceFront += patchTotals[p].irradianceFront;
-    sum.irradianceBack += patchTotals[p].irradianceBack;
-  }
+  const std::vector<SideTotals> surfaces = surfaceTotalsOf(scene, this->Patches, totals, workers);
   for (std::size_t p = 0; p < this->Patches; ++p)
   {
     const SideTotals& sum = surfaces[scene.patchRegion(p)];
@@ -120,6 +130,12 @@ void Solution::chooseLitSides(
     std::fill_n(this->LitSide.begin() + static_cast<std::ptrdiff_t>(p * Scene::ElementsPerPatch),
       Scene::ElementsPerPatch, side);
   }
+}
+
+std::vector<Solution::SideTotals> Solution::surfaceTotals(const Scene& scene, int workers) const
+{
+  return surfaceTotalsOf(
+    scene, this->Patches, [this](std::size_t e) { return this->elementTotals(e); }, workers);
 }
 
 } // namespace mlr

@@ -205,6 +205,9 @@ public:
   /// elsewhere (ranks holding frames apart sum elementTotals over the ranks).
   void chooseLitSides(
     const Scene& scene, const std::function<SideTotals(std::size_t element)>& totals, int workers);
+  /// The area-weighted sums of the elements' totals over each surface of `scene`, which
+  /// chooseLitSides chooses from: one per region (Scene::patchRegion).
+  std::vector<SideTotals> surfaceTotals(const Scene& scene, int workers) const;
   /// The rule chooseLitSides applies to a surface's totals on its two sides (its irradiance's,
   /// for a black surface whose totals are both 0): the larger, front on a tie.
   static Side litSideOf(double front, double back, double irradianceFront, double irradianceBack)

@@ -204,6 +204,44 @@ TEST(Chunks, ATimeLimitIsTheWholeSolvesAndItsMessagesNameTheAnimationsFrames)
   EXPECT_EQ(notReached, 1u);
 }
 
+TEST(Chunks, StreamedChunksWarnWhenTheAnimationLitTheOtherSide)
+{
+  // A thin panel under the sun from above for 4 frames, then from below for 8: streamed, every
+  // frame shows the first chunk's side (the top), where the whole animation lit the bottom
+  // more. The run says so; a run whose first chunk chose as the animation does is silent.
+  PatchMesh mesh;
+  scenes::addGriddedQuad(mesh, { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, 4, 4, Rgb(0.5));
+  const Scene scene = Scene::fromPatchMesh(mesh);
+  auto sun = [](std::size_t above)
+  {
+    std::vector<Vec3> towards;
+    for (std::size_t f = 0; f < Frames; ++f)
+    {
+      towards.push_back(f < above ? Vec3(0.1, 0.2, 1) : Vec3(0.1, 0.2, -1));
+    }
+    LightRig r;
+    r.directionalLights.emplace_back(towards, Rgb(100));
+    return r;
+  };
+  const SolverOptions o = options(4000, 5);
+  auto warned = [&](const LightRig& r)
+  {
+    const Solution s = solveInChunks(scene, r, o, 4, {}, [](std::size_t, Solution&) {});
+    EXPECT_EQ(s.statistics.chunks, 3u);
+    return std::count_if(s.warnings.begin(), s.warnings.end(),
+      [](const std::string& w)
+      {
+        return w.find("show the side the first chunk lit more") != std::string::npos ||
+          w.find("shows the side the first chunk lit more") != std::string::npos;
+      });
+  };
+  EXPECT_EQ(warned(sun(4)), 1);
+  EXPECT_EQ(warned(sun(8)), 0);
+  // Assembled rather than streamed, the lit sides are chosen over the whole animation.
+  const Solution whole = solveInChunks(scene, sun(4), o, 4);
+  EXPECT_EQ(whole.litSide(0), Side::Back);
+}
+
 TEST(Chunks, TheSidesLightCanReachAreProbedOnceForEveryChunk)
 {
   // The probes cost a fixed number of rays per patch side: per chunk, they would cost as
