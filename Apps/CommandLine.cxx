@@ -994,9 +994,11 @@ Computes the radiosity of a scene lit by a light that moves along a path, all li
 positions at once with reuse of paths, and writes the animation as a .pvd + .vtu series
 (one unstructured grid per frame with the cell arrays Radiosity, DirectRadiosity,
 IndirectRadiosity, EmittedRadiosity, RadiosityFront/RadiosityBack, Irradiance (the light
-arriving, W/m^2), Illuminance (lx), Reflectance, PatchId, Color, the display colour, and the
-scene's own cell arrays such as MaterialId, and the point arrays Radiosity, Irradiance, Illuminance, Color and ScenePointId on points split
-along creases for smooth shading).
+arriving, W/m^2), Illuminance (lx), their IrradianceFront/IrradianceBack and
+IlluminanceFront/IlluminanceBack of each side, Reflectance, PatchId, Color, the display
+colour, and the scene's own cell arrays such as MaterialId, and the point arrays Radiosity,
+Irradiance, Illuminance, Color and ScenePointId on points split along creases for smooth
+shading).
 
 Without any option it runs the built-in example: the Cornell box with its ceiling light
 moving through 30 positions along a diagonal just below the ceiling, and writes

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 #include <utility>
 
 namespace mlr::vtkoutputs
@@ -281,27 +282,21 @@ void addDisplayArrays(const Solution& solution, const SmoothShading& shading, st
 }
 
 void addIrradianceArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData)
+  double luminousEfficacy, bool twoSided, vtkPointData* pointData, vtkCellData* cellData)
 {
   const std::size_t n = solution.elementCount();
-  std::vector<Rgb> irradiance(n);
-  for (std::size_t e = 0; e < n; ++e)
+  // Irradiance and Illuminance of `values` into `data`, under the names given.
+  auto add = [&](const std::vector<Rgb>& values, vtkDataSetAttributes* data, const char* rgbName,
+               const char* luxName)
   {
-    irradiance[e] = solution.irradiance(frame, e, solution.litSide(e));
-  }
-  const std::vector<Rgb> pointIrradiance = pointMeans(shading, irradiance);
-  for (const auto& [values, data] :
-    { std::make_pair(&std::as_const(irradiance), static_cast<vtkDataSetAttributes*>(cellData)),
-      std::make_pair(&pointIrradiance, static_cast<vtkDataSetAttributes*>(pointData)) })
-  {
-    auto rgb = rgbArray("Irradiance", values->size());
+    auto rgb = rgbArray(rgbName, values.size());
     vtkNew<vtkFloatArray> lux;
-    lux->SetName("Illuminance");
-    lux->SetNumberOfValues(static_cast<vtkIdType>(values->size()));
-    for (std::size_t i = 0; i < values->size(); ++i)
+    lux->SetName(luxName);
+    lux->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
+    for (std::size_t i = 0; i < values.size(); ++i)
     {
       // From the array's single-precision values, so that the two arrays agree exactly.
-      setRgb(rgb, i, (*values)[i]);
+      setRgb(rgb, i, values[i]);
       float stored[3];
       rgb->GetTypedTuple(static_cast<vtkIdType>(i), stored);
       lux->SetValue(static_cast<vtkIdType>(i),
@@ -309,6 +304,26 @@ void addIrradianceArrays(const Solution& solution, const SmoothShading& shading,
     }
     data->AddArray(rgb);
     data->AddArray(lux);
+  };
+  std::vector<Rgb> irradiance(n);
+  for (std::size_t e = 0; e < n; ++e)
+  {
+    irradiance[e] = solution.irradiance(frame, e, solution.litSide(e));
+  }
+  add(irradiance, cellData, "Irradiance", "Illuminance");
+  add(pointMeans(shading, irradiance), pointData, "Irradiance", "Illuminance");
+  if (twoSided)
+  {
+    for (const auto& [side, rgbName, luxName] :
+      { std::make_tuple(Side::Front, "IrradianceFront", "IlluminanceFront"),
+        std::make_tuple(Side::Back, "IrradianceBack", "IlluminanceBack") })
+    {
+      for (std::size_t e = 0; e < n; ++e)
+      {
+        irradiance[e] = solution.irradiance(frame, e, side);
+      }
+      add(irradiance, cellData, rgbName, luxName);
+    }
   }
 }
 

@@ -88,10 +88,13 @@ std::vector<Rgb> pointMeans(const SmoothShading& shading, const std::vector<Rgb>
  * element's lit side in `frame`, direct and indirect, the element's own emission excluded;
  * at points the area-weighted mean, as point `Radiosity`) and `Illuminance` (one component,
  * lm/(scene unit)^2, lx for a scene in metres): `luminousEfficacy` (lm/W) times the
- * luminance of `Irradiance` (Documentation/Method.md, section 15).
+ * luminance of `Irradiance` (Documentation/Method.md, section 15). With `twoSided`, also the
+ * cell arrays `IrradianceFront`, `IrradianceBack`, `IlluminanceFront` and `IlluminanceBack`
+ * of both sides, as RadiosityFront and RadiosityBack: a panel shows one side for the whole
+ * animation, and the frames that light its other side must still say how much arrives there.
  */
 void addIrradianceArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData);
+  double luminousEfficacy, bool twoSided, vtkPointData* pointData, vtkCellData* cellData);
 
 /// Adds `AutoExposure` and `Exposure` (EV) and `ExposureScale`, 2^(AutoExposure + Exposure),
 /// the factor applied to radiosity before the tone map.

@@ -128,7 +128,8 @@ void passSceneCellArrays(
 {
   static const char* const FrameArrays[] = { "Radiosity", "DirectRadiosity", "IndirectRadiosity",
     "EmittedRadiosity", "RadiosityFront", "RadiosityBack", "Color", "Irradiance", "Illuminance",
-    "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError" };
+    "IrradianceFront", "IrradianceBack", "IlluminanceFront", "IlluminanceBack", "RadiosityStdError",
+    "IrradianceStdError", "IlluminanceStdError" };
   if (!input)
   {
     return;

@@ -1164,7 +1164,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
         std::exp2(cache.AutoExposure + this->Exposure), output->GetPointData(),
         output->GetCellData());
       mlr::vtkoutputs::addIrradianceArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
-        output->GetPointData(), output->GetCellData());
+        cache.TwoSided, output->GetPointData(), output->GetCellData());
       mlr::vtkoutputs::addStdErrorArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
         output->GetPointData(), output->GetCellData());
       if (cut)

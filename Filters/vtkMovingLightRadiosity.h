@@ -60,7 +60,8 @@
  *   which it bends by at most 30 degrees, received more power over the whole animation, so
  *   that a room made of outward-facing polygons still shows its lit walls, and a surface
  *   one side, not each element's noisier choice), `RadiosityFront`
- *   and `RadiosityBack` (when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
+ *   and `RadiosityBack`, `IrradianceFront`, `IrradianceBack`, `IlluminanceFront` and
+ *   `IlluminanceBack` (each side's, when TwoSided), `Reflectance` and `PatchId`, and `Color`, the
  *   display colour of `Radiosity` (see Exposure). The Scene's own cell arrays (a zone, a
  *   `MaterialId` with the field data `MaterialNames`) are passed on to the elements and
  *   patches, each taking the values of the Scene cell nearest its centre, since remeshing

@@ -221,3 +221,55 @@ def test_sun_time_steps_and_field_data(sun):
             area += a
         assert total / area == pytest.approx(0.5 * 800 * math.sin(s), rel=0.03)
         assert sun.GetOutput(2).GetNumberOfCells() == 0  # no area light to show
+
+
+def test_a_two_sided_panel_says_what_arrives_on_each_side_in_every_frame():
+    """A vertical panel facing +y under a sun 30 degrees high, from its front in frame 0 and
+    its back in frames 1 and 2: it shows its back (lit more), so frame 0's Irradiance is the
+    back's 0, while IrradianceFront holds the 800 cos 30 W/m^2 arriving in front."""
+    panel = vtkPlaneSource()  # x-z plane, normal (P1 - O) x (P2 - O) = +y
+    panel.SetOrigin(-0.5, 0, 0)
+    panel.SetPoint1(-0.5, 0, 1)
+    panel.SetPoint2(0.5, 0, 0)
+    panel.SetResolution(2, 2)
+    trajectory = vtkPolyData()
+    points = vtkPoints()
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    for direction in ((0, c, s), (0, -c, s), (0, -c, s)):
+        points.InsertNextPoint(*direction)
+    trajectory.SetPoints(points)
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(output(panel))
+    radiosity.SetTrajectoryData(trajectory)
+    radiosity.SetLightTypeToDirectional()
+    radiosity.SetSunIrradiance(800)
+    radiosity.SetNumberOfPaths(200000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetNumberOfThreads(2)
+    expected = 800 * math.cos(math.radians(30))
+    for frame, lit in ((0, "Front"), (1, "Back")):
+        assert radiosity.UpdateTimeStep(float(frame))
+        elements = radiosity.GetOutput(0)
+        cells = elements.GetCellData()
+        n = elements.GetNumberOfCells()
+        efficacy = field(elements, "LuminousEfficacy")
+        side = {name: [cells.GetArray("Irradiance" + name).GetTuple3(c) for c in range(n)]
+                for name in ("Front", "Back")}
+        dark = "Back" if lit == "Front" else "Front"
+        assert all(rgb == (0, 0, 0) for rgb in side[dark]), (frame, dark)
+        # Every element is an unbiased estimate of the same irradiance: their mean is within
+        # 4 standard errors of the mean (the lit frame's reported errors, same sun and paths).
+        radiosity.UpdateTimeStep(1.0)
+        errors = radiosity.GetOutput(0).GetCellData().GetArray("IrradianceStdError")
+        rms = math.sqrt(sum(errors.GetTuple3(c)[0] ** 2 for c in range(n)) / n)
+        assert 0 < rms < 0.1 * expected
+        mean = sum(rgb[0] for rgb in side[lit]) / n
+        assert abs(mean - expected) < 4 * rms / math.sqrt(n), (frame, mean, expected, rms)
+        radiosity.UpdateTimeStep(float(frame))
+        cells = radiosity.GetOutput(0).GetCellData()
+        for c in range(n):
+            # The panel shows its back in every frame, and lux follows each side's watts.
+            assert cells.GetArray("Irradiance").GetTuple3(c) == side["Back"][c]
+            for name in ("Front", "Back"):
+                lux = cells.GetArray("Illuminance" + name).GetValue(c)
+                assert lux == pytest.approx(efficacy * side[name][c][0], rel=1e-5, abs=1e-3)
