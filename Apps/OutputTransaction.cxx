@@ -87,17 +87,59 @@ void OutputTransaction::keep(const fs::path& finalPath)
 
 void OutputTransaction::commit()
 {
+  // The earlier files of these names step aside first, under hidden names, and come back if
+  // any rename fails: renamed one after another, a failure halfway left the new run's first
+  // frames beside the earlier run's last ones and its .pvd.
+  std::vector<std::pair<fs::path, fs::path>> asides; // final, its earlier file's hidden name
+  std::size_t renamed = 0;
+  auto undo = [&]() noexcept
+  {
+    std::error_code ignored;
+    for (std::size_t i = 0; i < renamed; ++i)
+    {
+      fs::rename(this->StagedFiles[i].final, this->StagedFiles[i].temporary, ignored);
+    }
+    for (const auto& [final, aside] : asides)
+    {
+      fs::rename(aside, final, ignored);
+    }
+  };
+  for (const Staged& file : this->StagedFiles)
+  {
+    std::error_code error;
+    if (fs::is_regular_file(file.final, error))
+    {
+      const fs::path aside =
+        file.final.parent_path() / ("." + file.final.filename().string() + ".earlier");
+      fs::rename(file.final, aside, error);
+      if (error)
+      {
+        undo();
+        throw std::runtime_error("cannot replace '" + file.final.string() +
+          "': " + error.message() + ": the earlier files are kept, nothing was written");
+      }
+      asides.emplace_back(file.final, aside);
+    }
+  }
   for (const Staged& file : this->StagedFiles)
   {
     std::error_code error;
     fs::rename(file.temporary, file.final, error);
     if (error)
     {
+      undo();
       throw std::runtime_error("cannot rename '" + file.temporary.string() + "' to '" +
-        file.final.string() + "': " + error.message());
+        file.final.string() + "': " + error.message() +
+        ": the earlier files are kept, nothing was written");
     }
+    ++renamed;
   }
   this->Committed = true;
+  for (const auto& [final, aside] : asides)
+  {
+    std::error_code ignored;
+    fs::remove(aside, ignored);
+  }
 
   std::set<fs::path> kept;
   for (const Staged& file : this->StagedFiles)

@@ -271,6 +271,26 @@ def test_frame_that_cannot_be_written_fails_the_run_and_leaves_nothing(tmp_path)
     assert all_files(tmp_path) == ["out/.s_0003.vtu.partial/keep"]
 
 
+def test_a_commit_that_fails_halfway_keeps_the_earlier_series_whole(tmp_path):
+    """Frame 3's name is taken by a folder when a second run commits: the frames renamed
+    before it step back, and the earlier series is left as it was, byte for byte (renamed one
+    after another, the new run's first frames stood beside the earlier run's .pvd)."""
+    args = ["--scene", SCENE, "--light", LIGHT] + PATH + ["--frames", str(FRAMES),
+                                                          "--output", "out/s.pvd"] + FAST
+    assert run(args, tmp_path).returncode == 0
+    out = tmp_path / "out"
+    (out / "s_0003.vtu").unlink()
+    (out / "s_0003.vtu").mkdir()
+    (out / "s_0003.vtu" / "keep").write_text("not the program's")
+    earlier = {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()}
+    result = run(args + ["--seed", "5"], tmp_path)
+    assert result.returncode == 1
+    assert "the earlier files are kept, nothing was written" in result.stderr, result.stderr
+    assert {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()} == earlier
+    assert sorted(all_files(tmp_path)) == sorted(["out/" + name for name in earlier] +
+                                                 ["out/s_0003.vtu/keep"])
+
+
 def test_xvfb_that_cannot_start_fails_the_run_with_its_message(tmp_path):
     env, pids = fake_xvfb(tmp_path, server="sh -c 'echo \"Fatal server error: no screens\" >&2; exit 1'")
     result = run(["--scene", SCENE, "--light", LIGHT, "--output", "out/s.pvd", "--png", "png",
