@@ -1449,6 +1449,22 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
                          "Y-up scene set Up to 0, 1, 0 (and on a Sun Path source Up 0, 1, 0 "
                          "and North 0, 0, -1)");
     }
+    const bool turned = this->AimAtPoint ||
+      std::any_of(trajectory.lights.begin(), trajectory.lights.end(),
+        [](const std::vector<mlr::PoseInput>& poses)
+        {
+          return std::any_of(poses.begin(), poses.end(),
+            [](const mlr::PoseInput& p) { return p.hasNormal || p.hasOrientation; });
+        });
+    if (format && format->GetNumberOfValues() > 0 && format->GetValue(0) == "glTF" && !turned &&
+      (this->LightType == POINT_LIGHT || this->LightType == LUMINAIRE_LIGHT))
+    {
+      // A point light or luminaire faces -z as given: down in a Z-up scene only.
+      warnings.push_back("the Scene was read from glTF, which is Y-up, and the " +
+        std::string(this->LightType == POINT_LIGHT ? "point light" : "luminaire") +
+        " faces -z, sideways in it: turn it down with AimAtPoint (--aim), or a Trajectory "
+        "Normal 0, -1, 0");
+    }
     cache.Times = trajectory.times;
     // A weather file's frames may skip hours (one per day at noon), a sun path's not: its
     // source says how long a frame lasts.

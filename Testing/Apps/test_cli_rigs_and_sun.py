@@ -399,6 +399,21 @@ def test_gltf_scene_is_y_up_for_the_sun(tmp_path):
             pytest.approx([expected] * 3, rel=0.05)
 
 
+def test_a_point_light_over_a_gltf_scene_is_warned_to_face_sideways(tmp_path):
+    # A point light faces -z: sideways in a Y-up glTF scene, which the run says, unless
+    # something turns it (--aim at the ground faces it down, and the ground is lit).
+    ground = write_gltf_ground(tmp_path)
+    light = ["--scene", ground, "--point-light", "--from", "0,1,0", "--to", "0,1,0",
+             "--frames", "1"]
+    sideways = solve(tmp_path, light, "a/s.pvd")
+    assert "the point light faces -z, sideways in it" in sideways.stderr, sideways.stderr
+    aimed = solve(tmp_path, light + ["--aim", "0,0,0"], "b/s.pvd")
+    assert "sideways" not in aimed.stderr, aimed.stderr
+    lit = numpy.ones(len(aimed[0][1].area), bool)
+    assert aimed[0][1].mean("DirectRadiosity", lit)[0] > \
+        2 * sideways[0][1].mean("DirectRadiosity", lit)[0]
+
+
 def test_sun_directions_with_power_and_irradiance(tmp_path):
     # One box: with the second one, along whose base the ground is split, the remeshing now
     # and then differs from run to run (a Core bug, reported), and these runs are compared
