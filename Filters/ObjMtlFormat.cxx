@@ -1,6 +1,7 @@
 // Wavefront OBJ and the MTL material libraries it names (readObj).
 #include "RadiositySceneFormats.h"
 
+#include "Plural.h"
 #include "SceneText.h"
 #include "SceneTextures.h"
 #include "TextLines.h"
@@ -122,7 +123,9 @@ std::map<std::string, MtlMaterial> readMtl(
   LogicalLines lines(in);
   std::string line, keyword, rest;
   MtlMaterial* current = nullptr;
+  std::string currentName;
   std::set<std::string> repeated;
+  std::vector<std::string> seeThrough;
   while (lines.next(line))
   {
     splitKeyword(line, keyword, rest);
@@ -141,6 +144,20 @@ std::map<std::string, MtlMaterial> readMtl(
           where + ": material " + named(rest) + " is defined again; its first definition is used");
       }
       current = known ? nullptr : &materials[rest];
+      currentName = rest;
+    }
+    else if ((keyword == "d" || keyword == "Tr") && current)
+    {
+      // Glass, curtains and cut-outs: a radiosity surface is opaque. Tr 1 is left out, as
+      // some exporters write it for an opaque material.
+      const std::vector<std::string> values = words(rest);
+      double value = 0;
+      if (!values.empty() && parseNumber(values.back(), value) &&
+        (keyword == "d" ? value < 1 : value > 0 && value < 1) &&
+        std::find(seeThrough.begin(), seeThrough.end(), currentName) == seeThrough.end())
+      {
+        seeThrough.push_back(currentName);
+      }
     }
     else if ((keyword == "map_Kd" || keyword == "map_Ke") && current)
     {
@@ -173,6 +190,18 @@ std::map<std::string, MtlMaterial> readMtl(
   if (in.bad())
   {
     throw FileError("the material library " + named(path) + " could not be read to its end");
+  }
+  if (!seeThrough.empty())
+  {
+    std::string list;
+    for (std::size_t i = 0; i < std::min<std::size_t>(seeThrough.size(), 3); ++i)
+    {
+      list += (i > 0 ? ", " : "") + named(seeThrough[i]);
+    }
+    warn("the material library " + named(path) + " has " + countOf(seeThrough.size(), "material") +
+      " that let light through (d below 1, or Tr): " + list +
+      (seeThrough.size() > 3 ? " ..." : "") +
+      "; they are read as opaque: they block all the light that reaches them");
   }
   return materials;
 }

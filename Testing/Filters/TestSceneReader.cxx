@@ -392,6 +392,23 @@ TEST(SceneReader, ObjWrittenOnWindowsKeepsItsFirstLineAndFindsItsLibrary)
   expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.63, 0.065, 0.05, 1e-12);
 }
 
+TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
+{
+  const TestFolder scratch("see-through");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "scene.mtl",
+    "newmtl white\nKd 0.7\nd 1\nTr 1\nnewmtl red\nKd 0.6 0.1 0.1\nd -halo 0.3\n"
+    "newmtl tinted\nKd 0.5\nTr 0.25\n");
+  writeFile(folder / "scene.obj", twoMaterialObj("scene.mtl"));
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  EXPECT_NE(result.warnings().find("has 2 materials that let light through (d below 1, or Tr): "
+                                   "'red', 'tinted'; they are read as opaque"),
+    std::string::npos)
+    << result.warnings();
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.6, 0.1, 0.1, 1e-12);
+}
+
 TEST(SceneReader, MaterialMissingFromTheMtlIsGreyWithAWarningNamingIt)
 {
   const TestFolder scratch("undefined-material");
