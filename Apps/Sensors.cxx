@@ -770,14 +770,9 @@ void writeSensorFrame(vtkPolyData* sensors, const std::filesystem::path& path)
 {
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetInputData(sensors);
-  writer->WriteToOutputStringOn();
   writer->SetDataModeToAppended();
   writer->SetCompressorTypeToLZ4();
-  if (!writer->Write())
-  {
-    throw std::runtime_error("cannot encode the sensors of '" + path.string() + "'");
-  }
-  writeFileBytes(path, writer->GetOutputString(), "the sensors");
+  writeXml(writer, path, "the sensors");
 }
 
 } // namespace mlr::cli

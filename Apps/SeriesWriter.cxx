@@ -16,6 +16,7 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkXMLUnstructuredGridWriter.h"
+#include "vtkXMLWriter.h"
 
 #include <algorithm>
 #include <cmath>
@@ -239,7 +240,6 @@ void FrameWriter::work()
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToLZ4();
-  writer->WriteToOutputStringOn();
   std::unique_lock<std::mutex> lock(this->Mutex);
   for (;;)
   {
@@ -263,11 +263,7 @@ void FrameWriter::work()
       grid->GetPointData()->ShallowCopy(job.pointData);
       grid->GetCellData()->ShallowCopy(job.cellData);
       grid->GetFieldData()->ShallowCopy(job.fieldData);
-      if (!writer->Write() || writer->GetErrorCode() != 0)
-      {
-        throw std::runtime_error("cannot encode the frame '" + job.path.string() + "'");
-      }
-      writeFileBytes(job.path, writer->GetOutputString(), "the frame");
+      writeXml(writer, job.path, "the frame");
     }
     catch (...)
     {
@@ -320,6 +316,90 @@ void writeFileBytes(
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   out.close();
   if (!out)
+  {
+    throw std::runtime_error("cannot write " + what + " '" + path.string() +
+      "': check the disk space and the permissions of its directory");
+  }
+}
+
+namespace
+{
+/// A file buffer whose writes always succeed as far as its stream can tell: the first that
+/// fails is recorded, and the rest are dropped.
+class RecordingFileBuf : public std::filebuf
+{
+public:
+  bool failed() const { return this->Failed; }
+
+protected:
+  int_type overflow(int_type c) override
+  {
+    if (!this->Failed && traits_type::eq_int_type(std::filebuf::overflow(c), traits_type::eof()) &&
+      !traits_type::eq_int_type(c, traits_type::eof()))
+    {
+      this->Failed = true;
+    }
+    if (this->Failed)
+    {
+      this->setp(this->pbase(), this->epptr());
+    }
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override
+  {
+    if (!this->Failed && std::filebuf::xsputn(s, n) < n)
+    {
+      this->Failed = true;
+    }
+    return n;
+  }
+  int sync() override
+  {
+    if (!this->Failed && std::filebuf::sync() != 0)
+    {
+      this->Failed = true;
+    }
+    return 0;
+  }
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override
+  {
+    const pos_type at =
+      this->Failed ? pos_type(off_type(-1)) : std::filebuf::seekoff(off, dir, which);
+    this->Failed = this->Failed || at == pos_type(off_type(-1));
+    return this->Failed ? pos_type(off_type(0)) : at;
+  }
+  pos_type seekpos(pos_type to, std::ios_base::openmode which) override
+  {
+    const pos_type at = this->Failed ? pos_type(off_type(-1)) : std::filebuf::seekpos(to, which);
+    this->Failed = this->Failed || at == pos_type(off_type(-1));
+    return this->Failed ? to : at;
+  }
+
+private:
+  bool Failed = false;
+};
+
+/// The writer's output stream, which it otherwise opens on its file name itself.
+struct StreamOf : vtkXMLWriter
+{
+  static std::ostream* vtkXMLWriter::*member() { return &StreamOf::Stream; }
+};
+}
+
+void writeXml(vtkXMLWriter* writer, const std::filesystem::path& path, const std::string& what)
+{
+  RecordingFileBuf file;
+  bool written = file.open(path, std::ios::out | std::ios::binary | std::ios::trunc) != nullptr;
+  if (written)
+  {
+    std::ostream stream(&file);
+    writer->*StreamOf::member() = &stream;
+    written = writer->Write() && writer->GetErrorCode() == 0;
+    writer->*StreamOf::member() = nullptr;
+    stream.flush();
+    written = file.close() != nullptr && written && !file.failed();
+  }
+  if (!written)
   {
     throw std::runtime_error("cannot write " + what + " '" + path.string() +
       "': check the disk space and the permissions of its directory");

@@ -21,6 +21,7 @@ class vtkPointData;
 class vtkPoints;
 class vtkPolyData;
 class vtkUnsignedCharArray;
+class vtkXMLWriter;
 
 namespace mlr::cli
 {
@@ -101,11 +102,19 @@ private:
 
 /**
  * Writes `bytes` to `path` (created or truncated), or throws naming `what` and the path when
- * any of them cannot be written. The VTK writers write through this, from memory: VTK 9.2's
- * XML writers crash on a full disk instead of returning their error.
+ * any of them cannot be written (a picture encoded in memory).
  */
 void writeFileBytes(
   const std::filesystem::path& path, const std::string& bytes, const std::string& what);
+
+/**
+ * Writes `path` (created or truncated) with `writer`, an XML writer whose input is set, or
+ * throws naming `what` and the path when any of it cannot be written. The writer streams into
+ * a file buffer that records a failed write instead of reporting it: VTK 9.2's XML writers
+ * crash in their own error path on a full disk, and encoding in memory first would hold whole
+ * frames per writing thread.
+ */
+void writeXml(vtkXMLWriter* writer, const std::filesystem::path& path, const std::string& what);
 
 /// Writes the .pvd collection: (time, file name relative to the .pvd) per frame.
 void writeCollection(

@@ -1,7 +1,9 @@
 #include "MovingLightRadiosityOutputs.h"
 
 #include "MovingLightRadiosityDisplay.h"
+#include "Plural.h"
 
+#include "vtkAbstractCellLocator.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
@@ -72,17 +74,17 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
   // floats) and PatchId; the patch mesh is a quarter of it. Smooth shading splits points at
   // creases: taken as a quarter more points than elements, each with 24 bytes of
   // coordinates, a ScenePointId and an inverse area, and 3 corner ids per element. Per
-  // frame: Radiosity, Direct, Indirect, Front, Back and Irradiance (3 floats each),
-  // Illuminance (a float) and Color (3 bytes) per element, point Radiosity, Irradiance,
-  // Illuminance and Color, and the patches' Radiosity; RadiosityStdError and
-  // IrradianceStdError (3 floats) and IlluminanceStdError (a float) on cells and points,
-  // counted whether or not the solve estimates its error.
+  // frame: Radiosity, Direct, Indirect, Emitted, Front, Back, Irradiance and its Front and
+  // Back (3 floats each), Illuminance and its Front and Back (a float each) and Color (3
+  // bytes) per element, point Radiosity, Irradiance, Illuminance and Color, and the patches'
+  // Radiosity; RadiosityStdError and IrradianceStdError (3 floats) and IlluminanceStdError
+  // (a float) on cells and points, counted whether or not the solve estimates its error.
   const std::uint64_t e = elements, p = points;
   const std::uint64_t split = p + e / 4;
   const std::uint64_t meshes =
     p * 24 + split * (24 + 4 + 8) + e * (32 + 12 + 8 + 24) + e / 4 * (32 + 12);
   const std::uint64_t frame =
-    e * (8 * 12 + 4 + 4 + 3) + split * (12 + 12 + 12 + 12 + 4 + 4 + 3) + e / 4 * 12;
+    e * (11 * 12 + 4 * 4 + 3) + split * (12 + 12 + 12 + 12 + 4 + 4 + 3) + e / 4 * 12;
   return meshes + frame;
 }
 
@@ -98,17 +100,12 @@ vtkSmartPointer<vtkPolyData> patchMesh(const Scene& scene, std::size_t cornerCou
   return mesh;
 }
 
-std::vector<vtkIdType> nearestCells(
-  vtkPolyData* scene, const std::vector<Vec3>& points, const std::vector<Triangle>& triangles)
+namespace
+{
+std::vector<vtkIdType> nearestCellsBy(vtkAbstractCellLocator* locator,
+  const std::vector<Vec3>& points, const std::vector<Triangle>& triangles)
 {
   std::vector<vtkIdType> nearest(triangles.size(), -1);
-  if (!scene || scene->GetNumberOfCells() == 0)
-  {
-    return nearest;
-  }
-  vtkNew<vtkStaticCellLocator> locator;
-  locator->SetDataSet(scene);
-  locator->BuildLocator();
   vtkNew<vtkGenericCell> cell;
   for (std::size_t t = 0; t < triangles.size(); ++t)
   {
@@ -123,39 +120,85 @@ std::vector<vtkIdType> nearestCells(
   return nearest;
 }
 
-void passSceneCellArrays(
-  vtkPolyData* input, const Scene& scene, vtkPolyData* elements, vtkPolyData* patches)
+vtkSmartPointer<vtkStaticCellLocator> locatorOf(vtkPolyData* scene)
 {
-  static const char* const FrameArrays[] = { "Radiosity", "DirectRadiosity", "IndirectRadiosity",
-    "EmittedRadiosity", "RadiosityFront", "RadiosityBack", "Color", "Irradiance", "Illuminance",
-    "IrradianceFront", "IrradianceBack", "IlluminanceFront", "IlluminanceBack", "RadiosityStdError",
-    "IrradianceStdError", "IlluminanceStdError" };
-  if (!input)
+  auto locator = vtkSmartPointer<vtkStaticCellLocator>::New();
+  locator->SetDataSet(scene);
+  locator->BuildLocator();
+  return locator;
+}
+}
+
+std::vector<vtkIdType> nearestCells(
+  vtkPolyData* scene, const std::vector<Vec3>& points, const std::vector<Triangle>& triangles)
+{
+  if (!scene || scene->GetNumberOfCells() == 0)
   {
-    return;
+    return std::vector<vtkIdType>(triangles.size(), -1);
   }
+  return nearestCellsBy(locatorOf(scene), points, triangles);
+}
+
+std::vector<vtkAbstractArray*> sceneCellArraysToPass(
+  vtkPolyData* input, std::vector<std::string>* warnings)
+{
+  // The meshes' own arrays (patchMesh, smoothElementMesh) and those a frame writes.
+  static const char* const OwnArrays[] = { "Reflectance", "PatchId", "Radiosity", "DirectRadiosity",
+    "IndirectRadiosity", "EmittedRadiosity", "RadiosityFront", "RadiosityBack", "Color",
+    "Irradiance", "Illuminance", "IrradianceFront", "IrradianceBack", "IlluminanceFront",
+    "IlluminanceBack", "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError" };
   std::vector<vtkAbstractArray*> passed;
-  vtkCellData* from = input->GetCellData();
-  for (int a = 0; a < from->GetNumberOfArrays(); ++a)
+  vtkCellData* from = input ? input->GetCellData() : nullptr;
+  for (int a = 0; from && a < from->GetNumberOfArrays(); ++a)
   {
     vtkAbstractArray* array = from->GetAbstractArray(a);
     const std::string name = array && array->GetName() ? array->GetName() : "";
-    if (!name.empty() && !elements->GetCellData()->HasArray(name.c_str()) &&
-      !patches->GetCellData()->HasArray(name.c_str()) &&
-      name.rfind("MovingLightRadiosity", 0) != 0 && name.rfind("vtk", 0) != 0 &&
-      std::find(std::begin(FrameArrays), std::end(FrameArrays), name) == std::end(FrameArrays))
+    if (name.empty() || name.rfind("MovingLightRadiosity", 0) == 0 || name.rfind("vtk", 0) == 0 ||
+      std::find(std::begin(OwnArrays), std::end(OwnArrays), name) != std::end(OwnArrays))
     {
-      passed.push_back(array);
+      continue;
     }
+    if (array->GetNumberOfTuples() != input->GetNumberOfCells())
+    {
+      if (warnings)
+      {
+        warnings->push_back("the Scene's cell array '" + name + "' has " +
+          std::to_string(array->GetNumberOfTuples()) + " values for " +
+          countOf(static_cast<std::size_t>(input->GetNumberOfCells()), "cell") +
+          ": it is not passed to the outputs");
+      }
+      continue;
+    }
+    passed.push_back(array);
   }
-  if (passed.empty())
+  return passed;
+}
+
+std::uint64_t bytesPerCell(const std::vector<vtkAbstractArray*>& arrays)
+{
+  std::uint64_t bytes = 0;
+  for (vtkAbstractArray* array : arrays)
+  {
+    // A string array's values are strings of their own: taken at 32 bytes each.
+    const auto value = static_cast<std::uint64_t>(
+      array->IsA("vtkStringArray") ? 32 : std::max(array->GetDataTypeSize(), 1));
+    bytes += value * static_cast<std::uint64_t>(std::max(array->GetNumberOfComponents(), 1));
+  }
+  return bytes;
+}
+
+void passSceneCellArrays(vtkPolyData* input, const std::vector<vtkAbstractArray*>& passed,
+  const Scene& scene, vtkPolyData* elements, vtkPolyData* patches)
+{
+  if (passed.empty() || !input || input->GetNumberOfCells() == 0)
   {
     return;
   }
+  const vtkSmartPointer<vtkStaticCellLocator> locator = locatorOf(input);
   for (auto [mesh, triangles] : { std::make_pair(elements, &scene.elementTriangles()),
          std::make_pair(patches, &scene.patchTriangles()) })
   {
-    const std::vector<vtkIdType> nearest = nearestCells(input, scene.points(), *triangles);
+    const std::vector<vtkIdType> nearest = nearestCellsBy(locator, scene.points(), *triangles);
     vtkNew<vtkIdList> sourceIds;
     vtkNew<vtkIdList> targetIds;
     for (std::size_t t = 0; t < nearest.size(); ++t)

@@ -14,8 +14,10 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
+class vtkAbstractArray;
 class vtkCellData;
 class vtkPointData;
 class vtkPolyData;
@@ -65,18 +67,28 @@ std::vector<vtkIdType> nearestCells(
   vtkPolyData* scene, const std::vector<Vec3>& points, const std::vector<Triangle>& triangles);
 
 /**
- * Gives each element of `elements` and patch of `patches` (the meshes of `scene`) the values
- * of the user's own cell arrays on its nearest cell of `input` (a zone, a MaterialId with its
- * field data MaterialNames), as vtkProbeFilter passes a source's arrays: remeshing merges
- * input cells, so an element has no input cell of its own. Left out: arrays the meshes
- * already have (their Reflectance), those a frame writes (a scene that is an earlier output
- * would keep a stale Radiosity), the filter's own MovingLightRadiosity* arrays and VTK's vtk*
- * ones (vtkOriginalCellIds, vtkGhostType: how the input was split, not what it is, so that
- * any number of ranks gives the serial arrays). Nothing is located when there is nothing to
- * pass.
+ * The user's own cell arrays of `input` (the Scene as solved) that passSceneCellArrays gives
+ * the meshes: a zone, a MaterialId. Left out: the arrays the meshes have (Reflectance,
+ * PatchId) or a frame writes (a scene that is an earlier output would keep a stale
+ * Radiosity), the filter's own MovingLightRadiosity* arrays, VTK's vtk* ones
+ * (vtkOriginalCellIds, vtkGhostType: how the input was split, not what it is, so that any
+ * number of ranks gives the serial arrays), and arrays of another length than the cells,
+ * each with a warning in `warnings`.
  */
-void passSceneCellArrays(
-  vtkPolyData* input, const Scene& scene, vtkPolyData* elements, vtkPolyData* patches);
+std::vector<vtkAbstractArray*> sceneCellArraysToPass(
+  vtkPolyData* input, std::vector<std::string>* warnings = nullptr);
+
+/// The bytes one cell holds of `arrays` (strings taken at 32 bytes a value).
+std::uint64_t bytesPerCell(const std::vector<vtkAbstractArray*>& arrays);
+
+/**
+ * Gives each element of `elements` and patch of `patches` (the meshes of `scene`) the values
+ * of `passed` (sceneCellArraysToPass) on its nearest cell of `input`, and the field data
+ * MaterialNames beside a MaterialId, as vtkProbeFilter passes a source's arrays: remeshing
+ * merges input cells, so an element has no input cell of its own.
+ */
+void passSceneCellArrays(vtkPolyData* input, const std::vector<vtkAbstractArray*>& passed,
+  const Scene& scene, vtkPolyData* elements, vtkPolyData* patches);
 
 /// Adds `Radiosity`, `DirectRadiosity` and `IndirectRadiosity` of each element's lit side in
 /// `frame`, and `RadiosityFront`/`RadiosityBack` when `twoSided` (see addDisplayArrays for the

@@ -1695,6 +1695,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       warnings.push_back("TimeLimit stops the rounds of a TargetRelativeError, and there is "
                          "none: the solve runs its NumberOfPaths whatever the time");
     }
+    // The Scene's own arrays, which every element and patch will carry.
+    const std::vector<vtkAbstractArray*> passedArrays =
+      mlr::vtkoutputs::sceneCellArraysToPass(sceneData, &warnings);
     for (const std::string& warning : warnings)
     {
       vtkWarningMacro(<< warning);
@@ -1722,7 +1725,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     // The outputs' estimate is linear in the counts; per item, rounded up.
     constexpr std::size_t many = std::size_t(1) << 20;
     options.outputBytesPerElement =
-      (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many;
+      (mlr::vtkoutputs::estimateOutputMemory(many, 0) + many - 1) / many +
+      (mlr::vtkoutputs::bytesPerCell(passedArrays) * 5 + 3) / 4;
     options.outputBytesPerPoint =
       (mlr::vtkoutputs::estimateOutputMemory(0, many) + many - 1) / many;
     mlr::validateOptions(solverOptions);
@@ -1822,7 +1826,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
             firstChunkExposure ? *firstChunkExposure : mlr::vtkoutputs::autoExposure(frames);
           cache.Patches = mlr::vtkoutputs::patchMesh(solving.scene, solving.patches.points.size());
           mlr::vtkoutputs::passSceneCellArrays(
-            sceneData, solving.scene, cache.Elements, cache.Patches);
+            sceneData, passedArrays, solving.scene, cache.Elements, cache.Patches);
           cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(frames);
           cache.TwoSided = solverOptions.twoSided;
           cache.FirstChunkLitSides = frames.litSideData();
@@ -1920,7 +1924,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.Elements = mlr::vtkoutputs::smoothElementMesh(scene, cache.Shading);
       cache.AutoExposure = apart ? apart->exposure : mlr::vtkoutputs::autoExposure(solution);
       cache.Patches = mlr::vtkoutputs::patchMesh(scene, animation.patches.points.size());
-      mlr::vtkoutputs::passSceneCellArrays(sceneData, scene, cache.Elements, cache.Patches);
+      mlr::vtkoutputs::passSceneCellArrays(
+        sceneData, passedArrays, scene, cache.Elements, cache.Patches);
       cache.Statistics = mlr::vtkoutputs::statisticsFieldData(solution.statistics, solverOptions);
       mlr::vtkoutputs::addErrorFieldData(cache.Statistics, solution);
       cache.PatchLitSides = mlr::vtkoutputs::patchLitSides(solution);

@@ -507,6 +507,17 @@ def test_the_scenes_own_cell_arrays_reach_every_element_and_patch():
     radiosity_array = vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity"))
     assert radiosity_array.max() < 1e5  # the solver's, not the stale 1e6
 
+    # An array of another length than the cells would be read past its end: left out, named.
+    plane = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5)
+    short = vtkIntArray()
+    short.SetName("Zone")
+    plane.GetCellData().AddArray(short)
+    elements, messages = lit(plane)
+    assert not messages["ErrorEvent"], messages
+    assert any("the Scene's cell array 'Zone' has 0 values for 1 cell: it is not passed" in w
+               for w in messages["WarningEvent"]), messages
+    assert elements.GetCellData().GetArray("Zone") is None
+
 
 def test_a_light_material_that_emits_nothing_says_what_it_emits_instead():
     # A material with no emission cannot give the light's power: LightPower does, said once.
