@@ -1125,9 +1125,9 @@ Solver:
                         add rounds of batches until the 95th percentile of the lit
                         elements' relative error is at most this in every frame (0.02 is
                         2%; default 0, off)
-  --time-limit SECONDS  with --target-error: start no more batches after this long, in
-                        chunks shared among the chunks still to solve (the result then
-                        depends on the machine's speed)
+  --time-limit SECONDS  with --target-error: start no more batches after this long; in
+                        chunks, what is left of it is shared among the chunks still to
+                        solve (the result then depends on the machine's speed)
 Sensors (measuring points that receive light but neither block nor reflect it):
   --sensors FILE.vtp    the points of a file, each with the point array Normals (the
                         direction its measuring side faces)

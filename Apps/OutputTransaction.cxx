@@ -88,8 +88,8 @@ void OutputTransaction::keep(const fs::path& finalPath)
 void OutputTransaction::commit()
 {
   // The earlier files of these names step aside first, under hidden names, and come back if
-  // any rename fails: renamed one after another, a failure halfway left the new run's first
-  // frames beside the earlier run's last ones and its .pvd.
+  // any rename fails: a failure halfway must not leave the new run's first frames beside the
+  // earlier run's last ones and its .pvd.
   std::vector<std::pair<fs::path, fs::path>> asides; // final, its earlier file's hidden name
   std::size_t renamed = 0;
   auto undo = [&]() noexcept

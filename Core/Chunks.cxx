@@ -13,7 +13,6 @@
 #include <numeric>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <string>
 #include <type_traits>
 
@@ -607,14 +606,9 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   // Streamed, every frame shows the side the first chunk chose; the sums of every chunk say
   // whether the whole animation would have chosen another (a warning).
   std::vector<Solution::SideTotals> animationTotals;
-  struct
-  {
-    std::size_t count = 0;
-    double worst = 0;
-    std::size_t frame = 0;
-    std::set<std::string> by;
-    std::string first;
-  } missed;
+  // The chunks that missed a target, from every chunk's figures (over ranks, exchanged).
+  std::size_t missed = 0;
+  std::set<std::string> missedBy;
   if (options.chunkOverlap > plan.overlap)
   {
     warnings.push_back("the chunk overlap of " + std::to_string(options.chunkOverlap) +
@@ -651,7 +645,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       if (options.timeLimitSeconds > 0)
       {
         // The limit is the whole solve's: what is left of it is shared among this rank's
-        // chunks still to solve (each alone ran up to the whole limit, 100 chunks 100 times).
+        // chunks still to solve: a chunk given the whole limit would let 100 chunks take 100
+        // times it.
         const double left = options.timeLimitSeconds -
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const std::size_t chunksLeft = (chunkCount - 1 - k) / ranks + 1;
@@ -662,7 +657,10 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         options.log("chunk " + std::to_string(k + 1) + " of " + std::to_string(chunkCount) +
           ": frames " + std::to_string(c.begin) + " to " + std::to_string(c.end - 1) +
           ", solving positions " + std::to_string(c.solveBegin) + " to " +
-          std::to_string(c.solveEnd - 1));
+          std::to_string(c.solveEnd - 1) +
+          (options.timeLimitSeconds > 0
+              ? ", within " + formatNumber(chunkOptions.timeLimitSeconds) + " s"
+              : std::string()));
       }
       // Over ranks a chunk is solved alone; a failure or cancel on any rank stops every rank
       // here, before the exchange.
@@ -684,18 +682,9 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       {
         if (w.rfind(TargetNotReached, 0) == 0)
         {
-          // One warning for the chunks that missed the target, after them all.
-          const std::vector<double>& p95 = current.errorEstimate.relativeErrorP95;
-          const auto worst = std::max_element(p95.begin(), p95.end());
-          if (!missed.count || (worst != p95.end() && *worst > missed.worst))
-          {
-            missed.worst = worst != p95.end() ? *worst : 0.0;
-            missed.frame = c.solveBegin + static_cast<std::size_t>(worst - p95.begin());
-          }
-          missed.by.insert(current.errorEstimate.stoppedBy);
-          missed.first = missed.count++ == 0 ? w : missed.first;
+          continue; // one warning for the chunks that missed the target, after them all
         }
-        else if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
+        if (std::find(warnings.begin(), warnings.end(), w) == warnings.end())
         {
           warnings.push_back(w);
         }
@@ -711,10 +700,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         animationTotals.resize(totals.size());
         for (std::size_t r = 0; r < totals.size(); ++r)
         {
-          animationTotals[r].front += totals[r].front;
-          animationTotals[r].back += totals[r].back;
-          animationTotals[r].irradianceFront += totals[r].irradianceFront;
-          animationTotals[r].irradianceBack += totals[r].irradianceBack;
+          animationTotals[r] += totals[r];
         }
       }
     }
@@ -782,6 +768,12 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         exchangeFigures(options, mine, chunkStatistics, chunkErrors, secondsExchanging);
       }
       accumulate(chunkStatistics, j == 0, stats);
+      if (chunkErrors.batches > 0 && options.targetRelativeError > 0 &&
+        chunkErrors.stoppedBy != "target")
+      {
+        ++missed;
+        missedBy.insert(chunkErrors.stoppedBy);
+      }
       if (chunkErrors.batches > 0)
       {
         accumulate(chunkErrors, j == 0, errors);
@@ -889,27 +881,23 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
         " the side the first chunk lit more, while over the whole animation the other side "
         "received more light: Radiosity, Color, Irradiance and their standard errors are of "
         "that first chunk's side in every frame" +
-        (options.twoSided ? " (RadiosityFront and RadiosityBack hold both sides)" : "") +
+        (options.twoSided ? " (RadiosityFront, RadiosityBack, IrradianceFront and "
+                            "IrradianceBack hold both sides)"
+                          : "") +
         ". Solved in one chunk (more memory, or fewer frames), the animation's side is shown");
     }
   }
-  if (missed.count == 1)
-  {
-    warnings.push_back(missed.first);
-  }
-  else if (missed.count > 1)
+  if (missed > 0)
   {
     std::string by;
-    for (const std::string& reason : missed.by)
+    for (const std::string& reason : missedBy)
     {
       by += (by.empty() ? "the " : " and the ") + reason;
     }
-    std::ostringstream s;
-    s << TargetNotReached << " " << percent(options.targetRelativeError) << " was not reached in "
-      << missed.count << " of " << countOf(chunkCount, "chunk") << ": " << by
-      << " stopped them, the worst with a p95 relative error of " << percent(missed.worst)
-      << " in frame " << missed.frame;
-    warnings.push_back(s.str());
+    warnings.push_back(std::string(TargetNotReached) + " " + percent(options.targetRelativeError) +
+      " was not reached in " + std::to_string(missed) + " of " + countOf(chunkCount, "chunk") +
+      ": " + by + " stopped " + (missed == 1 ? "it" : "them") +
+      "; each frame's p95 relative error is in the field data RelativeErrorP95 (--stats)");
   }
   Solution& out = onFrames ? result : whole;
   if (!onFrames)
@@ -977,6 +965,7 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   for (std::size_t k = first; k <= chunk; ++k)
   {
     const ChunkPlan::Chunk& c = plan.chunks[k];
+    chunkOptions.firstFrame = c.solveBegin;
     Solution current = solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin),
       chunkOptions, part(costs[1 + k - first]), setup);
     if (k < chunk)

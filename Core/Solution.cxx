@@ -84,10 +84,8 @@ std::vector<Solution::SideTotals> surfaceTotalsOf(const Scene& scene, std::size_
         {
           const Solution::SideTotals t = totals(e);
           const double area = scene.elementArea(e);
-          sum.front += area * t.front;
-          sum.back += area * t.back;
-          sum.irradianceFront += area * t.irradianceFront;
-          sum.irradianceBack += area * t.irradianceBack;
+          sum +=
+            { area * t.front, area * t.back, area * t.irradianceFront, area * t.irradianceBack };
         }
         patchTotals[p] = sum;
       }
@@ -96,11 +94,7 @@ std::vector<Solution::SideTotals> surfaceTotalsOf(const Scene& scene, std::size_
   std::vector<Solution::SideTotals> surfaces(scene.regionCount());
   for (std::size_t p = 0; p < patches; ++p)
   {
-    Solution::SideTotals& sum = surfaces[scene.patchRegion(p)];
-    sum.front += patchTotals[p].front;
-    sum.back += patchTotals[p].back;
-    sum.irradianceFront += patchTotals[p].irradianceFront;
-    sum.irradianceBack += patchTotals[p].irradianceBack;
+    surfaces[scene.patchRegion(p)] += patchTotals[p];
   }
   return surfaces;
 }

@@ -190,6 +190,14 @@ public:
   struct SideTotals
   {
     double front = 0, back = 0, irradianceFront = 0, irradianceBack = 0;
+    SideTotals& operator+=(const SideTotals& other)
+    {
+      this->front += other.front;
+      this->back += other.back;
+      this->irradianceFront += other.irradianceFront;
+      this->irradianceBack += other.irradianceBack;
+      return *this;
+    }
   };
   /// Element `element`'s sums over the frames held, added in frame order; its irradiance's
   /// only when its radiosity's are both 0 (else 0: chooseLitSides reads them only then).

@@ -161,28 +161,37 @@ TEST(Chunks, ThreadCountDoesNotChangeABit)
 
 TEST(Chunks, ATimeLimitIsTheWholeSolvesAndItsMessagesNameTheAnimationsFrames)
 {
-  // A limit too short for any round after the first: every chunk stops after its first
-  // round. Each chunk alone ran up to the whole limit before; its messages named the
-  // chunk's own positions ("frame 0" in every chunk), and each chunk warned apart.
+  // A target out of reach: every chunk runs until its share of the limit is spent. The
+  // shares are what is left over the chunks still to solve, so they add up to the limit at
+  // most; the messages name the animation's frames, and one warning covers the 3 chunks.
   const Scene scene = box();
   SolverOptions o = options(4000, 3);
   o.errorBatches = 2;
   o.targetRelativeError = 1e-4;
-  o.timeLimitSeconds = 1e-6;
+  o.timeLimitSeconds = 0.3;
   std::vector<std::string> log;
   o.log = [&](const std::string& line) { log.push_back(line); };
   const Solution s = solveInChunks(scene, rig(), o, 4);
   ASSERT_EQ(s.statistics.chunks, 3u);
   EXPECT_EQ(s.errorEstimate.stoppedBy, "time limit");
+  std::vector<double> shares;
   std::vector<std::size_t> roundFrames;
   for (const std::string& line : log)
   {
+    const std::size_t within = line.find(", within ");
+    if (line.rfind("chunk ", 0) == 0 && within != std::string::npos)
+    {
+      shares.push_back(std::stod(line.substr(within + 9)));
+    }
     const std::size_t at = line.find("(frame ");
     if (line.rfind("error estimate, round 1", 0) == 0 && at != std::string::npos)
     {
       roundFrames.push_back(std::stoul(line.substr(at + 7)));
     }
   }
+  ASSERT_EQ(shares.size(), 3u);
+  EXPECT_LE(shares[0], 0.1);
+  EXPECT_LE(shares[0] + shares[1] + shares[2], 0.3 + 3e-3);
   ASSERT_EQ(roundFrames.size(), 3u);
   // Chunk k solves the positions from 4k - 1 (its overlap) to 4k + 4.
   for (std::size_t k = 0; k < 3; ++k)
