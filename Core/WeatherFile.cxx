@@ -2,6 +2,7 @@
 
 #include "Error.h"
 #include "PhotometricParsing.h"
+#include "Plural.h"
 #include "RegularFile.h"
 
 #include <algorithm>
@@ -473,6 +474,32 @@ std::string irradianceClosureWarning(
     << formatNumber(file.longitude) << ") and time zone (" << formatNumber(file.timeZoneHours)
     << " h, east of Greenwich positive) may be hours off; check the LOCATION line";
   return s.str();
+}
+
+std::string directNormalAboveTheSunWarning(
+  const WeatherFile& file, const std::vector<WeatherFrame>& frames)
+{
+  std::size_t count = 0;
+  const WeatherFrame* first = nullptr;
+  for (const WeatherFrame& f : frames)
+  {
+    if (f.directNormal > MostDirectNormalIrradiance)
+    {
+      first = first ? first : &f;
+      ++count;
+    }
+  }
+  if (!first)
+  {
+    return {};
+  }
+  return "the weather file " + file.name + ": " + countOf(count, "chosen hour") +
+    (count == 1 ? " gives" : " give") +
+    " a direct normal irradiance above the sun's outside the atmosphere (" +
+    formatNumber(MostDirectNormalIrradiance) + " W/m^2), the first " +
+    formatNumber(first->directNormal) + " W/m^2 on line " + std::to_string(first->line) +
+    ": check that its columns are read as the EPW orders them (field 15 is the direct normal "
+    "irradiance) and that its unit is Wh/m^2";
 }
 
 } // namespace mlr

@@ -104,4 +104,16 @@ std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSe
 std::string irradianceClosureWarning(
   const WeatherFile& file, const std::vector<WeatherFrame>& frames);
 
+/// The sun's direct normal irradiance outside the atmosphere at its nearest (January):
+/// the solar constant, 1361 W/m^2, times (1 + 0.034). No hour on the ground exceeds it.
+constexpr double MostDirectNormalIrradiance = 1408;
+
+/**
+ * A warning when chosen hours give a direct normal irradiance above the sun's outside the
+ * atmosphere (MostDirectNormalIrradiance), naming how many and the file line of the first:
+ * a column taken for another, or a unit that is not W/m^2. Empty when none does.
+ */
+std::string directNormalAboveTheSunWarning(
+  const WeatherFile& file, const std::vector<WeatherFrame>& frames);
+
 } // namespace mlr

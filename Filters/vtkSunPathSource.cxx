@@ -69,10 +69,13 @@ int vtkSunPathSource::RequestData(
       selection.up = { this->Up[0], this->Up[1], this->Up[2] };
       const mlr::WeatherFile file = mlr::readWeatherFile(this->WeatherFile);
       hours = mlr::weatherFrames(file, selection);
-      const std::string closure = mlr::irradianceClosureWarning(file, hours);
-      if (!closure.empty())
+      for (const std::string& warning : { mlr::irradianceClosureWarning(file, hours),
+             mlr::directNormalAboveTheSunWarning(file, hours) })
       {
-        vtkWarningMacro(<< closure);
+        if (!warning.empty())
+        {
+          vtkWarningMacro(<< warning);
+        }
       }
       for (const mlr::WeatherFrame& h : hours)
       {

@@ -433,6 +433,23 @@ TEST(WeatherFile, IrradiancesThatDisagreeWithTheirSunAreWarnedOf)
   EXPECT_EQ(irradianceClosureWarning(file, hours(60, std::nan(""), 20)), "");
 }
 
+TEST(WeatherFile, ADirectNormalAboveTheSunsOutsideTheAtmosphereIsWarnedOf)
+{
+  WeatherFile file;
+  file.name = "t.epw";
+  std::vector<WeatherFrame> hours(3);
+  hours[0].directNormal = 900;
+  hours[1].directNormal = MostDirectNormalIrradiance; // the sun at its nearest: possible
+  hours[2].directNormal = 1500;
+  hours[2].line = 4391;
+  EXPECT_EQ(directNormalAboveTheSunWarning(file, { hours[0], hours[1] }), "");
+  const std::string warning = directNormalAboveTheSunWarning(file, hours);
+  EXPECT_NE(warning.find("t.epw: 1 chosen hour gives a direct normal irradiance above the sun's "
+                         "outside the atmosphere (1408 W/m^2), the first 1500 W/m^2 on line 4391"),
+    std::string::npos)
+    << warning;
+}
+
 TEST(WeatherFile, TheShippedYearReads)
 {
   const WeatherFile file = readWeatherFile(MLR_SOURCE_DIR "/Data/paris_synthetic.epw");
