@@ -589,7 +589,7 @@ void darkenNight(
     mlr::formatNumber(up[0]) + ", " + mlr::formatNumber(up[1]) + ", " + mlr::formatNumber(up[2]);
   if (!darkened.empty())
   {
-    warnings.push_back("the sun is below the horizon (across Up " + upText + ") in " +
+    warnings.push_back("the sun is below the horizon (up " + upText + ") in " +
       std::to_string(darkened.size()) + " of " + mlr::countOf(sun.size(), "frame") + ", " +
       framesNamed(darkened) + ": " + (darkened.size() == 1 ? "that frame is" : "those frames are") +
       " night, dark");

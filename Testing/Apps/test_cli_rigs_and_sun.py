@@ -461,7 +461,7 @@ def test_sun_directions_below_the_horizon_are_dark_frames_with_a_warning(tmp_pat
     scene = write_town(tmp_path, boxes)
     directions = write_points(tmp_path / "sun.vtp", [(0, 0, 1), (0, 0, -1), (0, -1, 1)])
     frames = solve(tmp_path, ["--scene", scene, "--sun-directions", directions])
-    assert ("the sun is below the horizon (across Up 0, 0, 1) in 1 of 3 frames, frame 1: that "
+    assert ("the sun is below the horizon (up 0, 0, 1) in 1 of 3 frames, frame 1: that "
             "frame is night, dark") in frames.stderr, frames.stderr
     assert not frames[1][1].cells("Radiosity").any()
     for (_, frame), elevation in ((frames[0], 90.0), (frames[2], 45.0)):
@@ -473,7 +473,7 @@ def test_sun_directions_below_the_horizon_are_dark_frames_with_a_warning(tmp_pat
     result = run(["--scene", scene, "--sun-directions", directions, "--up", "0,1,0",
                   "--output", "y/s.pvd"] + FAST, tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "below the horizon (across Up 0, 1, 0) in 1 of 3 frames, frame 2:" in result.stderr
+    assert "below the horizon (up 0, 1, 0) in 1 of 3 frames, frame 2:" in result.stderr
 
 
 # --- Area lights: aim, Normal, Orientation, Power --------------------------------------------
