@@ -279,9 +279,10 @@ vtkDataArray* pointArray(vtkPointSet* data, const char* name, int components, in
   return numbers;
 }
 
-/// Refuses a MaterialId array of floating-point values that are not whole numbers, rather than
-/// rounding them to some material.
-void checkWholeMaterialIds(vtkDataArray* ids)
+/// Refuses a MaterialId array `ids` of `surface` of floating-point values that are not whole
+/// numbers, rather than rounding them to some material; the message names the cell as the
+/// input has it, in its `block` ("block 1") of a composite input not yet joined.
+void checkWholeMaterialIds(vtkPolyData* surface, vtkDataArray* ids, const std::string& block)
 {
   if (ids->GetDataType() != VTK_FLOAT && ids->GetDataType() != VTK_DOUBLE)
   {
@@ -293,7 +294,10 @@ void checkWholeMaterialIds(vtkDataArray* ids)
     if (id != std::floor(id))
     {
       std::ostringstream s;
-      s << "the Scene's cell array MaterialId holds " << id << " (cell " << cell
+      s << "the Scene's cell array MaterialId holds " << id << " ("
+        << (block.empty() ? cellPlace(surface, cell)
+                          : block + " cell " +
+                 std::to_string(inputIdOf(surface->GetCellData(), InputCellIds, cell)))
         << "): give whole numbers, each an index into the field data MaterialNames";
       throw Error(s.str());
     }
@@ -309,7 +313,7 @@ vtkDataArray* materialIdArray(vtkPolyData* scene)
   {
     return nullptr;
   }
-  checkWholeMaterialIds(ids);
+  checkWholeMaterialIds(scene, ids, "");
   return ids;
 }
 
@@ -455,7 +459,7 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
     auto* ids = vtkDataArray::SafeDownCast(surface->GetCellData()->GetAbstractArray("MaterialId"));
     if (names && ids)
     {
-      checkWholeMaterialIds(ids);
+      checkWholeMaterialIds(surface, ids, label);
       // A copy, so that the block's own arrays stay as they are.
       auto renumbered = vtkSmartPointer<vtkPolyData>::New();
       renumbered->ShallowCopy(surface);

@@ -728,14 +728,15 @@ def test_material_ids_that_are_not_whole_numbers_are_named():
     scene.GetCellData().AddArray(ids)
     blocks = vtkMultiBlockDataSet()
     blocks.SetBlock(0, scene)
-    for data in (scene, blocks):
+    for data, place in ((scene, "cell 1"), (blocks, "block 0 cell 1")):
         radiosity = vtkMovingLightRadiosity()
         radiosity.SetSceneData(data)
         radiosity.SetLightMaterial("lamp")
         radiosity.SetNumberOfThreads(2)
         errors = recorded(radiosity, "ErrorEvent")
         assert not radiosity.UpdateTimeStep(0.0)
-        assert any("MaterialId holds 0.5 (cell 1): give whole numbers" in e for e in errors), errors
+        assert any(f"MaterialId holds 0.5 ({place}): give whole numbers" in e
+                   for e in errors), errors
 
 
 def test_a_light_of_any_data_set_lights_as_its_polygons():
