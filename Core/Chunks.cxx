@@ -658,9 +658,9 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
           ": frames " + std::to_string(c.begin) + " to " + std::to_string(c.end - 1) +
           ", solving positions " + std::to_string(c.solveBegin) + " to " +
           std::to_string(c.solveEnd - 1) +
-          (options.timeLimitSeconds > 0
-              ? ", within " + formatNumber(chunkOptions.timeLimitSeconds) + " s"
-              : std::string()));
+          (options.timeLimitSeconds > 0 ? ", within " +
+                formatNumber(std::round(chunkOptions.timeLimitSeconds * 1000) / 1000) + " s"
+                                        : std::string()));
       }
       // Over ranks a chunk is solved alone; a failure or cancel on any rank stops every rank
       // here, before the exchange.

@@ -148,14 +148,22 @@ std::vector<vtkAbstractArray*> sceneCellArraysToPass(
     "Irradiance", "Illuminance", "IrradianceFront", "IrradianceBack", "IlluminanceFront",
     "IlluminanceBack", "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError" };
   std::vector<vtkAbstractArray*> passed;
+  std::string named; // arrays with an output's name, as the warning lists them
+  std::size_t namedCount = 0;
   vtkCellData* from = input ? input->GetCellData() : nullptr;
   for (int a = 0; from && a < from->GetNumberOfArrays(); ++a)
   {
     vtkAbstractArray* array = from->GetAbstractArray(a);
     const std::string name = array && array->GetName() ? array->GetName() : "";
     if (name.empty() || name.rfind("MovingLightRadiosity", 0) == 0 || name.rfind("vtk", 0) == 0 ||
-      std::find(std::begin(OwnArrays), std::end(OwnArrays), name) != std::end(OwnArrays))
+      name == "Reflectance")
     {
+      continue;
+    }
+    if (std::find(std::begin(OwnArrays), std::end(OwnArrays), name) != std::end(OwnArrays))
+    {
+      named += (named.empty() ? "'" : ", '") + name + "'";
+      ++namedCount;
       continue;
     }
     if (array->GetNumberOfTuples() != input->GetNumberOfCells())
@@ -170,6 +178,14 @@ std::vector<vtkAbstractArray*> sceneCellArraysToPass(
       continue;
     }
     passed.push_back(array);
+  }
+  if (warnings && namedCount > 0)
+  {
+    // One warning: a scene that is an earlier output carries a dozen of them.
+    warnings->push_back(std::string("the Scene's cell ") +
+      (namedCount == 1 ? "array " : "arrays ") + named + (namedCount == 1 ? " has" : " have") +
+      " the name of an output array: the outputs carry their own, not the Scene's (rename " +
+      (namedCount == 1 ? "it" : "them") + " to keep " + (namedCount == 1 ? "it" : "them") + ")");
   }
   return passed;
 }

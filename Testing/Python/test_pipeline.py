@@ -506,6 +506,8 @@ def test_the_scenes_own_cell_arrays_reach_every_element_and_patch():
         assert seen == {1, 2, 3}, port
     radiosity_array = vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity"))
     assert radiosity_array.max() < 1e5  # the solver's, not the stale 1e6
+    assert sum("the Scene's cell array 'Radiosity' has the name of an output array" in w
+               for w in messages["WarningEvent"]) == 1, messages  # one warning, not per block
 
     # An array of another length than the cells would be read past its end: left out, named.
     plane = grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5)
