@@ -515,6 +515,16 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
   }
   append->Update();
   vtkSmartPointer<vtkPolyData> whole = append->GetOutput();
+  for (const auto& [name, count] : arrayLeaves)
+  {
+    // vtkAppendPolyData keeps an array only where every block's has one type and width.
+    if (count == leaves && !whole->GetCellData()->HasArray(name.c_str()))
+    {
+      warnings.push_back("the " + port + "'s cell array '" + name +
+        "' is on every block, but not of one type and number of components, so it is "
+        "dropped: give it one type (int, double...) and width on every block");
+    }
+  }
   if (materialNames->GetNumberOfValues() > 0)
   {
     whole->GetFieldData()->RemoveArray("MaterialNames");

@@ -268,6 +268,18 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     assert areas[0.2] == pytest.approx(1.0, rel=1e-9)
     assert areas[0.7] == pytest.approx(2.0, rel=1e-9)
 
+    # An array of another type on each block is dropped too, with a warning naming it.
+    from vtkmodules.vtkCommonCore import vtkIntArray, vtkLongLongArray
+    for block, kind in ((0, vtkIntArray), (1, vtkLongLongArray)):
+        zone = kind()
+        zone.SetName("Zone")
+        zone.SetNumberOfTuples(blocks.GetBlock(block).GetNumberOfCells())
+        zone.Fill(block)
+        blocks.GetBlock(block).GetCellData().AddArray(zone)
+    elements, messages = lit(blocks)
+    assert any("cell array 'Zone' is on every block, but not of one type and number of "
+               "components, so it is dropped" in w for w in messages["WarningEvent"]), messages
+
     # A block without the Reflectance array: it is dropped, with a warning naming it.
     blocks.SetBlock(1, grey_plane((0, 0, 0), (0, 1, 0), (0, 0, 2)))
     elements, messages = lit(blocks)
