@@ -309,6 +309,24 @@ std::string xmlEscaped(const std::string& text)
 }
 }
 
+namespace
+{
+/// Throws that `what` could not be written to `path`, named as the user asked for it: a
+/// staged file's hidden temporary name (.NAME.partial) as NAME.
+[[noreturn]] void failedWrite(const std::string& what, const std::filesystem::path& path)
+{
+  std::string name = path.filename().string();
+  const std::string staged = ".partial";
+  if (name.size() > staged.size() + 1 && name.front() == '.' &&
+    name.compare(name.size() - staged.size(), staged.size(), staged) == 0)
+  {
+    name = name.substr(1, name.size() - staged.size() - 1);
+  }
+  throw std::runtime_error("cannot write " + what + " '" + (path.parent_path() / name).string() +
+    "': check the disk space and the permissions of its directory");
+}
+}
+
 void writeFileBytes(
   const std::filesystem::path& path, const std::string& bytes, const std::string& what)
 {
@@ -317,8 +335,7 @@ void writeFileBytes(
   out.close();
   if (!out)
   {
-    throw std::runtime_error("cannot write " + what + " '" + path.string() +
-      "': check the disk space and the permissions of its directory");
+    failedWrite(what, path);
   }
 }
 
@@ -401,8 +418,7 @@ void writeXml(vtkXMLWriter* writer, const std::filesystem::path& path, const std
   }
   if (!written)
   {
-    throw std::runtime_error("cannot write " + what + " '" + path.string() +
-      "': check the disk space and the permissions of its directory");
+    failedWrite(what, path);
   }
 }
 
