@@ -644,9 +644,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       progressBase += share;
       if (options.timeLimitSeconds > 0)
       {
-        // The limit is the whole solve's: what is left of it is shared among this rank's
-        // chunks still to solve: a chunk given the whole limit would let 100 chunks take 100
-        // times it.
+        // The limit is the whole solve's, shared among this rank's chunks still to solve: a
+        // chunk given the whole limit would let 100 chunks take 100 times it.
         const double left = options.timeLimitSeconds -
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const std::size_t chunksLeft = (chunkCount - 1 - k) / ranks + 1;
