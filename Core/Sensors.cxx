@@ -42,7 +42,6 @@ struct SensorScratch
   std::vector<Rgb> variance, gatheredSquares, pointSum, pointSquares, strata;
   std::vector<Rgb> perPoint;
   std::vector<double> skySum, skySquares;
-  std::vector<std::size_t> hits, cells;
   std::vector<float> dx, dy, dz;
   std::vector<std::uint8_t> visible;
   std::vector<Rgb> values;
@@ -51,11 +50,12 @@ struct SensorScratch
   /// The rays this worker cast (SensorStatistics).
   std::uint64_t shadowRays = 0, gatheringRays = 0;
 
-  /// Room for every sensor's work, so that no vector grows (and memory is what
-  /// estimateSensorMemory says): `batch` shadow rays at most per light, and `pointFrames`
-  /// values of an area light's points over the frames.
-  void reserve(std::size_t frames, std::size_t skyPositions, std::size_t skies, std::size_t rays,
-    std::size_t batch, std::size_t pointFrames)
+  /// Room for every sensor's work on a block of `frames`, so that no vector grows (and memory
+  /// is what estimateSensorMemory says): `skyEntries` sums over the skies' positions, `batch`
+  /// shadow rays at most per light, and `pointFrames` values of an area light's points over
+  /// the frames.
+  void reserve(std::size_t frames, std::size_t skyEntries, std::size_t skies, std::size_t batch,
+    std::size_t pointFrames)
   {
     for (std::vector<Rgb>* v : { &this->total, &this->sun, &this->gathered, &this->variance,
            &this->gatheredSquares, &this->pointSum, &this->pointSquares, &this->strata })
@@ -63,10 +63,8 @@ struct SensorScratch
       v->reserve(frames);
     }
     this->perPoint.reserve(pointFrames);
-    this->skySum.reserve(skyPositions);
-    this->skySquares.reserve(skyPositions);
-    this->hits.reserve(rays);
-    this->cells.reserve(rays * skies);
+    this->skySum.reserve(skyEntries);
+    this->skySquares.reserve(skyEntries);
     for (std::vector<float>* v : { &this->dx, &this->dy, &this->dz })
     {
       v->reserve(batch);
@@ -78,17 +76,16 @@ struct SensorScratch
     this->skyBase.reserve(skies);
   }
   /// The bytes reserve() takes.
-  static std::uint64_t bytes(std::size_t frames, std::size_t skyPositions, std::size_t skies,
-    std::size_t rays, std::size_t batch, std::size_t pointFrames)
+  static std::uint64_t bytes(std::size_t frames, std::size_t skyEntries, std::size_t skies,
+    std::size_t batch, std::size_t pointFrames)
   {
     return saturatingSum(saturatingSum(saturatingSum(saturatingProduct(8 * sizeof(Rgb), frames),
-                                         saturatingProduct(2 * sizeof(double), skyPositions)),
+                                         saturatingProduct(2 * sizeof(double), skyEntries)),
                            saturatingProduct(sizeof(Rgb), pointFrames)),
-      saturatingSum(saturatingProduct({ sizeof(std::size_t), rays, 1 + skies }),
-        saturatingSum(saturatingProduct(3 * sizeof(float) + sizeof(std::uint8_t) + sizeof(Rgb) +
-                          2 * sizeof(std::uint32_t),
-                        batch),
-          saturatingProduct(sizeof(std::size_t), skies))));
+      saturatingSum(saturatingProduct(3 * sizeof(float) + sizeof(std::uint8_t) + sizeof(Rgb) +
+                        2 * sizeof(std::uint32_t),
+                      batch),
+        saturatingProduct(sizeof(std::size_t), skies)));
   }
 
   void clearRays()
@@ -274,12 +271,41 @@ double emittedDensity(const IntensityDistribution& f, const PhotometricFrame& fr
   return f.density(frame.toLocal(towards));
 }
 
-void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& rig,
-  const std::vector<MovingLight>& emitters, const Solution& solution, const SensorSet& sensors,
-  std::size_t s, const SolverOptions& options, const SensorOptions& sensorOptions,
-  const SensorBatchSpread* solutionSpread, SensorScratch& scratch, SensorSolution& result)
+/**
+ * What a group of sensors' hemisphere rays found, the same for every frame: the element sides
+ * they reach, as slots of a table of the solution's radiosity, and the sky cells of those that
+ * escape, as keys sky x Sky::Cells + cell, each distinct key with its rays.
+ */
+struct Hemispheres
 {
-  const std::size_t frames = solution.frameCount();
+  SensorReach reach;
+  std::vector<std::size_t> cellBegin{ 0 };
+  std::vector<std::uint32_t> cellKey, cellCount;
+};
+
+/// The number of distinct values of a sorted vector.
+std::size_t distinctCount(const std::vector<std::size_t>& sorted)
+{
+  return sorted.empty() ? 0
+                        : 1 +
+      static_cast<std::size_t>(std::count_if(
+        sorted.begin() + 1, sorted.end(), [&](const std::size_t& v) { return v != *(&v - 1); }));
+}
+
+/**
+ * The irradiance of sensor `s` (the group's `g`-th) in frames `first` to `first + count`,
+ * into `result`: its hemisphere's reads from `hemispheres` and `table` (that block's
+ * radiosity, `block` frames a row), and its shadow rays towards every light. Every sum of a
+ * frame runs in the same order whatever the block, so the bits do not depend on it.
+ */
+void solveSensorFrames(const RayTracer& tracer, const LightRig& rig,
+  const std::vector<MovingLight>& emitters, const SensorSet& sensors, std::size_t s, std::size_t g,
+  const Hemispheres& hemispheres, const std::vector<Rgb>& table, std::size_t block,
+  std::size_t first, std::size_t count, const SolverOptions& options,
+  const SensorOptions& sensorOptions, const SensorBatchSpread* solutionSpread,
+  SensorScratch& scratch, SensorSolution& result)
+{
+  const std::size_t frames = result.frameCount();
   const Vec3& p = sensors.points[s];
   const Vec3& n = sensors.normals[s];
   const Vec3 origin = tracer.liftOff(p, n);
@@ -287,85 +313,55 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
   for (std::vector<Rgb>* v : { &scratch.total, &scratch.sun, &scratch.gathered, &scratch.variance,
          &scratch.gatheredSquares })
   {
-    v->assign(frames, Rgb());
+    v->assign(count, Rgb());
   }
 
-  // The hemisphere, once for all frames: sky visibility and the surface a ray reaches do not
-  // depend on the frame, only the radiance found there does.
-  std::size_t skyPositions = 0;
+  // The hemisphere: each distinct element side or sky cell costs one pass over the frames,
+  // however many rays found it, in the order of the keys.
+  const SensorReach& reach = hemispheres.reach;
+  for (std::size_t i = reach.keysBegin(g); i < reach.keysEnd(g); ++i)
+  {
+    const Rgb* row = table.data() + reach.slot(i) * block;
+    const double hits = reach.hits(i);
+    for (std::size_t f = 0; f < count; ++f)
+    {
+      const Rgb& read = row[f];
+      scratch.gathered[f] += read * hits;
+      scratch.gatheredSquares[f] += read * read * hits;
+    }
+  }
+  // Per sky, its sums over the block's positions, or over its one position.
   std::vector<std::size_t>& skyBase = scratch.skyBase;
   skyBase.clear();
+  std::size_t skyEntries = 0;
   for (const Sky& sky : rig.skies)
   {
-    skyBase.push_back(skyPositions);
-    skyPositions += sky.positions();
+    skyBase.push_back(skyEntries);
+    skyEntries += sky.positions() > 1 ? count : 1;
   }
-  scratch.skySum.assign(skyPositions, 0.0);
-  scratch.skySquares.assign(skyPositions, 0.0);
-  const std::uint32_t rays = sensorOptions.hemisphereRays;
-  scratch.gatheringRays += rays;
-  // What each ray found, as keys: an element side (2 element + side), or an escaped ray's sky
-  // cell per sky. Sorted and counted, each distinct key costs one pass over the frames,
-  // however many rays found it, and the sums run in key order.
-  scratch.hits.clear();
-  scratch.cells.clear();
-  castHemisphere(tracer, origin, n, s, options, rays, scratch.hits,
-    [&](const Vec3& direction)
-    {
-      for (std::size_t k = 0; k < rig.skies.size(); ++k)
-      {
-        const std::size_t cell = rig.skies[k].cell(direction);
-        if (cell < Sky::Cells)
-        {
-          scratch.cells.push_back(k * Sky::Cells + cell);
-        }
-      }
-    });
-  std::sort(scratch.hits.begin(), scratch.hits.end());
-  std::sort(scratch.cells.begin(), scratch.cells.end());
-  for (std::size_t i = 0; i < scratch.hits.size();)
+  scratch.skySum.assign(skyEntries, 0.0);
+  scratch.skySquares.assign(skyEntries, 0.0);
+  for (std::size_t i = hemispheres.cellBegin[g]; i < hemispheres.cellBegin[g + 1]; ++i)
   {
-    std::size_t end = i;
-    while (end < scratch.hits.size() && scratch.hits[end] == scratch.hits[i])
-    {
-      ++end;
-    }
-    const double count = static_cast<double>(end - i);
-    const std::size_t element = scratch.hits[i] / 2;
-    const Side side = static_cast<Side>(scratch.hits[i] % 2);
-    for (std::size_t f = 0; f < frames; ++f)
-    {
-      const Rgb read = gatheredRadiosity(scene, solution, f, element, side);
-      scratch.gathered[f] += read * count;
-      scratch.gatheredSquares[f] += read * read * count;
-    }
-    i = end;
-  }
-  for (std::size_t i = 0; i < scratch.cells.size();)
-  {
-    std::size_t end = i;
-    while (end < scratch.cells.size() && scratch.cells[end] == scratch.cells[i])
-    {
-      ++end;
-    }
-    const double count = static_cast<double>(end - i);
-    const std::size_t k = scratch.cells[i] / Sky::Cells;
+    const double hits = static_cast<double>(hemispheres.cellCount[i]);
+    const std::size_t k = hemispheres.cellKey[i] / Sky::Cells;
     const Sky& sky = rig.skies[k];
-    const double* density = sky.densities(scratch.cells[i] % Sky::Cells);
+    const double* density = sky.densities(hemispheres.cellKey[i] % Sky::Cells);
     double* sum = scratch.skySum.data() + skyBase[k];
     double* squares = scratch.skySquares.data() + skyBase[k];
-    for (std::size_t j = 0; j < sky.positions(); ++j)
+    const std::size_t entries = sky.positions() > 1 ? count : 1;
+    const std::size_t from = sky.positions() > 1 ? first : 0;
+    for (std::size_t j = 0; j < entries; ++j)
     {
-      sum[j] += density[j] * count;
-      squares[j] += density[j] * density[j] * count;
+      sum[j] += density[from + j] * hits;
+      squares[j] += density[from + j] * density[from + j] * hits;
     }
-    i = end;
   }
-  const double perRay = 1.0 / static_cast<double>(rays);
+  const double perRay = 1.0 / static_cast<double>(sensorOptions.hemisphereRays);
   // An escaped ray's value is the sum of every sky's: with several skies the square of that
   // sum is bounded by their count times the sum of their squares (Cauchy-Schwarz).
   const double skyBound = static_cast<double>(std::max<std::size_t>(rig.skies.size(), 1));
-  for (std::size_t f = 0; f < frames; ++f)
+  for (std::size_t f = 0; f < count; ++f)
   {
     Rgb sum = scratch.gathered[f];
     double skySquares = 0;
@@ -373,23 +369,24 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
     for (std::size_t k = 0; k < rig.skies.size(); ++k)
     {
       const Sky& sky = rig.skies[k];
-      const std::size_t j = poseOf(sky.positions(), f);
-      const double weight = M_PI * sky.integral(j);
-      sum += Rgb(weight * scratch.skySum[skyBase[k] + j]);
-      skySquares += weight * weight * scratch.skySquares[skyBase[k] + j];
+      const std::size_t entry = skyBase[k] + (sky.positions() > 1 ? f : 0);
+      const double weight = M_PI * sky.integral(poseOf(sky.positions(), first + f));
+      sum += Rgb(weight * scratch.skySum[entry]);
+      skySquares += weight * weight * scratch.skySquares[entry];
     }
     scratch.total[f] += sum * perRay;
-    scratch.variance[f] += varianceOfMean(
-      sum, scratch.gatheredSquares[f] + Rgb(skyBound * skySquares), static_cast<double>(rays));
+    scratch.variance[f] +=
+      varianceOfMean(sum, scratch.gatheredSquares[f] + Rgb(skyBound * skySquares),
+        static_cast<double>(sensorOptions.hemisphereRays));
   }
 
   // Directional lights: one shadow ray per frame.
   for (const DirectionalLight& light : rig.directionalLights)
   {
     scratch.clearRays();
-    for (std::size_t f = 0; f < frames; ++f)
+    for (std::size_t f = 0; f < count; ++f)
     {
-      const std::size_t k = poseOf(light.frameCount(), f);
+      const std::size_t k = poseOf(light.frameCount(), first + f);
       const Vec3& towards = light.direction(k);
       const double cosine = dot(n, towards);
       const Rgb e = light.irradiance() * light.powerFactor(k) * cosine;
@@ -405,9 +402,9 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
   for (const PointLight& light : rig.pointLights)
   {
     scratch.clearRays();
-    for (std::size_t f = 0; f < frames; ++f)
+    for (std::size_t f = 0; f < count; ++f)
     {
-      const std::size_t k = poseOf(light.frameCount(), f);
+      const std::size_t k = poseOf(light.frameCount(), first + f);
       const Vec3 d = p - light.position(k);
       const double r2 = dot(d, d);
       const double r = std::sqrt(r2);
@@ -429,7 +426,7 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
   }
 
   // Area lights and the scene's emitters: the same uniform points of the light in every
-  // frame, posed there, each with its shadow ray.
+  // frame (drawn again for every block), posed there, each with its shadow ray.
   const std::uint32_t samples = sensorOptions.areaLightSamples;
   const std::size_t areaLights = rig.areaLights.size() + emitters.size();
   for (std::size_t i = 0; i < areaLights; ++i)
@@ -454,9 +451,9 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
       }
       Vec3 own, ownNormal;
       light.samplePoint(u, v, own, ownNormal);
-      for (std::size_t frame = 0; frame < frames; ++frame)
+      for (std::size_t frame = 0; frame < count; ++frame)
       {
-        const std::size_t k = poseOf(light.frameCount(), frame);
+        const std::size_t k = poseOf(light.frameCount(), first + frame);
         const Rgb power = light.power() * light.pose(k).power;
         if (!(power.maxComponent() > 0))
         {
@@ -483,27 +480,26 @@ void solveSensor(const Scene& scene, const RayTracer& tracer, const LightRig& ri
       }
     }
     traceShadows(tracer, origin, false, scratch, scratch.total);
-    scratch.perPoint.assign(static_cast<std::size_t>(samples) * frames, Rgb());
+    scratch.perPoint.assign(static_cast<std::size_t>(samples) * count, Rgb());
     for (std::size_t r = 0; r < scratch.visible.size() && r < scratch.values.size(); ++r)
     {
       if (scratch.visible[r])
       {
-        scratch
-          .perPoint[static_cast<std::size_t>(scratch.points[r]) * frames + scratch.targets[r]] =
+        scratch.perPoint[static_cast<std::size_t>(scratch.points[r]) * count + scratch.targets[r]] =
           scratch.values[r];
       }
     }
-    addAreaLightVariance(samples, frames, scratch);
+    addAreaLightVariance(samples, count, scratch);
   }
 
-  for (std::size_t frame = 0; frame < frames; ++frame)
+  for (std::size_t f = 0; f < count; ++f)
   {
-    result.irradianceData()[s * frames + frame] =
-      FloatRgb(scratch.total[frame] + scratch.sun[frame]);
-    result.sunData()[s * frames + frame] = FloatRgb(scratch.sun[frame]);
+    const std::size_t frame = first + f;
+    result.irradianceData()[s * frames + frame] = FloatRgb(scratch.total[f] + scratch.sun[f]);
+    result.sunData()[s * frames + frame] = FloatRgb(scratch.sun[f]);
     // The sensor's own sampling and the solution's noise are independent (different streams):
     // their variances add.
-    Rgb variance = scratch.variance[frame];
+    Rgb variance = scratch.variance[f];
     if (solutionSpread)
     {
       const Rgb e = solutionSpread->stdError(frame, s);
@@ -573,17 +569,6 @@ SensorSet normalizedSensors(const SensorSet& sensors, const SensorOptions& optio
 
 namespace
 {
-/// The sky positions of a rig, all its skies together.
-std::size_t skyPositionsOf(const LightRig& rig)
-{
-  std::size_t positions = 0;
-  for (const Sky& sky : rig.skies)
-  {
-    positions += sky.positions();
-  }
-  return positions;
-}
-
 /// The most shadow rays one light casts from one sensor: one per frame for directional and
 /// point lights, one per sample and frame for area lights and the scene's emitters.
 std::size_t shadowBatch(
@@ -612,10 +597,6 @@ std::size_t pointFrames(
     : saturatingProduct(std::max<std::uint32_t>(sensorOptions.areaLightSamples, 1), frames);
 }
 
-/// SensorBatchSpread reads the batches a block of frames at a time, in a table of at most this
-/// many bytes, or of one frame's reads when those alone take more.
-constexpr std::uint64_t SpreadTableBytes = 16ULL << 20;
-
 /// The most frames one solve of an animation in chunks of `framesPerChunk` overlapping by
 /// chunkOverlap(framesPerChunk, `overlap`) reads.
 std::size_t framesPerSolve(std::size_t frames, std::size_t framesPerChunk, std::uint64_t overlap)
@@ -625,6 +606,124 @@ std::size_t framesPerSolve(std::size_t frames, std::size_t framesPerChunk, std::
     return frames;
   }
   return std::min(frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk, overlap));
+}
+}
+
+void SensorReach::reserve(std::size_t sensors, std::size_t keys)
+{
+  this->KeyBegin.reserve(this->KeyBegin.size() + sensors);
+  this->KeySlot.reserve(this->KeySlot.size() + keys);
+  this->KeyCount.reserve(this->KeyCount.size() + keys);
+}
+
+void SensorReach::addSensor(const std::vector<std::size_t>& h, std::size_t patches)
+{
+  if (this->RowOf.empty())
+  {
+    this->RowOf.assign(2 * patches, std::numeric_limits<std::uint32_t>::max());
+  }
+  for (std::size_t i = 0; i < h.size();)
+  {
+    std::size_t end = i;
+    while (end < h.size() && h[end] == h[i])
+    {
+      ++end;
+    }
+    const std::size_t element = h[i] / 2, side = h[i] % 2;
+    const std::size_t patchSide = 2 * Scene::patchOfElement(element) + side;
+    if (this->RowOf[patchSide] == std::numeric_limits<std::uint32_t>::max())
+    {
+      this->RowOf[patchSide] = static_cast<std::uint32_t>(this->PatchSides.size());
+      this->PatchSides.push_back(static_cast<std::uint32_t>(patchSide));
+    }
+    this->KeySlot.push_back(static_cast<std::uint32_t>(
+      this->RowOf[patchSide] * Scene::ElementsPerPatch + element % Scene::ElementsPerPatch));
+    this->KeyCount.push_back(static_cast<std::uint32_t>(end - i));
+    i = end;
+  }
+  this->KeyBegin.push_back(this->KeySlot.size());
+}
+
+std::size_t SensorReach::framesPerBlock(std::size_t frames, const SensorBudget& budget) const
+{
+  const std::uint64_t row = this->PatchSides.size() * Scene::ElementsPerPatch * sizeof(Rgb);
+  return static_cast<std::size_t>(
+    std::clamp<std::uint64_t>(budget.tableBytes / std::max<std::uint64_t>(row, 1), 1,
+      std::max<std::size_t>(std::min(frames, budget.framesPerBlock), 1)));
+}
+
+void SensorReach::read(const Scene& scene, const Solution& solution, std::size_t first,
+  std::size_t count, std::size_t block, int workers, const std::function<bool()>& keepGoing,
+  std::vector<Rgb>& table) const
+{
+  constexpr std::size_t PatchSidesPerTask = 64;
+  table.resize(this->PatchSides.size() * Scene::ElementsPerPatch * block);
+  parallelFor((this->PatchSides.size() + PatchSidesPerTask - 1) / PatchSidesPerTask, workers,
+    [&](std::size_t task, int)
+    {
+      const std::size_t end = std::min(this->PatchSides.size(), (task + 1) * PatchSidesPerTask);
+      for (std::size_t row = task * PatchSidesPerTask; row < end; ++row)
+      {
+        const std::size_t patch = this->PatchSides[row] / 2;
+        const auto side = static_cast<Side>(this->PatchSides[row] % 2);
+        Rgb* out = table.data() + row * Scene::ElementsPerPatch * block;
+        for (std::size_t f = 0; f < count; ++f)
+        {
+          Rgb read[Scene::ElementsPerPatch];
+          gatheredRadiosities(scene, solution, first + f, patch, side, read);
+          for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
+          {
+            out[k * block + f] = read[k];
+          }
+        }
+      }
+    },
+    [&](std::size_t) { return !keepGoing || keepGoing(); });
+}
+
+std::uint64_t SensorReach::tableBytes(
+  std::size_t patches, std::size_t frames, const SensorBudget& budget)
+{
+  const std::uint64_t row =
+    saturatingProduct({ 2 * Scene::ElementsPerPatch * sizeof(Rgb), patches });
+  // A block is as many frames as the budget holds, or one frame when one row takes more.
+  return std::min<std::uint64_t>(std::max(budget.tableBytes, row),
+    saturatingProduct(row, std::max<std::size_t>(std::min(frames, budget.framesPerBlock), 1)));
+}
+
+std::uint64_t SensorReach::indexBytes(std::size_t patches)
+{
+  return saturatingProduct(2 * sizeof(std::uint32_t), 2 * patches);
+}
+
+namespace
+{
+std::uint64_t hemisphereBytesPerSensor(const LightRig& rig, const SensorOptions& sensorOptions)
+{
+  return saturatingSum(saturatingProduct({ sizeof(std::size_t) + SensorReach::BytesPerKey,
+                         sensorOptions.hemisphereRays, 1 + rig.skies.size() }),
+    2 * sizeof(std::vector<std::size_t>) + 2 * sizeof(std::size_t));
+}
+
+/// The sensors of a group: as many as the budget holds, in whole tasks, at least one task.
+std::size_t sensorsPerGroup(std::size_t sensors, const LightRig& rig,
+  const SensorOptions& sensorOptions, const SensorBudget& budget)
+{
+  const std::uint64_t fit = budget.hemisphereBytes / hemisphereBytesPerSensor(rig, sensorOptions);
+  return std::min<std::size_t>(
+    sensors, std::max<std::uint64_t>(SensorsPerTask, fit / SensorsPerTask * SensorsPerTask));
+}
+
+/// The sums over sky positions a sensor keeps for a block of `frames`: that many for a sky that
+/// moves, one for a sky that does not.
+std::size_t skyEntriesOf(const LightRig& rig, std::size_t frames)
+{
+  std::size_t entries = 0;
+  for (const Sky& sky : rig.skies)
+  {
+    entries += sky.positions() > 1 ? frames : 1;
+  }
+  return entries;
 }
 }
 
@@ -641,20 +740,30 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
     saturatingSum(saturatingProduct({ 3 * sizeof(FloatRgb), sensors, frames }),
       saturatingProduct(2 * sizeof(Vec3), sensors));
   const auto workers = static_cast<std::uint64_t>(resolveThreadCount(options.threads));
+  const SensorBudget budget;
+  const std::size_t mostFrames = std::min(frames, budget.framesPerBlock);
   const std::uint64_t scratch = saturatingProduct(workers,
-    SensorScratch::bytes(frames, skyPositionsOf(rig), rig.skies.size(),
-      sensorOptions.hemisphereRays, shadowBatch(rig, sceneEmits, frames, sensorOptions),
-      pointFrames(rig, sceneEmits, frames, sensorOptions)));
+    SensorScratch::bytes(mostFrames, skyEntriesOf(rig, mostFrames), rig.skies.size(),
+      shadowBatch(rig, sceneEmits, mostFrames, sensorOptions),
+      pointFrames(rig, sceneEmits, mostFrames, sensorOptions)));
+  // One group's hemispheres, and the table of what they read with its index.
+  const std::size_t patches = elements / Scene::ElementsPerPatch;
+  const std::uint64_t hemispheres =
+    saturatingSum(saturatingProduct(sensorsPerGroup(sensors, rig, sensorOptions, budget),
+                    hemisphereBytesPerSensor(rig, sensorOptions)),
+      saturatingSum(
+        SensorReach::tableBytes(patches, frames, budget), SensorReach::indexBytes(patches)));
   // The scene's emitters as area lights: their triangles, generously per element.
   const std::uint64_t emitters = sceneEmits ? saturatingProduct(elements, 256) : 0;
   // With batches, the reads of every batch (solveAnimation), the chunks' length unknown here
   // unless set.
   const std::uint64_t spread = estimatesError(options)
     ? SensorBatchSpread::estimateMemory(sensors, frames,
-        static_cast<std::size_t>(options.framesPerChunk), options.chunkOverlap,
-        elements / Scene::ElementsPerPatch, sensorOptions, static_cast<int>(workers))
+        static_cast<std::size_t>(options.framesPerChunk), options.chunkOverlap, patches,
+        sensorOptions, static_cast<int>(workers))
     : 0;
-  return saturatingSum(saturatingSum(saturatingSum(results, scratch), spread),
+  return saturatingSum(
+    saturatingSum(saturatingSum(results, scratch), saturatingSum(spread, hemispheres)),
     saturatingSum(RayTracer::estimateMemory(elements, points), emitters));
 }
 
@@ -671,7 +780,6 @@ SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
   const SensorSet sensors = normalizedSensors(given, sensorOptions);
   this->Sensors = sensors.size();
   this->SolutionError.assign(this->Sensors * this->Frames, FloatRgb());
-  this->KeyBegin.assign(this->Sensors + 1, 0);
   if (this->Sensors == 0 || this->Frames == 0)
   {
     return;
@@ -698,39 +806,15 @@ SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
       },
       [](std::size_t) { return true; });
   }
-  std::size_t total = 0;
+  std::size_t keys = 0;
   for (const std::vector<std::size_t>& h : hits)
   {
-    total += h.size();
+    keys += distinctCount(h);
   }
-  this->KeySlot.reserve(total);
-  this->KeyCount.reserve(total);
-  // The table's rows, the patch sides in the order the sensors first reach them.
-  std::vector<std::uint32_t> rowOf(
-    2 * scene.patchCount(), std::numeric_limits<std::uint32_t>::max());
+  this->Reach.reserve(this->Sensors, keys);
   for (std::size_t s = 0; s < this->Sensors; ++s)
   {
-    const std::vector<std::size_t>& h = hits[s];
-    for (std::size_t i = 0; i < h.size();)
-    {
-      std::size_t end = i;
-      while (end < h.size() && h[end] == h[i])
-      {
-        ++end;
-      }
-      const std::size_t element = h[i] / 2, side = h[i] % 2;
-      const std::size_t patchSide = 2 * Scene::patchOfElement(element) + side;
-      if (rowOf[patchSide] == std::numeric_limits<std::uint32_t>::max())
-      {
-        rowOf[patchSide] = static_cast<std::uint32_t>(this->PatchSides.size());
-        this->PatchSides.push_back(static_cast<std::uint32_t>(patchSide));
-      }
-      this->KeySlot.push_back(static_cast<std::uint32_t>(
-        rowOf[patchSide] * Scene::ElementsPerPatch + element % Scene::ElementsPerPatch));
-      this->KeyCount.push_back(static_cast<std::uint32_t>(end - i));
-      i = end;
-    }
-    this->KeyBegin[s + 1] = this->KeySlot.size();
+    this->Reach.addSensor(hits[s], scene.patchCount());
     std::vector<std::size_t>().swap(hits[s]);
   }
 }
@@ -760,39 +844,15 @@ void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const S
   ++this->SolveBatches;
   const double inverse = 1.0 / static_cast<double>(this->SolveBatches);
   const double perRay = 1.0 / static_cast<double>(this->Rays);
-  const std::size_t rows = this->PatchSides.size() * Scene::ElementsPerPatch;
-  const std::size_t block = static_cast<std::size_t>(std::clamp<std::uint64_t>(
-    SpreadTableBytes / std::max<std::uint64_t>(rows * sizeof(FloatRgb), 1), 1,
-    std::max<std::size_t>(this->SolveFrames, 1)));
-  std::vector<FloatRgb> table(rows * block);
+  const std::size_t block = this->Reach.framesPerBlock(this->SolveFrames, SensorBudget());
+  std::vector<Rgb> table;
   std::vector<std::vector<Rgb>> sums(
     static_cast<std::size_t>(this->Workers), std::vector<Rgb>(block));
-  constexpr std::size_t PatchSidesPerTask = 64;
   for (std::size_t first = 0; first < this->SolveFrames; first += block)
   {
     const std::size_t count = std::min(block, this->SolveFrames - first);
-    parallelFor((this->PatchSides.size() + PatchSidesPerTask - 1) / PatchSidesPerTask,
-      this->Workers,
-      [&](std::size_t task, int)
-      {
-        const std::size_t end = std::min(this->PatchSides.size(), (task + 1) * PatchSidesPerTask);
-        for (std::size_t row = task * PatchSidesPerTask; row < end; ++row)
-        {
-          const std::size_t patch = this->PatchSides[row] / 2;
-          const auto side = static_cast<Side>(this->PatchSides[row] % 2);
-          FloatRgb* out = table.data() + row * Scene::ElementsPerPatch * block;
-          for (std::size_t f = 0; f < count; ++f)
-          {
-            Rgb read[Scene::ElementsPerPatch];
-            gatheredRadiosities(this->SceneRef, solution, first + f, patch, side, read);
-            for (std::size_t k = 0; k < Scene::ElementsPerPatch; ++k)
-            {
-              out[k * block + f] = FloatRgb(read[k]);
-            }
-          }
-        }
-      },
-      [&](std::size_t) { return !keepGoing || keepGoing(); });
+    this->Reach.read(
+      this->SceneRef, solution, first, count, block, this->Workers, keepGoing, table);
     parallelFor((this->Sensors + SensorsPerTask - 1) / SensorsPerTask, this->Workers,
       [&](std::size_t task, int worker)
       {
@@ -801,13 +861,13 @@ void SensorBatchSpread::add(std::uint64_t batch, std::size_t firstFrame, const S
         for (std::size_t s = task * SensorsPerTask; s < end; ++s)
         {
           std::fill(sum.begin(), sum.begin() + static_cast<std::ptrdiff_t>(count), Rgb());
-          for (std::size_t i = this->KeyBegin[s]; i < this->KeyBegin[s + 1]; ++i)
+          for (std::size_t i = this->Reach.keysBegin(s); i < this->Reach.keysEnd(s); ++i)
           {
-            const FloatRgb* row = table.data() + static_cast<std::size_t>(this->KeySlot[i]) * block;
-            const double hits = static_cast<double>(this->KeyCount[i]);
+            const Rgb* row = table.data() + this->Reach.slot(i) * block;
+            const double hits = this->Reach.hits(i);
             for (std::size_t f = 0; f < count; ++f)
             {
-              sum[f] += Rgb(row[f]) * hits;
+              sum[f] += row[f] * hits;
             }
           }
           // Welford's update, in batch order: the bits do not depend on the workers.
@@ -888,22 +948,20 @@ std::uint64_t SensorBatchSpread::estimateMemory(std::size_t sensors, std::size_t
   const std::uint64_t running = saturatingProduct(
     { 2 * sizeof(FloatRgb), sensors, framesPerSolve(frames, framesPerChunk, overlap) });
   const std::uint64_t errors = saturatingProduct({ sizeof(FloatRgb), sensors, frames });
-  const std::uint64_t table = std::min<std::uint64_t>(
-    saturatingSum(SpreadTableBytes,
-      saturatingProduct({ 2 * Scene::ElementsPerPatch * sizeof(FloatRgb), patches })),
-    saturatingProduct({ 2 * Scene::ElementsPerPatch * sizeof(FloatRgb), patches, frames }));
+  const std::uint64_t table =
+    SensorReach::tableBytes(patches, framesPerSolve(frames, framesPerChunk, overlap), {});
   // The patch sides' rows and their list, and every worker's sums over a block of frames.
-  const std::uint64_t rows =
-    saturatingSum(saturatingProduct(2 * sizeof(std::uint32_t), 2 * patches),
-      saturatingProduct({ sizeof(Rgb), static_cast<std::size_t>(std::max(workers, 1)),
-        framesPerSolve(frames, framesPerChunk, overlap) }));
+  const std::uint64_t rows = saturatingSum(SensorReach::indexBytes(patches),
+    saturatingProduct({ sizeof(Rgb), static_cast<std::size_t>(std::max(workers, 1)),
+      framesPerSolve(frames, framesPerChunk, overlap) }));
   return saturatingSum(
     saturatingSum(keys, running), saturatingSum(errors, saturatingSum(table, rows)));
 }
 
 SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solution& solution,
   const SensorSet& given, const SolverOptions& options, const SensorOptions& sensorOptions,
-  const std::function<bool(double fraction)>& progress, const SensorBatchSpread* solutionSpread)
+  const std::function<bool(double fraction)>& progress, const SensorBatchSpread* solutionSpread,
+  const SensorBudget& budget)
 {
   const auto started = std::chrono::steady_clock::now();
   const SensorSet sensors = normalizedSensors(given, sensorOptions);
@@ -912,17 +970,6 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   if (sensors.empty() || frames == 0)
   {
     return result;
-  }
-  const RayTracer tracer(scene);
-  const std::vector<MovingLight> emitters = sceneEmitters(scene);
-  const int workers = resolveThreadCount(options.threads);
-  std::vector<SensorScratch> scratch(static_cast<std::size_t>(workers));
-  const std::size_t batch = shadowBatch(rig, !emitters.empty(), frames, sensorOptions);
-  const std::size_t points = pointFrames(rig, !emitters.empty(), frames, sensorOptions);
-  for (SensorScratch& worker : scratch)
-  {
-    worker.reserve(
-      frames, skyPositionsOf(rig), rig.skies.size(), sensorOptions.hemisphereRays, batch, points);
   }
   if (solutionSpread &&
     (solutionSpread->frameCount() != frames || solutionSpread->sensorCount() != sensors.size()))
@@ -933,20 +980,123 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   {
     result.setSolutionBatches(solutionSpread->batches());
   }
-  const std::size_t tasks = (sensors.size() + SensorsPerTask - 1) / SensorsPerTask;
-  parallelFor(
-    tasks, workers,
-    [&](std::size_t task, int worker)
-    {
-      const std::size_t end = std::min(sensors.size(), (task + 1) * SensorsPerTask);
-      for (std::size_t s = task * SensorsPerTask; s < end; ++s)
+  const RayTracer tracer(scene);
+  const std::vector<MovingLight> emitters = sceneEmitters(scene);
+  const int workers = resolveThreadCount(options.threads);
+  std::vector<SensorScratch> scratch(static_cast<std::size_t>(workers));
+  const std::size_t mostFrames = std::min(frames, std::max<std::size_t>(budget.framesPerBlock, 1));
+  for (SensorScratch& worker : scratch)
+  {
+    worker.reserve(mostFrames, skyEntriesOf(rig, mostFrames), rig.skies.size(),
+      shadowBatch(rig, !emitters.empty(), mostFrames, sensorOptions),
+      pointFrames(rig, !emitters.empty(), mostFrames, sensorOptions));
+  }
+  // The sensors in groups, each traced once and then solved a block of frames at a time, in
+  // which the radiosity their rays read is read once per patch side and frame.
+  const std::size_t perGroup = sensorsPerGroup(sensors.size(), rig, sensorOptions, budget);
+  const double total = 2.0 * static_cast<double>(sensors.size());
+  double fraction = 0;
+  const auto keepGoing = [&] { return !progress || progress(fraction / total); };
+  std::vector<Rgb> table;
+  for (std::size_t begin = 0; begin < sensors.size(); begin += perGroup)
+  {
+    const std::size_t group = std::min(perGroup, sensors.size() - begin);
+    const std::size_t tasks = (group + SensorsPerTask - 1) / SensorsPerTask;
+    const double before = 2.0 * static_cast<double>(begin);
+    std::vector<std::vector<std::size_t>> hits(group), cells(group);
+    parallelFor(
+      tasks, workers,
+      [&](std::size_t task, int worker)
       {
-        solveSensor(scene, tracer, rig, emitters, solution, sensors, s, options, sensorOptions,
-          solutionSpread, scratch[static_cast<std::size_t>(worker)], result);
+        const std::size_t end = std::min(group, (task + 1) * SensorsPerTask);
+        for (std::size_t g = task * SensorsPerTask; g < end; ++g)
+        {
+          const std::size_t s = begin + g;
+          hits[g].reserve(sensorOptions.hemisphereRays);
+          cells[g].reserve(
+            static_cast<std::size_t>(sensorOptions.hemisphereRays) * rig.skies.size());
+          castHemisphere(tracer, tracer.liftOff(sensors.points[s], sensors.normals[s]),
+            sensors.normals[s], s, options, sensorOptions.hemisphereRays, hits[g],
+            [&](const Vec3& direction)
+            {
+              for (std::size_t k = 0; k < rig.skies.size(); ++k)
+              {
+                const std::size_t cell = rig.skies[k].cell(direction);
+                if (cell < Sky::Cells)
+                {
+                  cells[g].push_back(k * Sky::Cells + cell);
+                }
+              }
+            });
+          std::sort(hits[g].begin(), hits[g].end());
+          std::sort(cells[g].begin(), cells[g].end());
+          scratch[static_cast<std::size_t>(worker)].gatheringRays += sensorOptions.hemisphereRays;
+        }
+      },
+      [&](std::size_t done)
+      {
+        fraction = before + static_cast<double>(group * done) / static_cast<double>(tasks);
+        return keepGoing();
+      });
+    Hemispheres hemispheres;
+    std::size_t keys = 0, cellKeys = 0;
+    for (std::size_t g = 0; g < group; ++g)
+    {
+      keys += distinctCount(hits[g]);
+      cellKeys += distinctCount(cells[g]);
+    }
+    hemispheres.reach.reserve(group, keys);
+    hemispheres.cellBegin.reserve(group + 1);
+    hemispheres.cellKey.reserve(cellKeys);
+    hemispheres.cellCount.reserve(cellKeys);
+    for (std::size_t g = 0; g < group; ++g)
+    {
+      hemispheres.reach.addSensor(hits[g], scene.patchCount());
+      const std::vector<std::size_t>& c = cells[g];
+      for (std::size_t i = 0; i < c.size();)
+      {
+        std::size_t end = i;
+        while (end < c.size() && c[end] == c[i])
+        {
+          ++end;
+        }
+        hemispheres.cellKey.push_back(static_cast<std::uint32_t>(c[i]));
+        hemispheres.cellCount.push_back(static_cast<std::uint32_t>(end - i));
+        i = end;
       }
-    },
-    [&](std::size_t done)
-    { return !progress || progress(static_cast<double>(done) / static_cast<double>(tasks)); });
+      hemispheres.cellBegin.push_back(hemispheres.cellKey.size());
+      std::vector<std::size_t>().swap(hits[g]);
+      std::vector<std::size_t>().swap(cells[g]);
+    }
+    const std::size_t block = hemispheres.reach.framesPerBlock(frames, budget);
+    for (std::size_t first = 0; first < frames; first += block)
+    {
+      const std::size_t count = std::min(block, frames - first);
+      const double solved =
+        before + static_cast<double>(group) * (1.0 + static_cast<double>(first) / frames);
+      fraction = solved;
+      hemispheres.reach.read(scene, solution, first, count, block, workers, keepGoing, table);
+      parallelFor(
+        tasks, workers,
+        [&](std::size_t task, int worker)
+        {
+          const std::size_t end = std::min(group, (task + 1) * SensorsPerTask);
+          for (std::size_t g = task * SensorsPerTask; g < end; ++g)
+          {
+            solveSensorFrames(tracer, rig, emitters, sensors, begin + g, g, hemispheres, table,
+              block, first, count, options, sensorOptions, solutionSpread,
+              scratch[static_cast<std::size_t>(worker)], result);
+          }
+        },
+        [&](std::size_t done)
+        {
+          fraction = solved +
+            static_cast<double>(group * count * done) /
+              (static_cast<double>(tasks) * static_cast<double>(frames));
+          return keepGoing();
+        });
+    }
+  }
   for (const SensorScratch& worker : scratch)
   {
     result.statistics().shadowRays += worker.shadowRays;

@@ -124,6 +124,70 @@ private:
 };
 
 /**
+ * How the sensors use memory beyond their results, which any budget leaves the same bits: what
+ * their rays read is held a block of frames at a time, and their hemisphere rays a group of
+ * sensors at a time.
+ */
+struct SensorBudget
+{
+  /// The radiosity the rays read, a double RGB per element of every patch side reached and
+  /// frame of a block, or one frame's when that takes more.
+  std::uint64_t tableBytes = std::uint64_t(16) << 20;
+  /// The most frames of a block: each worker's sums and shadow rays grow with them.
+  std::size_t framesPerBlock = 1024;
+  /// A group's hemisphere rays: a key per ray and sky while traced, and a slot and a count per
+  /// distinct key kept; or those of 16 sensors when they take more.
+  std::uint64_t hemisphereBytes = std::uint64_t(64) << 20;
+};
+
+/**
+ * The element sides some sensors' hemisphere rays reach, and a table of their radiosity
+ * (gatheredRadiosities) read a block of frames at a time. Each patch side reached is a row of
+ * its four elements, read with one reconstruction of its bounced light per frame however many
+ * sensors and rays reach it; each sensor then sums its distinct element sides' entries, in the
+ * order of their keys (2 element + side), weighed by its rays that reached them.
+ */
+class SensorReach
+{
+public:
+  /// Room for `sensors` more sensors of `keys` distinct keys in all.
+  void reserve(std::size_t sensors, std::size_t keys);
+  /// Adds the next sensor's hits, keys 2 element + side sorted, on a scene of `patches`.
+  void addSensor(const std::vector<std::size_t>& sortedHits, std::size_t patches);
+  std::size_t sensorCount() const { return this->KeyBegin.size() - 1; }
+  std::size_t rowCount() const { return this->PatchSides.size(); }
+  /// The frames of one block within `budget`: at least 1, at most `frames`.
+  std::size_t framesPerBlock(std::size_t frames, const SensorBudget& budget) const;
+  /// Fills `table` (rowCount() x 4 elements, `block` frames each) with frames `first` to
+  /// `first + count` of `solution`, on `workers` threads; `keepGoing` false cancels.
+  void read(const Scene& scene, const Solution& solution, std::size_t first, std::size_t count,
+    std::size_t block, int workers, const std::function<bool()>& keepGoing,
+    std::vector<Rgb>& table) const;
+  /// Sensor `sensor`'s keys: each one's entries start at table() + slot(i) x block.
+  std::size_t keysBegin(std::size_t sensor) const { return this->KeyBegin[sensor]; }
+  std::size_t keysEnd(std::size_t sensor) const { return this->KeyBegin[sensor + 1]; }
+  std::size_t slot(std::size_t key) const { return this->KeySlot[key]; }
+  double hits(std::size_t key) const { return static_cast<double>(this->KeyCount[key]); }
+
+  /// Bytes per key kept.
+  static constexpr std::uint64_t BytesPerKey = 2 * sizeof(std::uint32_t);
+  /// The most bytes of a table within `budget` for `patches` patches (both sides reached)
+  /// over `frames` frames.
+  static std::uint64_t tableBytes(
+    std::size_t patches, std::size_t frames, const SensorBudget& budget);
+  /// The bytes of the rows' index over `patches` patches.
+  static std::uint64_t indexBytes(std::size_t patches);
+
+private:
+  std::vector<std::size_t> KeyBegin{ 0 };
+  std::vector<std::uint32_t> KeySlot, KeyCount;
+  /// The rows: the patch sides reached (2 patch + side), in the order first reached.
+  std::vector<std::uint32_t> PatchSides;
+  /// Per patch side, its row or none.
+  std::vector<std::uint32_t> RowOf;
+};
+
+/**
  * The solution's noise as the sensors read it. A sensor's hemisphere rays read the patch
  * solution (gatheredRadiosity()), whose error is correlated from element to element (the
  * elements of a patch share its bounced light, neighbours its gradient, walks cross many
@@ -182,12 +246,7 @@ private:
   std::uint32_t Rays = 0;
   std::size_t Frames = 0, Sensors = 0, FramesPerChunk = 0;
   std::uint64_t ChunkOverlap = 0; ///< SolverOptions::chunkOverlap
-  /// Per sensor, its distinct element sides hit (as slots of the table) and their ray counts.
-  std::vector<std::size_t> KeyBegin;
-  std::vector<std::uint32_t> KeySlot, KeyCount;
-  /// The patch sides some sensor's rays reach (2 patch + side): the table's rows, four
-  /// elements each.
-  std::vector<std::uint32_t> PatchSides;
+  SensorReach Reach;
   /// Of the solve being read: its first frame, frames, batches, and per sensor and frame the
   /// running mean and squared deviations of the reads.
   std::size_t SolveFirst = 0, SolveFrames = 0;
@@ -224,7 +283,7 @@ std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std:
 SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solution& solution,
   const SensorSet& sensors, const SolverOptions& options, const SensorOptions& sensorOptions = {},
   const std::function<bool(double fraction)>& progress = {},
-  const SensorBatchSpread* solutionSpread = nullptr);
+  const SensorBatchSpread* solutionSpread = nullptr, const SensorBudget& budget = {});
 
 /**
  * The relative error of frame `frame` over its lit sensors, those whose irradiance (sum over

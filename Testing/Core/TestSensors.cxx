@@ -451,6 +451,58 @@ TEST(Sensors, TheThreadCountDoesNotChangeTheResultBitForBit)
   EXPECT_GT(sun, 0.0) << "some sensors see the sun";
 }
 
+TEST(Sensors, AnyBudgetGivesTheSameBits)
+{
+  // Seven frames of a moving sun, a changing and a fixed sky, a lamp and a moving area light over
+  // 42 sensors facing every way: read a frame at a time, in groups of 16 sensors, every frame
+  // of every sensor still sums its rays in the same order.
+  RoomCase c = room(7);
+  c.soup = scenes::boxOfQuads({ 0, 0, 0 }, { 3, 2, 2.5 }, std::vector<Rgb>(6, Rgb(0.6)), true);
+  c.soup.polygons.pop_back(); // no ceiling
+  c.soup.materials.pop_back();
+  std::vector<Vec3> suns;
+  std::vector<SkyFrame> skies;
+  for (int f = 0; f < 7; ++f)
+  {
+    suns.push_back(sunDirection(70 - 5 * f, 10 * f));
+    skies.push_back({ suns.back(), 100.0 + 7 * f, 0 });
+  }
+  c.rig.directionalLights.emplace_back(suns, Rgb(500));
+  // A clear sky brightest about its moving sun: its shape changes from frame to frame.
+  c.rig.skies.emplace_back(SkyModel::CieClear, Vec3(0, 0, 1), skies);
+  c.rig.skies.emplace_back(
+    SkyModel::CieOvercast, Vec3(0, 0, 1), std::vector<SkyFrame>{ { {}, 30, 0 } });
+  LightPose lamp;
+  lamp.position = { 1, 1, 2 };
+  c.rig.pointLights.emplace_back(Rgb(50), std::vector<LightPose>{ lamp });
+  for (int i = 0; i < 30; ++i)
+  {
+    c.sensors.points.push_back({ 0.1 + 0.09 * i, 0.2 + 0.05 * i, 0.3 + 0.05 * (i % 5) });
+    c.sensors.normals.push_back({ std::sin(i * 0.3), std::cos(i * 0.2), 0.5 });
+  }
+  const Animation a = solveAnimation(c.soup, c.rig, roomOptions(2, {}));
+  const AnimationOptions options = roomOptions(2, c.sensors);
+  SensorSolution whole =
+    solveSensors(a.scene, c.rig, a.solution, c.sensors, options.solver, options.sensorOptions);
+  SensorBudget tight;
+  tight.tableBytes = 1;
+  tight.framesPerBlock = 2;
+  tight.hemisphereBytes = 1;
+  SensorSolution pieces = solveSensors(a.scene, c.rig, a.solution, c.sensors, options.solver,
+    options.sensorOptions, {}, nullptr, tight);
+  EXPECT_TRUE(sameBits(whole.irradianceData(), pieces.irradianceData()));
+  EXPECT_TRUE(sameBits(whole.sunData(), pieces.sunData()));
+  EXPECT_TRUE(sameBits(whole.stdErrorData(), pieces.stdErrorData()));
+  EXPECT_EQ(whole.statistics().shadowRays, pieces.statistics().shadowRays);
+  EXPECT_EQ(whole.statistics().gatheringRays, pieces.statistics().gatheringRays);
+  double gathered = 0;
+  for (std::size_t s = 0; s < c.sensors.size(); ++s)
+  {
+    gathered += whole.irradiance(6, s).g;
+  }
+  EXPECT_GT(gathered, 0.0);
+}
+
 namespace
 {
 /**
