@@ -197,8 +197,10 @@ double SkyDistribution::operator()(const Vec3& v, double gradation) const
       return 1.0 + 2.0 * cosZ;
     case SkyModel::CieClear:
     {
-      const double chi = std::acos(std::clamp(dot(v, this->Sun), -1.0, 1.0));
-      const double c = std::cos(chi);
+      // cos chi is the dot product itself: std::cos of the angle took a third of a year's
+      // tables.
+      const double c = std::clamp(dot(v, this->Sun), -1.0, 1.0);
+      const double chi = std::acos(c);
       const double indicatrix =
         1.0 + 10.0 * (std::exp(-3.0 * chi) - std::exp(-3.0 * M_PI / 2)) + 0.45 * c * c;
       return gradation * indicatrix;
@@ -207,8 +209,8 @@ double SkyDistribution::operator()(const Vec3& v, double gradation) const
       break;
   }
   const double* k = this->Coefficients;
-  const double gamma = std::acos(std::clamp(dot(v, this->Sun), -1.0, 1.0));
-  const double c = std::cos(gamma);
+  const double c = std::clamp(dot(v, this->Sun), -1.0, 1.0);
+  const double gamma = std::acos(c);
   // Negative only where the fit extrapolates badly: no light there.
   return std::max(0.0, gradation * (1.0 + k[2] * std::exp(k[3] * gamma) + k[4] * c * c));
 }
