@@ -439,7 +439,7 @@ void writeCollection(
   out.close();
   if (!out)
   {
-    throw std::runtime_error("cannot write '" + path.string() + "'");
+    failedWrite("the collection", path);
   }
 }
 

@@ -409,7 +409,7 @@ std::vector<WeatherFrame> weatherFrames(const WeatherFile& file, const WeatherSe
       {
         throw Error("the weather file " + file.name + ", line " + std::to_string(h.line) +
           ": the " + (std::isnan(h.directNormal) ? "direct normal" : "diffuse horizontal") +
-          " irradiance of a chosen hour is missing (9999): fill it in, or choose dates and "
+          " irradiance of a chosen hour is missing (9999 or more): fill it in, or choose dates and "
           "hours without it");
       }
       f.directNormal = h.directNormal;

@@ -271,6 +271,20 @@ def test_frame_that_cannot_be_written_fails_the_run_and_leaves_nothing(tmp_path)
     assert all_files(tmp_path) == ["out/.s_0003.vtu.partial/keep"]
 
 
+def test_a_collection_that_cannot_be_written_is_named_with_a_hint(tmp_path):
+    """The .pvd, written after its frames, fails: the run names it as asked for (not its
+    hidden temporary name), says what to check, and leaves none of its frames."""
+    blocker = tmp_path / "out" / ".s.pvd.partial"
+    blocker.mkdir(parents=True)
+    (blocker / "keep").write_text("not the program's")
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", str(FRAMES), "--output", "out/s.pvd"] + FAST, tmp_path)
+    assert result.returncode == 1
+    assert "cannot write the collection 'out/s.pvd': check the disk space" in result.stderr, \
+        result.stderr
+    assert all_files(tmp_path) == ["out/.s.pvd.partial/keep"]
+
+
 def test_a_commit_that_fails_halfway_keeps_the_earlier_series_whole(tmp_path):
     """Frame 3's name is taken by a folder when a second run commits: the frames renamed
     before it step back, and the earlier series is left as it was, byte for byte (renamed one

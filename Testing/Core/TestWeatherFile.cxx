@@ -322,11 +322,12 @@ TEST(WeatherFile, HoursAreChosenByDateHourAndDaylight)
   expectError([&] { weatherFrames(file, s); }, "north");
 
   // A missing irradiance matters only in a chosen hour.
-  const WeatherFile missing = parseWeatherFile(withField(4000, 15, "9999"), "t.epw");
+  const WeatherFile missing = parseWeatherFile(withField(4000, 15, "99999"), "t.epw");
   s = WeatherSelection();
   s.firstMonth = s.lastMonth = 6;
   s.firstDay = s.lastDay = 16;
-  expectError([&] { weatherFrames(missing, s); }, "line 4000: the diffuse horizontal irradiance");
+  expectError([&] { weatherFrames(missing, s); },
+    "line 4000: the diffuse horizontal irradiance of a chosen hour is missing (9999 or more)");
   s.firstDay = s.lastDay = 17;
   EXPECT_NO_THROW(weatherFrames(missing, s));
 }
