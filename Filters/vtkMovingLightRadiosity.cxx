@@ -1769,6 +1769,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       solverOptions.log = [this](const std::string& message)
       {
         this->SetProgressText(message.c_str());
+        // An event of its own (Core logs on this thread): a chunk's last round and the next
+        // chunk's first line come before any progress, and an observer saw only the second.
+        this->UpdateProgress(this->GetProgress());
         vtkDebugMacro(<< message);
       };
     }

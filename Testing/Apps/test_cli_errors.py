@@ -85,6 +85,20 @@ def test_target_error_is_reached_in_every_frame(tmp_path):
         assert values(grid, "ErrorBatches")[0] > 16
 
 
+def test_every_chunk_prints_the_round_that_reached_the_target(tmp_path):
+    """Each chunk's last round ends right before the next chunk's first line: both show."""
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH[:-2] + FAST +
+                 ["--frames", "4", "--frames-per-chunk", "2", "--target-error", "0.3",
+                  "--output", "out/e.pvd"], tmp_path)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("chunk ")]
+    assert len(starts) == 2, result.stdout
+    for begin, end in zip(starts, starts[1:] + [len(lines)]):
+        rounds = [line for line in lines[begin:end] if ", round " in line]
+        assert rounds and rounds[-1].endswith(": reached"), result.stdout
+
+
 @pytest.mark.parametrize("args, message", [
     (["--error-batches", "0"], "--error-batches is 0: give a value from 1 to 4096"),
     (["--error-batches", "5000"], "--error-batches is 5000: give a value from 1 to 4096"),
