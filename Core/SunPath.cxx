@@ -156,4 +156,22 @@ std::vector<SunPosition> sunPath(const SunPathRequest& r)
   return path;
 }
 
+std::string timeZoneWarning(double longitude, double timeZoneHours)
+{
+  const double solar = longitude / 15;
+  const double apart = std::remainder(timeZoneHours - solar, 24.0);
+  if (!(std::abs(apart) > 3.5))
+  {
+    return {};
+  }
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << "the clock times are taken at UTC"
+    << (timeZoneHours < 0 ? "" : "+") << formatNumber(timeZoneHours) << ", " << std::abs(apart)
+    << " hours " << (apart > 0 ? "ahead of" : "behind") << " the sun's time at longitude "
+    << formatNumber(longitude) << " (UTC" << (solar < 0 ? "" : "+") << solar
+    << "): if they are the site's clock times, give its offset from UTC, east positive "
+    << "(--time-zone, or the Sun Path's TimeZone; e.g. " << std::lround(solar) << ")";
+  return s.str();
+}
+
 } // namespace mlr

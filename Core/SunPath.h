@@ -3,6 +3,7 @@
 
 #include "Vec3.h"
 
+#include <string>
 #include <vector>
 
 namespace mlr
@@ -64,5 +65,14 @@ int dayOfYear(int year, int month, int day);
  * north that is not horizontal.
  */
 std::vector<SunPosition> sunPath(const SunPathRequest& request);
+
+/**
+ * A warning when the clock `timeZoneHours` ahead of UTC is more than 3.5 hours from the mean
+ * solar time of `longitude` (longitude / 15 hours, across the date line the shorter way):
+ * the times were most likely meant as local clock times with the default UTC, or with the
+ * offset's sign turned. Real time zones stay within about 3 hours of their solar time
+ * (western China, Alaska). Empty otherwise.
+ */
+std::string timeZoneWarning(double longitude, double timeZoneHours);
 
 } // namespace mlr

@@ -98,6 +98,11 @@ int vtkSunPathSource::RequestData(
       request.up = { this->Up[0], this->Up[1], this->Up[2] };
       path = mlr::sunPath(request);
       dayOfYear = mlr::dayOfYear(this->Year, this->Month, this->Day);
+      const std::string warning = mlr::timeZoneWarning(this->Longitude, this->TimeZone);
+      if (!warning.empty())
+      {
+        vtkWarningMacro(<< warning);
+      }
     }
   }
   catch (const mlr::Error& e)

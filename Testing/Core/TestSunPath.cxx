@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 using namespace mlr;
 using mlr::checks::expectError;
@@ -168,4 +171,25 @@ TEST(SunPath, BadRequestsSayWhatToFix)
   r = SunPathRequest();
   r.north = { 0, 0, 1 };
   expectError([&] { sunPath(r); }, "north");
+}
+
+TEST(SunPath, AClockFarFromTheSunsTimeIsNamed)
+{
+  // Paris at UTC or CEST, Kashgar on Beijing time (2.9 hours ahead), Nome on Alaska's summer
+  // time (3 hours) and Kiribati's Line Islands at UTC+14 across the date line (0.5 hours)
+  // are real clocks: no warning.
+  for (const auto& [longitude, zone] : std::vector<std::pair<double, double>>{
+         { 2.35, 0 }, { 2.35, 2 }, { 76.0, 8 }, { -165.4, -8 }, { -157.4, 14 } })
+  {
+    EXPECT_EQ(timeZoneWarning(longitude, zone), "") << longitude << " at " << zone;
+  }
+  // New York at the default UTC, and at +5 for -5.
+  EXPECT_EQ(timeZoneWarning(-74.0, 0),
+    "the clock times are taken at UTC+0, 4.9 hours ahead of the sun's time at longitude -74 "
+    "(UTC-4.9): if they are the site's clock times, give its offset from UTC, east positive "
+    "(--time-zone, or the Sun Path's TimeZone; e.g. -5)");
+  EXPECT_NE(timeZoneWarning(-74.0, 5).find("9.9 hours ahead"), std::string::npos);
+  // Tokyo at -9 for +9: 18.3 hours apart one way, 5.7 the other across the date line.
+  EXPECT_NE(timeZoneWarning(139.7, -9).find("5.7 hours ahead"), std::string::npos)
+    << timeZoneWarning(139.7, -9);
 }
