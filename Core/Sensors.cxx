@@ -621,6 +621,7 @@ void SensorReach::addSensor(const std::vector<std::size_t>& h, std::size_t patch
   if (this->RowOf.empty())
   {
     this->RowOf.assign(2 * patches, std::numeric_limits<std::uint32_t>::max());
+    this->PatchSides.reserve(2 * patches);
   }
   for (std::size_t i = 0; i < h.size();)
   {
@@ -785,7 +786,7 @@ SensorBatchSpread::SensorBatchSpread(const Scene& scene, const SensorSet& given,
     return;
   }
   // The rays do not depend on the solution: traced once, each sensor's element sides sorted
-  // and counted as solveSensor counts them.
+  // and counted as solveSensors counts them.
   std::vector<std::vector<std::size_t>> hits(this->Sensors);
   {
     const RayTracer tracer(scene);
@@ -994,15 +995,19 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
   // The sensors in groups, each traced once and then solved a block of frames at a time, in
   // which the radiosity their rays read is read once per patch side and frame.
   const std::size_t perGroup = sensorsPerGroup(sensors.size(), rig, sensorOptions, budget);
-  const double total = 2.0 * static_cast<double>(sensors.size());
-  double fraction = 0;
-  const auto keepGoing = [&] { return !progress || progress(fraction / total); };
-  std::vector<Rgb> table;
+  // Progress in sensor-frames, tracing a sensor's hemisphere counting as solving its frames:
+  // whole numbers, which never step back and end at 1 exactly.
+  const std::uint64_t total = 2 * static_cast<std::uint64_t>(sensors.size()) * frames;
+  std::uint64_t done = 0;
+  const auto keepGoing = [&]
+  { return !progress || progress(static_cast<double>(done) / static_cast<double>(total)); };
   for (std::size_t begin = 0; begin < sensors.size(); begin += perGroup)
   {
     const std::size_t group = std::min(perGroup, sensors.size() - begin);
     const std::size_t tasks = (group + SensorsPerTask - 1) / SensorsPerTask;
-    const double before = 2.0 * static_cast<double>(begin);
+    const std::uint64_t before = 2 * static_cast<std::uint64_t>(begin) * frames;
+    auto sensorsOf = [&](std::size_t tasksDone)
+    { return static_cast<std::uint64_t>(std::min(group, tasksDone * SensorsPerTask)); };
     std::vector<std::vector<std::size_t>> hits(group), cells(group);
     parallelFor(
       tasks, workers,
@@ -1033,9 +1038,9 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
           scratch[static_cast<std::size_t>(worker)].gatheringRays += sensorOptions.hemisphereRays;
         }
       },
-      [&](std::size_t done)
+      [&](std::size_t tasksDone)
       {
-        fraction = before + static_cast<double>(group * done) / static_cast<double>(tasks);
+        done = before + sensorsOf(tasksDone) * frames;
         return keepGoing();
       });
     Hemispheres hemispheres;
@@ -1069,12 +1074,14 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
       std::vector<std::size_t>().swap(cells[g]);
     }
     const std::size_t block = hemispheres.reach.framesPerBlock(frames, budget);
+    // Of this group's size: a table kept from a group before would grow to twice its own.
+    std::vector<Rgb> table;
     for (std::size_t first = 0; first < frames; first += block)
     {
       const std::size_t count = std::min(block, frames - first);
-      const double solved =
-        before + static_cast<double>(group) * (1.0 + static_cast<double>(first) / frames);
-      fraction = solved;
+      const std::uint64_t solved = before + static_cast<std::uint64_t>(group) * frames +
+        static_cast<std::uint64_t>(group) * first;
+      done = solved;
       hemispheres.reach.read(scene, solution, first, count, block, workers, keepGoing, table);
       parallelFor(
         tasks, workers,
@@ -1088,11 +1095,9 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
               scratch[static_cast<std::size_t>(worker)], result);
           }
         },
-        [&](std::size_t done)
+        [&](std::size_t tasksDone)
         {
-          fraction = solved +
-            static_cast<double>(group * count * done) /
-              (static_cast<double>(tasks) * static_cast<double>(frames));
+          done = solved + sensorsOf(tasksDone) * count;
           return keepGoing();
         });
     }

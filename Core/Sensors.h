@@ -135,8 +135,9 @@ struct SensorBudget
   std::uint64_t tableBytes = std::uint64_t(16) << 20;
   /// The most frames of a block: each worker's sums and shadow rays grow with them.
   std::size_t framesPerBlock = 1024;
-  /// A group's hemisphere rays: a key per ray and sky while traced, and a slot and a count per
-  /// distinct key kept; or those of 16 sensors when they take more.
+  /// A group's hemisphere rays: while traced, a key per ray (its element side) and per ray and
+  /// sky (its cell), and kept, a slot and a count per distinct key; or those of 16 sensors
+  /// when they take more.
   std::uint64_t hemisphereBytes = std::uint64_t(64) << 20;
 };
 
@@ -156,14 +157,14 @@ public:
   void addSensor(const std::vector<std::size_t>& sortedHits, std::size_t patches);
   std::size_t sensorCount() const { return this->KeyBegin.size() - 1; }
   std::size_t rowCount() const { return this->PatchSides.size(); }
-  /// The frames of one block within `budget`: at least 1, at most `frames`.
+  /// The frames of one block within `budget`: at least 1, at most `frames` (when above 0).
   std::size_t framesPerBlock(std::size_t frames, const SensorBudget& budget) const;
   /// Fills `table` (rowCount() x 4 elements, `block` frames each) with frames `first` to
   /// `first + count` of `solution`, on `workers` threads; `keepGoing` false cancels.
   void read(const Scene& scene, const Solution& solution, std::size_t first, std::size_t count,
     std::size_t block, int workers, const std::function<bool()>& keepGoing,
     std::vector<Rgb>& table) const;
-  /// Sensor `sensor`'s keys: each one's entries start at table() + slot(i) x block.
+  /// Sensor `sensor`'s keys: key i's entries in read()'s table start at slot(i) x block.
   std::size_t keysBegin(std::size_t sensor) const { return this->KeyBegin[sensor]; }
   std::size_t keysEnd(std::size_t sensor) const { return this->KeyBegin[sensor + 1]; }
   std::size_t slot(std::size_t key) const { return this->KeySlot[key]; }
@@ -258,11 +259,13 @@ private:
 };
 
 /**
- * Bytes solveSensors() allocates at its peak for `sensors` sensors over `frames` frames on a
- * scene of `elements` elements on `points` points lit by `rig` (and by its own emitters when
- * `sceneEmits`): the three results per sensor and frame, the unit sensors, the sensors' own
- * ray tracer, and every worker's per-frame sums and shadow-ray batch (the longest: an area
- * light's samples x frames) with its values per sample and frame.
+ * Bytes solveSensors() allocates at its peak, at the default SensorBudget, for `sensors`
+ * sensors over `frames` frames on a scene of `elements` elements on `points` points lit by
+ * `rig` (and by its own emitters when `sceneEmits`): the three results per sensor and frame,
+ * the unit sensors, the sensors' own ray tracer, one group's hemisphere rays, the table of
+ * what they read with its index, and every worker's sums and shadow-ray batch over a block
+ * of frames (the longest: an area light's samples x the block's frames) with its values per
+ * sample and frame.
  */
 std::uint64_t estimateSensorMemory(std::size_t sensors, std::size_t frames, std::size_t elements,
   std::size_t points, const LightRig& rig, bool sceneEmits, const SolverOptions& options,

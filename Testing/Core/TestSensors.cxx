@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -484,17 +485,33 @@ TEST(Sensors, AnyBudgetGivesTheSameBits)
   const AnimationOptions options = roomOptions(2, c.sensors);
   SensorSolution whole =
     solveSensors(a.scene, c.rig, a.solution, c.sensors, options.solver, options.sensorOptions);
-  SensorBudget tight;
+  // A frame at a time (the table's one frame) in groups of 16 sensors, and blocks of 3, 3
+  // and 1 frames.
+  SensorBudget tight, threes;
   tight.tableBytes = 1;
-  tight.framesPerBlock = 2;
   tight.hemisphereBytes = 1;
-  SensorSolution pieces = solveSensors(a.scene, c.rig, a.solution, c.sensors, options.solver,
-    options.sensorOptions, {}, nullptr, tight);
-  EXPECT_TRUE(sameBits(whole.irradianceData(), pieces.irradianceData()));
-  EXPECT_TRUE(sameBits(whole.sunData(), pieces.sunData()));
-  EXPECT_TRUE(sameBits(whole.stdErrorData(), pieces.stdErrorData()));
-  EXPECT_EQ(whole.statistics().shadowRays, pieces.statistics().shadowRays);
-  EXPECT_EQ(whole.statistics().gatheringRays, pieces.statistics().gatheringRays);
+  threes.framesPerBlock = 3;
+  for (const SensorBudget& budget : { tight, threes })
+  {
+    std::vector<double> shares;
+    SensorSolution pieces = solveSensors(
+      a.scene, c.rig, a.solution, c.sensors, options.solver, options.sensorOptions,
+      [&](double share)
+      {
+        shares.push_back(share);
+        return true;
+      },
+      nullptr, budget);
+    EXPECT_TRUE(sameBits(whole.irradianceData(), pieces.irradianceData()));
+    EXPECT_TRUE(sameBits(whole.sunData(), pieces.sunData()));
+    EXPECT_TRUE(sameBits(whole.stdErrorData(), pieces.stdErrorData()));
+    EXPECT_EQ(whole.statistics().shadowRays, pieces.statistics().shadowRays);
+    EXPECT_EQ(whole.statistics().gatheringRays, pieces.statistics().gatheringRays);
+    ASSERT_FALSE(shares.empty());
+    EXPECT_TRUE(std::is_sorted(shares.begin(), shares.end()));
+    EXPECT_GE(shares.front(), 0.0);
+    EXPECT_EQ(shares.back(), 1.0);
+  }
   double gathered = 0;
   for (std::size_t s = 0; s < c.sensors.size(); ++s)
   {
