@@ -76,10 +76,11 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<double> DaylightEfficacy;
   /// Per frame with a sky or the sun: the Perez efficacy of the direct sun alone (lm/W).
   std::vector<double> SunEfficacy;
-  /// The Sensors output without its frame's arrays (its metrics for SensorThreshold), the
-  /// sensors, their solution and the time steps the metrics count.
+  /// The Sensors output without its frame's arrays (its metrics for SensorSteps' threshold
+  /// and efficacies, these from SensorEfficacy where no daylight has its own), the sensors,
+  /// their solution and the time steps the metrics count.
   vtkSmartPointer<vtkPolyData> SensorMesh;
-  double SensorThreshold = 0;
+  double SensorEfficacy = 0;
   mlr::SensorSet SensorPoints;
   mlr::SensorSolution Sensors;
   mlr::vtksensors::MetricSteps SensorSteps;
@@ -327,6 +328,24 @@ void vtkMovingLightRadiosity::SetKeepingTheSolve(T& property, T value)
 void vtkMovingLightRadiosity::SetExposure(double exposure)
 {
   this->SetKeepingTheSolve(this->Exposure, exposure);
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetLuminousEfficacy(double efficacy)
+{
+  // Without lumens to turn into watts the efficacy only turns irradiance into illuminance,
+  // which the outputs do from the cached solve.
+  if (this->LightFluxLumens > 0 ||
+    (this->LightFluxFromFile && !this->LightDistributionFile.empty()))
+  {
+    if (efficacy != this->LuminousEfficacy)
+    {
+      this->LuminousEfficacy = efficacy;
+      this->Modified();
+    }
+    return;
+  }
+  this->SetKeepingTheSolve(this->LuminousEfficacy, efficacy);
 }
 
 //------------------------------------------------------------------------------
@@ -793,6 +812,21 @@ mlr::IntensityDistribution lightDistribution(
   return mlr::IntensityDistribution::lambertian();
 }
 
+/// The efficacy of each time step the sensors' metrics count: the daylight's of its frame
+/// (`daylight`, `sun`: the direct sun's), or the light's `luminous` where there is none.
+void setMetricEfficacies(const std::vector<double>& daylight, const std::vector<double>& sun,
+  double luminous, mlr::vtksensors::MetricSteps& steps)
+{
+  steps.efficacy.clear();
+  steps.sunEfficacy.clear();
+  for (std::size_t t = 0; t < steps.frame.size(); ++t)
+  {
+    steps.efficacy.push_back(
+      daylight.empty() ? luminous : daylight[std::min(t, daylight.size() - 1)]);
+    steps.sunEfficacy.push_back(sun.empty() ? luminous : sun[std::min(t, sun.size() - 1)]);
+  }
+}
+
 /// A light's power: `colour` itself (W), or with LightFluxLumens (or LightFluxFromFile, the
 /// file's own flux) that colour scaled to those lumens / LuminousEfficacy watts of luminance.
 mlr::Rgb luminairePower(vtkMovingLightRadiosity* self, const mlr::Rgb& colour,
@@ -1188,12 +1222,15 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     {
       if (cache.SensorMesh && cache.OutputsLight)
       {
-        if (cache.SensorThreshold != this->DaylightAutonomyThreshold)
+        if (cache.SensorSteps.autonomyThreshold != this->DaylightAutonomyThreshold ||
+          cache.SensorEfficacy != this->LuminousEfficacy)
         {
           cache.SensorSteps.autonomyThreshold = this->DaylightAutonomyThreshold;
+          setMetricEfficacies(
+            cache.DaylightEfficacy, cache.SunEfficacy, this->LuminousEfficacy, cache.SensorSteps);
+          cache.SensorEfficacy = this->LuminousEfficacy;
           cache.SensorMesh =
             mlr::vtksensors::sensorMesh(cache.SensorPoints, cache.Sensors, cache.SensorSteps);
-          cache.SensorThreshold = this->DaylightAutonomyThreshold;
         }
         output->ShallowCopy(cache.SensorMesh);
         mlr::vtksensors::addSensorArrays(
@@ -1943,17 +1980,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       for (std::size_t t = 0; t < cache.Times.size(); ++t)
       {
         steps.frame.push_back(solution.frameCount() > 1 ? t : 0);
-        steps.efficacy.push_back(cache.DaylightEfficacy.empty()
-            ? this->LuminousEfficacy
-            : cache.DaylightEfficacy[std::min(t, cache.DaylightEfficacy.size() - 1)]);
-        steps.sunEfficacy.push_back(cache.SunEfficacy.empty()
-            ? this->LuminousEfficacy
-            : cache.SunEfficacy[std::min(t, cache.SunEfficacy.size() - 1)]);
       }
+      setMetricEfficacies(cache.DaylightEfficacy, cache.SunEfficacy, this->LuminousEfficacy, steps);
+      cache.SensorEfficacy = this->LuminousEfficacy;
       cache.Sensors = std::move(animation.sensors);
       mlr::vtksensors::addSensorStatistics(cache.Statistics, cache.Sensors);
       cache.SensorMesh = mlr::vtksensors::sensorMesh(options.sensors, cache.Sensors, steps);
-      cache.SensorThreshold = steps.autonomyThreshold;
       cache.SensorPoints = std::move(options.sensors);
       cache.SensorSteps = std::move(steps);
     }

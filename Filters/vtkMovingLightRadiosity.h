@@ -682,9 +682,12 @@ public:
    * kept as given and make the update fail with an error naming LuminousEfficacy. Daylight
    * is not white light: with a sky, or LightType Directional (the sun) alone, the arrays use
    * Perez's efficacy of each frame's daylight instead (field data `LuminousEfficacy` and
-   * `LuminousEfficacyModel`). Default 179 (Radiance's value for white light).
+   * `LuminousEfficacyModel`). Default 179 (Radiance's value for white light). Changing it
+   * keeps the solve (the arrays and the sensors' metrics are computed again from it) unless
+   * it converts a light's lumens into watts (LightFluxLumens, or LightFluxFromFile with a
+   * LightDistributionFile).
    */
-  vtkSetMacro(LuminousEfficacy, double);
+  void SetLuminousEfficacy(double efficacy);
   vtkGetMacro(LuminousEfficacy, double);
   ///@}
   // --------------------------------------------------------------- end of Display block

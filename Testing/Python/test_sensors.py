@@ -231,3 +231,64 @@ def test_bad_sensors_are_refused_by_name(data, words):
     assert any(words in e and "Sensors" in e for e in errors), errors
     assert radiosity.GetOutput(0).GetNumberOfCells() == 0
     assert radiosity.GetOutput(3).GetNumberOfPoints() == 0
+
+
+def test_a_lamps_efficacy_keeps_the_solve_unless_it_turns_lumens_into_watts():
+    """A lamp's luminous efficacy only turns its irradiance into lux: changing it solved the
+    whole animation again for the same bits (QA). The Illuminance and the sensors' metrics
+    are now recomputed from the solve kept. With LightFluxLumens it turns lumens into watts,
+    and solves again."""
+    ground = vtkPlaneSource()
+    ground.SetOrigin(-1, -1, 0)
+    ground.SetPoint1(1, -1, 0)
+    ground.SetPoint2(-1, 1, 0)
+    ground.SetResolution(4, 4)
+    path = vtkPolyData()
+    points = vtkPoints()
+    for x in (-0.3, 0.0, 0.3):
+        points.InsertNextPoint(x, 0, 1)
+    path.SetPoints(points)
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(output(ground))
+    radiosity.SetTrajectoryData(path)
+    radiosity.SetLightTypeToPoint()
+    radiosity.SetLightPower(20, 20, 20)
+    radiosity.SetNumberOfPaths(4000)
+    radiosity.SetPatchSize(0.5)
+    radiosity.SetSensorsData(sensors(UP, UP_NORMALS))
+
+    def read(step):
+        assert radiosity.UpdateTimeStep(float(step))
+        out = radiosity.GetOutput(vtkMovingLightRadiosity.SENSORS_OUTPUT_PORT)
+        data = out.GetPointData()
+        return (vtk_to_numpy(data.GetArray("Irradiance")).copy(),
+                vtk_to_numpy(data.GetArray("Illuminance")).copy(),
+                vtk_to_numpy(data.GetArray("DaylightAutonomy")).copy(),
+                vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Illuminance")).copy())
+
+    before = [read(step) for step in range(3)]
+    solves = radiosity.GetSolveCount()
+    # A threshold between the sensors' lowest lux at 179 and half of it: the autonomy over the
+    # three steps falls where a sensor's lux at half the efficacy goes under it.
+    lux = numpy.array([b[1] for b in before])
+    radiosity.SetDaylightAutonomyThreshold(float(lux.min()) * 0.75)
+    assert all(a == pytest.approx(1.0) for a in read(0)[2])
+    radiosity.SetLuminousEfficacy(179 / 2)
+    after = [read(step) for step in range(3)]
+    assert radiosity.GetSolveCount() == solves
+    for b, a in zip(before, after):
+        assert numpy.array_equal(a[0], b[0])
+        numpy.testing.assert_allclose(a[1], b[1] / 2, rtol=1e-6)
+        numpy.testing.assert_allclose(a[3], b[3] / 2, rtol=1e-6)
+    autonomy = (lux / 2 >= lux.min() * 0.75).mean(axis=0)
+    numpy.testing.assert_allclose(after[0][2], autonomy)
+    assert autonomy.min() < 1
+
+    # Lumens into watts: the light's power changes, and the solve with it.
+    radiosity.SetLightFluxLumens(2000)
+    read(0)
+    solves = radiosity.GetSolveCount()
+    watts = read(0)[0]
+    radiosity.SetLuminousEfficacy(179)
+    assert numpy.allclose(read(0)[0], watts / 2, rtol=1e-5)
+    assert radiosity.GetSolveCount() == solves + 1
