@@ -325,6 +325,70 @@ void vtkMovingLightRadiosity::SetKeepingTheSolve(T& property, T value)
 }
 
 //------------------------------------------------------------------------------
+template <typename T>
+void vtkMovingLightRadiosity::SetUnlessUsed(T& property, T value, bool unused)
+{
+  if (unused)
+  {
+    this->SetKeepingTheSolve(property, value);
+  }
+  else if (!(value == property))
+  {
+    property = value;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkMovingLightRadiosity::SetPathPoint(double* point, double x, double y, double z)
+{
+  // A connected Trajectory gives the positions: the path's ends wait unused, and dragging
+  // their widget by mistake does not solve the animation again.
+  const bool unused = this->GetNumberOfInputConnections(TRAJECTORY_PORT) > 0;
+  const double given[3] = { x, y, z };
+  for (int i = 0; i < 3; ++i)
+  {
+    this->SetUnlessUsed(point[i], given[i], unused);
+  }
+}
+
+void vtkMovingLightRadiosity::SetPathStart(double x, double y, double z)
+{
+  this->SetPathPoint(this->PathStart, x, y, z);
+}
+
+void vtkMovingLightRadiosity::SetPathStart(const double start[3])
+{
+  this->SetPathStart(start[0], start[1], start[2]);
+}
+
+void vtkMovingLightRadiosity::SetPathEnd(double x, double y, double z)
+{
+  this->SetPathPoint(this->PathEnd, x, y, z);
+}
+
+void vtkMovingLightRadiosity::SetPathEnd(const double end[3])
+{
+  this->SetPathEnd(end[0], end[1], end[2]);
+}
+
+void vtkMovingLightRadiosity::SetNumberOfPositions(int positions)
+{
+  this->SetUnlessUsed(
+    this->NumberOfPositions, positions, this->GetNumberOfInputConnections(TRAJECTORY_PORT) > 0);
+}
+
+void vtkMovingLightRadiosity::SetSunIrradiance(double irradiance)
+{
+  this->SetUnlessUsed(this->SunIrradiance, irradiance, this->LightType != DIRECTIONAL_LIGHT);
+}
+
+void vtkMovingLightRadiosity::SetSensorRays(int rays)
+{
+  this->SetUnlessUsed(this->SensorRays, rays, this->GetNumberOfInputConnections(SENSORS_PORT) == 0);
+}
+
+//------------------------------------------------------------------------------
 void vtkMovingLightRadiosity::SetExposure(double exposure)
 {
   this->SetKeepingTheSolve(this->Exposure, exposure);

@@ -324,27 +324,30 @@ public:
   /**
    * First light centroid position when no Trajectory is connected. Not used for a
    * LightMaterial with PathFromLightMaterial on: that lamp starts where the Scene has it.
-   * Default 0, 0, 0.
+   * With a Trajectory connected a change keeps the solve. Default 0, 0, 0.
    */
-  vtkSetVector3Macro(PathStart, double);
+  void SetPathStart(double x, double y, double z);
+  void SetPathStart(const double start[3]);
   vtkGetVector3Macro(PathStart, double);
   ///@}
 
   ///@{
   /**
-   * Last light centroid position when no Trajectory is connected. Default 1, 0, 0.
+   * Last light centroid position when no Trajectory is connected; with one a change keeps the
+   * solve. Default 1, 0, 0.
    */
-  vtkSetVector3Macro(PathEnd, double);
+  void SetPathEnd(double x, double y, double z);
+  void SetPathEnd(const double end[3]);
   vtkGetVector3Macro(PathEnd, double);
   ///@}
 
   ///@{
   /**
    * Light positions (frames) from PathStart to PathEnd when no Trajectory is connected
-   * (one frame when there is no light at all, only emissive scene surfaces), from 1 to 100000.
-   * Default 10.
+   * (one frame when there is no light at all, only emissive scene surfaces), from 1 to 100000;
+   * with a Trajectory connected a change keeps the solve. Default 10.
    */
-  vtkSetMacro(NumberOfPositions, int);
+  void SetNumberOfPositions(int positions);
   vtkGetMacro(NumberOfPositions, int);
   ///@}
 
@@ -384,9 +387,10 @@ public:
    * Irradiance of the directional light on a surface facing it, W/m^2 (before the
    * Trajectory's Power factor). A Trajectory with the point array DirectNormalIrradiance (a
    * weather file's, from vtkSunPathSource) gives it per frame instead, and SunIrradiance 0
-   * still turns the direct sun off; 0 or more. Default 1000 (the sun at noon on a clear day).
+   * still turns the direct sun off; 0 or more. Other light types keep the solve when it
+   * changes. Default 1000 (the sun at noon on a clear day).
    */
-  vtkSetMacro(SunIrradiance, double);
+  void SetSunIrradiance(double irradiance);
   vtkGetMacro(SunIrradiance, double);
   ///@}
 
@@ -708,9 +712,9 @@ public:
    * sky through those that escape, the surfaces' radiosity through those that hit; and an
    * eighth as many points (at least 1) each sensor samples on every area light, each with a
    * shadow ray per frame. Their noise falls as one over the square root or faster. From 1 to
-   * 1000000; default 512.
+   * 1000000; without Sensors a change keeps the solve. Default 512.
    */
-  vtkSetMacro(SensorRays, int);
+  void SetSensorRays(int rays);
   vtkGetMacro(SensorRays, int);
   ///@}
 
@@ -814,6 +818,11 @@ private:
   /// threads): a kept solve still serves the outputs.
   template <typename T>
   void SetKeepingTheSolve(T& property, T value);
+  /// Sets a property that the solve does not use as the inputs and the other properties stand
+  /// (`unused`) keeping the solve, else as any other.
+  template <typename T>
+  void SetUnlessUsed(T& property, T value, bool unused);
+  void SetPathPoint(double* point, double x, double y, double z);
   /// Solves every frame and caches the result; returns false (after an error) on failure.
   bool Solve(vtkInformationVector** inputVector);
   /// Fills output port `port` with frame `frame` of the cache; false (after an error) when

@@ -137,6 +137,39 @@ def test_threads_and_exposure_keep_the_solve(pipeline):
     radiosity.UpdateTimeStep(0.0)
 
 
+def test_properties_the_solve_does_not_use_keep_it(pipeline):
+    """With a Trajectory connected the path's ends and positions wait unused, as SunIrradiance
+    does for an area light and SensorRays without sensors: changing them solved the animation
+    again for the same bits (QA; in ParaView, a drag of the path's widget by mistake)."""
+    radiosity = pipeline["filter"]
+    radiosity.UpdateTimeStep(0.0)
+    solves = radiosity.GetSolveCount()
+    before = vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")).copy()
+    radiosity.SetPathStart(0.3, 0.5, 0.3)
+    radiosity.SetPathEnd([0.1, 0.5, 0.1])
+    radiosity.SetNumberOfPositions(radiosity.GetNumberOfPositions() + 3)
+    radiosity.SetSunIrradiance(radiosity.GetSunIrradiance() / 2)
+    radiosity.SetSensorRays(radiosity.GetSensorRays() * 2)
+    radiosity.UpdateTimeStep(1.0)
+    radiosity.UpdateTimeStep(0.0)
+    assert radiosity.GetSolveCount() == solves
+    assert numpy.array_equal(
+        vtk_to_numpy(radiosity.GetOutput(0).GetCellData().GetArray("Radiosity")), before)
+    # Without the Trajectory the path is used: a change solves again.
+    lone = vtkMovingLightRadiosity()
+    lone.SetInputConnection(0, pipeline["scene"].GetOutputPort())
+    lone.SetInputConnection(1, pipeline["light"].GetOutputPort())
+    lone.SetNumberOfPaths(2000)
+    lone.SetPatchSize(0.1)
+    lone.SetPathStart(0.15, 0.5478, 0.15)
+    lone.SetPathEnd(0.40, 0.5478, 0.40)
+    lone.SetNumberOfPositions(2)
+    lone.UpdateTimeStep(0.0)
+    lone.SetPathEnd(0.35, 0.5478, 0.35)
+    lone.UpdateTimeStep(0.0)
+    assert lone.GetSolveCount() == 2
+
+
 def test_pvd_series_written_and_read_back(pipeline, tmp_path):
     radiosity = pipeline["filter"]
     grid = vtkAppendFilter()  # polygons -> unstructured grid, for .vtu
