@@ -8,6 +8,7 @@
 #include "SeriesWriter.h"
 
 #include "vtkCellArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkGenericCell.h"
 #include "vtkIdList.h"
@@ -768,8 +769,14 @@ vtkSmartPointer<vtkPolyData> workPlaneSensors(vtkPolyData* scene, const Triple& 
 
 void writeSensorFrame(vtkPolyData* sensors, const std::filesystem::path& path)
 {
+  vtkNew<vtkPolyData> frame;
+  frame->ShallowCopy(sensors);
+  vtkNew<vtkFieldData> fieldData;
+  fieldData->ShallowCopy(sensors->GetFieldData());
+  keepOwnFrameFigures(fieldData);
+  frame->SetFieldData(fieldData);
   vtkNew<vtkXMLPolyDataWriter> writer;
-  writer->SetInputData(sensors);
+  writer->SetInputData(frame);
   writer->SetDataModeToAppended();
   writer->SetCompressorTypeToLZ4();
   writeXml(writer, path, "the sensors");

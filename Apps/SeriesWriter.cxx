@@ -197,6 +197,7 @@ void FrameWriter::write(vtkPolyData* elements, double time, const std::filesyste
   job.pointData->ShallowCopy(elements->GetPointData());
   job.cellData->ShallowCopy(elements->GetCellData());
   job.fieldData->ShallowCopy(elements->GetFieldData());
+  keepOwnFrameFigures(job.fieldData);
   vtkNew<vtkDoubleArray> timeValue;
   timeValue->SetName("TimeValue");
   timeValue->InsertNextValue(time);
@@ -419,6 +420,32 @@ void writeXml(vtkXMLWriter* writer, const std::filesystem::path& path, const std
   if (!written)
   {
     failedWrite(what, path);
+  }
+}
+
+void keepOwnFrameFigures(vtkFieldData* fieldData)
+{
+  vtkDataArray* shown = fieldData->GetArray("FrameIndex");
+  if (!shown || shown->GetNumberOfTuples() == 0)
+  {
+    return;
+  }
+  const auto frame = static_cast<vtkIdType>(shown->GetComponent(0, 0));
+  for (const char* name : { "RelativeErrorMedian", "RelativeErrorP95", "LitElements",
+         "SensorRelativeErrorMedian", "SensorRelativeErrorP95", "LitSensors" })
+  {
+    vtkDataArray* all = fieldData->GetArray(name);
+    if (!all || all->GetNumberOfTuples() == 0)
+    {
+      continue;
+    }
+    vtkSmartPointer<vtkDataArray> own;
+    own.TakeReference(all->NewInstance());
+    own->SetName(name);
+    own->SetNumberOfComponents(all->GetNumberOfComponents());
+    // A scene lit only by what does not move is one frame shown at every time step.
+    own->InsertNextTuple(std::clamp<vtkIdType>(frame, 0, all->GetNumberOfTuples() - 1), all);
+    fieldData->AddArray(own); // replaces the array of that name
   }
 }
 

@@ -116,6 +116,14 @@ void writeFileBytes(
  */
 void writeXml(vtkXMLWriter* writer, const std::filesystem::path& path, const std::string& what);
 
+/**
+ * Replaces in `fieldData` each of the filter's arrays of one figure per frame (the error
+ * estimate's RelativeErrorMedian, RelativeErrorP95, LitElements and the sensors' own) by
+ * the figure of the frame it shows (its FrameIndex): a frame's file holds its own, not a
+ * year's worth in every file. The arrays replaced are new: the filter's stay whole.
+ */
+void keepOwnFrameFigures(vtkFieldData* fieldData);
+
 /// Writes the .pvd collection: (time, file name relative to the .pvd) per frame.
 void writeCollection(
   const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);

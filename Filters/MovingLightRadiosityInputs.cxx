@@ -402,8 +402,8 @@ std::vector<std::pair<vtkDataObject*, std::string>> leavesOf(
 }
 }
 
-vtkSmartPointer<vtkPolyData> surfaceOf(
-  vtkDataObject* input, const std::string& port, std::vector<std::string>& warnings)
+vtkSmartPointer<vtkPolyData> surfaceOf(vtkDataObject* input, const std::string& port,
+  std::vector<std::string>& warnings, const std::vector<std::pair<std::string, double>>& fills)
 {
   if (!input)
   {
@@ -438,6 +438,7 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
   vtkNew<vtkAppendPolyData> append;
   std::map<std::string, int> arrayLeaves;
   int leaves = 0;
+  std::vector<std::pair<vtkSmartPointer<vtkPolyData>, std::string>> surfaces;
   // Materials (cell array MaterialId into field data MaterialNames, as the scene reader gives
   // them) are matched by name over the blocks: each block's ids are renumbered into one list.
   vtkNew<vtkStringArray> materialNames;
@@ -497,12 +498,64 @@ vtkSmartPointer<vtkPolyData> surfaceOf(
         ++arrayLeaves[name];
       }
     }
-    append->AddInputData(surface);
+    surfaces.emplace_back(surface, label);
     ++leaves;
   }
   if (leaves == 0)
   {
     return vtkSmartPointer<vtkPolyData>::New();
+  }
+  // A material array that some blocks lack takes its default on them: dropping it would take
+  // every block's materials away for the sake of one.
+  for (const auto& [name, value] : fills)
+  {
+    const int count = arrayLeaves.count(name) ? arrayLeaves[name] : 0;
+    if (count == 0 || count == leaves)
+    {
+      continue;
+    }
+    vtkDataArray* model = nullptr;
+    for (const auto& surface : surfaces)
+    {
+      model = model ? model : surface.first->GetCellData()->GetArray(name.c_str());
+    }
+    std::vector<std::string> filled;
+    for (auto& [surface, label] : surfaces)
+    {
+      if (!model || surface->GetCellData()->GetAbstractArray(name.c_str()))
+      {
+        continue;
+      }
+      vtkSmartPointer<vtkDataArray> constant;
+      constant.TakeReference(model->NewInstance());
+      constant->SetName(name.c_str());
+      constant->SetNumberOfComponents(model->GetNumberOfComponents());
+      constant->SetNumberOfTuples(surface->GetNumberOfCells());
+      for (int c = 0; c < model->GetNumberOfComponents(); ++c)
+      {
+        constant->FillComponent(c, value);
+      }
+      surface->GetCellData()->AddArray(constant);
+      filled.push_back("'" + label + "'");
+    }
+    if (model)
+    {
+      arrayLeaves[name] = leaves;
+      std::string blocks;
+      for (std::size_t i = 0; i < filled.size(); ++i)
+      {
+        blocks += (i == 0 ? "" : ", ") + filled[i];
+      }
+      std::ostringstream message;
+      message << "the " << port << "'s cell array '" << name << "' is on " << count << " of its "
+              << leaves << " blocks with cells: the " << (filled.size() == 1 ? "block " : "blocks ")
+              << blocks << " without it take " << value << ": give it to every block";
+      warnings.push_back(message.str());
+    }
+  }
+  for (const auto& surface : surfaces)
+  {
+    append->AddInputData(surface.first);
   }
   for (const auto& [name, count] : arrayLeaves)
   {

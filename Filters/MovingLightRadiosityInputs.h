@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vtkSmartPointer.h"
@@ -23,11 +24,14 @@ namespace mlr::vtkinputs
 /// surface of another data set (its polygons and the boundary faces of its volume cells, with
 /// their cell and field data); the surfaces of a composite data set's leaves, appended, their
 /// materials (MaterialId, MaterialNames) matched by name, and a cell array that not every leaf
-/// has dropped with a warning in `warnings`. Null for no input. Throws mlr::Error, naming the
-/// port, for data that has no surface (a table). A surface made here carries the input's cell
-/// and point ids and its leaves' blocks, which the messages of the functions below give.
-vtkSmartPointer<vtkPolyData> surfaceOf(
-  vtkDataObject* data, const std::string& port, std::vector<std::string>& warnings);
+/// has dropped with a warning in `warnings`, except the arrays of `fills` (the Scene's
+/// reflectance and emission), which the leaves without them take with the value given, with a
+/// warning naming those leaves. Null for no input. Throws mlr::Error, naming the port, for
+/// data that has no surface (a table). A surface made here carries the input's cell and point
+/// ids and its leaves' blocks, which the messages of the functions below give.
+vtkSmartPointer<vtkPolyData> surfaceOf(vtkDataObject* data, const std::string& port,
+  std::vector<std::string>& warnings,
+  const std::vector<std::pair<std::string, double>>& fills = {});
 
 /// The Scene's polygons (strips split into triangles) with one material each: reflectance
 /// from the cell array named `reflectanceName` (1 or 3 components, each in [0, 1)) and

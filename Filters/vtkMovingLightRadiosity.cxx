@@ -1460,7 +1460,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   try
   {
     // The Scene and the Light as polygons, whatever data they are, before their pieces travel
-    // between ranks.
+    // between ranks. A Scene block without a material array takes the default material.
+    const std::vector<std::pair<std::string, double>> sceneMaterialFills = {
+      { this->ReflectanceArrayName, mlr::Material().reflectance.g },
+      { this->EmissionArrayName, 0.0 }
+    };
+    const std::vector<std::pair<std::string, double>> noFills;
     for (const int port : { SCENE_PORT, LIGHT_PORT })
     {
       if (inputVector[port]->GetNumberOfInformationObjects() > 0)
@@ -1468,7 +1473,8 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         vtkNew<vtkInformation> info;
         info->Set(vtkDataObject::DATA_OBJECT(),
           mlr::vtkinputs::surfaceOf(vtkDataObject::GetData(inputVector[port], 0),
-            port == SCENE_PORT ? "Scene" : "Light", warnings));
+            port == SCENE_PORT ? "Scene" : "Light", warnings,
+            port == SCENE_PORT ? sceneMaterialFills : noFills));
         surfaces[port]->Append(info);
         inputs[port] = surfaces[port];
       }

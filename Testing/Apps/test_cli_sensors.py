@@ -188,6 +188,13 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
     figures = json.loads(stats.read_text())["sensors"]["errorEstimate"]
     assert len(figures["relativeErrorMedian"]) == 3
     assert figures["litSensors"] == [3, 3, 3]
+    # Each frame's file has its own figures, not every frame's.
+    for frame, (_, sensors) in enumerate(frames):
+        fields = sensors.GetFieldData()
+        assert fields.GetArray("SensorRelativeErrorP95").GetNumberOfTuples() == 1
+        assert fields.GetArray("SensorRelativeErrorP95").GetValue(0) == pytest.approx(
+            figures["relativeErrorP95"][frame])
+        assert fields.GetArray("LitSensors").GetValue(0) == 3
     for median, p95 in zip(figures["relativeErrorMedian"], figures["relativeErrorP95"]):
         assert 0 < median <= p95 < 0.5
     result = run(args + ["--error-batches", "1", "--stats", str(stats)], tmp_path)
