@@ -549,7 +549,8 @@ vtkSmartPointer<vtkPolyData> surfaceOf(vtkDataObject* input, const std::string& 
       std::ostringstream message;
       message << "the " << port << "'s cell array '" << name << "' is on " << count << " of its "
               << leaves << " blocks with cells: the " << (filled.size() == 1 ? "block " : "blocks ")
-              << blocks << " without it take " << value << ": give it to every block";
+              << blocks << " without it " << (filled.size() == 1 ? "takes " : "take ") << value
+              << ": give it to every block";
       warnings.push_back(message.str());
     }
   }

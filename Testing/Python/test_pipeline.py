@@ -313,11 +313,20 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     assert any("cell array 'Zone' is on every block, but not of one type and number of "
                "components, so it is dropped" in w for w in messages["WarningEvent"]), messages
 
-    # A block without the Reflectance array: it is dropped, with a warning naming it.
+    # A block without the Reflectance array takes the default grey 0.5, with a warning naming
+    # it; the other keeps its own (dropping the array greyed the whole scene: QA).
     blocks.SetBlock(1, grey_plane((0, 0, 0), (0, 1, 0), (0, 0, 2)))
     elements, messages = lit(blocks)
-    assert any("cell array 'Reflectance' is on 1 of its 2 blocks" in w
-               for w in messages["WarningEvent"]), messages
+    assert any("cell array 'Reflectance' is on 1 of its 2 blocks with cells: the block "
+               "'block 1' without it takes 0.5" in w for w in messages["WarningEvent"]), messages
+    reflectance = elements.GetCellData().GetArray("Reflectance")
+    areas = {}
+    for c in range(elements.GetNumberOfCells()):
+        rho = round(reflectance.GetTuple(c)[0], 6)
+        areas[rho] = areas.get(rho, 0.0) + elements.GetCell(c).ComputeArea()
+    assert sorted(areas) == [0.2, 0.5]
+    assert areas[0.2] == pytest.approx(1.0, rel=1e-9)
+    assert areas[0.5] == pytest.approx(2.0, rel=1e-9)
 
     # A table has no surface: the error says what to give.
     elements, messages = lit(vtkTable())
