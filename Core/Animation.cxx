@@ -95,7 +95,14 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   // solve in those chunks, with what lives beside it: the caller's outputs and input, the
   // scene and its patches.
   std::size_t framesPerChunk = frames;
-  const std::uint64_t input = soupBytes(soup);
+  // The caller holds the soup and the rig through the solve: a year's sky tables are half a
+  // GiB.
+  std::uint64_t skyBytes = 0;
+  for (const Sky& sky : lights.skies)
+  {
+    skyBytes = saturatingSum(skyBytes, sky.allocatedBytes());
+  }
+  const std::uint64_t input = saturatingSum(soupBytes(soup), skyBytes);
   auto checkChunkedMemory = [&](std::size_t patches, std::size_t elements, std::size_t points,
                               bool approximate, const SolveSetup* setup = nullptr)
   {
@@ -116,7 +123,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
                       options.solver, options.sensorOptions),
         saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })),
-      !streamed && sensors == 0 && options.solver.ranks <= 1 && frames > 2 * MinimumFramesPerChunk);
+      !streamed && sensors == 0 && options.solver.ranks <= 1 && frames > 2 * MinimumFramesPerChunk,
+      skyBytes);
   };
 
   RemeshOptions remeshing = options.remeshing;

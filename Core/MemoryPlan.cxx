@@ -362,7 +362,7 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options)
 
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate, std::size_t sensors,
-  std::uint64_t sensorBytes, bool couldStream)
+  std::uint64_t sensorBytes, bool couldStream, std::uint64_t skyBytes)
 {
   const std::string about = approximate ? "about " : "";
   std::string detail = countOf(frames, "frame") + " x (" + about + std::to_string(patches) +
@@ -379,6 +379,15 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
     {
       advice = "use fewer sensors (a coarser grid) or fewer sensor rays (SensorRays, "
                "--sensor-rays), or raise the limit";
+    }
+  }
+  if (skyBytes > 0)
+  {
+    detail += ", and the sky's tables (" + gibibytes(skyBytes) + ")";
+    if (skyBytes > estimate / 2)
+    {
+      advice = "solve fewer frames of a sky that changes (fewer dates or hours), or raise the "
+               "limit";
     }
   }
   MemoryBudget(options.memoryLimitBytes).check(estimate, "the solve", detail, advice);

@@ -118,10 +118,11 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options);
  * `approximate` says the counts are expected ones, before remeshing; `sensorBytes` of the
  * estimate are the `sensors`', and when they are most of it the advice is about them;
  * `couldStream`: every frame is kept where the frames could be kept a few chunks at a time,
- * which the advice then offers).
+ * which the advice then offers; `skyBytes` of the estimate are the skies' tables, likewise).
  */
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate = false,
-  std::size_t sensors = 0, std::uint64_t sensorBytes = 0, bool couldStream = false);
+  std::size_t sensors = 0, std::uint64_t sensorBytes = 0, bool couldStream = false,
+  std::uint64_t skyBytes = 0);
 
 } // namespace mlr

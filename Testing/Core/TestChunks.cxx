@@ -772,6 +772,34 @@ TEST(Chunks, TheSceneAndTheInputCountAgainstTheMemoryLimit)
   EXPECT_NO_THROW(solveAnimation(soup, rig(), options));
 }
 
+TEST(Chunks, TheSkysTablesCountAgainstTheMemoryLimit)
+{
+  // A sky that changes in each of 200 frames holds 200 tables of 7,200 cells (23 MB) through
+  // the solve of a small ground: a limit of half the tables must refuse the solve, naming
+  // them, though the rest fits many times over (a year's 0.47 GiB went uncounted: QA).
+  PolygonSoup soup;
+  soup.points = { { -1, -1, 0 }, { 1, -1, 0 }, { 1, 1, 0 }, { -1, 1, 0 } };
+  soup.polygons = { { 0, 1, 2, 3 } };
+  soup.materials = { Material() };
+  std::vector<SkyFrame> frames;
+  for (int f = 0; f < 200; ++f)
+  {
+    frames.push_back({ {}, 100.0 + f, 0 });
+  }
+  LightRig lights;
+  lights.skies.emplace_back(SkyModel::CieOvercast, Vec3(0, 0, 1), frames);
+  const std::uint64_t tables = lights.skies.front().allocatedBytes();
+  EXPECT_GE(tables, 200u * Sky::Cells * 2 * sizeof(double));
+  AnimationOptions options;
+  options.solver.pathsPerFrame = 2000;
+  options.solver.threads = 1;
+  options.remeshing.targetEdgeLength = 1;
+  options.solver.memoryLimitBytes = tables / 2;
+  checks::expectError([&] { solveAnimation(soup, lights, options); }, "the sky's tables");
+  options.solver.memoryLimitBytes = 4 * tables;
+  EXPECT_NO_THROW(solveAnimation(soup, lights, options));
+}
+
 TEST(Chunks, TheChunksLengthFollowsTheSidesLightCanReach)
 {
   // Inside a closed box the outer sides, half of them, take no sums and no results: a memory
