@@ -1591,6 +1591,12 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
     }
     if (soup.polygons.empty())
     {
+      if (!sceneData || sceneData->GetNumberOfCells() == 0)
+      {
+        // Connected, so meant to be lit: empty outputs alone would not say why.
+        warnings.push_back("the Scene input is connected but empty (no cells; an upstream "
+                           "filter gave nothing?): the outputs are empty");
+      }
       for (const std::string& warning : warnings)
       {
         vtkWarningMacro(<< warning);

@@ -687,6 +687,19 @@ def test_an_empty_light_is_named_before_nothing_emits():
     assert any("nothing emits light" in m for m in messages), messages
 
 
+def test_an_empty_scene_is_named():
+    """A Scene that an upstream filter emptied (a Threshold keeping nothing) gave empty outputs
+    and not a word (QA)."""
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(vtkPolyData())
+    radiosity.SetNumberOfThreads(2)
+    messages = recorded(radiosity, "WarningEvent", "ErrorEvent")
+    radiosity.UpdateTimeStep(0.0)
+    assert radiosity.GetOutput(0).GetNumberOfCells() == 0
+    assert any("the Scene input is connected but empty" in m for m in messages), messages
+
+
 def test_inputs_and_properties_that_change_nothing_are_warned_of():
     """A Light input beside LightType Point or Directional, a Trajectory with only the Scene's
     own emitters, a TimeLimit without a target: accepted silently, where the command line
