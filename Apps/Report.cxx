@@ -353,6 +353,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
         { "spacing", jsonNumber((*options.workPlane)[1]) } };
     }
     sensors["count"] = sensorCount;
+    sensors["rays"] = filter->GetSensorRays();
     sensors["daylightAutonomyThresholdLx"] = jsonNumber(filter->GetDaylightAutonomyThreshold());
     // Their error estimate's figures per frame, as the elements' (errorEstimate below).
     for (const auto& [name, key] :

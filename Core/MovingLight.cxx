@@ -26,7 +26,9 @@ MovingLight::MovingLight(const std::vector<std::vector<Vec3>>& polygons, const R
     poses[k].position = this->Centroid + translations[k];
     if (!isFinite(translations[k]))
     {
-      throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
+      throw Error("light position " + std::to_string(k) +
+        " has NaN or infinite coordinates: give every point of the Trajectory (or the path's "
+        "ends) finite coordinates");
     }
   }
   this->setPoses(poses);
@@ -55,7 +57,9 @@ void checkPoses(const std::vector<LightPose>& poses, const Rgb& power)
     const LightPose& pose = poses[k];
     if (!isFinite(pose.position))
     {
-      throw Error("light position " + std::to_string(k) + " has NaN or infinite coordinates");
+      throw Error("light position " + std::to_string(k) +
+        " has NaN or infinite coordinates: give every point of the Trajectory (or the path's "
+        "ends) finite coordinates");
     }
     if (!isWithinCoordinateRange(pose.position))
     {

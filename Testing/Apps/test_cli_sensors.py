@@ -185,6 +185,7 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
         assert numpy.all(error < 0.5 * array(sensors, "Irradiance"))
         efficacy = sensors.GetFieldData().GetArray("LuminousEfficacy").GetValue(0)
         assert lux == pytest.approx(efficacy * (error @ [0.2126, 0.7152, 0.0722]), rel=1e-5)
+    assert json.loads(stats.read_text())["sensors"]["rays"] == 512
     figures = json.loads(stats.read_text())["sensors"]["errorEstimate"]
     assert len(figures["relativeErrorMedian"]) == 3
     assert figures["litSensors"] == [3, 3, 3]

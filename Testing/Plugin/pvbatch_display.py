@@ -65,6 +65,12 @@ check(yellow[0] > 0.8 and yellow[1] > 0.6 and yellow[2] < 0.5,
 check(light_display.RenderPointsAsSpheres == 1 and light_display.PointSize >= 8,
       f"the Light's vertices are drawn as {'spheres' if light_display.RenderPointsAsSpheres else 'dots'}"
       f" {light_display.PointSize} pixels across, expected spheres of 8 pixels or more")
+# The Sensors likewise: a work plane of 2-pixel dots was hard to see (QA).
+controller.ShowInPreferredView(proxy, 3, view.SMProxy)
+sensors_display = GetDisplayProperties(OutputPort(radiosity, 3), view)
+check(sensors_display.RenderPointsAsSpheres == 1 and sensors_display.PointSize == 8,
+      f"the Sensors are drawn as {'spheres' if sensors_display.RenderPointsAsSpheres else 'dots'}"
+      f" {sensors_display.PointSize} pixels across, expected spheres of 8 pixels")
 
 
 def fetch(time, port=0):
