@@ -256,6 +256,16 @@ def grey_plane(origin, point1, point2, reflectance=None):
     return data
 
 
+def reflectance_areas(elements):
+    """The elements' area of each (grey) reflectance."""
+    reflectance = elements.GetCellData().GetArray("Reflectance")
+    areas = {}
+    for c in range(elements.GetNumberOfCells()):
+        rho = round(reflectance.GetTuple(c)[0], 6)
+        areas[rho] = areas.get(rho, 0.0) + elements.GetCell(c).ComputeArea()
+    return areas
+
+
 def lit(scene, paths=4000):
     """The Elements output of the scene under the sun straight above, and the warnings."""
     radiosity = vtkMovingLightRadiosity()
@@ -292,11 +302,7 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     blocks.SetBlock(1, wall.GetOutput())
     elements, messages = lit(blocks)
     assert not messages["ErrorEvent"], messages
-    reflectance = elements.GetCellData().GetArray("Reflectance")
-    areas = {}
-    for c in range(elements.GetNumberOfCells()):
-        rho = round(reflectance.GetTuple(c)[0], 6)
-        areas[rho] = areas.get(rho, 0.0) + elements.GetCell(c).ComputeArea()
+    areas = reflectance_areas(elements)
     assert sorted(areas) == [0.2, 0.7]
     assert areas[0.2] == pytest.approx(1.0, rel=1e-9)
     assert areas[0.7] == pytest.approx(2.0, rel=1e-9)
@@ -319,11 +325,7 @@ def test_any_data_set_or_multiblock_gives_its_surface():
     elements, messages = lit(blocks)
     assert any("cell array 'Reflectance' is on 1 of its 2 blocks with cells: the block "
                "'block 1' without it takes 0.5" in w for w in messages["WarningEvent"]), messages
-    reflectance = elements.GetCellData().GetArray("Reflectance")
-    areas = {}
-    for c in range(elements.GetNumberOfCells()):
-        rho = round(reflectance.GetTuple(c)[0], 6)
-        areas[rho] = areas.get(rho, 0.0) + elements.GetCell(c).ComputeArea()
+    areas = reflectance_areas(elements)
     assert sorted(areas) == [0.2, 0.5]
     assert areas[0.2] == pytest.approx(1.0, rel=1e-9)
     assert areas[0.5] == pytest.approx(2.0, rel=1e-9)

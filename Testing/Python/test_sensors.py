@@ -72,14 +72,19 @@ def trajectory():
     return data
 
 
+def ground():
+    """A 2 x 2 ground of 4 x 4 quads about the origin, facing up."""
+    plane = vtkPlaneSource()
+    plane.SetOrigin(-1, -1, 0)
+    plane.SetPoint1(1, -1, 0)
+    plane.SetPoint2(-1, 1, 0)
+    plane.SetResolution(4, 4)
+    return output(plane)
+
+
 def make_filter(sensor_data, threads=2):
-    ground = vtkPlaneSource()
-    ground.SetOrigin(-1, -1, 0)
-    ground.SetPoint1(1, -1, 0)
-    ground.SetPoint2(-1, 1, 0)
-    ground.SetResolution(4, 4)
     radiosity = vtkMovingLightRadiosity()
-    radiosity.SetSceneData(output(ground))
+    radiosity.SetSceneData(ground())
     radiosity.SetTrajectoryData(trajectory())
     radiosity.SetLightTypeToDirectional()
     radiosity.SetSunIrradiance(DNI)
@@ -238,18 +243,13 @@ def test_a_lamps_efficacy_keeps_the_solve_unless_it_turns_lumens_into_watts():
     whole animation again for the same bits (QA). The Illuminance and the sensors' metrics
     are now recomputed from the solve kept. With LightFluxLumens it turns lumens into watts,
     and solves again."""
-    ground = vtkPlaneSource()
-    ground.SetOrigin(-1, -1, 0)
-    ground.SetPoint1(1, -1, 0)
-    ground.SetPoint2(-1, 1, 0)
-    ground.SetResolution(4, 4)
     path = vtkPolyData()
     points = vtkPoints()
     for x in (-0.3, 0.0, 0.3):
         points.InsertNextPoint(x, 0, 1)
     path.SetPoints(points)
     radiosity = vtkMovingLightRadiosity()
-    radiosity.SetSceneData(output(ground))
+    radiosity.SetSceneData(ground())
     radiosity.SetTrajectoryData(path)
     radiosity.SetLightTypeToPoint()
     radiosity.SetLightPower(20, 20, 20)
