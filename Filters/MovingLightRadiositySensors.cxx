@@ -42,8 +42,15 @@ SensorSet sensorsFromPoints(vtkPointSet* input)
   }
   if (normals->GetNumberOfComponents() != 3)
   {
-    throw Error("the Sensors input's Normals has " +
-      std::to_string(normals->GetNumberOfComponents()) + " components: give 3 (x, y, z)");
+    const int components = normals->GetNumberOfComponents();
+    throw Error("the Sensors input's Normals has " + std::to_string(components) +
+      (components == 1 ? " component" : " components") + ": give 3 (x, y, z)");
+  }
+  if (normals->GetNumberOfTuples() != n)
+  {
+    // Fewer would be read past their end; more belong to no sensor.
+    throw Error("the Sensors input's Normals has " + std::to_string(normals->GetNumberOfTuples()) +
+      " tuples for " + std::to_string(n) + " points: give one normal per sensor point");
   }
   sensors.points.resize(static_cast<std::size_t>(n));
   sensors.normals.resize(static_cast<std::size_t>(n));

@@ -227,6 +227,9 @@ def test_standard_errors_come_as_the_elements_do():
         (sensors(UP, None), "no point array Normals"),
         (sensors(UP, [(0, 0, 1), (0, 0, 0), (0, 0, 1)]), "sensor 1 has a zero or non-finite normal"),
         (sensors([(0, 0, 1), (float("nan"), 0, 1)], [(0, 0, 1), (0, 0, 1)]), "sensor 1 has a point"),
+        # Too few normals were read past their end, too many accepted silently (QA).
+        (sensors(UP, UP_NORMALS[:2]), "Normals has 2 tuples for 3 points"),
+        (sensors(UP, UP_NORMALS + [(0, 0, 1)]), "Normals has 4 tuples for 3 points"),
     ],
 )
 def test_bad_sensors_are_refused_by_name(data, words):
