@@ -250,6 +250,13 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     {
       sensorProgress = [&](double f) { return progress(1 - sensorShare + sensorShare * f); };
     }
+    if (options.solver.log)
+    {
+      // The last stage of the progress, which may take seconds of its own: named.
+      options.solver.log("sensors: " + std::to_string(options.sensors.size()) + " x " +
+        std::to_string(options.sensorOptions.hemisphereRays) + " hemisphere rays over " +
+        std::to_string(animation.solution.frameCount()) + " frames");
+    }
     animation.sensors =
       solveSensors(scene, lights, animation.solution, options.sensors, options.solver,
         options.sensorOptions, sensorProgress, sensorSpread ? &*sensorSpread : nullptr);

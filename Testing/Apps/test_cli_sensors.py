@@ -172,6 +172,8 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
     result = run(args + ["--stats", str(stats)], tmp_path)
     assert result.returncode == 0, result.stderr
     assert "relative error of the lit sensors: median" in result.stdout, result.stdout
+    # Their stage is named above the progress bar, not left as the solve's last percent.
+    assert "sensors: 3 x 512 hemisphere rays over 3 frames" in result.stdout, result.stdout
     frames = read_sensor_series(tmp_path)
     assert len(frames) == 3
     for _, sensors in frames:
