@@ -1459,6 +1459,24 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
   vtkNew<vtkInformationVector> surfaces[2];
   try
   {
+    // An input that is a time series is taken at its first step (RequestUpdateExtent): a
+    // Trajectory of one point per step is no path, so say so.
+    const char* portNames[4] = { "Scene", "Light", "Trajectory", "Sensors" };
+    for (int port = 0; port < 4; ++port)
+    {
+      vtkInformation* info = inputVector[port]->GetInformationObject(0);
+      const int steps = info ? info->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()) : 0;
+      if (steps > 1)
+      {
+        std::ostringstream message;
+        message << "the " << portNames[port] << " input has " << steps
+                << " time steps: only its first (time "
+                << info->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS())[0]
+                << ") is used; give one data set"
+                << (port == TRAJECTORY_PORT ? " whose points are the light's positions" : "");
+        warnings.push_back(message.str());
+      }
+    }
     // The Scene and the Light as polygons, whatever data they are, before their pieces travel
     // between ranks. A Scene block without a material array takes the default material.
     const std::vector<std::pair<std::string, double>> sceneMaterialFills = {
@@ -1488,7 +1506,6 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         [this](const std::string& message) { vtkErrorMacro(<< message); });
       // Every rank gets the whole Scene, Light and Trajectory, whatever pieces arrived.
       const auto start = std::chrono::steady_clock::now();
-      const char* names[4] = { "Scene", "Light", "Trajectory", "Sensors" };
       for (int port = 0; port < 4; ++port)
       {
         if (inputVector[port]->GetNumberOfInformationObjects() == 0)
@@ -1497,7 +1514,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         }
         wholeInputs[port] =
           mlr::vtkparallel::gatherPieces(controller, vtkDataObject::GetData(inputs[port], 0),
-            names[port], port == SCENE_PORT ? &cellRanks : nullptr);
+            portNames[port], port == SCENE_PORT ? &cellRanks : nullptr);
         vtkNew<vtkInformation> info;
         info->Set(vtkDataObject::DATA_OBJECT(), wholeInputs[port]);
         gathered[port]->Append(info);

@@ -702,6 +702,43 @@ def test_an_empty_scene_is_named():
     assert any("the Scene input is connected but empty" in m for m in messages), messages
 
 
+def test_a_trajectory_that_is_a_time_series_is_named():
+    """A .pvd of one point per time step is no path: its first step alone became a single
+    frame, without a word (QA). It is now named, with what to give."""
+    from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+
+    class OnePointPerStep(VTKPythonAlgorithmBase):
+        def __init__(self):
+            super().__init__(nInputPorts=0, nOutputPorts=1, outputType="vtkPolyData")
+
+        def RequestInformation(self, request, inInfo, outInfo):
+            info = outInfo.GetInformationObject(0)
+            info.Set(vtkStreamingDemandDrivenPipeline.TIME_STEPS(), [0.0, 1.0, 2.0], 3)
+            info.Set(vtkStreamingDemandDrivenPipeline.TIME_RANGE(), [0.0, 2.0], 2)
+            return 1
+
+        def RequestData(self, request, inInfo, outInfo):
+            points = vtkPoints()
+            points.InsertNextPoint(0.25, 0.5478, 0.25)
+            vtkPolyData.GetData(outInfo).SetPoints(points)
+            return 1
+
+    series = OnePointPerStep()
+    radiosity = vtkMovingLightRadiosity()
+    radiosity.SetSceneData(grey_plane((0, 0, 0), (1, 0, 0), (0, 1, 0), 0.5))
+    radiosity.SetLightTypeToPoint()
+    radiosity.SetInputConnection(2, series.GetOutputPort())
+    radiosity.SetNumberOfPaths(2000)
+    radiosity.SetNumberOfThreads(2)
+    messages = recorded(radiosity, "WarningEvent")
+    assert radiosity.UpdateTimeStep(0.0)
+    assert any("the Trajectory input has 3 time steps: only its first (time 0) is used; give "
+               "one data set whose points are the light's positions" in m for m in messages), \
+        messages
+
+
 def test_inputs_and_properties_that_change_nothing_are_warned_of():
     """A Light input beside LightType Point or Directional, a Trajectory with only the Scene's
     own emitters, a TimeLimit without a target: accepted silently, where the command line
