@@ -283,13 +283,28 @@ struct Hemispheres
   std::vector<std::uint32_t> cellKey, cellCount;
 };
 
+/// Calls `f(value, count)` for each run of equal values of a sorted vector, in order.
+template <typename F>
+void forEachRun(const std::vector<std::size_t>& sorted, const F& f)
+{
+  for (std::size_t i = 0; i < sorted.size();)
+  {
+    std::size_t end = i;
+    while (end < sorted.size() && sorted[end] == sorted[i])
+    {
+      ++end;
+    }
+    f(sorted[i], end - i);
+    i = end;
+  }
+}
+
 /// The number of distinct values of a sorted vector.
 std::size_t distinctCount(const std::vector<std::size_t>& sorted)
 {
-  return sorted.empty() ? 0
-                        : 1 +
-      static_cast<std::size_t>(std::count_if(
-        sorted.begin() + 1, sorted.end(), [&](const std::size_t& v) { return v != *(&v - 1); }));
+  std::size_t runs = 0;
+  forEachRun(sorted, [&](std::size_t, std::size_t) { ++runs; });
+  return runs;
 }
 
 /**
@@ -623,25 +638,20 @@ void SensorReach::addSensor(const std::vector<std::size_t>& h, std::size_t patch
     this->RowOf.assign(2 * patches, std::numeric_limits<std::uint32_t>::max());
     this->PatchSides.reserve(2 * patches);
   }
-  for (std::size_t i = 0; i < h.size();)
-  {
-    std::size_t end = i;
-    while (end < h.size() && h[end] == h[i])
+  forEachRun(h,
+    [&](std::size_t key, std::size_t count)
     {
-      ++end;
-    }
-    const std::size_t element = h[i] / 2, side = h[i] % 2;
-    const std::size_t patchSide = 2 * Scene::patchOfElement(element) + side;
-    if (this->RowOf[patchSide] == std::numeric_limits<std::uint32_t>::max())
-    {
-      this->RowOf[patchSide] = static_cast<std::uint32_t>(this->PatchSides.size());
-      this->PatchSides.push_back(static_cast<std::uint32_t>(patchSide));
-    }
-    this->KeySlot.push_back(static_cast<std::uint32_t>(
-      this->RowOf[patchSide] * Scene::ElementsPerPatch + element % Scene::ElementsPerPatch));
-    this->KeyCount.push_back(static_cast<std::uint32_t>(end - i));
-    i = end;
-  }
+      const std::size_t element = key / 2, side = key % 2;
+      const std::size_t patchSide = 2 * Scene::patchOfElement(element) + side;
+      if (this->RowOf[patchSide] == std::numeric_limits<std::uint32_t>::max())
+      {
+        this->RowOf[patchSide] = static_cast<std::uint32_t>(this->PatchSides.size());
+        this->PatchSides.push_back(static_cast<std::uint32_t>(patchSide));
+      }
+      this->KeySlot.push_back(static_cast<std::uint32_t>(
+        this->RowOf[patchSide] * Scene::ElementsPerPatch + element % Scene::ElementsPerPatch));
+      this->KeyCount.push_back(static_cast<std::uint32_t>(count));
+    });
   this->KeyBegin.push_back(this->KeySlot.size());
 }
 
@@ -1057,18 +1067,12 @@ SensorSolution solveSensors(const Scene& scene, const LightRig& rig, const Solut
     for (std::size_t g = 0; g < group; ++g)
     {
       hemispheres.reach.addSensor(hits[g], scene.patchCount());
-      const std::vector<std::size_t>& c = cells[g];
-      for (std::size_t i = 0; i < c.size();)
-      {
-        std::size_t end = i;
-        while (end < c.size() && c[end] == c[i])
+      forEachRun(cells[g],
+        [&](std::size_t key, std::size_t count)
         {
-          ++end;
-        }
-        hemispheres.cellKey.push_back(static_cast<std::uint32_t>(c[i]));
-        hemispheres.cellCount.push_back(static_cast<std::uint32_t>(end - i));
-        i = end;
-      }
+          hemispheres.cellKey.push_back(static_cast<std::uint32_t>(key));
+          hemispheres.cellCount.push_back(static_cast<std::uint32_t>(count));
+        });
       hemispheres.cellBegin.push_back(hemispheres.cellKey.size());
       std::vector<std::size_t>().swap(hits[g]);
       std::vector<std::size_t>().swap(cells[g]);
