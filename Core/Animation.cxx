@@ -103,6 +103,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     skyBytes = saturatingSum(skyBytes, sky.allocatedBytes());
   }
   const std::uint64_t input = saturatingSum(soupBytes(soup), skyBytes);
+  std::uint64_t checkedBytes = 0;
   auto checkChunkedMemory = [&](std::size_t patches, std::size_t elements, std::size_t points,
                               bool approximate, const SolveSetup* setup = nullptr)
   {
@@ -116,10 +117,10 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     framesPerChunk = chooseFramesPerChunk(patches, elements, points, frames, options.solver,
       lightCount, outputs, streamed, kept, reachable, firstHits);
     const std::size_t sensors = options.sensors.size();
-    checkSolveMemory(estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
-                       options.solver, lightCount, outputs, streamed, kept, reachable, firstHits),
-      streamed ? std::min(frames, framesPerChunk) : frames, patches, elements, options.solver,
-      approximate, sensors,
+    checkedBytes = estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
+      options.solver, lightCount, outputs, streamed, kept, reachable, firstHits);
+    checkSolveMemory(checkedBytes, streamed ? std::min(frames, framesPerChunk) : frames, patches,
+      elements, options.solver, approximate, sensors,
       saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
                       options.solver, options.sensorOptions),
         saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })),
@@ -240,6 +241,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     sensorSpread->finish();
   }
   animation.solution.statistics.secondsRemeshing = animation.remeshing.seconds;
+  animation.solution.statistics.memoryCheckedBytes = checkedBytes;
   animation.solution.statistics.patchEdgeLength = animation.remeshing.targetEdgeLength;
   animation.warnings.insert(animation.warnings.end(), animation.solution.warnings.begin(),
     animation.solution.warnings.end());

@@ -72,6 +72,11 @@ struct SolverStatistics
   std::uint64_t memoryEstimateBytes = 0;
   std::uint64_t memoryResultBytes = 0;
   std::uint64_t memoryAccumulatorBytes = 0;
+  /// What the memory check held against the limit (solveAnimation): the solve in its chunks
+  /// with all that lives beside it, the finished frames, the caller's outputs, the scene, its
+  /// input and the sensors. The process's peak is this plus the program's own (about 60 MB
+  /// for the command line); 0 for a bare solve.
+  std::uint64_t memoryCheckedBytes = 0;
   /// The shooting accumulators had one copy per worker (else one shared copy, MemoryPlan).
   bool accumulatorCopyPerWorker = true;
   int threads = 0;

@@ -411,6 +411,10 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
     static_cast<double>(statistics.memoryEstimateBytes) /
       std::max(
         1.0, static_cast<double>(statistics.elements) * static_cast<double>(statistics.frames)));
+  if (statistics.memoryCheckedBytes > 0)
+  {
+    count("MemoryCheckedBytes", statistics.memoryCheckedBytes);
+  }
   count("AccumulatorCopyPerWorker", statistics.accumulatorCopyPerWorker ? 1 : 0);
   count("ReuseShooting", statistics.reuseShooting ? 1 : 0);
   count("ReuseGathering", statistics.reuseGathering ? 1 : 0);

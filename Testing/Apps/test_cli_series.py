@@ -160,6 +160,9 @@ def test_stats_time_the_stages(series):
     assert peak > results
     assert statistics["MemoryEstimateBytesPerElementFrame"] == pytest.approx(
         statistics["MemoryEstimateBytes"] / (FRAMES * statistics["Elements"]))
+    # What the memory check held against the limit adds to the solve's peak the finished
+    # frames, the outputs and the scene.
+    assert statistics["MemoryCheckedBytes"] > statistics["MemoryEstimateBytes"]
     assert statistics["AccumulatorCopyPerWorker"] in (0, 1)
     assert 0 <= statistics["ShadowRaysBlocked"] <= statistics["ShadowRays"]
     # Disjoint stretches of the run, all within its total.
