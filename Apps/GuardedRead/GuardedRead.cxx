@@ -5,6 +5,7 @@
 
 #include "vtkCellArray.h"
 #include "vtkDataSet.h"
+#include "vtkFieldData.h"
 #include "vtkGenericDataObjectReader.h"
 #include "vtkGeometryFilter.h"
 #include "vtkLogger.h"
@@ -13,6 +14,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkOutputWindow.h"
 #include "vtkPLYReader.h"
+#include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
 #include "vtkSTLReader.h"
@@ -539,6 +541,15 @@ vtkSmartPointer<vtkPolyData> polygonsOf(vtkAlgorithm* reader)
   if (!vtkDataSet::SafeDownCast(output))
   {
     return nullptr;
+  }
+  if (auto* points = vtkPointSet::SafeDownCast(output); points && points->GetNumberOfCells() == 0)
+  {
+    // Points alone, such as sensors in a .vtu: the surface of no cells would drop them.
+    auto cloud = vtkSmartPointer<vtkPolyData>::New();
+    cloud->SetPoints(points->GetPoints());
+    cloud->GetPointData()->ShallowCopy(points->GetPointData());
+    cloud->GetFieldData()->ShallowCopy(points->GetFieldData());
+    return cloud;
   }
   // Volumetric or other data sets: their surface, with the cell arrays carried along.
   vtkNew<vtkGeometryFilter> surface;

@@ -21,8 +21,9 @@ from test_cli_rigs_and_sun import Polygons, run, write_points
 
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints
-from vtkmodules.vtkCommonDataModel import vtkPolyData
-from vtkmodules.vtkIOXML import vtkXMLPolyDataReader, vtkXMLPolyDataWriter
+from vtkmodules.vtkCommonDataModel import vtkPolyData, vtkUnstructuredGrid
+from vtkmodules.vtkIOXML import (vtkXMLPolyDataReader, vtkXMLPolyDataWriter,
+                                 vtkXMLUnstructuredGridWriter)
 
 W, D, H = 3.0, 2.0, 2.5
 HEIGHT, SPACING = 0.8, 0.5
@@ -161,6 +162,30 @@ def test_sensors_file_with_a_moving_lamp_and_the_threshold(tmp_path):
         assert result.returncode == 0, result.stderr
         da = array(read_sensor_series(tmp_path)[0][1], "DaylightAutonomy")
         assert numpy.allclose(da, expected), (threshold, da)
+
+
+def test_sensors_as_points_of_an_unstructured_grid_without_cells(tmp_path):
+    """A .vtu of points and no cells is a sensors file like a .vtp: the same sensors, the same
+    values (the surface of no cells would have dropped its points)."""
+    args = moving_lamp_args(tmp_path)
+    result = run(args, tmp_path)
+    assert result.returncode == 0, result.stderr
+    expected = array(read_sensor_series(tmp_path)[1][1], "Illuminance")
+    polygons = vtkXMLPolyDataReader()
+    polygons.SetFileName(args[args.index("--sensors") + 1])
+    polygons.Update()
+    grid = vtkUnstructuredGrid()
+    grid.SetPoints(polygons.GetOutput().GetPoints())
+    grid.GetPointData().ShallowCopy(polygons.GetOutput().GetPointData())
+    assert grid.GetNumberOfCells() == 0
+    writer = vtkXMLUnstructuredGridWriter()
+    writer.SetInputData(grid)
+    writer.SetFileName(str(tmp_path / "sensors.vtu"))
+    assert writer.Write()
+    args[args.index("--sensors") + 1] = str(tmp_path / "sensors.vtu")
+    result = run(args, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert numpy.array_equal(array(read_sensor_series(tmp_path)[1][1], "Illuminance"), expected)
 
 
 def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
