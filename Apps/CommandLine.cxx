@@ -1138,9 +1138,9 @@ Sensors (measuring points that receive light but neither block nor reflect it):
                         over the faces facing down that see a light, or the sky, from
                         above (a room modelled with outward normals), without that room's
                         roof
-  --sensor-rays N       rays each sensor casts over its hemisphere (default 512), and an
-                        eighth as many points it samples on each area light: raise it
-                        for less noise on the sensors
+  --sensor-rays N       rays each sensor casts over its hemisphere (16 to 1000000, default
+                        512), and an eighth as many points it samples on each area
+                        light: raise it for less noise on the sensors
   --da-threshold LX     the illuminance DaylightAutonomy counts the frames at or above
                         (default 300). The sensors' series is PATH_sensors.pvd with
                         PATH_sensors_0000.vtp ... (point arrays Irradiance, Illuminance per

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 
 namespace mlr
 {
@@ -558,13 +559,17 @@ void checkSensors(const SensorSet& sensors, const SensorOptions& options)
         "side faces (any length but 0)");
     }
   }
-  for (const auto& [count, what] : { std::make_pair(options.hemisphereRays, "hemisphere rays"),
-         std::make_pair(options.areaLightSamples, "area light samples") })
+  for (const auto& [count, least, what] :
+    { std::make_tuple(options.hemisphereRays, MinimumHemisphereRays, "hemisphere rays"),
+      std::make_tuple(options.areaLightSamples, std::uint32_t(1), "area light samples") })
   {
-    if (count < 1 || count > MaximumSensorRays)
+    if (count < least || count > MaximumSensorRays)
     {
       throw Error(std::string("the sensors' ") + what + " per sensor are " + std::to_string(count) +
-        ": give 1 to " + std::to_string(MaximumSensorRays));
+        ": give " + std::to_string(least) + " to " + std::to_string(MaximumSensorRays) +
+        (count < least && least > 1 ? " (fewer give a standard error that reads 0 when they all "
+                                      "miss what lights the sensor)"
+                                    : ""));
     }
   }
 }

@@ -43,11 +43,15 @@ struct SensorOptions
 /// The most sensors and rays per sensor accepted: beyond them a run would not finish.
 constexpr std::uint64_t MaximumSensors = 100000000;
 constexpr std::uint32_t MaximumSensorRays = 1000000;
+/// The fewest hemisphere rays: a standard error from fewer reads 0 too often, for a sensor
+/// whose few rays all missed what lights it.
+constexpr std::uint32_t MinimumHemisphereRays = 16;
 
 /**
  * Throws mlr::Error naming the first sensor whose point is not finite or out of the
  * coordinate range, or whose normal is missing, zero or not finite, and the counts of
- * `options` outside 1 to MaximumSensorRays. Normals of any length but 0 are accepted and
+ * `options` outside MinimumHemisphereRays (hemisphere rays) or 1 (area light samples) to
+ * MaximumSensorRays. Normals of any length but 0 are accepted and
  * normalised by normalizedSensors().
  */
 void checkSensors(const SensorSet& sensors, const SensorOptions& options = {});

@@ -282,7 +282,9 @@ const PropertyRange PropertyRanges[] = {
     [](Self* f) { return static_cast<double>(f->GetErrorBatches()); } },
   { "Exposure", -20, 20, "-20 to 20 EV (0 is the automatic exposure)",
     [](Self* f) { return f->GetExposure(); } },
-  { "SensorRays", 1, 1000000, "1 to 1000000 rays per sensor (512 is typical)",
+  { "SensorRays", mlr::MinimumHemisphereRays, mlr::MaximumSensorRays,
+    "16 to 1000000 rays per sensor (512 is typical; fewer give a standard error that reads 0 "
+    "when they all miss what lights the sensor)",
     [](Self* f) { return static_cast<double>(f->GetSensorRays()); } },
   { "DaylightAutonomyThreshold", 0, Most, "0 or an illuminance in lx (300 is typical)",
     [](Self* f) { return f->GetDaylightAutonomyThreshold(); } },

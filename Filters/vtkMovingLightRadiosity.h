@@ -711,8 +711,8 @@ public:
    * Cosine-distributed rays each sensor casts over its hemisphere, once for all frames: the
    * sky through those that escape, the surfaces' radiosity through those that hit; and an
    * eighth as many points (at least 1) each sensor samples on every area light, each with a
-   * shadow ray per frame. Their noise falls as one over the square root or faster. From 1 to
-   * 1000000; without Sensors a change keeps the solve. Default 512.
+   * shadow ray per frame. Their noise falls as one over the square root or faster. From 16
+   * to 1000000; without Sensors a change keeps the solve. Default 512.
    */
   void SetSensorRays(int rays);
   vtkGetMacro(SensorRays, int);

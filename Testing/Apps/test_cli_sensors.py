@@ -247,7 +247,9 @@ def test_the_sensors_series_and_stats_carry_their_standard_errors(tmp_path):
      "use fewer sensors (a coarser grid) or fewer sensor rays"),
     (["--sensor-rays", "64"], 2, "--sensor-rays is for the sensors"),
     (["--work-plane", "0.8,0.5", "--sensor-rays", "0"], 2,
-     "--sensor-rays is 0: give a value from 1 to 1000000"),
+     "--sensor-rays is 0: give a value from 16 to 1000000"),
+    (["--work-plane", "0.8,0.5", "--sensor-rays", "15"], 2,
+     "--sensor-rays is 15: give a value from 16 to 1000000"),
 ])
 def test_bad_sensor_options(tmp_path, extra, status, words):
     result = run(["--scene", write_room(tmp_path), "--sky", "uniform"] + extra + FAST, tmp_path)

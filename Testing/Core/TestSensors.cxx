@@ -812,6 +812,11 @@ TEST(Sensors, BadSensorsAreRefusedByName)
   SensorOptions none;
   none.hemisphereRays = 0;
   expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), none); }, "hemisphere rays");
+  SensorOptions few;
+  few.hemisphereRays = MinimumHemisphereRays - 1;
+  expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), few); }, "give 16 to");
+  few.hemisphereRays = MinimumHemisphereRays;
+  EXPECT_NO_THROW(checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), few));
   SensorOptions many;
   many.areaLightSamples = MaximumSensorRays + 1;
   expectError([&] { checkSensors(oneSensor({ 0, 0, 1 }, { 0, 0, 1 }), many); }, "area light");
