@@ -69,6 +69,42 @@ def box_pipeline(**properties):
     return radiosity, {"box": box, "light": light, "trajectory": trajectory}
 
 
+def generic_decorators(prop):
+    hints = prop.GetHints()
+    for i in range(hints.GetNumberOfNestedElements() if hints else 0):
+        element = hints.GetNestedElement(i)
+        if element.GetName() == "PropertyWidgetDecorator" and \
+                element.GetAttribute("type") == "GenericDecorator":
+            yield element
+
+
+def decorator_matches(source, decorator):
+    """Whether ParaView 5.11's GenericDecorator (pqGenericPropertyWidgetDecorator::valueMatch)
+    shows or enables its widget: the named property's unchecked element `index` (the value in
+    the panel before Apply) as vtkVariant spells it, equal to `value` or to one of the
+    space-separated `values`; inverse="1" negates. Int and string properties only: the ones
+    the XML depends on, whose spelling is exact."""
+    from vtkmodules.vtkCommonCore import vtkVariant  # pvbatch's, once ParaView is set up
+
+    other = source.GetProperty(decorator.GetAttribute("property"))
+    index = int(decorator.GetAttribute("index") or 0)
+    if other.IsA("vtkSMIntVectorProperty") or other.IsA("vtkSMStringVectorProperty"):
+        value = vtkVariant(other.GetUncheckedElement(index)).ToString()
+    else:
+        raise TypeError(f"{other.GetXMLName()} is a {other.GetClassName()}")
+    given = decorator.GetAttribute("value")
+    status = value in ([given] if given is not None else decorator.GetAttribute("values").split(" "))
+    return status != (decorator.GetAttribute("inverse") == "1")
+
+
+def shown(source, name):
+    """Whether the panel shows property `name` of `source` (a proxy) for the unchecked values
+    of the others: ParaView shows a widget when every visibility decorator of it agrees."""
+    return all(decorator_matches(source, d)
+               for d in generic_decorators(source.GetProperty(name))
+               if d.GetAttribute("mode") == "visibility")
+
+
 class Checks:
     """Collects failures so that one run reports every broken expectation."""
 

@@ -34,7 +34,7 @@ import sys  # noqa: E402
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support"))
 from movinglightradiosity import vtkMovingLightRadiosity  # noqa: E402
 from vtk_messages import recorded  # noqa: E402
-from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkVariant  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkDoubleArray  # noqa: E402
 from vtkmodules.vtkFiltersSources import vtkCubeSource  # noqa: E402
 
 
@@ -220,32 +220,6 @@ check(found == EXPECTED, f"properties {sorted(found)}, expected {sorted(EXPECTED
 
 
 # --- Shown when they apply ----------------------------------------------------------------
-def generic_decorators(prop):
-    hints = prop.GetHints()
-    for i in range(hints.GetNumberOfNestedElements() if hints else 0):
-        element = hints.GetNestedElement(i)
-        if element.GetName() == "PropertyWidgetDecorator" and \
-                element.GetAttribute("type") == "GenericDecorator":
-            yield element
-
-
-def decorator_matches(source, decorator):
-    """Whether ParaView 5.11's GenericDecorator (pqGenericPropertyWidgetDecorator::valueMatch)
-    shows or enables its widget: the named property's unchecked element `index` (the value in
-    the panel before Apply) as vtkVariant spells it, equal to `value` or to one of the
-    space-separated `values`; inverse="1" negates. Int and string properties only: the ones
-    the XML depends on, whose spelling is exact."""
-    other = source.GetProperty(decorator.GetAttribute("property"))
-    index = int(decorator.GetAttribute("index") or 0)
-    if other.IsA("vtkSMIntVectorProperty") or other.IsA("vtkSMStringVectorProperty"):
-        value = vtkVariant(other.GetUncheckedElement(index)).ToString()
-    else:
-        raise TypeError(f"{other.GetXMLName()} is a {other.GetClassName()}")
-    given = decorator.GetAttribute("value")
-    status = value in ([given] if given is not None else decorator.GetAttribute("values").split(" "))
-    return status != (decorator.GetAttribute("inverse") == "1")
-
-
 # The panel silently ignores a decorator naming no property of the proxy, and the widget is
 # then always there: every decorator must name one, in a mode ParaView knows.
 iterator = pristine.NewPropertyIterator()
@@ -253,7 +227,7 @@ iterator.Begin()
 while not iterator.IsAtEnd():
     name, prop = iterator.GetKey(), iterator.GetProperty()
     iterator.Next()
-    for decorator in generic_decorators(prop):
+    for decorator in support.generic_decorators(prop):
         depends = decorator.GetAttribute("property")
         check(pristine.GetProperty(depends) is not None,
               f"property {name}: its decorator depends on {depends!r}, no property of the filter")
@@ -264,7 +238,7 @@ while not iterator.IsAtEnd():
 # when it is cleared; their defaults are checked above.
 for name in ("LightPowerFromMaterial", "PathFromLightMaterial"):
     prop = pristine.GetProperty(name)
-    rules = [d for d in generic_decorators(prop) if d.GetAttribute("mode") == "visibility"]
+    rules = [d for d in support.generic_decorators(prop) if d.GetAttribute("mode") == "visibility"]
     if not check(len(rules) == 1, f"property {name}: {len(rules)} visibility decorators, "
                  "expected one, on Light Material"):
         continue
@@ -272,10 +246,25 @@ for name in ("LightPowerFromMaterial", "PathFromLightMaterial"):
     shown = {}
     for typed in ("", "light", ""):
         material.SetUncheckedElement(0, typed)
-        shown.setdefault(typed, []).append(decorator_matches(pristine, rules[0]))
+        shown.setdefault(typed, []).append(support.decorator_matches(pristine, rules[0]))
     material.ClearUncheckedElements()
     check(shown == {"": [False, False], "light": [True]},
           f"property {name}: shown {shown} by Light Material, expected only when one is named")
+
+# The directional light (the sun) has Sun Irradiance for its power and no aim.
+light_type, aim = pristine.GetProperty("LightType"), pristine.GetProperty("AimAtPoint")
+for kind in range(4):
+    light_type.SetUncheckedElement(0, kind)
+    for aiming in (0, 1):
+        aim.SetUncheckedElement(0, aiming)
+        for name, expected in (("LightPower", kind != 1), ("AimAtPoint", kind != 1),
+                               ("AimPoint", kind != 1 and aiming == 1),
+                               ("SunIrradiance", kind == 1)):
+            actual = support.shown(pristine, name)
+            check(actual == expected, f"{name} is {'shown' if actual else 'hidden'} for "
+                  f"LightType {kind}, AimAtPoint {aiming}: expected the opposite")
+light_type.ClearUncheckedElements()
+aim.ClearUncheckedElements()
 
 # --- The first Apply ----------------------------------------------------------------------
 radiosity.UpdatePipeline()

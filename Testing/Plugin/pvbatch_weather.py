@@ -35,6 +35,20 @@ for name, default in (("WeatherFile", [""]), ("FirstDate", [1, 1]), ("LastDate",
         not isinstance(value, str) else [value]
     check(value == default, f"{name} is {value} by default, expected {default}")
 
+# The panel shows the weather file's own properties with a file, the day's without.
+WEATHER_ONLY = {"FirstDate", "LastDate", "Hours", "IncludeNight"}
+DAY_ONLY = {"Latitude", "Longitude", "Year", "Month", "Day", "StartTime", "EndTime",
+            "StepMinutes", "TimeZone"}
+file_property = proxy.GetProperty("WeatherFile")
+for typed in ("", weather):
+    file_property.SetUncheckedElement(0, typed)
+    for name in WEATHER_ONLY | DAY_ONLY | {"WeatherFile", "North", "Up"}:
+        expected = name not in (DAY_ONLY if typed else WEATHER_ONLY)
+        actual = support.shown(proxy, name)
+        check(actual == expected, f"Sun Path's {name} is {'shown' if actual else 'hidden'} "
+              f"with WeatherFile {typed!r}: expected the opposite")
+file_property.ClearUncheckedElements()
+
 sun.WeatherFile = weather
 sun.FirstDate = [6, 21]
 sun.LastDate = [6, 21]
