@@ -784,9 +784,12 @@ void addSky(vtkMovingLightRadiosity* self, const mlr::vtkinputs::Trajectory& tra
 }
 
 /// The Trajectory's positions, else the straight path from PathStart (or from `start`, where
-/// the Scene has a LightMaterial's lamp) to PathEnd.
+/// the Scene has a LightMaterial's lamp) to PathEnd. `forTimes`: only its times are wanted,
+/// so directions of the sun that no solve can use are left for the solve to refuse (a script
+/// sets LightType before PathStart and PathEnd, and ParaView asks for the times between).
 mlr::vtkinputs::Trajectory trajectoryOf(vtkMovingLightRadiosity* self,
-  vtkInformationVector* trajectoryInput, std::size_t lights, const std::optional<mlr::Vec3>& start)
+  vtkInformationVector* trajectoryInput, std::size_t lights, const std::optional<mlr::Vec3>& start,
+  bool forTimes = false)
 {
   if (self->GetNumberOfInputConnections(vtkMovingLightRadiosity::TRAJECTORY_PORT) == 0)
   {
@@ -808,7 +811,7 @@ mlr::vtkinputs::Trajectory trajectoryOf(vtkMovingLightRadiosity* self,
     }
     mlr::vtkinputs::Trajectory line = mlr::vtkinputs::straightTrajectory(
       first, { end[0], end[1], end[2] }, self->GetNumberOfPositions());
-    if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT)
+    if (self->GetLightType() == vtkMovingLightRadiosity::DIRECTIONAL_LIGHT && !forTimes)
     {
       for (std::size_t k = 0; k < line.lights[0].size(); ++k)
       {
@@ -1001,8 +1004,8 @@ int vtkMovingLightRadiosity::RequestInformation(
   try
   {
     // Where the straight path starts does not change its times.
-    times = trajectoryOf(
-      this, inputVector[TRAJECTORY_PORT], lightsOf(this, inputVector[LIGHT_PORT]), std::nullopt)
+    times = trajectoryOf(this, inputVector[TRAJECTORY_PORT],
+      lightsOf(this, inputVector[LIGHT_PORT]), std::nullopt, true)
               .times;
   }
   catch (const mlr::Error& e)

@@ -1039,6 +1039,14 @@ TEST(FilterSun, WithoutTrajectoryTheDirectionGoesFromPathStartToPathEnd)
   // The defaults start at the origin, which is no direction: an error naming PathStart and
   // PathEnd, not a crash; opposite directions pass through zero half-way.
   filter->SetPathStart(0, 0, 0);
+  // Its times are still known, without an error: a script that sets LightType before the
+  // directions must not see one.
+  {
+    vtkNew<MessageRecorder> messages;
+    messages->watch(filter);
+    EXPECT_EQ(timeSteps(filter), (std::vector<double>{ 0, 1, 2 }));
+    EXPECT_EQ(messages->allErrors(), "");
+  }
   expectError(filter, "from PathStart to PathEnd, and frame 0's is zero or not a number");
   filter->SetPathStart(1, 0, 1);
   filter->SetPathEnd(-1, 0, -1);
