@@ -78,13 +78,14 @@ std::uint64_t estimateOutputMemory(std::size_t elements, std::size_t points)
   // Back (3 floats each), Illuminance and its Front and Back (a float each) and Color (3
   // bytes) per element, point Radiosity, Irradiance, Illuminance and Color, and the patches'
   // Radiosity; RadiosityStdError and IrradianceStdError (3 floats) and IlluminanceStdError
-  // (a float) on cells and points, counted whether or not the solve estimates its error.
+  // (a float) on cells and points, and each side's on cells, counted whether or not the
+  // solve estimates its error.
   const std::uint64_t e = elements, p = points;
   const std::uint64_t split = p + e / 4;
   const std::uint64_t meshes =
     p * 24 + split * (24 + 4 + 8) + e * (32 + 12 + 8 + 24) + e / 4 * (32 + 12);
   const std::uint64_t frame =
-    e * (11 * 12 + 4 * 4 + 3) + split * (12 + 12 + 12 + 12 + 4 + 4 + 3) + e / 4 * 12;
+    e * (15 * 12 + 6 * 4 + 3) + split * (12 + 12 + 12 + 12 + 4 + 4 + 3) + e / 4 * 12;
   return meshes + frame;
 }
 
@@ -146,7 +147,9 @@ std::vector<vtkAbstractArray*> sceneCellArraysToPass(
   static const char* const OwnArrays[] = { "Reflectance", "PatchId", "Radiosity", "DirectRadiosity",
     "IndirectRadiosity", "EmittedRadiosity", "RadiosityFront", "RadiosityBack", "Color",
     "Irradiance", "Illuminance", "IrradianceFront", "IrradianceBack", "IlluminanceFront",
-    "IlluminanceBack", "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError" };
+    "IlluminanceBack", "RadiosityStdError", "IrradianceStdError", "IlluminanceStdError",
+    "RadiosityStdErrorFront", "RadiosityStdErrorBack", "IrradianceStdErrorFront",
+    "IrradianceStdErrorBack", "IlluminanceStdErrorFront", "IlluminanceStdErrorBack" };
   std::vector<vtkAbstractArray*> passed;
   std::string named; // arrays with an output's name, as the warning lists them
   std::size_t namedCount = 0;
@@ -282,7 +285,7 @@ void addElementRadiosity(
 }
 
 void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData)
+  double luminousEfficacy, bool twoSided, vtkPointData* pointData, vtkCellData* cellData)
 {
   if (!solution.hasErrorEstimate())
   {
@@ -321,6 +324,32 @@ void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, s
   };
   add(radiosity, irradiance, cellData);
   add(pointMeans(shading, radiosity), pointMeans(shading, irradiance), pointData);
+  if (!twoSided)
+  {
+    return;
+  }
+  // Each side's, as RadiosityFront and IrradianceFront have: a side lit in some frames only
+  // (a panel's back in the evening) has a value the lit side's error does not cover.
+  for (const auto& [side, name] :
+    { std::make_pair(Side::Front, "Front"), std::make_pair(Side::Back, "Back") })
+  {
+    auto radiosityArray = rgbArray((std::string("RadiosityStdError") + name).c_str(), n);
+    auto irradianceArray = rgbArray((std::string("IrradianceStdError") + name).c_str(), n);
+    vtkNew<vtkFloatArray> lux;
+    lux->SetName((std::string("IlluminanceStdError") + name).c_str());
+    lux->SetNumberOfValues(static_cast<vtkIdType>(n));
+    for (std::size_t e = 0; e < n; ++e)
+    {
+      const Rgb arriving = solution.irradianceStdError(frame, e, side);
+      setRgb(radiosityArray, e, solution.radiosityStdError(frame, e, side));
+      setRgb(irradianceArray, e, arriving);
+      lux->SetValue(
+        static_cast<vtkIdType>(e), static_cast<float>(luminousEfficacy * luminance(arriving)));
+    }
+    cellData->AddArray(radiosityArray);
+    cellData->AddArray(irradianceArray);
+    cellData->AddArray(lux);
+  }
 }
 
 void addErrorFieldData(vtkFieldData* fieldData, const Solution& solution)
@@ -389,6 +418,11 @@ vtkSmartPointer<vtkFieldData> statisticsFieldData(
   count("Chunks", statistics.chunks);
   count("FramesPerChunk", statistics.framesPerChunk);
   count("ChunkOverlap", statistics.chunkOverlap);
+  if (statistics.chunk >= 0)
+  {
+    // A streamed chunk's frame: the figures below are that chunk's solve.
+    count("Chunk", static_cast<std::uint64_t>(statistics.chunk));
+  }
   count("Patches", statistics.patches);
   count("Elements", statistics.elements);
   real("PatchEdgeLength", statistics.patchEdgeLength);

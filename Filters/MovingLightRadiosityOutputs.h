@@ -102,9 +102,11 @@ struct SmoothShading;
 /// element's lit side in `frame`: `RadiosityStdError` and `IrradianceStdError` (RGB,
 /// W/(scene unit)^2) and `IlluminanceStdError` (`luminousEfficacy` times the luminance of
 /// `IrradianceStdError`) to the cells, and to the points as their area-weighted means over the
-/// cells around each point (as point `Radiosity` is made); nothing without one.
+/// cells around each point (as point `Radiosity` is made); when `twoSided`, also each side's
+/// to the cells (`RadiosityStdErrorFront`, `...Back`, and so for the others); nothing
+/// without one.
 void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, std::size_t frame,
-  double luminousEfficacy, vtkPointData* pointData, vtkCellData* cellData);
+  double luminousEfficacy, bool twoSided, vtkPointData* pointData, vtkCellData* cellData);
 
 /// With an error estimate, adds to `fieldData` the per-frame arrays (one value per solved frame)
 /// `RelativeErrorMedian`, `RelativeErrorP95` and `LitElements`, and `ErrorBatches`,

@@ -1269,7 +1269,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
       mlr::vtkoutputs::addIrradianceArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
         cache.TwoSided, output->GetPointData(), output->GetCellData());
       mlr::vtkoutputs::addStdErrorArrays(*frames, cache.Shading, solved, efficacyOf(cache, frame),
-        output->GetPointData(), output->GetCellData());
+        cache.TwoSided, output->GetPointData(), output->GetCellData());
       if (cut)
       {
         // Cut from the whole frame, so that the point arrays at the cut average over the

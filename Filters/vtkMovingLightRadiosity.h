@@ -78,7 +78,8 @@
  *   and points carry the standard errors `RadiosityStdError` and `IrradianceStdError` (3
  *   components, W/m^2, of `Radiosity` and `Irradiance`) and `IlluminanceStdError` (lx,
  *   LuminousEfficacy times the luminance of `IrradianceStdError`), at points averaged as
- *   `Radiosity`. `Color` is the active scalars of
+ *   `Radiosity`; with TwoSided, cells also carry each side's, `RadiosityStdErrorFront`,
+ *   `RadiosityStdErrorBack` and so for the other two. `Color` is the active scalars of
  *   points and cells. Its field data holds the solver statistics (paths, rays by kind,
  *   seconds by phase, patches, elements, frames, reuse modes, predicted speed-up), the frame
  *   shown (`FrameIndex`), where the light is in it (`LightPosition`, its centroid, and

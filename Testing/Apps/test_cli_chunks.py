@@ -29,6 +29,17 @@ def mean_radiosity(path):
     return float(numpy.mean(vtk_to_numpy(reader.GetOutput().GetCellData().GetArray("Radiosity"))))
 
 
+def field_values(path):
+    """The first value of each field data array of a .vtu, by name."""
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    data = reader.GetOutput().GetFieldData()
+    arrays = (data.GetAbstractArray(i) for i in range(data.GetNumberOfArrays()))
+    return {a.GetName(): a.GetVariantValue(0).ToDouble() for a in arrays
+            if a.GetNumberOfTuples() > 0 and a.GetNumberOfComponents() == 1}
+
+
 def test_chunks_are_reported_and_agree_with_one_chunk(tmp_path):
     common = ["--scene", SCENE, "--light", LIGHT] + PATH + ["--frames", str(FRAMES),
                                                             "--error-batches", "1"] + FAST
@@ -44,6 +55,12 @@ def test_chunks_are_reported_and_agree_with_one_chunk(tmp_path):
     assert stats["statistics"]["Frames"] == FRAMES
     assert json.loads((tmp_path / "w/s.json").read_text())["statistics"]["Chunks"] == 1
     assert len([f for f in all_files(tmp_path / "c") if f.endswith(".vtu")]) == FRAMES
+    # A streamed frame holds its chunk's solve, named, in the run's layout of chunks.
+    last = field_values(tmp_path / "c/s_0010.vtu")
+    assert last["Chunk"] == 2 and last["Chunks"] == 3 and last["FramesPerChunk"] == 4
+    assert last["ChunkOverlap"] == stats["statistics"]["ChunkOverlap"]
+    assert last["PathsCast"] < stats["statistics"]["PathsCast"]
+    assert "Chunk" not in field_values(tmp_path / "w/s_0010.vtu")
     # A frame's mean radiosity over the box has a relative standard error of about
     # 1/sqrt(N) = 0.7% at N = 20,000; the seams (frames 3, 4, 7, 8) too: 5% is far outside.
     for f in range(FRAMES):

@@ -2,6 +2,7 @@
 // error in field data, a target reached with StoppedBy, none of it with one batch, and bad
 // ErrorBatches, TargetRelativeError and TimeLimit refused by name.
 #include "FilterTestSupport.h"
+#include "GeneratedScenes.h"
 
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -118,6 +119,68 @@ TEST(FilterErrorEstimate, StandardErrorArraysOnCellsAndPointsAndPerFrameFieldDat
   EXPECT_EQ(fieldValue(out, "ErrorBatches"), 8);
   EXPECT_EQ(fieldValue(out, "PathsPerFrame"), 20000);
   EXPECT_EQ(stringValue(field, "StoppedBy"), "batches");
+}
+
+TEST(FilterErrorEstimate, EachSideHasItsOwnStandardError)
+{
+  // A panel at mid-height in the box: its top lit by the lamp, its underside by the floor's
+  // bounce. Each side's value gets each side's error, the lit side's the one of
+  // RadiosityStdError.
+  BoxSetup setup = closedBoxSetup(Frames);
+  PatchMesh mesh = scenes::closedBox(4, true, { Rgb(0.5) });
+  scenes::addGriddedQuad(
+    mesh, Vec3(0.3, 0.3, 0.5), Vec3(0.4, 0, 0), Vec3(0, 0.4, 0), 2, 2, Rgb(0.6, 0.5, 0.4));
+  setup.scene = scenePolyData(mesh);
+  auto filter = fastFilter(setup);
+  filter->SetErrorBatches(8);
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  vtkPolyData* out = filter->GetOutput(0);
+  vtkCellData* cells = out->GetCellData();
+  vtkDataArray* litError = cells->GetArray("RadiosityStdError");
+  vtkDataArray* radiosity = cells->GetArray("Radiosity");
+  std::size_t panelCells = 0;
+  for (vtkIdType c = 0; c < cells->GetNumberOfTuples(); ++c)
+  {
+    bool matchesLit = false, allLit = true; // allLit: both sides' errors in (0, value)
+    for (const char* side : { "Front", "Back" })
+    {
+      vtkDataArray* value = cells->GetArray((std::string("Radiosity") + side).c_str());
+      vtkDataArray* error = cells->GetArray((std::string("RadiosityStdError") + side).c_str());
+      vtkDataArray* arriving = cells->GetArray((std::string("IrradianceStdError") + side).c_str());
+      vtkDataArray* lux = cells->GetArray((std::string("IlluminanceStdError") + side).c_str());
+      ASSERT_NE(error, nullptr) << side;
+      ASSERT_NE(arriving, nullptr) << side;
+      ASSERT_NE(lux, nullptr) << side;
+      const double* e = arriving->GetTuple3(c);
+      EXPECT_NEAR(lux->GetComponent(c, 0),
+        filter->GetLuminousEfficacy() * (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]),
+        1e-5 * lux->GetComponent(c, 0));
+      bool same = true;
+      for (int k = 0; k < 3; ++k)
+      {
+        same = same && error->GetComponent(c, k) == litError->GetComponent(c, k) &&
+          value->GetComponent(c, k) == radiosity->GetComponent(c, k);
+        // Lit by many batches' paths here: an error above 0 and below the value.
+        allLit = allLit && error->GetComponent(c, k) > 0 &&
+          error->GetComponent(c, k) < value->GetComponent(c, k);
+      }
+      matchesLit = matchesLit || same;
+    }
+    EXPECT_TRUE(matchesLit) << "cell " << c << ": neither side's error is the lit side's";
+    double bounds[6];
+    out->GetCellBounds(c, bounds);
+    if (bounds[4] > 0.49 && bounds[5] < 0.51)
+    {
+      EXPECT_TRUE(allLit) << "panel cell " << c << ": a side without an error below its value";
+      ++panelCells;
+    }
+  }
+  EXPECT_GE(panelCells, std::size_t(16));
+  // One-sided, the sides' arrays are not there.
+  filter->SetTwoSided(false);
+  ASSERT_TRUE(filter->UpdateTimeStep(1));
+  EXPECT_EQ(filter->GetOutput(0)->GetCellData()->GetArray("RadiosityStdErrorFront"), nullptr);
+  EXPECT_NE(filter->GetOutput(0)->GetCellData()->GetArray("RadiosityStdError"), nullptr);
 }
 
 TEST(FilterErrorEstimate, OneBatchHasNoErrorArrays)
