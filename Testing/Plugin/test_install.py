@@ -91,3 +91,21 @@ def test_paraview_gui_loads_the_installed_plugin(installed, tmp_path):
                                              DISPLAY=display))
     text = report_file.read_text() if report_file.exists() else "(no report: the script did not run)"
     assert result.returncode == 0 and text.strip() == "OK", f"{text}\n{report}"
+
+
+def test_a_cxx_program_builds_on_the_installed_package(installed, tmp_path):
+    """Examples/cxx finds the VTK module with find_package(MovingLightRadiosity) in the
+    prefix, builds, and solves the Cornell box with it."""
+    cmake = ENV.get("MLR_CMAKE", "cmake")
+    source = os.path.join(HERE, os.pardir, os.pardir, "Examples", "cxx")
+    build = tmp_path / "example"
+    result, report = run([cmake, "-S", source, "-B", build, "-G", "Ninja",
+                          f"-DCMAKE_PREFIX_PATH={installed['prefix']}"], env=environment())
+    assert result.returncode == 0, report
+    result, report = run([cmake, "--build", build], env=environment())
+    assert result.returncode == 0, report
+    data = os.path.join(HERE, os.pardir, os.pardir, "Data")
+    result, report = run([build / "cornell_frame", data, "5000"], env=environment())
+    assert result.returncode == 0, report
+    assert re.search(r"^12116 elements, mean red radiosity \d+\.\d+ W/m\^2 in frame 15$",
+                     result.stdout, re.M), report
