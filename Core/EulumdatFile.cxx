@@ -2,6 +2,7 @@
 #include "Error.h"
 #include "PhotometricParsing.h"
 #include "Photometry.h"
+#include "Plural.h"
 
 #include <algorithm>
 #include <cmath>
@@ -78,13 +79,18 @@ public:
 
   std::size_t left() const { return this->Lines.size() - this->Line; }
 
-  /// The lines left after the intensities that are not blank.
-  std::size_t remaining() const
+  /// The lines left after the intensities that are not blank, and the first of them
+  /// (counted from 1).
+  std::size_t remaining(std::size_t& firstLine) const
   {
     std::size_t n = 0;
     for (std::size_t l = this->Line; l < this->Lines.size(); ++l)
     {
-      n += photometry::trim(this->Lines[l]).empty() ? 0 : 1;
+      if (!photometry::trim(this->Lines[l]).empty())
+      {
+        firstLine = n == 0 ? l + 1 : firstLine;
+        ++n;
+      }
     }
     return n;
   }
@@ -340,10 +346,11 @@ Luminaire parseEulumdat(const std::string& text, const std::string& name)
       anyLight = anyLight || value > 0;
     }
   }
-  if (const std::size_t extra = fields.remaining())
+  std::size_t extraLine = 0;
+  if (const std::size_t extra = fields.remaining(extraLine))
   {
-    luminaire.warnings.push_back(name + ", line " + std::to_string(fields.line() + 1) +
-      ": ignored " + std::to_string(extra) + " lines after the intensities");
+    luminaire.warnings.push_back(name + ", line " + std::to_string(extraLine) + ": ignored " +
+      countOf(extra, "line") + " after the intensities");
   }
   if (!anyLight)
   {

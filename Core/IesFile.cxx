@@ -4,8 +4,10 @@
 #include "Error.h"
 #include "PhotometricParsing.h"
 #include "Photometry.h"
+#include "Plural.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -163,7 +165,12 @@ std::vector<double> readAngles(Tokens& tokens, std::size_t n, const std::string&
       tokens.fail(field() + " is " + formatNumber(angles[i]) + " degrees: it must be within [" +
         formatNumber(lowest) + ", " + formatNumber(highest) + "]");
     }
-    if (i > 0 && !(angles[i] > angles[i - 1]))
+    if (i == 1 && !(angles[1] > angles[0]))
+    {
+      tokens.fail(field() + " is " + formatNumber(angles[1]) + " degrees, not above the first, " +
+        formatNumber(angles[0]) + ": the angles must ascend strictly, from the lowest");
+    }
+    if (i > 1 && !(angles[i] > angles[i - 1]))
     {
       // A count too large reads the next block's values as angles, and they seldom ascend.
       tokens.fail(field() + " is " + formatNumber(angles[i]) + " degrees, not above the previous " +
@@ -178,6 +185,17 @@ std::vector<double> readAngles(Tokens& tokens, std::size_t n, const std::string&
 bool near(double a, double b)
 {
   return std::abs(a - b) < 1e-6;
+}
+
+/// The largest difference between consecutive `angles`.
+double largestStep(const std::vector<double>& angles)
+{
+  double step = 0;
+  for (std::size_t i = 1; i < angles.size(); ++i)
+  {
+    step = std::max(step, angles[i] - angles[i - 1]);
+  }
+  return step;
 }
 
 constexpr double Degree = 3.14159265358979323846 / 180;
@@ -439,9 +457,16 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
   Luminaire luminaire;
 
-  // The edition: 1986 files have no such line, and there pfactor below still counts.
+  // The edition: 1986 files have no such line, and there pfactor below still counts. Blank
+  // lines before it are skipped, as ies2rad does: read as 1986, a 2019 file would take its
+  // file generation type for that factor.
   int year = 1986;
-  const std::string_view first = photometry::trim(lines[0]);
+  std::size_t firstLine = 0;
+  while (firstLine + 1 < lines.size() && photometry::trim(lines[firstLine]).empty())
+  {
+    ++firstLine;
+  }
+  const std::string_view first = photometry::trim(lines[firstLine]);
   if (first.rfind("IESNA", 0) == 0 || first.rfind("IES:", 0) == 0)
   {
     if (first == "IESNA91")
@@ -463,15 +488,22 @@ Luminaire parseIes(const std::string& text, const std::string& name)
     else
     {
       year = 2002;
-      luminaire.warnings.push_back(
-        name + ", line 1: unknown edition '" + std::string(first) + "', read as LM-63-2002");
+      luminaire.warnings.push_back(name + ", line " + std::to_string(firstLine + 1) +
+        ": unknown edition '" + std::string(first) + "', read as LM-63-2002");
     }
   }
 
   // Keyword lines ([TEST], [MANUFAC], ...) up to the TILT line: they carry nothing the solve
-  // needs.
+  // needs. A 1986 label may start with the word, "TILTABLE BRACKET": the TILT line is the
+  // word alone before its '='.
+  auto isTiltLine = [](std::string_view line)
+  {
+    line = photometry::trim(line);
+    return line.rfind("TILT", 0) == 0 &&
+      (line.size() == 4 || !std::isalnum(static_cast<unsigned char>(line[4])));
+  };
   std::size_t tiltLine = 0;
-  while (tiltLine < lines.size() && photometry::trim(lines[tiltLine]).rfind("TILT", 0) != 0)
+  while (tiltLine < lines.size() && !isTiltLine(lines[tiltLine]))
   {
     ++tiltLine;
   }
@@ -609,10 +641,13 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   {
     symmetry = photometry::PlaneSymmetry::AboutC90C270;
   }
-  else if (!(near(h0, 0) && h1 > 180))
+  else if (!(near(h0, 0) && h1 > 180 && 360 - h1 <= largestStep(horizontal) + 1e-6))
   {
+    // A full turn may leave out 360, the repeat of 0, but no more than one step of its own:
+    // across a larger gap the intensities would be made up.
     tokens.fail("the horizontal angles run from " + formatNumber(h0) + " to " + formatNumber(h1) +
-      " degrees: type C tables run 0 to 0, 90, 180 or 360, or 90 to 270");
+      " degrees: type C tables run 0 to 0, 90, 180 or 360 (or to 360 less one step), or 90 "
+      "to 270");
   }
 
   const double scale = multiplier * ballast * photometricFactor;
@@ -641,7 +676,7 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   if (const std::size_t extra = tokens.remaining(extraLine))
   {
     luminaire.warnings.push_back(name + ", line " + std::to_string(extraLine) + ": ignored " +
-      std::to_string(extra) + " values after the candela table");
+      countOf(extra, "value") + " after the candela table");
   }
   if (!anyLight)
   {

@@ -690,6 +690,16 @@ TEST(Photometry, IesBallastLampFactorScalesOnly1986And1991Files)
   }
   checks::expectError([&] { edition("IESNA91", "0"); },
     "edition.ies, line 5: the ballast-lamp photometric factor is 0");
+  // Blank lines before the edition line are skipped: read as 1986, a 2019 file's generation
+  // type 1.10100 scaled the flux by 10%.
+  std::string blank = base;
+  blank.replace(0, blank.find('\n'), "\n  \r\nIES:LM-63-2019");
+  blank.replace(blank.find("\n1 1 40\n"), 8, "\n1 1.10100 40\n");
+  EXPECT_NEAR(parseIes(blank, "blank.ies").lumens, flux, 1e-12 * flux);
+  // A 1986 label may start with TILT: the TILT line is the word before its '='.
+  std::string label = base;
+  label.replace(0, label.find('\n'), "TILTABLE BRACKET, MODEL 7");
+  EXPECT_NEAR(parseIes(label, "label.ies").lumens, flux, 1e-12 * flux);
 }
 
 TEST(Photometry, IesSymmetricFormsEqualTheFullTable)
@@ -886,6 +896,17 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   const std::string odd = iesFile({ 0, 45, 90 }, { 0, 45, 120 }, f);
   e = error(odd);
   EXPECT_NE(e.find("line 7: the horizontal angles run from 0 to 120"), std::string::npos) << e;
+  // A full turn may leave out 360, one step of its own, and no more: 0 to 200 would make up
+  // the intensities over 160 degrees.
+  EXPECT_NO_THROW(parseIes(iesFile({ 0, 45, 90 }, degrees(0, 350, 10), f), "turn.ies"));
+  e = error(iesFile({ 0, 45, 90 }, degrees(0, 200, 10), f));
+  EXPECT_NE(e.find("line 7: the horizontal angles run from 0 to 200"), std::string::npos) << e;
+  // Angles listed from the highest: no advice about their count.
+  e = error(with("0 45 90", "90 45 0"));
+  EXPECT_NE(e.find("line 6: vertical angle 2 of 3 is 45 degrees, not above the first, 90: the "
+                   "angles must ascend strictly, from the lowest"),
+    std::string::npos)
+    << e;
   EXPECT_NE(error("").find("is empty"), std::string::npos);
 }
 
@@ -1260,6 +1281,15 @@ TEST(Photometry, BadEulumdatFilesNameTheLineAndField)
   const auto f = [](double g, double) { return 100 * cosPower(g, 1); };
   const std::string good = ldtFile(1, 90, gammas, f);
   ASSERT_NO_THROW(parseEulumdat(good, "good.ldt"));
+  // Text after the intensities is named by its own line, past the blank ones.
+  const std::size_t lineCount =
+    static_cast<std::size_t>(std::count(good.begin(), good.end(), '\n'));
+  const Luminaire trailing = parseEulumdat(good + "\n\nextra text\n", "trailing.ldt");
+  ASSERT_EQ(trailing.warnings.size(), 1u);
+  EXPECT_NE(trailing.warnings[0].find("trailing.ldt, line " + std::to_string(lineCount + 3) +
+              ": ignored 1 line after the intensities"),
+    std::string::npos)
+    << trailing.warnings[0];
   auto line = [&](std::size_t number, const std::string& to)
   {
     std::vector<std::string> lines;
