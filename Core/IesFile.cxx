@@ -73,9 +73,12 @@ public:
   }
 
   /// Throws naming the file and the line of the last token read.
-  [[noreturn]] void fail(const std::string& what) const
+  [[noreturn]] void fail(const std::string& what) const { throw Error(this->where() + what); }
+
+  /// "name, line n: " of the last token read.
+  std::string where() const
   {
-    throw Error(this->Name + ", line " + std::to_string(this->TokenLine + 1) + ": " + what);
+    return this->Name + ", line " + std::to_string(this->TokenLine + 1) + ": ";
   }
 
   /// The values left after the table, and the line they start on.
@@ -555,11 +558,15 @@ Luminaire parseIes(const std::string& text, const std::string& name)
   }
 
   tokens.number("the number of lamps");
+  // Not used: the flux is the table's integral, in relative and absolute photometry alike.
+  // A value that is neither rated lumens nor -1 is named, not refused, as ies2rad reads it.
   const double lumensPerLamp = tokens.number("the lumens per lamp");
   if (!(lumensPerLamp > 0) && lumensPerLamp != -1)
   {
-    tokens.fail("the lumens per lamp are " + formatNumber(lumensPerLamp) +
-      ": give the rated lumens, or -1 for absolute photometry");
+    luminaire.warnings.push_back(tokens.where() + "the lumens per lamp are " +
+      formatNumber(lumensPerLamp) +
+      ", neither rated lumens nor -1 (absolute photometry); the flux is the candela table's "
+      "integral either way");
   }
   const double multiplier = tokens.number("the candela multiplier");
   if (!(multiplier > 0))

@@ -814,6 +814,14 @@ TEST(Photometry, BadIesFilesNameTheLineAndField)
   std::string e = error(good.substr(0, good.rfind(' ')));
   EXPECT_NE(e.find("bad.ies: the file ends"), std::string::npos) << e;
   EXPECT_NE(e.find("truncated"), std::string::npos) << e;
+  // The lumens per lamp are not used (the flux is the table's integral): 0 is named, not
+  // refused.
+  const Luminaire zero = parseIes(with("1 -1 1 3 1", "1 0 1 3 1"), "zero.ies");
+  ASSERT_EQ(zero.warnings.size(), 1u);
+  EXPECT_NE(zero.warnings[0].find("zero.ies, line 4: the lumens per lamp are 0, neither"),
+    std::string::npos)
+    << zero.warnings[0];
+  EXPECT_EQ(zero.lumens, parseIes(good, "good.ies").lumens);
   e = error(with("1 -1 1 3", "1 -1 x 3"));
   EXPECT_NE(e.find("bad.ies, line 4: the candela multiplier is 'x'"), std::string::npos) << e;
   e = error(with("0 45 90", "0 95 90"));
