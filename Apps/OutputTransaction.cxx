@@ -24,8 +24,14 @@ OutputTransaction::~OutputTransaction()
 {
   if (!this->Committed)
   {
+    this->moveBack();
     this->rollback();
   }
+}
+
+fs::path OutputTransaction::temporaryOf(const fs::path& finalPath)
+{
+  return finalPath.parent_path() / ("." + finalPath.filename().string() + ".partial");
 }
 
 void OutputTransaction::createDirectories(const fs::path& directory)
@@ -63,7 +69,7 @@ fs::path OutputTransaction::stage(const fs::path& finalPath)
     throw std::runtime_error(
       "'" + finalPath.string() + "' would be written twice in one run: nothing was written");
   }
-  fs::path temporary = finalPath.parent_path() / ("." + finalPath.filename().string() + ".partial");
+  fs::path temporary = temporaryOf(finalPath);
   this->StagedFiles.push_back({ temporary, finalPath });
   return temporary;
 }
@@ -87,23 +93,30 @@ void OutputTransaction::keep(const fs::path& finalPath)
 
 void OutputTransaction::commit()
 {
+  this->moveIntoPlace();
+  this->finish();
+}
+
+void OutputTransaction::moveBack() noexcept
+{
+  std::error_code ignored;
+  for (std::size_t i = 0; i < this->Renamed; ++i)
+  {
+    fs::rename(this->StagedFiles[i].final, this->StagedFiles[i].temporary, ignored);
+  }
+  for (const auto& [final, aside] : this->Asides)
+  {
+    fs::rename(aside, final, ignored);
+  }
+  this->Renamed = 0;
+  this->Asides.clear();
+}
+
+void OutputTransaction::moveIntoPlace()
+{
   // The earlier files of these names step aside first, under hidden names, and come back if
   // any rename fails: a failure halfway must not leave the new run's first frames beside the
   // earlier run's last ones and its .pvd.
-  std::vector<std::pair<fs::path, fs::path>> asides; // final, its earlier file's hidden name
-  std::size_t renamed = 0;
-  auto undo = [&]() noexcept
-  {
-    std::error_code ignored;
-    for (std::size_t i = 0; i < renamed; ++i)
-    {
-      fs::rename(this->StagedFiles[i].final, this->StagedFiles[i].temporary, ignored);
-    }
-    for (const auto& [final, aside] : asides)
-    {
-      fs::rename(aside, final, ignored);
-    }
-  };
   for (const Staged& file : this->StagedFiles)
   {
     std::error_code error;
@@ -114,11 +127,11 @@ void OutputTransaction::commit()
       fs::rename(file.final, aside, error);
       if (error)
       {
-        undo();
+        this->moveBack();
         throw std::runtime_error("cannot replace '" + file.final.string() +
           "': " + error.message() + ": the earlier files are kept, nothing was written");
       }
-      asides.emplace_back(file.final, aside);
+      this->Asides.emplace_back(file.final, aside);
     }
   }
   for (const Staged& file : this->StagedFiles)
@@ -127,19 +140,24 @@ void OutputTransaction::commit()
     fs::rename(file.temporary, file.final, error);
     if (error)
     {
-      undo();
+      this->moveBack();
       throw std::runtime_error("cannot rename '" + file.temporary.string() + "' to '" +
         file.final.string() + "': " + error.message() +
         ": the earlier files are kept, nothing was written");
     }
-    ++renamed;
+    ++this->Renamed;
   }
+}
+
+void OutputTransaction::finish()
+{
   this->Committed = true;
-  for (const auto& [final, aside] : asides)
+  for (const auto& [final, aside] : this->Asides)
   {
     std::error_code ignored;
     fs::remove(aside, ignored);
   }
+  this->Asides.clear();
 
   std::set<fs::path> kept;
   for (const Staged& file : this->StagedFiles)

@@ -5,6 +5,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mlr::cli
@@ -53,6 +54,23 @@ public:
   /// Renames every staged file to its final name. Throws std::runtime_error on failure.
   void commit();
 
+  /// commit() in two steps, for processes that commit together (MPI ranks): moveIntoPlace()
+  /// renames the staged files, the earlier ones set aside (undone, and an error thrown, if
+  /// any rename fails); finish() then drops the earlier files and the replaced series' rest.
+  /// Until finish(), destroying the transaction moves every file back: when another process
+  /// failed, this one's earlier files return too.
+  void moveIntoPlace();
+  void finish();
+
+  /// Whether this transaction staged `finalPath`.
+  bool stages(const std::filesystem::path& finalPath) const
+  {
+    return this->StagedNames.count(std::filesystem::absolute(finalPath).lexically_normal()) > 0;
+  }
+
+  /// The hidden name stage() writes `finalPath` under.
+  static std::filesystem::path temporaryOf(const std::filesystem::path& finalPath);
+
 private:
   struct Staged
   {
@@ -64,6 +82,7 @@ private:
     std::string prefix, suffix;
   };
   void rollback() noexcept;
+  void moveBack() noexcept;
 
   std::vector<Staged> StagedFiles;
   std::set<std::filesystem::path> StagedNames; ///< absolute, normalised
@@ -76,6 +95,10 @@ private:
   std::vector<Removal> RemovedFiles;
   std::vector<std::filesystem::path> KeptFiles;
   std::vector<std::filesystem::path> CreatedDirectories;
+  /// Of moveIntoPlace(): the files renamed (the first of StagedFiles), and the earlier
+  /// files set aside (final name, hidden name).
+  std::size_t Renamed = 0;
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> Asides;
   bool Committed = false;
 };
 

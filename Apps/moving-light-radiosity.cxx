@@ -984,23 +984,34 @@ int run(int argc, char** argv, RankJob& job)
   }
   else
   {
-    // Every rank's files are staged before any is renamed; the other ranks rename theirs
-    // before rank 0 renames its frames and then the index that names them all.
+    // Every rank's files are staged before any is renamed. Rank 0 must see the others' (one
+    // folder on a file system they share), or its index would name frames it cannot reach.
+    // Then all rename theirs, and only once every rank has may any drop the earlier files: a
+    // rank that fails moves its own back, and the others move theirs back as they leave.
     std::string failure;
     if (job.rank() == 0)
     {
-      failure = failureOf(writeIndex);
+      failure = failureOf(
+        [&]
+        {
+          for (const FrameRecord& record : records)
+          {
+            const fs::path frame = naming.directory / record.file;
+            std::error_code error;
+            if (!output.stages(frame) && !fs::exists(OutputTransaction::temporaryOf(frame), error))
+            {
+              throw InputError("rank 0 does not see '" + frame.string() +
+                "', which another rank wrote: give every rank the same --output, in a folder "
+                "on a file system all of them share (not a node's own disk), and start them "
+                "in the same working folder; nothing was written");
+            }
+          }
+          writeIndex();
+        });
     }
     agreeAcrossRanks(job, failure);
-    if (job.rank() > 0)
-    {
-      failure = failureOf([&] { output.commit(); });
-    }
-    agreeAcrossRanks(job, failure);
-    if (job.rank() == 0)
-    {
-      output.commit();
-    }
+    agreeAcrossRanks(job, failureOf([&] { output.moveIntoPlace(); }));
+    output.finish();
   }
   bar.finish();
 

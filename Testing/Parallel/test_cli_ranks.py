@@ -136,3 +136,38 @@ def test_an_interrupt_in_the_second_round_of_chunks_leaves_nothing(tmp_path):
     left = subprocess.run(["pgrep", "-f", "--", str(tmp_path / "out")], capture_output=True,
                           text=True)
     assert left.stdout == "", left.stdout
+
+
+def series_files(folder):
+    return {f: (folder / f).read_bytes() for f in all_files(folder)}
+
+
+def test_a_rename_failing_on_one_rank_keeps_the_earlier_series_whole(tmp_path):
+    """A folder where rank 0's frame 9 goes makes its rename fail after rank 1 could have
+    renamed its own: every rank moves back, and the earlier series is as it was."""
+    earlier = run_ranks(1, COMMON + ["--frames", "6", "--output", "out/s.pvd"], tmp_path)
+    assert earlier.returncode == 0, earlier.stderr
+    (tmp_path / "out" / "s_0009.vtu").mkdir()
+    before = series_files(tmp_path / "out")
+    # Chunks of 4 over 12 frames: rank 0 solves frames 0-3 and 8-11, rank 1 frames 4-7.
+    result = run_ranks(2, COMMON + ["--frames", "12", "--frames-per-chunk", "4", "--output",
+                                    "out/s.pvd"], tmp_path)
+    assert result.returncode == 1
+    assert "the earlier files are kept, nothing was written" in result.stderr, result.stderr
+    assert series_files(tmp_path / "out") == before
+    assert sorted(os.listdir(tmp_path / "out")) == sorted(
+        [f"s_{f:04d}.vtu" for f in range(6)] + ["s.pvd", "s_0009.vtu"])
+
+
+def test_ranks_whose_folders_differ_are_refused(tmp_path):
+    """Rank 0's index would name frames another rank wrote where it cannot see them."""
+    args = [CLI] + COMMON + ["--frames", "8", "--frames-per-chunk", "4", "--output", "out/s.pvd"]
+    for rank in ("a", "b"):
+        (tmp_path / rank).mkdir()
+    result = subprocess.run(MPIEXEC + ["-n", "1", "-wdir", str(tmp_path / "a")] + args +
+                            [":", "-n", "1", "-wdir", str(tmp_path / "b")] + args,
+                            capture_output=True, text=True, timeout=240)
+    assert result.returncode == 1
+    assert "rank 0 does not see 'out/s_00" in result.stderr and "which another rank wrote" in \
+        result.stderr
+    assert all_files(tmp_path) == []
