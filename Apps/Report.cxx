@@ -1,6 +1,7 @@
 #include "Report.h"
 
 #include "CommandLine.h"
+#include "SeriesWriter.h"
 
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -471,7 +472,7 @@ void writeStatisticsJson(const std::filesystem::path& path, const Options& optio
   out.close();
   if (!out)
   {
-    throw std::runtime_error("cannot write the statistics file '" + path.string() + "'");
+    failedWrite("the statistics file", path);
   }
 }
 

@@ -310,11 +310,7 @@ std::string xmlEscaped(const std::string& text)
 }
 }
 
-namespace
-{
-/// Throws that `what` could not be written to `path`, named as the user asked for it: a
-/// staged file's hidden temporary name (.NAME.partial) as NAME.
-[[noreturn]] void failedWrite(const std::string& what, const std::filesystem::path& path)
+void failedWrite(const std::string& what, const std::filesystem::path& path)
 {
   std::string name = path.filename().string();
   const std::string staged = ".partial";
@@ -325,7 +321,6 @@ namespace
   }
   throw std::runtime_error("cannot write " + what + " '" + (path.parent_path() / name).string() +
     "': check the disk space and the permissions of its directory");
-}
 }
 
 void writeFileBytes(

@@ -128,4 +128,8 @@ void keepOwnFrameFigures(vtkFieldData* fieldData);
 void writeCollection(
   const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);
 
+/// Throws that `what` could not be written to `path`, named as the user asked for it: a
+/// staged file's hidden temporary name (.NAME.partial) as NAME, with the disk hint.
+[[noreturn]] void failedWrite(const std::string& what, const std::filesystem::path& path);
+
 } // namespace mlr::cli

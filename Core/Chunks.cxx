@@ -378,7 +378,7 @@ Solution handedOn(const ChunkPlan& plan, std::size_t chunk, const Estimate& befo
   finished.patchLitSideData() = patchLitSides;
   summariseErrors(finished, current.errorEstimate);
   finished.statistics = current.statistics;
-  finished.statistics.chunk = static_cast<std::int64_t>(chunk);
+  finished.statistics.chunk = static_cast<std::int64_t>(chunk) + 1;
   finished.statistics.chunks = plan.chunks.size();
   finished.statistics.framesPerChunk = plan.framesPerChunk;
   finished.statistics.chunkOverlap = plan.overlap;

@@ -25,9 +25,9 @@ struct SolverStatistics
   std::uint64_t framesPerChunk = 0;
   /// m, the frames each seam's blend takes from either chunk (0 for one chunk).
   std::uint64_t chunkOverlap = 0;
-  /// Of one chunk's frames handed on as it is solved (streamed): the chunk's index, and the
-  /// figures are its solve's (frames: its positions, its overlap's included) but for the
-  /// chunks' layout above; -1 for the whole solve's.
+  /// Of one chunk's frames handed on as it is solved (streamed): the chunk, counted from 1 as
+  /// the progress lines count them, and the figures are its solve's (frames: its positions,
+  /// its overlap's included) but for the chunks' layout above; -1 for the whole solve's.
   std::int64_t chunk = -1;
   std::uint64_t patches = 0;
   std::uint64_t elements = 0;
