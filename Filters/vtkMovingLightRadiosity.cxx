@@ -112,15 +112,21 @@ struct vtkMovingLightRadiosity::vtkInternals
   std::vector<mlr::Side> FirstChunkLitSides, FirstChunkPatchLitSides;
   int ChunksSolvedAgain = 0;
 
-  /// Puts a chunk's frames first among the cached ones, dropping the oldest beyond `kept`.
+  /// Puts a chunk's frames first among the cached ones, dropping the oldest beyond `kept`
+  /// but the chunk that holds frame WantedFrame: during the first solve, the time step asked
+  /// for, which would otherwise be solved again at once.
   void cacheChunk(std::size_t first, mlr::Solution frames, std::size_t kept)
   {
     this->RankFrames.insert(this->RankFrames.begin(), { first, std::move(frames) });
-    if (this->RankFrames.size() > kept)
+    while (this->RankFrames.size() > kept)
     {
-      this->RankFrames.resize(kept);
+      auto oldest = std::prev(this->RankFrames.end());
+      const bool wanted = this->WantedFrame >= oldest->first &&
+        this->WantedFrame < oldest->first + oldest->frames.frameCount();
+      this->RankFrames.erase(wanted ? std::prev(oldest) : oldest);
     }
   }
+  std::size_t WantedFrame = std::numeric_limits<std::size_t>::max();
   std::vector<mlr::Side> PatchLitSides;
   bool TwoSided = true;
 
@@ -1123,6 +1129,14 @@ int vtkMovingLightRadiosity::RequestData(
     }
     return 0;
   }
+  // The time step asked for: with CachedChunks, the first solve keeps its chunk.
+  const int fromPort = request->Has(vtkExecutive::FROM_OUTPUT_PORT())
+    ? std::max(request->Get(vtkExecutive::FROM_OUTPUT_PORT()), 0)
+    : 0;
+  vtkInformation* trigger = outputVector->GetInformationObject(fromPort);
+  const bool timed = trigger->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+  this->RequestedTime =
+    timed ? trigger->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()) : std::nan("");
   if (!(unchanged && cache.HasResult) && !this->Solve(inputVector))
   {
     return 0;
@@ -1130,13 +1144,7 @@ int vtkMovingLightRadiosity::RequestData(
 
   // All the outputs show the frame asked for on the port whose update runs this request, so that
   // UpdateTimeStep(t) followed by GetOutput(PATCHES_PORT) gives the patches of time t too.
-  const int fromPort = request->Has(vtkExecutive::FROM_OUTPUT_PORT())
-    ? std::max(request->Get(vtkExecutive::FROM_OUTPUT_PORT()), 0)
-    : 0;
-  vtkInformation* trigger = outputVector->GetInformationObject(fromPort);
-  const double requested = trigger->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-    ? trigger->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-    : cache.Times.front();
+  const double requested = timed ? this->RequestedTime : cache.Times.front();
   const std::size_t frame = mlr::vtkinputs::frameAtOrBelow(cache.Times, requested);
   for (int port = 0; port < this->GetNumberOfOutputPorts(); ++port)
   {
@@ -1595,6 +1603,9 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
         "Normal 0, -1, 0");
     }
     cache.Times = trajectory.times;
+    cache.WantedFrame = std::isnan(this->RequestedTime)
+      ? 0
+      : mlr::vtkinputs::frameAtOrBelow(cache.Times, this->RequestedTime);
     // A weather file's frames may skip hours (one per day at noon), a sun path's not: its
     // source says how long a frame lasts.
     vtkDataObject* path = vtkDataObject::GetData(inputs[TRAJECTORY_PORT], 0);
@@ -2159,6 +2170,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.FramesPerChunk = static_cast<std::size_t>(solution.statistics.framesPerChunk);
     }
     cache.HasResult = true;
+    cache.WantedFrame = std::numeric_limits<std::size_t>::max();
     // A statistic, not a property: it must not change the MTime and invalidate the cache.
     ++this->SolveCount;
     return true;

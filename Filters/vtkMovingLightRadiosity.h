@@ -839,6 +839,8 @@ private:
   std::function<void(std::size_t, vtkPolyData*)> ChunkFramesObserver;
   /// This update was aborted: nothing more is reported until the next one starts.
   bool ProgressStopped = false;
+  /// The time step this update asks for (NaN: none), whose chunk a CachedChunks solve keeps.
+  double RequestedTime = 0;
 };
 
 #endif
