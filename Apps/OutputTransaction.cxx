@@ -64,7 +64,7 @@ fs::path OutputTransaction::stage(const fs::path& finalPath)
 {
   // Two files staged under one name would share a temporary file, and the second rename
   // would fail after the first had replaced the earlier file.
-  if (!this->StagedNames.insert(fs::absolute(finalPath).lexically_normal()).second)
+  if (!this->StagedNames.insert(stagedName(finalPath)).second)
   {
     throw std::runtime_error(
       "'" + finalPath.string() + "' would be written twice in one run: nothing was written");

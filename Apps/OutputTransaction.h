@@ -65,7 +65,7 @@ public:
   /// Whether this transaction staged `finalPath`.
   bool stages(const std::filesystem::path& finalPath) const
   {
-    return this->StagedNames.count(std::filesystem::absolute(finalPath).lexically_normal()) > 0;
+    return this->StagedNames.count(stagedName(finalPath)) > 0;
   }
 
   /// The hidden name stage() writes `finalPath` under.
@@ -83,6 +83,11 @@ private:
   };
   void rollback() noexcept;
   void moveBack() noexcept;
+  /// A staged file's key in StagedNames.
+  static std::filesystem::path stagedName(const std::filesystem::path& finalPath)
+  {
+    return std::filesystem::absolute(finalPath).lexically_normal();
+  }
 
   std::vector<Staged> StagedFiles;
   std::set<std::filesystem::path> StagedNames; ///< absolute, normalised

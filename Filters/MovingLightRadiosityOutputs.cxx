@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 
 namespace mlr::vtkoutputs
@@ -292,21 +293,14 @@ void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, s
     return;
   }
   const std::size_t n = solution.elementCount();
-  std::vector<Rgb> radiosity(n), irradiance(n);
-  for (std::size_t e = 0; e < n; ++e)
-  {
-    const Side lit = solution.litSide(e);
-    radiosity[e] = solution.radiosityStdError(frame, e, lit);
-    irradiance[e] = solution.irradianceStdError(frame, e, lit);
-  }
   auto add = [&](const std::vector<Rgb>& radiosityValues, const std::vector<Rgb>& irradianceValues,
-               vtkDataSetAttributes* data)
+               vtkDataSetAttributes* data, const std::string& suffix)
   {
     const std::size_t count = radiosityValues.size();
-    auto radiosityArray = rgbArray("RadiosityStdError", count);
-    auto irradianceArray = rgbArray("IrradianceStdError", count);
+    auto radiosityArray = rgbArray(("RadiosityStdError" + suffix).c_str(), count);
+    auto irradianceArray = rgbArray(("IrradianceStdError" + suffix).c_str(), count);
     vtkNew<vtkFloatArray> lux;
-    lux->SetName("IlluminanceStdError");
+    lux->SetName(("IlluminanceStdError" + suffix).c_str());
     lux->SetNumberOfValues(static_cast<vtkIdType>(count));
     for (std::size_t i = 0; i < count; ++i)
     {
@@ -322,33 +316,30 @@ void addStdErrorArrays(const Solution& solution, const SmoothShading& shading, s
     data->AddArray(irradianceArray);
     data->AddArray(lux);
   };
-  add(radiosity, irradiance, cellData);
-  add(pointMeans(shading, radiosity), pointMeans(shading, irradiance), pointData);
-  if (!twoSided)
+  // The side each element shows (or the side `only`, when given).
+  std::vector<Rgb> radiosity(n), irradiance(n);
+  auto fill = [&](const std::optional<Side>& only)
   {
-    return;
-  }
-  // Each side's, as RadiosityFront and IrradianceFront have: a side lit in some frames only
-  // (a panel's back in the evening) has a value the lit side's error does not cover.
-  for (const auto& [side, name] :
-    { std::make_pair(Side::Front, "Front"), std::make_pair(Side::Back, "Back") })
-  {
-    auto radiosityArray = rgbArray((std::string("RadiosityStdError") + name).c_str(), n);
-    auto irradianceArray = rgbArray((std::string("IrradianceStdError") + name).c_str(), n);
-    vtkNew<vtkFloatArray> lux;
-    lux->SetName((std::string("IlluminanceStdError") + name).c_str());
-    lux->SetNumberOfValues(static_cast<vtkIdType>(n));
     for (std::size_t e = 0; e < n; ++e)
     {
-      const Rgb arriving = solution.irradianceStdError(frame, e, side);
-      setRgb(radiosityArray, e, solution.radiosityStdError(frame, e, side));
-      setRgb(irradianceArray, e, arriving);
-      lux->SetValue(
-        static_cast<vtkIdType>(e), static_cast<float>(luminousEfficacy * luminance(arriving)));
+      const Side side = only ? *only : solution.litSide(e);
+      radiosity[e] = solution.radiosityStdError(frame, e, side);
+      irradiance[e] = solution.irradianceStdError(frame, e, side);
     }
-    cellData->AddArray(radiosityArray);
-    cellData->AddArray(irradianceArray);
-    cellData->AddArray(lux);
+  };
+  fill(std::nullopt);
+  add(radiosity, irradiance, cellData, "");
+  add(pointMeans(shading, radiosity), pointMeans(shading, irradiance), pointData, "");
+  if (twoSided)
+  {
+    // Each side's, as RadiosityFront and IrradianceFront have: a side lit in some frames only
+    // (a panel's back in the evening) has a value the lit side's error does not cover.
+    for (const auto& [side, name] :
+      { std::make_pair(Side::Front, "Front"), std::make_pair(Side::Back, "Back") })
+    {
+      fill(side);
+      add(radiosity, irradiance, cellData, name);
+    }
   }
 }
 
