@@ -446,8 +446,8 @@ void accumulate(const ErrorEstimateSummary& c, bool first, ErrorEstimateSummary&
 namespace
 {
 /// What ended a chunk's batches, as a number that a sum over ranks carries.
-constexpr std::array<const char*, 5> StopReasons = { "", "batches", "target", "time limit",
-  "path limit" };
+constexpr std::array<const char*, 6> StopReasons = { "", "batches", "target", "time limit",
+  "path limit", "batch limit" };
 
 /// Every field of a chunk's statistics and error summary, in one order, for the ranks that
 /// share chunks out (visit(field) with a reference to each).
@@ -613,6 +613,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   // The chunks that missed a target, from every chunk's figures (over ranks, exchanged).
   std::size_t missed = 0;
   std::set<std::string> missedBy;
+  std::vector<std::uint64_t> chunkBatches;
   if (options.chunkOverlap > plan.overlap)
   {
     warnings.push_back("the chunk overlap of " + std::to_string(options.chunkOverlap) +
@@ -781,6 +782,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
       {
         accumulate(chunkErrors, j == 0, errors);
       }
+      chunkBatches.push_back(chunkErrors.batches);
       if (j == 0 && overRanks)
       {
         litSides.resize(scene.elementCount(), Side::Front);
@@ -912,6 +914,10 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
   {
     out.errorEstimate = errors;
   }
+  if (out.errorEstimate.batches > 0)
+  {
+    out.errorEstimate.chunkBatches = std::move(chunkBatches);
+  }
   out.statistics = stats;
   out.statistics.frames = frames;
   out.statistics.chunks = plan.chunks.size();
@@ -929,7 +935,8 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
 
 Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, std::size_t chunk, const std::vector<Side>& litSides,
-  const std::vector<Side>& patchLitSides, const ProgressCallback& progress)
+  const std::vector<Side>& patchLitSides, const std::vector<std::uint64_t>& chunkBatches,
+  const ProgressCallback& progress)
 {
   const std::size_t frames = frameCount(rig, scene.hasEmission());
   const ChunkPlan plan = planChunks(frames, framesPerChunk, options.chunkOverlap);
@@ -937,6 +944,11 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   {
     throw Error("chunk " + std::to_string(chunk) + " of an animation in " +
       std::to_string(plan.chunks.size()) + " chunks");
+  }
+  if (!chunkBatches.empty() && chunkBatches.size() != plan.chunks.size())
+  {
+    throw Error("the batches of " + countOf(chunkBatches.size(), "chunk") +
+      " for an animation in " + countOf(plan.chunks.size(), "chunk"));
   }
   // The chunk before, for its estimate of the seam between them; then this chunk, in the unit
   // of the first solve (solveInChunks).
@@ -969,6 +981,12 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   {
     const ChunkPlan::Chunk& c = plan.chunks[k];
     chunkOptions.firstFrame = c.solveBegin;
+    if (!chunkBatches.empty())
+    {
+      // The first solve's rounds, whatever the time they take now.
+      chunkOptions.timeLimitSeconds = 0;
+      chunkOptions.batchLimit = chunkBatches[k];
+    }
     Solution current = solve(scene, sliceRig(rig, c.solveBegin, c.solveEnd - c.solveBegin),
       chunkOptions, part(costs[1 + k - first]), setup);
     if (k < chunk)

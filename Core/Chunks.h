@@ -113,15 +113,17 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
 
 /**
  * The frames that chunk `chunk` of planChunks(frames, framesPerChunk, options.chunkOverlap)
- * finishes, solved again
- * alone (a cache that dropped them): that chunk and, for the blend at its first seam, the
- * chunk before it, so about twice one chunk's solve. The same bits as the frames
- * solveInChunks hands on for it with the same scene, rig and options (any thread count), with
- * `litSides` and `patchLitSides` (those solveInChunks gave: the first chunk's). One rank
+ * finishes, solved again alone (a cache that dropped them): that chunk and, for the blend at
+ * its first seam, the chunk before it, so about twice one chunk's solve. The same bits as the
+ * frames solveInChunks hands on for it with the same scene, rig and options (any thread
+ * count), with `litSides` and `patchLitSides` (those solveInChunks gave: the first chunk's)
+ * and `chunkBatches` (its ErrorEstimateSummary::chunkBatches: each chunk then runs the
+ * batches it ran, where a time limit cut its rounds; empty: the options' rounds). One rank
  * only. Throws as solve() does, and mlr::Error for a chunk past the last.
  */
 Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, std::size_t chunk, const std::vector<Side>& litSides,
-  const std::vector<Side>& patchLitSides, const ProgressCallback& progress = {});
+  const std::vector<Side>& patchLitSides, const std::vector<std::uint64_t>& chunkBatches = {},
+  const ProgressCallback& progress = {});
 
 } // namespace mlr

@@ -585,7 +585,17 @@ void solveInBatches(const Scene& scene, const SolverOptions& options, const Batc
       stoppedBy = "path limit";
       break;
     }
+    if (options.batchLimit > 0 && spread.count() >= options.batchLimit)
+    {
+      log(s.str() + ": the batches of the first solve stop it");
+      stoppedBy = "batch limit";
+      break;
+    }
     planned = std::min(cap, nextBatchCount(spread.count(), p95, target));
+    if (options.batchLimit > 0)
+    {
+      planned = std::min(planned, options.batchLimit);
+    }
     ++summary.rounds;
     const double perSecond = static_cast<double>(spread.count()) / secondsSince(start);
     s << ": " << planned - spread.count() << " batches more, about "

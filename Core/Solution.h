@@ -97,8 +97,12 @@ struct ErrorEstimateSummary
   std::uint64_t pathsPerFrame = 0; ///< N of all batches together
   double target = 0;               ///< SolverOptions::targetRelativeError
   /// What ended the batches: "batches" (the fixed count, no target), "target" (reached),
-  /// "time limit" or "path limit" (the target was not reached).
+  /// "time limit" or "path limit" (the target was not reached), "batch limit" (a chunk solved
+  /// again, SolverOptions::batchLimit).
   std::string stoppedBy;
+  /// Solved in chunks: each chunk's batches, in chunk order, for solving one again with the
+  /// same bits (solveChunk).
+  std::vector<std::uint64_t> chunkBatches;
   /// Per frame, over the lit elements (ErrorEstimate.h): the median and the 95th
   /// percentile of the relative error, and how many elements are lit.
   std::vector<double> relativeErrorMedian, relativeErrorP95;

@@ -62,6 +62,10 @@ struct SolverOptions
   /// solve, each of which completes its first round. The round count then depends on the
   /// machine's speed: the result is no longer reproducible.
   double timeLimitSeconds = 0;
+  /// With a target: run at most this many batches, all rounds together (0: only the path
+  /// limit). A chunk solved again runs the batches its first solve ran (solveChunk), so that
+  /// the cut of a time limit is repeated bit for bit, whatever the time it now takes.
+  std::uint64_t batchLimit = 0;
   /// The unit the results are stored in (Solution::storageScale), a power of two; 0 takes
   /// it from the scene and the rig solved (storageScaleFor). Solves whose results are
   /// blended, as the chunks of one animation, set the one of the whole rig.
@@ -128,8 +132,8 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
 {
   const auto& [pathsPerFrame, gatheringRatio, firstBounceSurvival, reuseShooting, balanceFrames,
     reuseGathering, twoSided, seed, threads, memoryLimitBytes, framesPerChunk, chunkOverlap,
-    errorBatches, targetRelativeError, timeLimitSeconds, storageScale, firstFrame, rank, ranks,
-    sumAcrossRanks, sumDoublesAcrossRanks, log, batchSolved] = options;
+    errorBatches, targetRelativeError, timeLimitSeconds, batchLimit, storageScale, firstFrame, rank,
+    ranks, sumAcrossRanks, sumDoublesAcrossRanks, log, batchSolved] = options;
   visit("pathsPerFrame", pathsPerFrame, OptionRole::Result);
   visit("gatheringRatio", gatheringRatio, OptionRole::Result);
   visit("firstBounceSurvival", firstBounceSurvival, OptionRole::Result);
@@ -150,6 +154,7 @@ void visitSolverOptions(const SolverOptions& options, Visitor&& visit)
   // The ranks stop together (the first to run out of time stops all), so they must agree on
   // the limit.
   visit("timeLimitSeconds", timeLimitSeconds, OptionRole::Result);
+  visit("batchLimit", batchLimit, OptionRole::Result);
   visit("storageScale", storageScale, OptionRole::Result);
   visit("firstFrame", firstFrame, OptionRole::PerRank);
   visit("rank", rank, OptionRole::PerRank);

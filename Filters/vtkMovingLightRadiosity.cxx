@@ -110,6 +110,7 @@ struct vtkMovingLightRadiosity::vtkInternals
   mlr::SolverOptions ChunkOptions;
   std::size_t FramesPerChunk = 0;
   std::vector<mlr::Side> FirstChunkLitSides, FirstChunkPatchLitSides;
+  std::vector<std::uint64_t> ChunkBatches;
   int ChunksSolvedAgain = 0;
 
   /// Puts a chunk's frames first among the cached ones, dropping the oldest beyond `kept`
@@ -1225,7 +1226,7 @@ bool vtkMovingLightRadiosity::FillOutput(int port, std::size_t frame, vtkPolyDat
     {
       cache.cacheChunk(plan.finishedBegin(chunk),
         mlr::solveChunk(*cache.ChunkScene, cache.Rig, cache.ChunkOptions, cache.FramesPerChunk,
-          chunk, cache.FirstChunkLitSides, cache.FirstChunkPatchLitSides,
+          chunk, cache.FirstChunkLitSides, cache.FirstChunkPatchLitSides, cache.ChunkBatches,
           [this](double fraction)
           {
             this->UpdateProgress(fraction);
@@ -2168,6 +2169,7 @@ bool vtkMovingLightRadiosity::Solve(vtkInformationVector** inputVector)
       cache.ChunkOptions = solverOptions;
       cache.ChunkOptions.log = {};
       cache.FramesPerChunk = static_cast<std::size_t>(solution.statistics.framesPerChunk);
+      cache.ChunkBatches = solution.errorEstimate.chunkBatches;
     }
     cache.HasResult = true;
     cache.WantedFrame = std::numeric_limits<std::size_t>::max();

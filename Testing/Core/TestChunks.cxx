@@ -702,6 +702,59 @@ TEST(Chunks, AChunkSolvedAgainHasTheBitsOfTheWholeRun)
     "chunk 4 of an animation in 4 chunks");
 }
 
+TEST(Chunks, AChunkSolvedAgainRepeatsTheBatchesItsFirstSolveRan)
+{
+  // A target's rounds differ between chunks; a chunk solved again under a time limit that
+  // would now stop it after its first round still runs the batches of the first solve.
+  const Scene scene = box();
+  SolverOptions o = options(4000, 29, 2);
+  o.errorBatches = 4;
+  o.targetRelativeError = 0.3;
+  constexpr std::size_t perChunk = 4;
+  FrameBits whole;
+  std::vector<Side> sides, patchSides;
+  const Solution first = solveInChunks(scene, rig(), o, perChunk, {},
+    [&](std::size_t firstFrame, Solution& frames)
+    {
+      recordFrames(firstFrame, frames, whole);
+      if (firstFrame == 0)
+      {
+        sides = frames.litSideData();
+        patchSides = frames.patchLitSideData();
+      }
+    });
+  const std::vector<std::uint64_t>& batches = first.errorEstimate.chunkBatches;
+  const ChunkPlan plan = planChunks(Frames, perChunk);
+  ASSERT_EQ(batches.size(), plan.chunks.size());
+  EXPECT_EQ(first.errorEstimate.batches, *std::min_element(batches.begin(), batches.end()));
+  ASSERT_GT(*std::max_element(batches.begin(), batches.end()), o.errorBatches)
+    << "the target needs more than one round, which the time limit below would cut";
+
+  SolverOptions cut = o;
+  cut.timeLimitSeconds = 1e-3;
+  for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+  {
+    Solution again = solveChunk(scene, rig(), cut, perChunk, k, sides, patchSides, batches);
+    FrameBits bits;
+    recordFrames(plan.finishedBegin(k), again, bits);
+    for (const auto& [frame, b] : bits)
+    {
+      EXPECT_EQ(b, whole.at(frame)) << "chunk " << k << ", frame " << frame;
+    }
+    EXPECT_EQ(again.errorEstimate.batches, batches[k]) << "chunk " << k;
+  }
+  // Without the first solve's batches the time limit cuts the rounds: other values.
+  const std::size_t longest =
+    static_cast<std::size_t>(std::max_element(batches.begin(), batches.end()) - batches.begin());
+  const Solution cutShort = solveChunk(scene, rig(), cut, perChunk, longest, sides, patchSides);
+  EXPECT_EQ(cutShort.errorEstimate.batches, o.errorBatches);
+  checks::expectError(
+    [&] {
+      solveChunk(scene, rig(), o, perChunk, 0, sides, patchSides, { 4, 4 });
+    },
+    "the batches of 2 chunks for an animation in 3 chunks");
+}
+
 TEST(Chunks, ACancelOnOneRankStopsEveryRankBetweenChunks)
 {
   const Scene scene = box();

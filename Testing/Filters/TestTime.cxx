@@ -16,6 +16,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
 #include <vector>
 
 using namespace mlr;
@@ -252,6 +254,37 @@ TEST(FilterTime, CachedChunksSolveADroppedChunkAgainWithTheSameValues)
       << "time " << t;
   }
   EXPECT_EQ(fieldValue(all->GetOutput(), "ChunksSolvedAgain"), 0);
+}
+
+TEST(FilterTime, AChunkSolvedAgainRepeatsTheRoundsATimeLimitCut)
+{
+  // A target no solve reaches, stopped by a TimeLimit: each chunk runs the batches its share
+  // of the time allowed. Solved again when asked for after the cache dropped it, a chunk runs
+  // the same batches, whatever the time it takes now, and shows the same values.
+  BoxSetup setup = closedBoxSetup(12);
+  auto filter = fastFilter(setup);
+  filter->SetFramesPerChunk(3);
+  filter->SetCachedChunks(1);
+  filter->SetErrorBatches(4);
+  filter->SetTargetRelativeError(1e-4);
+  filter->SetTimeLimit(1.0);
+  ASSERT_TRUE(filter->UpdateTimeStep(3));
+  std::map<std::string, std::vector<float>> first;
+  for (const char* name : { "Radiosity", "RadiosityStdError" })
+  {
+    first[name] = arrayValues(filter->GetOutput(), name);
+    ASSERT_FALSE(first[name].empty()) << name;
+  }
+  const double p95 = fieldValue(filter->GetOutput(), "RelativeErrorP95");
+  ASSERT_TRUE(filter->UpdateTimeStep(9));
+  ASSERT_TRUE(filter->UpdateTimeStep(3));
+  EXPECT_EQ(fieldValue(filter->GetOutput(), "ChunksSolvedAgain"), 2);
+  for (const auto& [name, values] : first)
+  {
+    EXPECT_EQ(arrayValues(filter->GetOutput(), name.c_str()), values) << name;
+  }
+  EXPECT_EQ(fieldValue(filter->GetOutput(), "RelativeErrorP95"), p95);
+  EXPECT_EQ(filter->GetSolveCount(), 1);
 }
 
 TEST(FilterTime, AChunkOverlapIsKeptWhenADroppedChunkIsSolvedAgain)
