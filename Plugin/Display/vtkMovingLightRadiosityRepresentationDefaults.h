@@ -18,7 +18,8 @@
  * title="Illuminance (lx)" /> gives the lookup table ParaView makes for that array, whichever
  * representation colours by it first, the named preset (one of IlluminancePresets.json, which
  * the plugin registers), log scale and the scalar bar's title. The range stays ParaView's: the
- * data's range at the time, a minimum of 0 raised to 1e-4 of the maximum but at most 1.
+ * data's range at the time, a minimum of 0 raised to 1e-4 of the maximum but at most 1 (which
+ * vtkSMMovingLightRadiosityRepresentationProxy gives without ParaView's warning).
  * It only changes what colouring by the array looks like: ColorBy still chooses the array.
  * map_scalars="0|1" on a <ColorBy> or a <ColorMap> sets Map Scalars whenever the
  * representation is coloured by that array again, so that switching between an array of

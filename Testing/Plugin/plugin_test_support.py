@@ -105,6 +105,28 @@ def shown(source, name):
                if d.GetAttribute("mode") == "visibility")
 
 
+class PrintedMessages:
+    """What VTK prints while in a `with` block (errors and warnings, ParaView's generic warnings
+    from vtkGenericWarningMacro too): `text` so far. A vtkStringOutputWindow stands in for the
+    output window meanwhile; ParaView's log on stderr still shows them."""
+
+    def __enter__(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+        self._previous = vtkOutputWindow.GetInstance()
+        self._window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self._window)
+        return self
+
+    def __exit__(self, *exception):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
+        vtkOutputWindow.SetInstance(self._previous)
+        return False
+
+    @property
+    def text(self):
+        return self._window.GetOutput()
+
+
 class Checks:
     """Collects failures so that one run reports every broken expectation."""
 
