@@ -35,6 +35,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), os.pardir, "Support")
 from movinglightradiosity import vtkMovingLightRadiosity  # noqa: E402
 from vtk_messages import recorded  # noqa: E402
 from vtkmodules.vtkCommonCore import vtkDoubleArray  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkPolyData  # noqa: E402
 from vtkmodules.vtkFiltersSources import vtkCubeSource  # noqa: E402
 
 
@@ -52,6 +53,25 @@ def glowing_box_filter():
     radiosity = vtkMovingLightRadiosity()
     radiosity.SetInputData(vtkMovingLightRadiosity.SCENE_PORT, box)
     return radiosity
+
+
+def refused(name, value):
+    """The errors naming `name` of the filter given `value` for it, on an empty Scene: the
+    properties' ranges are checked before anything else, and nothing is solved."""
+    probe = vtkMovingLightRadiosity()
+    probe.SetInputData(vtkMovingLightRadiosity.SCENE_PORT, vtkPolyData())
+    getattr(probe, "Set" + name)(value)
+    errors = recorded(probe, "ErrorEvent")
+    probe.Update()
+    return [e for e in errors if name in e]
+
+
+def range_domain(prop):
+    """The property's one range domain (int or double), or None."""
+    found = [d for d in domains(prop) if d.IsA("vtkSMIntRangeDomain") or
+             d.IsA("vtkSMDoubleRangeDomain")]
+    return found[0] if len(found) == 1 else None
+
 
 radiosity, sources = support.box_pipeline()
 proxy = radiosity.SMProxy
@@ -144,6 +164,14 @@ PARAVIEW_OWN = {"PathFromLightMaterial": ([1.0], [0.0])}
 # The chunks of a long animation.
 EXPECTED |= {"FramesPerChunk", "ChunkOverlap", "CachedChunks"}
 ADVANCED |= {"FramesPerChunk", "ChunkOverlap", "CachedChunks"}
+# Values inside a domain that the filter refuses, which a range domain (one interval) cannot
+# leave out, and what the documentation says of them.
+INSIDE_REFUSED = {"FramesPerChunk": {1: "1 is refused"}}
+# Filter bounds a domain leaves out: a single number with both bounds is shown as a slider
+# between them, of no use from 0 to 1e30 lm or to 1000000 frames (ChunkOverlap's own limit is
+# half of Frames Per Chunk); NumberOfPaths is an int property, whose panel stops at 2^31 - 1
+# paths, below the filter's 1e11.
+WIDER = {"LightFluxLumens", "ChunkOverlap", "NumberOfPaths"}
 vtk_defaults = vtkMovingLightRadiosity()
 # The pipeline above changed NumberOfPaths: a proxy fresh from the XML holds the defaults.
 pristine = servermanager.filters.MovingLightRadiosity().SMProxy
@@ -216,7 +244,58 @@ while not iterator.IsAtEnd():
             probe.Update()
             check(any(name in e for e in errors),
                   f"{where}: {value}, outside the domain, is not refused by name: {errors}")
+
+    # And the domain holds nothing the filter refuses: its bounds, and a count's values next
+    # to them, pass the filter's range check. A range domain cannot leave out a value inside
+    # it: those the filter refuses there are in INSIDE_REFUSED, and the documentation says so.
+    domain = range_domain(prop)
+    if prop.GetNumberOfElements() == 1 and domain is not None:
+        counts = domain.IsA("vtkSMIntRangeDomain")
+        inside = []
+        if domain.GetMinimumExists(0):
+            inside += [domain.GetMinimum(0)] + ([domain.GetMinimum(0) + 1] if counts else [])
+        if domain.GetMaximumExists(0):
+            inside += [domain.GetMaximum(0)] + ([domain.GetMaximum(0) - 1] if counts else [])
+        for value in inside:
+            errors = refused(name, value)
+            said = INSIDE_REFUSED.get(name, {}).get(value)
+            if said is None:
+                check(not errors, f"{where}: {value}, in the domain, is refused: {errors}")
+            else:
+                check(errors, f"{where}: {value} is listed as refused, but the filter takes it")
+                check(said in text, f"{where}: the documentation does not say {said!r}")
 check(found == EXPECTED, f"properties {sorted(found)}, expected {sorted(EXPECTED)}")
+
+# The domains' bounds are the filter's table (vtkMovingLightRadiosity::GetPropertyRange), or
+# absent where the filter has none (VTK_INT_MAX for a count, the largest double), but for
+# WIDER, whose bound is left out for the reason given: above it the filter refuses by name.
+for name in sorted(found):
+    bounds = [0.0, 0.0]
+    if not vtkMovingLightRadiosity.GetPropertyRange(name, bounds):
+        continue
+    where = f"property {name}"
+    domain = range_domain(proxy.GetProperty(name))
+    if not check(domain is not None, f"{where}: no range domain for the filter's {bounds}"):
+        continue
+    counts = domain.IsA("vtkSMIntRangeDomain")
+    unbounded = bounds[1] >= (2 ** 31 - 1 if counts else sys.float_info.max)
+    low = domain.GetMinimum(0) if domain.GetMinimumExists(0) else None
+    high = domain.GetMaximum(0) if domain.GetMaximumExists(0) else None
+    check(low == bounds[0], f"{where}: the domain's minimum is {low}, the filter's {bounds[0]}")
+    if name in WIDER:
+        check(high is None, f"{where}: listed in WIDER, but the domain has a maximum {high}")
+        above = int(bounds[1]) + 1 if counts else 2 * bounds[1]
+        check(refused(name, above), f"{where}: {above}, above the filter's maximum, is taken")
+    else:
+        check(high == (None if unbounded else bounds[1]),
+              f"{where}: the domain's maximum is {high}, the filter's {bounds[1]}")
+# The light power's bound is the one the filter's table gives the lumens (MaximumLightPower).
+bounds = [0.0, 0.0]
+vtkMovingLightRadiosity.GetPropertyRange("LightFluxLumens", bounds)
+domain = range_domain(proxy.GetProperty("LightPower"))
+check(domain is not None and
+      all(domain.GetMaximumExists(i) and domain.GetMaximum(i) == bounds[1] for i in range(3)),
+      f"property LightPower: its domain does not end at the filter's {bounds[1]} W per channel")
 
 
 # --- Shown when they apply ----------------------------------------------------------------
