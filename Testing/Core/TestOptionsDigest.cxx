@@ -44,6 +44,8 @@ SolverOptions changed(SolverOptions options, const std::string& name)
     options.chunkOverlap = 4;
   else if (name == "timeLimitSeconds")
     options.timeLimitSeconds = 60;
+  else if (name == "batchLimit")
+    options.batchLimit = 12;
   else if (name == "storageScale")
     options.storageScale = 0.25;
   else if (name == "log")
@@ -81,7 +83,7 @@ TEST(OptionsDigest, EveryFieldIsVisitedOnce)
   {
     EXPECT_TRUE(names.insert(name).second) << name << " visited twice";
   }
-  EXPECT_EQ(names.size(), 23u);
+  EXPECT_EQ(names.size(), 24u);
 }
 
 TEST(OptionsDigest, EveryOptionThatDecidesTheResultChangesTheDigest)
