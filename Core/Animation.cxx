@@ -179,7 +179,8 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const double sensorShare = options.sensors.empty() ? 0.0 : SensorShare;
   const double solveShare = 1 - RemeshingShare - sensorShare;
   const double setupCost = SolveSetup::cost(scene, options.solver);
-  const double setupShare = setupCost / (setupCost + solveCost(scene, lights, options.solver));
+  const double setupShare =
+    setupCost / (setupCost + chunksCost(scene, lights, options.solver, framesPerChunk));
   std::optional<SolveSetup> setup;
   agreeAcrossRanks(options.solver,
     [&]

@@ -535,6 +535,41 @@ void exchangeFrames(const SolverOptions& options, Solution& frames, double& seco
 }
 }
 
+namespace
+{
+/// Per element side and position of a chunk, in solveCost's units, past its solve: its
+/// estimates blended at the seams, its sides' totals and each frame's error figures (measured
+/// with solveCost's figures, Documentation/Performance.md, "Progress").
+constexpr double ChunkSideFrameCost = 0.2;
+
+/// The expected cost of chunk `chunk`'s solve and of finishing its frames.
+double chunkCost(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  const ChunkPlan& plan, std::size_t chunk)
+{
+  const std::size_t positions = plan.chunks[chunk].solveEnd - plan.chunks[chunk].solveBegin;
+  return solveCost(scene, rig, options, positions) +
+    ChunkSideFrameCost * static_cast<double>(scene.elementCount()) *
+    (options.twoSided ? 2.0 : 1.0) * static_cast<double>(positions);
+}
+}
+
+double chunksCost(
+  const Scene& scene, const LightRig& rig, const SolverOptions& options, std::size_t framesPerChunk)
+{
+  const ChunkPlan plan =
+    planChunks(frameCount(rig, scene.hasEmission()), framesPerChunk, options.chunkOverlap);
+  if (plan.chunks.size() == 1)
+  {
+    return solveCost(scene, rig, options);
+  }
+  double cost = 0;
+  for (std::size_t k = 0; k < plan.chunks.size(); ++k)
+  {
+    cost += chunkCost(scene, rig, options, plan, k);
+  }
+  return cost;
+}
+
 Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   std::size_t framesPerChunk, const ProgressCallback& progress, const ChunkFramesCallback& onFrames,
   const FirstChunkFigure& figure, const SolveSetup* givenSetup)
@@ -582,13 +617,12 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
 
   // Progress: the setup (unless given), then each chunk, by their expected rays.
   const double setupCost = givenSetup ? 0.0 : SolveSetup::cost(scene, options);
-  double chunksCost = 0;
+  double solvesCost = 0;
   for (std::size_t k = rank; k < chunkCount; k += ranks)
   {
-    chunksCost +=
-      solveCost(scene, rig, options, plan.chunks[k].solveEnd - plan.chunks[k].solveBegin);
+    solvesCost += chunkCost(scene, rig, options, plan, k);
   }
-  const double totalCost = setupCost + chunksCost;
+  const double totalCost = setupCost + solvesCost;
   std::optional<SolveSetup> ownSetup;
   if (!givenSetup)
   {
@@ -639,7 +673,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     {
       const ChunkPlan::Chunk& c = plan.chunks[k];
       const std::size_t positions = c.solveEnd - c.solveBegin;
-      const double share = solveCost(scene, rig, options, positions) / totalCost;
+      const double share = chunkCost(scene, rig, options, plan, k) / totalCost;
       ProgressCallback chunkProgress;
       if (progress)
       {
@@ -960,8 +994,7 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   std::vector<double> costs{ SolveSetup::cost(scene, options) };
   for (std::size_t k = first; k <= chunk; ++k)
   {
-    costs.push_back(
-      solveCost(scene, rig, options, plan.chunks[k].solveEnd - plan.chunks[k].solveBegin));
+    costs.push_back(chunkCost(scene, rig, options, plan, k));
   }
   const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
   double base = 0;

@@ -87,6 +87,11 @@ struct FirstChunkFigure
   std::function<void(double value)> receive;
 };
 
+/// The expected cost of solveInChunks past its setup, in solveCost's units, to weigh its
+/// share of a progress: every chunk's solve and the finishing of its frames.
+double chunksCost(const Scene& scene, const LightRig& rig, const SolverOptions& options,
+  std::size_t framesPerChunk);
+
 /**
  * Solves the animation in the chunks of planChunks(frames, framesPerChunk,
  * options.chunkOverlap). With one chunk

@@ -26,36 +26,90 @@ double secondsSince(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The fractions of the progress its phases take, weighted by their expected ray counts: the
-/// reachability probes (none when a SolveSetup brings them), then the passes, each shooting
-/// every source, then gathering.
+/// The progress's cost model, in units of one shooting path's rays (shootingCost), measured
+/// in the Cornell box from 3,000 to 195,000 elements, 20,000 to 2 million paths and 30 to 300
+/// frames (Documentation/Performance.md, "Progress"). Past a few thousand elements per
+/// hundred thousand paths, the work per element side and frame outweighs the rays.
+/// A probe ray of the setup, the tracer's build included.
+constexpr double ProbeRayCost = 4;
+/// A gathering ray, whose light is read in every frame.
+constexpr double GatheringRayCost = 3.5;
+/// Per element side and frame of one pass (a batch, or a solve without batches): shooting's
+/// sums zeroed and reduced, gathering's light of each side scored, and a batch merged into
+/// the running mean and spread.
+constexpr double ShootingSideFrameCost = 0.085;
+constexpr double GatheringSideFrameCost = 0.2;
+constexpr double BatchSideFrameCost = 0.09;
+
+/// The element sides of `scene`, which the work per side and frame scales with.
+double elementSides(const Scene& scene, const SolverOptions& options)
+{
+  return static_cast<double>(scene.elementCount()) * (options.twoSided ? 2.0 : 1.0);
+}
+
+/// The batches a solve runs (its first round's): 1 without an error estimate.
+double batchCount(const SolverOptions& options)
+{
+  return estimatesError(options) ? static_cast<double>(options.errorBatches) : 1.0;
+}
+
+/// The options of one pass: a batch's N.
+SolverOptions passOptions(const SolverOptions& options)
+{
+  SolverOptions pass = options;
+  pass.pathsPerFrame = std::max<std::uint64_t>(
+    1, options.pathsPerFrame / static_cast<std::uint64_t>(batchCount(options)));
+  return pass;
+}
+
+/// The expected cost of one pass's gathering: its k N rays, at least one per element side
+/// (per frame without reuse), and its work per side and frame.
+double gatheringCost(const Scene& scene, std::size_t frames, const SolverOptions& pass)
+{
+  const double rays = std::max(
+    pass.gatheringRatio * static_cast<double>(pass.pathsPerFrame), elementSides(scene, pass));
+  return GatheringRayCost * rays * (pass.reuseGathering ? 1.0 : static_cast<double>(frames)) +
+    GatheringSideFrameCost * elementSides(scene, pass) * static_cast<double>(frames);
+}
+
+/// The work per side and frame of one pass besides gathering's: shooting's, and a batch's
+/// merge.
+double passSideFrameCost(const Scene& scene, std::size_t frames, const SolverOptions& options)
+{
+  return (ShootingSideFrameCost + (estimatesError(options) ? BatchSideFrameCost : 0.0)) *
+    elementSides(scene, options) * static_cast<double>(frames);
+}
+
+/// The fractions of the progress its phases take, weighted by their expected cost: the
+/// reachability probes (none when a SolveSetup brings them), then the passes (one per batch),
+/// each shooting every source, then gathering.
 struct ProgressPlan
 {
   double probing = 0;
   /// Of a pass's progress.
   std::vector<double> shooting;
 
-  ProgressPlan(const std::vector<LightSource>& sources, std::size_t frames,
-    const SolverOptions& options, double probeRays)
+  ProgressPlan(const Scene& scene, const std::vector<LightSource>& sources, std::size_t frames,
+    const SolverOptions& options, double setupCost)
   {
+    const SolverOptions pass = passOptions(options);
+    const double perSource = ShootingSideFrameCost * elementSides(scene, options) *
+      static_cast<double>(frames) / static_cast<double>(std::max<std::size_t>(1, sources.size()));
     double total = 0;
     for (const LightSource& source : sources)
     {
-      this->shooting.push_back(shootingCost(source, options));
+      this->shooting.push_back(shootingCost(source, pass) + perSource);
       total += this->shooting.back();
     }
-    total += gatheringCost(frames, options);
+    total += gatheringCost(scene, frames, pass);
     for (double& share : this->shooting)
     {
       share /= total;
     }
-    this->probing = probeRays / (probeRays + total);
-  }
-
-  static double gatheringCost(std::size_t frames, const SolverOptions& options)
-  {
-    return options.gatheringRatio * static_cast<double>(options.pathsPerFrame) *
-      (options.reuseGathering ? 1.0 : static_cast<double>(frames));
+    const double merges = estimatesError(options)
+      ? BatchSideFrameCost * elementSides(scene, options) * static_cast<double>(frames)
+      : 0.0;
+    this->probing = setupCost / (setupCost + batchCount(options) * (total + merges));
   }
 };
 
@@ -240,7 +294,8 @@ Solution solveWith(const Scene& scene, const LightRig& rig, const SolverOptions&
       {
         checkBatchPathsPerPosition(source, options);
       }
-      shares.emplace(sources, frames, options, setup ? 0.0 : SolveSetup::cost(scene, options));
+      shares.emplace(
+        scene, sources, frames, options, setup ? 0.0 : SolveSetup::cost(scene, options));
       if (progress && !progress(0.0))
       {
         throw Cancelled();
@@ -459,7 +514,7 @@ SolveSetup::~SolveSetup() = default;
 
 double SolveSetup::cost(const Scene& scene, const SolverOptions& options)
 {
-  return static_cast<double>(scene.patchCount()) * (options.twoSided ? 2.0 : 1.0) *
+  return ProbeRayCost * static_cast<double>(scene.patchCount()) * (options.twoSided ? 2.0 : 1.0) *
     ReachabilityProbesPerSide;
 }
 
@@ -490,7 +545,11 @@ double solveCost(
   {
     add(1);
   }
-  return shooting + ProgressPlan::gatheringCost(frames, options);
+  // Shooting's rays are the whole N's however it is batched; the rest is every pass's.
+  return shooting +
+    batchCount(options) *
+    (gatheringCost(scene, frames, passOptions(options)) +
+      passSideFrameCost(scene, frames, options));
 }
 
 } // namespace mlr
