@@ -119,13 +119,18 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
     const std::size_t sensors = options.sensors.size();
     checkedBytes = estimateChunkedMemory(patches, elements, points, frames, framesPerChunk,
       options.solver, lightCount, outputs, streamed, kept, reachable, firstHits);
-    checkSolveMemory(checkedBytes, streamed ? std::min(frames, framesPerChunk) : frames, patches,
-      elements, options.solver, approximate, sensors,
+    // Streamed in chunks, a chunk's positions are held, not the frames.
+    const bool chunked = streamed && framesPerChunk < frames;
+    const std::size_t held = chunked
+      ? std::min(
+          frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk, options.solver.chunkOverlap))
+      : frames;
+    checkSolveMemory(checkedBytes, held, patches, elements, options.solver, approximate, sensors,
       saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
                       options.solver, options.sensorOptions),
         saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })),
       !streamed && sensors == 0 && options.solver.ranks <= 1 && frames > 2 * MinimumFramesPerChunk,
-      skyBytes);
+      skyBytes, chunked ? framesPerChunk : 0);
   };
 
   RemeshOptions remeshing = options.remeshing;

@@ -362,16 +362,31 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options)
 
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate, std::size_t sensors,
-  std::uint64_t sensorBytes, bool couldStream, std::uint64_t skyBytes)
+  std::uint64_t sensorBytes, bool couldStream, std::uint64_t skyBytes, std::size_t framesPerChunk)
 {
   const std::string about = approximate ? "about " : "";
-  std::string detail = countOf(frames, "frame") + " x (" + about + std::to_string(patches) +
-    " patches + " + about + std::to_string(elements) +
+  std::string detail =
+    (framesPerChunk > 0 ? countOf(frames, "position") + " (a chunk of " +
+          countOf(framesPerChunk, "frame") + " and " +
+          std::to_string(chunkOverlap(framesPerChunk, options.chunkOverlap)) + " more on each side)"
+                        : countOf(frames, "frame")) +
+    " x (" + about + std::to_string(patches) + " patches + " + about + std::to_string(elements) +
     " elements) x 2 sides x RGB, plus per-thread buffers";
   std::string advice = couldStream
     ? "use fewer frames or a larger patch size, keep fewer frames in memory (the filter's "
       "CachedChunks: the others are solved again when shown), or raise the limit"
     : "use fewer frames or a larger patch size, or raise the limit";
+  if (framesPerChunk > 0 && options.framesPerChunk > 0)
+  {
+    advice = "use fewer frames per chunk (FramesPerChunk, --frames-per-chunk; 0 lets the "
+             "memory limit choose) or a larger patch size, or raise the limit";
+  }
+  else if (framesPerChunk > 0)
+  {
+    // The limit chose the shortest chunks: fewer frames would not help.
+    advice = "even chunks of " + countOf(framesPerChunk, "frame") +
+      " do not fit: use a larger patch size (fewer elements), or raise the limit";
+  }
   if (sensors > 0)
   {
     detail += ", and " + countOf(sensors, "sensor") + " (" + gibibytes(sensorBytes) + ")";

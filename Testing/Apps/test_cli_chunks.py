@@ -174,3 +174,26 @@ def test_chunks_of_two_frames_stream_every_frame(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "chunk 3 of 3: frames 4 to 4" in result.stdout
     assert all_files(tmp_path / "out") == ["s.pvd"] + [f"s_{f:04d}.vtu" for f in range(5)]
+
+
+def test_a_memory_refusal_in_chunks_counts_a_chunks_positions(tmp_path):
+    # Streamed in chunks, a chunk's positions are what the solve holds, its overlap included;
+    # the advice is about the chunks' length, and when the limit already chose the shortest
+    # chunks it does not ask for fewer frames.
+    common = ["--scene", SCENE, "--light", LIGHT] + PATH + ["--frames", "300",
+                                                            "--patch-size", "0.005",
+                                                            "--memory-limit", "300",
+                                                            "--output", "s.pvd"]
+    given = run(common + ["--frames-per-chunk", "40"], tmp_path)
+    assert given.returncode == 1, given.stderr
+    assert "(50 positions (a chunk of 40 frames and 5 more on each side) x (about" \
+        in given.stderr, given.stderr
+    assert "use fewer frames per chunk (FramesPerChunk, --frames-per-chunk; 0 lets the " \
+        "memory limit choose)" in given.stderr, given.stderr
+    chosen = run(common, tmp_path)
+    assert chosen.returncode == 1, chosen.stderr
+    assert "(4 positions (a chunk of 2 frames and 1 more on each side) x (about" \
+        in chosen.stderr, chosen.stderr
+    assert "even chunks of 2 frames do not fit: use a larger patch size" in chosen.stderr
+    assert "fewer frames" not in chosen.stderr, chosen.stderr
+    assert all_files(tmp_path) == []
