@@ -20,6 +20,25 @@ bool isSeriesFile(const std::string& name, const std::string& prefix, const std:
       [](unsigned char c) { return std::isdigit(c) != 0; });
 }
 
+namespace
+{
+/// Whether `name` is the hidden name of a file of a series (isSeriesFile) that a transaction
+/// staged (.NAME.partial) or set aside (.NAME.earlier).
+bool isLeftOver(const std::string& name, const std::string& prefix, const std::string& suffix)
+{
+  for (const std::string ending : { ".partial", ".earlier" })
+  {
+    if (name.size() > 1 + ending.size() && name[0] == '.' &&
+      name.compare(name.size() - ending.size(), ending.size(), ending) == 0 &&
+      isSeriesFile(name.substr(1, name.size() - 1 - ending.size()), prefix, suffix))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+}
+
 OutputTransaction::~OutputTransaction()
 {
   if (!this->Committed)
@@ -178,6 +197,13 @@ void OutputTransaction::finish()
       const fs::path path = (series.directory / name).lexically_normal();
       if (isSeriesFile(name, series.prefix, series.suffix) && entry.is_regular_file() &&
         kept.count(path) == 0)
+      {
+        fs::remove(entry.path(), error);
+      }
+      // What a run killed before it could clean up (SIGKILL, out of memory) left of this
+      // series: its staged files and the earlier ones it set aside. Every process that
+      // commits with this one has renamed its own by now.
+      else if (isLeftOver(name, series.prefix, series.suffix) && entry.is_regular_file())
       {
         fs::remove(entry.path(), error);
       }

@@ -37,7 +37,8 @@ public:
   std::filesystem::path stage(const std::filesystem::path& finalPath);
 
   /// At commit, also delete the files of `directory` named `prefix` + digits + `suffix` that
-  /// were not staged: the frames of an earlier, longer series of the same name.
+  /// were not staged: the frames of an earlier, longer series of the same name; and the
+  /// hidden files of such names that a killed run staged or set aside.
   void replaceSeries(
     const std::filesystem::path& directory, const std::string& prefix, const std::string& suffix);
 

@@ -308,6 +308,22 @@ def test_a_commit_that_fails_halfway_keeps_the_earlier_series_whole(tmp_path):
                                                  ["out/s_0003.vtu/keep"])
 
 
+def test_the_next_run_removes_what_a_killed_run_left(tmp_path):
+    """A run killed by SIGKILL (or the out-of-memory killer) cannot clean up: its staged frames
+    (.s_0007.vtu.partial) and the earlier frames it had set aside (.s_0001.vtu.earlier) stay.
+    The next run of the series removes them when it commits, and only them."""
+    out = tmp_path / "out"
+    out.mkdir()
+    left = [".s_0001.vtu.earlier", ".s_0007.vtu.partial", ".s_0012.vtu.partial"]
+    others = [".notes.partial", ".s_extra.vtu.partial", ".t_0001.vtu.partial", "s_0001.vtu.partial"]
+    for name in left + others:
+        (out / name).write_text("left over")
+    result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
+                 ["--frames", "2", "--output", "out/s.pvd"] + FAST, tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert sorted(all_files(out)) == sorted(["s.pvd", "s_0000.vtu", "s_0001.vtu"] + others)
+
+
 def test_xvfb_that_cannot_start_fails_the_run_with_its_message(tmp_path):
     env, pids = fake_xvfb(tmp_path, server="sh -c 'echo \"Fatal server error: no screens\" >&2; exit 1'")
     result = run(["--scene", SCENE, "--light", LIGHT, "--output", "out/s.pvd", "--png", "png",
