@@ -235,13 +235,16 @@ public:
     }
     // Extensions a reader must understand: those of materials only change what is not read
     // here (or the emission strength, which is read), punctual lights are left out with a
-    // warning; geometry compression is not supported.
+    // warning, and a texture whose image is in a format of an extension (WebP, KTX2, AVIF) is
+    // a texture that cannot be decoded: a warning, its factor alone is used. Geometry
+    // compression is not supported.
+    static const std::set<std::string> readable = { "KHR_texture_transform", "KHR_lights_punctual",
+      "EXT_texture_webp", "KHR_texture_basisu", "EXT_texture_avif" };
     for (const auto& required : this->array("extensionsRequired"))
     {
       const std::string name =
         required.is_string() ? required.get<std::string>() : std::string("?");
-      if (name.rfind("KHR_materials_", 0) != 0 && name != "KHR_texture_transform" &&
-        name != "KHR_lights_punctual")
+      if (name.rfind("KHR_materials_", 0) != 0 && readable.count(name) == 0)
       {
         this->fail(
           "it requires the extension " + printable(name) + ", which this reader does not support");
@@ -448,22 +451,32 @@ public:
       const std::string where = "textures[" + std::to_string(i) + "]";
       this->index(this->object(textures, i, where), "source", "images", where);
       this->index(textures[i], "sampler", "samplers", where);
+      // EXT_texture_webp, KHR_texture_basisu, EXT_texture_avif: an image of their format.
+      const auto extensions = textures[i].find("extensions");
+      if (extensions != textures[i].end() && extensions->is_object())
+      {
+        for (const auto& extension : extensions->items())
+        {
+          if (extension.value().is_object())
+          {
+            this->index(extension.value(), "source", "images",
+              where + ".extensions." + printable(extension.key()));
+          }
+        }
+      }
     }
     const Json& images = this->array("images");
     for (std::size_t i = 0; i < images.size(); ++i)
     {
       const std::string where = "images[" + std::to_string(i) + "]";
       const Json& image = this->object(images, i, where);
+      // An image in a bufferView of another format than PNG or JPEG (image/webp, image/ktx2)
+      // is decoded when a material uses it, and is a warning then, as an image file is.
       if (this->index(image, "bufferView", "bufferViews", where) >= 0)
       {
-        const auto mime = image.find("mimeType");
-        if (mime == image.end() || !mime->is_string() ||
-          (*mime != "image/png" && *mime != "image/jpeg"))
-        {
-          this->fail(where + " is in a bufferView but its mimeType is not image/png or image/jpeg");
-        }
+        continue;
       }
-      else if (!image.contains("uri") || !image["uri"].is_string())
+      if (!image.contains("uri") || !image["uri"].is_string())
       {
         this->fail(where + " has neither a uri nor a bufferView");
       }
@@ -977,14 +990,27 @@ public:
     const Json& entry = this->Root["textures"][texture];
     std::string problem;
     std::optional<std::array<double, 3>> mean;
-    if (!entry.contains("source"))
+    // The core source (PNG or JPEG, a fallback when an extension gives another format), else
+    // the image of an extension such as EXT_texture_webp, which is warned of below.
+    std::int64_t source = entry.contains("source") ? entry["source"].get<std::int64_t>() : -1;
+    if (source < 0 && entry.contains("extensions") && entry["extensions"].is_object())
+    {
+      for (const auto& extension : entry["extensions"].items())
+      {
+        if (source < 0 && extension.value().is_object() && extension.value().contains("source"))
+        {
+          source = extension.value()["source"].get<std::int64_t>();
+        }
+      }
+    }
+    if (source < 0)
     {
       problem = "its texture has no image";
     }
     else
     {
       // Each image is decoded once, however many textures and materials name it.
-      const std::size_t image = entry["source"].get<std::size_t>();
+      const std::size_t image = static_cast<std::size_t>(source);
       auto known = this->ImageMeans.find(image);
       if (known == this->ImageMeans.end())
       {

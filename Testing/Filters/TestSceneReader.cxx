@@ -788,6 +788,61 @@ TEST(SceneReader, GltfBaseColourTextureIsAveragedInLinearColour)
   expectRgbNear(tuple3(broken.output, "Reflectance", 2), 0.99, 0.99, 0.99, 0, "damaged texture");
 }
 
+TEST(SceneReader, GltfTexturesOfWebpOrKtx2AreWarnedOfAndTheFileIsRead)
+{
+  // EXT_texture_webp (and KHR_texture_basisu) put an image of their format in a bufferView,
+  // as gltf-transform and the glTF-Sample-Assets' WEBP and KTX2 variants write them: such a
+  // texture cannot be decoded here, which is a warning naming the material (the factor alone
+  // is used), not a reason to refuse the scene. Both were refused: the required extension,
+  // and the image's mimeType image/webp.
+  const TestFolder scratch("gltf-webp");
+  const fs::path& folder = scratch.path;
+  std::string buffer = gltfBuffer();
+  const std::string webp = std::string("RIFF\x1a\0\0\0WEBPVP8L", 16) + std::string(14, '\0');
+  buffer += webp;
+  std::string json = gltfJson(dataUri(buffer),
+    R"(,
+  "textures": [{"extensions": {"EXT_texture_webp": {"source": 0}}}, {"source": 0}],
+  "images": [{"bufferView": 2, "mimeType": "image/webp"}])");
+  replaceOnce(json, R"("byteLength": 120})", R"("byteLength": 150})");
+  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 120, "byteLength": 30}])");
+  replaceOnce(json, R"("baseColorFactor": [0.725, 0.71, 0.68, 1]})",
+    R"("baseColorFactor": [0.725, 0.71, 0.68, 1], "baseColorTexture": {"index": 0}})");
+  replaceOnce(json, R"("baseColorFactor": [0.63, 0.065, 0.05, 1]})",
+    R"("baseColorFactor": [0.63, 0.065, 0.05, 1], "baseColorTexture": {"index": 1}})");
+  std::string required = json;
+  replaceOnce(required, R"("scene": 0,)", R"("scene": 0,
+  "extensionsUsed": ["EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"],)");
+  writeFile(folder / "used.gltf", json);
+  writeFile(folder / "required.gltf", required);
+  for (const char* name : { "used.gltf", "required.gltf" })
+  {
+    SCOPED_TRACE(name);
+    const ReadResult result = readScene(folder / name);
+    ASSERT_TRUE(result.succeeded) << result.errors();
+    expectTwoMaterialScene(result.output, 1e-12);
+    for (const char* material : { "'white'", "'red'" })
+    {
+      EXPECT_NE(
+        result.warnings().find(std::string("the glTF material ") + material), std::string::npos)
+        << result.warnings();
+    }
+    EXPECT_NE(result.warnings().find("neither PNG nor JPEG, so its factor alone is used"),
+      std::string::npos)
+      << result.warnings();
+  }
+  // An extension's image index is checked as the core one is.
+  replaceOnce(required, R"({"source": 0}}})", R"({"source": 7}}})");
+  writeFile(folder / "bad-index.gltf", required);
+  const ReadResult bad = readScene(folder / "bad-index.gltf");
+  EXPECT_FALSE(bad.succeeded);
+  EXPECT_NE(
+    bad.errors().find("textures[0].extensions.EXT_texture_webp.source = 7"), std::string::npos)
+    << bad.errors();
+}
+
 /// An OBJ file with one unit quad per material of `materials`, in that order, reading `mtl`.
 std::string quadPerMaterialObj(const std::string& mtl, const std::vector<std::string>& materials)
 {
