@@ -184,6 +184,8 @@ Scene readPly(
   std::vector<PlyElement> elements;
   PlyFormat format = PlyFormat::Ascii;
   bool hasFormat = false, ended = false;
+  std::size_t unknownLines = 0;
+  std::string firstUnknown;
   for (std::size_t number = 2; !ended && std::getline(in, line); ++number)
   {
     if (number > 10000)
@@ -246,8 +248,22 @@ Scene readPly(
     }
     else
     {
-      fail("has an unknown header line, " + where);
+      // Blender 2.4x's exporter writes "Created by Blender3D 247 - www.blender.org, source
+      // file: ..." without 'comment'. Only element, property and format lines shape the body,
+      // so such a line is read as a comment, with a warning (as VTK's PLY reader skips it).
+      if (unknownLines++ == 0)
+      {
+        firstUnknown = where;
+      }
     }
+  }
+  if (unknownLines > 0)
+  {
+    warn("the PLY file " + named(path) + " has " + std::to_string(unknownLines) +
+      " header line(s) of no PLY keyword, read as comments: " + firstUnknown +
+      (unknownLines > 1 ? " ..." : "") +
+      " (start such a line with 'comment'; a misspelt element or property line would leave "
+      "the body misread)");
   }
   if (!ended || !hasFormat)
   {

@@ -3,6 +3,7 @@
 #include "FilterTestSupport.h"
 
 #include "vtkCallbackCommand.h"
+#include "vtkCell.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkExecutive.h"
@@ -679,6 +680,33 @@ TEST(SceneReader, PlyTriangleStripsBecomeTrianglesFacingOneWay)
         << result.warnings();
     }
   }
+}
+
+TEST(SceneReader, PlyHeaderLineWithoutAKeywordIsReadAsACommentWithAWarning)
+{
+  // Blender 2.4x wrote its credit line without 'comment' (assimp's test model Wuson.ply, and
+  // the PLY files of that Blender in the wild); VTK's reader skips it. It was refused.
+  const TestFolder scratch("ply-blender24");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "blender24.ply",
+    "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org, source file: \n"
+    "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    "element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+    "0 0 0 51 102 153\n2 0 0 51 102 153\n2 3 0 51 102 153\n0 3 0 51 102 153\n4 0 1 2 3\n");
+  const ReadResult result = readScene(folder / "blender24.ply");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  ASSERT_EQ(result.output->GetNumberOfCells(), 1);
+  EXPECT_EQ(result.output->GetCell(0)->GetNumberOfPoints(), 4);
+  double bounds[6];
+  result.output->GetBounds(bounds);
+  EXPECT_DOUBLE_EQ(bounds[1], 2);
+  EXPECT_DOUBLE_EQ(bounds[3], 3);
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.2, 0.4, 0.6, 1e-12);
+  EXPECT_NE(result.warnings().find("blender24.ply' has 1 header line(s) of no PLY keyword, read "
+                                   "as comments: line 3 'Created by Blender3D 247"),
+    std::string::npos)
+    << result.warnings();
 }
 
 TEST(SceneReader, GltfNodeTransformsAndEmission)
