@@ -133,10 +133,8 @@ std::map<std::string, MtlMaterial> readMtl(
       named(objPath) + ", line " + std::to_string(lines.number());
     if (keyword == "newmtl")
     {
-      if (rest.empty())
-      {
-        throw FileError(where + ": 'newmtl' without a material name");
-      }
+      // Blender writes 'newmtl' without a name for a material slot without one (and 'usemtl'
+      // without a name for its faces): the unnamed material, kept under the empty name.
       const bool known = materials.count(rest) != 0;
       if (known && repeated.insert(rest).second)
       {
@@ -261,7 +259,8 @@ Scene readObj(
 
   LogicalLines lines(in);
   std::string line, keyword, rest;
-  std::size_t unnamedMaterials = 0;
+  std::size_t unnamedMaterials = 0, firstUnnamedLine = 0;
+  bool facesBeforeUsemtl = false, sawUsemtl = false;
   while (lines.next(line))
   {
     if (lines.number() % 65536 == 0)
@@ -327,10 +326,10 @@ Scene readObj(
       // get the default one, as faces before any 'usemtl' do.
       if (rest.empty() && unnamedMaterials++ == 0)
       {
-        warn(where() +
-          ": 'usemtl' without a material name; the faces after it (and after any "
-          "other such line) have the default material, grey 0.5");
+        firstUnnamedLine = lines.number();
       }
+      facesBeforeUsemtl = facesBeforeUsemtl || (!sawUsemtl && !faceStart.empty());
+      sawUsemtl = true;
       currentMaterial = materialId(rest.empty() ? "none" : rest);
     }
     else if (keyword == "mtllib")
@@ -446,13 +445,26 @@ Scene readObj(
     colour = product;
   };
 
+  // A bare 'usemtl' takes the libraries' unnamed material (Blender's 'newmtl' without a name)
+  // when they have one and no face before any 'usemtl' shares its default material.
+  const bool unnamedFromLibrary =
+    unnamedMaterials > 0 && !facesBeforeUsemtl && library.count(std::string()) != 0;
+  if (unnamedMaterials > 0)
+  {
+    warn("the OBJ file " + named(path) + ", line " + std::to_string(firstUnnamedLine) +
+      ": 'usemtl' without a material name; the faces after it (and after any other such line) " +
+      (unnamedFromLibrary
+          ? "have the material library's unnamed material ('newmtl' without a name), 'none' here"
+          : "have the default material, grey 0.5"));
+  }
+
   Scene scene;
   scene.format = "OBJ";
   for (const auto& name : usedMaterials)
   {
     Material material;
     material.name = name;
-    const auto found = library.find(name);
+    const auto found = library.find(name == "none" && unnamedFromLibrary ? std::string() : name);
     const std::string what = "material " + named(name) + " of " + named(path);
     if (found != library.end())
     {

@@ -442,6 +442,42 @@ TEST(SceneReader, ObjBareUsemtlGivesTheDefaultMaterialWithAWarning)
   EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "none" }));
 }
 
+TEST(SceneReader, ObjBareUsemtlTakesTheUnnamedMaterialOfItsLibrary)
+{
+  // Blender writes a material slot without a name as 'newmtl' without a name in the MTL and
+  // 'usemtl' without a name in the OBJ (assimp's test model empty_mat.obj): the faces take
+  // that material. The whole file was refused ('newmtl' without a material name).
+  const TestFolder scratch("unnamed-newmtl");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "scene.mtl",
+    "# Blender MTL File: ''\nnewmtl white\nKd 0.725 0.71 0.68\nnewmtl \nNs 0\nKd 0.63 0.065 "
+    "0.05\nKe 1 2 3\nd 1\n");
+  std::string obj = twoMaterialObj("scene.mtl");
+  replaceOnce(obj, "usemtl red\n", "usemtl \n");
+  writeFile(folder / "scene.obj", obj);
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.725, 0.71, 0.68, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.63, 0.065, 0.05, 1e-12);
+  expectRgbNear(tuple3(result.output, "Emission", 3), Pi, 2 * Pi, 3 * Pi, 1e-12);
+  EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "none" }));
+  EXPECT_NE(result.warnings().find("line 13: 'usemtl' without a material name; the faces after "
+                                   "it (and after any other such line) have the material "
+                                   "library's unnamed material"),
+    std::string::npos)
+    << result.warnings();
+
+  // Faces before any 'usemtl' keep the default grey, and so do those of the bare 'usemtl'
+  // that shares their material 'none'.
+  writeFile(folder / "early.obj", "v 9 9 9\nv 9 8 9\nv 8 9 9\nf 1 2 3\n" + obj);
+  const ReadResult early = readScene(folder / "early.obj");
+  ASSERT_TRUE(early.succeeded) << early.errors();
+  ASSERT_EQ(early.output->GetNumberOfCells(), 5);
+  expectRgbNear(tuple3(early.output, "Reflectance", 4), 0.5, 0.5, 0.5, 0);
+  EXPECT_NE(early.warnings().find("have the default material, grey 0.5"), std::string::npos)
+    << early.warnings();
+}
+
 TEST(SceneReader, MaterialNamesWithControlCharactersSurviveAnXmlRoundTrip)
 {
   // VTK's XML files end each string value with a NUL byte: a name holding one came back as
