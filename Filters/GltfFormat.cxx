@@ -1334,6 +1334,10 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   std::map<std::int64_t, int> materialIds; // glTF material (-1: the default) -> output material
   std::vector<std::int64_t> materialOrder;
   std::vector<std::array<double, 3>> vertexColourOfCell;
+  std::vector<char> cellHasColour;
+  // Output materials some of whose cells have no COLOR_0, which take the material's own
+  // (clamped) reflectance; the others' cells take the product of their factor and colours.
+  std::vector<char> usedWithoutColour;
   bool anyColour = false;
   std::size_t skippedPrimitives = 0;
   const Json& nodes = checks.array("nodes");
@@ -1438,6 +1442,7 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         material = static_cast<int>(materialOrder.size());
         materialIds[gltfMaterial] = material;
         materialOrder.push_back(gltfMaterial);
+        usedWithoutColour.push_back(0);
       }
       std::vector<double> colours;
       std::size_t colourComponents = 0;
@@ -1449,6 +1454,10 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
           document.fail("a primitive of meshes[" + std::to_string(meshIndex) +
             "] has a COLOR_0 that is not one RGB or RGBA colour per vertex");
         }
+      }
+      if (colours.empty() && !triangles.empty())
+      {
+        usedWithoutColour[static_cast<std::size_t>(material)] = 1;
       }
       // Only the vertices the triangles use, each once: primitives often share one POSITION
       // accessor of the whole mesh (an exporter's single vertex buffer), which copied whole
@@ -1499,6 +1508,7 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
           }
         }
         vertexColourOfCell.push_back(mean);
+        cellHasColour.push_back(colours.empty() ? 0 : 1);
       }
     }
   }
@@ -1535,14 +1545,22 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   std::set<std::string> names;
   auto failMaterial = [&](const std::string& problem) { document.fail(problem); };
   std::vector<std::string> seeThrough;
+  // The factor (times the texture's mean) of each output material before it is clamped: COLOR_0
+  // multiplies it, and only the product is clamped (a white default material under colours of
+  // 0.2 reflects 0.2, not 0.198, and is not warned of).
+  std::vector<std::array<double, 3>> unclamped;
+  const Warn ignore = [](const std::string&) {};
   for (const std::int64_t gltfIndex : materialOrder)
   {
     Material material;
+    const Warn& warnOfClamping = usedWithoutColour[unclamped.size()] ? warn : ignore;
     if (gltfIndex < 0)
     {
       material.name = "default";
-      material.reflectance = checkedReflectance({ { 1, 1, 1 } },
-        "the glTF default material (of primitives without a material) in " + named(path), warn);
+      unclamped.push_back({ { 1, 1, 1 } });
+      material.reflectance = checkedReflectance(unclamped.back(),
+        "the glTF default material (of primitives without a material) in " + named(path),
+        warnOfClamping);
     }
     else
     {
@@ -1565,7 +1583,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
           base[c] *= mean[c];
         }
       }
-      material.reflectance = checkedReflectance(base, what, warn);
+      unclamped.push_back(base);
+      material.reflectance = checkedReflectance(base, what, warnOfClamping);
       // Cut-outs (leaves, fences), glass and curtains: a radiosity surface is opaque.
       const Json extensions = source.value("extensions", Json::object());
       const auto alpha = source.find("alphaMode");
@@ -1630,8 +1649,13 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
     scene.cellReflectance.resize(vertexColourOfCell.size());
     for (std::size_t cell = 0; cell < vertexColourOfCell.size(); ++cell)
     {
-      const auto& base =
-        scene.materials[static_cast<std::size_t>(scene.materialOfCell[cell])].reflectance;
+      const std::size_t material = static_cast<std::size_t>(scene.materialOfCell[cell]);
+      if (!cellHasColour[cell])
+      {
+        scene.cellReflectance[cell] = scene.materials[material].reflectance;
+        continue;
+      }
+      const auto& base = unclamped[material];
       for (std::size_t c = 0; c < 3; ++c)
       {
         const double value = std::max(0.0, base[c] * vertexColourOfCell[cell][c]);

@@ -1264,6 +1264,48 @@ TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
   expectRgbNear(tuple3(result.output, "Reflectance", 3), Red[0], Red[1], Red[2], 1e-6);
 }
 
+TEST(SceneReader, GltfVertexColoursMultiplyTheFactorBeforeItIsClamped)
+{
+  // A primitive without a material (white, as glTF's default material is) coloured by
+  // COLOR_0 (51, 102, 153): its cells reflect (0.2, 0.4, 0.6), as the file says. The factor
+  // was clamped to 0.99 first, with a warning of a reflectance of 1 that no cell had, and the
+  // colours read 1% dark (0.198, 0.396, 0.594): a model painted by vertex colours alone.
+  const TestFolder scratch("gltf-colours-default");
+  const fs::path& folder = scratch.path;
+  std::string buffer = gltfBuffer();
+  for (int v = 0; v < 8; ++v)
+  {
+    buffer += std::string("\x33\x66\x99\xff", 4);
+  }
+  std::string json = gltfJson(dataUri(buffer));
+  replaceOnce(json, R"("byteLength": 120)", R"("byteLength": 152)");
+  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 120, "byteLength": 32}])");
+  replaceOnce(json, R"("count": 6, "type": "SCALAR"}])",
+    R"("count": 6, "type": "SCALAR"},
+    {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"}])");
+  replaceOnce(json, R"("POSITION": 0}, "indices": 1, "material": 0,)",
+    R"("POSITION": 0, "COLOR_0": 3}, "indices": 1,)");
+  writeFile(folder / "colours.gltf", json);
+  const ReadResult result = readScene(folder / "colours.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectRgbNear(tuple3(result.output, "Reflectance", 0), 0.2, 0.4, 0.6, 1e-12);
+  expectRgbNear(tuple3(result.output, "Reflectance", 3), Red[0], Red[1], Red[2], 1e-12);
+  EXPECT_EQ(result.warnings(), "");
+
+  // The same default material on a primitive without colours is clamped, with its warning.
+  std::string uncoloured = json;
+  replaceOnce(uncoloured, R"("indices": 2, "material": 1,)", R"("indices": 2,)");
+  writeFile(folder / "uncoloured.gltf", uncoloured);
+  const ReadResult mixed = readScene(folder / "uncoloured.gltf");
+  ASSERT_TRUE(mixed.succeeded) << mixed.errors();
+  expectRgbNear(tuple3(mixed.output, "Reflectance", 0), 0.2, 0.4, 0.6, 1e-12);
+  expectRgbNear(tuple3(mixed.output, "Reflectance", 3), 0.99, 0.99, 0.99, 0);
+  EXPECT_NE(mixed.warnings().find("the glTF default material"), std::string::npos)
+    << mixed.warnings();
+}
+
 TEST(SceneReader, AbortGivesAnEmptyOutputAndTheNextUpdateReads)
 {
   const TestFolder scratch("abort");
