@@ -239,7 +239,7 @@ public:
     // a texture that cannot be decoded: a warning, its factor alone is used. Geometry
     // compression is not supported.
     static const std::set<std::string> readable = { "KHR_texture_transform", "KHR_lights_punctual",
-      "EXT_texture_webp", "KHR_texture_basisu", "EXT_texture_avif" };
+      "EXT_texture_webp", "KHR_texture_basisu", "EXT_texture_avif", "KHR_mesh_quantization" };
     for (const auto& required : this->array("extensionsRequired"))
     {
       const std::string name =
@@ -248,6 +248,14 @@ public:
       {
         this->fail(
           "it requires the extension " + printable(name) + ", which this reader does not support");
+      }
+    }
+    bool quantized = false;
+    for (const char* list : { "extensionsUsed", "extensionsRequired" })
+    {
+      for (const auto& name : this->array(list))
+      {
+        quantized = quantized || (name.is_string() && name == "KHR_mesh_quantization");
       }
     }
     // Buffers and their views.
@@ -372,11 +380,16 @@ public:
         {
           const std::int64_t a =
             this->index(*attributes, attribute.key().c_str(), "accessors", where + ".attributes");
+          // KHR_mesh_quantization (gltfpack's output) stores positions as 8- or 16-bit
+          // integers, normalized or not, which the node transforms scale back.
+          const std::int64_t component = this->AccessorComponent[static_cast<std::size_t>(a)];
           if (attribute.key() == "POSITION" &&
             (this->AccessorType[static_cast<std::size_t>(a)] != "VEC3" ||
-              this->AccessorComponent[static_cast<std::size_t>(a)] != 5126))
+              (component != 5126 && (!quantized || component == 5125))))
           {
-            this->fail(where + ".attributes.POSITION is not a VEC3 of floats");
+            this->fail(where + ".attributes.POSITION is not a VEC3 of floats" +
+              (quantized ? std::string(" or of 8- or 16-bit integers (KHR_mesh_quantization)")
+                         : std::string(" (integers need the extension KHR_mesh_quantization)")));
           }
         }
         const std::int64_t indices = this->index(primitive, "indices", "accessors", where);

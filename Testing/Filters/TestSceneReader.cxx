@@ -1236,6 +1236,77 @@ TEST(SceneReader, GltfSparseAccessorsMorphTargetsAndPunctualLights)
     << index.errors();
 }
 
+TEST(SceneReader, GltfQuantizedPositionsAreRead)
+{
+  // KHR_mesh_quantization, which gltfpack writes by default: positions as 16-bit integers
+  // (padded to a stride of 8 bytes) under a node that scales them back, or as normalized
+  // 8-bit integers. The two-material scene reads as from floats; it was refused.
+  const TestFolder scratch("gltf-quantized");
+  const fs::path& folder = scratch.path;
+  auto quantized = [&](const std::string& componentType, bool normalized, int unit,
+                     const std::string& scale, std::size_t componentBytes)
+  {
+    std::string buffer;
+    for (const auto& corner : Corners)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        const int value = c < 3 ? static_cast<int>(corner[c]) * unit : 0;
+        for (std::size_t b = 0; b < componentBytes; ++b)
+        {
+          buffer += static_cast<char>((value >> (8 * b)) & 0xff);
+        }
+      }
+    }
+    const std::size_t positionBytes = buffer.size();
+    buffer.append(
+      reinterpret_cast<const char*>(Triangles), sizeof(Triangles)); // 24 bytes of indices
+    std::string json = gltfJson(dataUri(buffer), "", "[0, 0, 0]");
+    replaceOnce(
+      json, R"("byteLength": 120})", R"("byteLength": )" + std::to_string(buffer.size()) + "}");
+    replaceOnce(json, R"({"buffer": 0, "byteOffset": 0, "byteLength": 96},
+    {"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+      R"({"buffer": 0, "byteOffset": 0, "byteLength": )" + std::to_string(positionBytes) +
+        R"(, "byteStride": )" + std::to_string(4 * componentBytes) + R"(},
+    {"buffer": 0, "byteOffset": )" +
+        std::to_string(positionBytes) + R"(, "byteLength": 24}])");
+    replaceOnce(json, R"("componentType": 5126, "count": 8, "type": "VEC3",)",
+      R"("componentType": )" + componentType + (normalized ? R"(, "normalized": true)" : "") +
+        R"(, "count": 8, "type": "VEC3",)");
+    replaceOnce(json, R"({"mesh": 0})", R"({"mesh": 0, "scale": )" + scale + "}");
+    replaceOnce(json, R"("scene": 0,)", R"("scene": 0,
+  "extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"],)");
+    return json;
+  };
+  writeFile(folder / "short.gltf", quantized("5123", false, 1000, "[0.001, 0.001, 0.001]", 2));
+  writeFile(folder / "byte.gltf", quantized("5120", true, 127, "[1, 1, 1]", 1));
+  for (const char* name : { "short.gltf", "byte.gltf" })
+  {
+    SCOPED_TRACE(name);
+    const ReadResult result = readScene(folder / name);
+    ASSERT_TRUE(result.succeeded) << result.errors();
+    expectTwoMaterialScene(result.output, 1e-12);
+    double bounds[6];
+    result.output->GetBounds(bounds);
+    for (int i = 0; i < 6; ++i)
+    {
+      EXPECT_NEAR(bounds[i], i % 2, 1e-9) << i;
+    }
+    EXPECT_NEAR(windingNormal(result.output, 0)[2], 1, 1e-9);
+  }
+  // Without the extension, integer positions are refused, naming it.
+  std::string plain = quantized("5123", false, 1000, "[0.001, 0.001, 0.001]", 2);
+  replaceOnce(plain,
+    R"("extensionsUsed": ["KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"],)",
+    "");
+  writeFile(folder / "plain.gltf", plain);
+  const ReadResult refused = readScene(folder / "plain.gltf");
+  EXPECT_FALSE(refused.succeeded);
+  EXPECT_NE(
+    refused.errors().find("integers need the extension KHR_mesh_quantization"), std::string::npos)
+    << refused.errors();
+}
+
 TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
 {
   const TestFolder scratch("gltf-colours");
