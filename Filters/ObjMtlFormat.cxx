@@ -40,6 +40,22 @@ void splitKeyword(const std::string& line, std::string& keyword, std::string& re
   rest = space == std::string::npos ? std::string() : trim(text.substr(space));
 }
 
+/// FileError when `in` starts with a UTF-16 byte order mark (Windows tools save "Unicode"
+/// text so): read byte by byte, its lines hold no keyword, and the file would seem empty.
+void refuseUtf16(std::istream& in, const std::string& what)
+{
+  char bom[2] = { 0, 0 };
+  in.read(bom, 2);
+  const auto first = static_cast<unsigned char>(bom[0]),
+             second = static_cast<unsigned char>(bom[1]);
+  if (in.gcount() == 2 && ((first == 0xff && second == 0xfe) || (first == 0xfe && second == 0xff)))
+  {
+    throw FileError(what + " is UTF-16 text: save it as UTF-8 (or ASCII) and read it again");
+  }
+  in.clear();
+  in.seekg(0);
+}
+
 struct MtlMaterial
 {
   std::optional<std::array<double, 3>> kd, ke;
@@ -119,6 +135,7 @@ std::map<std::string, MtlMaterial> readMtl(
   const std::string& path, const std::string& objPath, const Warn& warn)
 {
   std::ifstream in = openFile(path, "material library");
+  refuseUtf16(in, "the material library " + named(path) + " of the OBJ file " + named(objPath));
   std::map<std::string, MtlMaterial> materials;
   LogicalLines lines(in);
   std::string line, keyword, rest;
@@ -229,6 +246,7 @@ Scene readObj(
   const std::string& path, const Warn& warn, const Progress& progress, const MemoryBudget& budget)
 {
   std::ifstream in = openFile(path, "OBJ file");
+  refuseUtf16(in, "the OBJ file " + named(path));
   const std::uintmax_t size = std::max<std::uintmax_t>(1, fileSize(path));
   // OBJ declares no counts: its lines, about 16 bytes each in files written by modellers, are
   // the estimate, each taken as a vertex and a triangle.

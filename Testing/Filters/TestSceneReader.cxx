@@ -393,6 +393,40 @@ TEST(SceneReader, ObjWrittenOnWindowsKeepsItsFirstLineAndFindsItsLibrary)
   expectRgbNear(tuple3(result.output, "Reflectance", 3), 0.63, 0.065, 0.05, 1e-12);
 }
 
+TEST(SceneReader, ObjOrMtlInUtf16IsRefusedSayingSo)
+{
+  // Notepad's and PowerShell's "Unicode" is UTF-16 with a byte order mark (assimp's test model
+  // box_UTF16BE.obj): read as bytes, no line has a keyword, and the error said the file had
+  // no faces; an MTL in UTF-16 left every material grey without a word.
+  const TestFolder scratch("utf16");
+  const fs::path& folder = scratch.path;
+  auto utf16 = [](const std::string& text, bool bigEndian)
+  {
+    std::string out = bigEndian ? "\xfe\xff" : "\xff\xfe";
+    for (const char c : text)
+    {
+      out += bigEndian ? std::string{ '\0', c } : std::string{ c, '\0' };
+    }
+    return out;
+  };
+  const std::string mtl = "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n";
+  writeFile(folder / "be.obj", utf16(twoMaterialObj("scene.mtl"), true));
+  writeFile(folder / "le.obj", utf16(twoMaterialObj("scene.mtl"), false));
+  writeFile(folder / "scene.mtl", utf16(mtl, false));
+  writeFile(folder / "utf8.obj", twoMaterialObj("scene.mtl"));
+  for (const char* name : { "be.obj", "le.obj", "utf8.obj" })
+  {
+    SCOPED_TRACE(name);
+    const ReadResult result = readScene(folder / name);
+    EXPECT_FALSE(result.succeeded);
+    const std::string expected = std::string(name) == "utf8.obj"
+      ? "the material library '" + (folder / "scene.mtl").string() + "' of the OBJ file '" +
+        (folder / name).string() + "' is UTF-16 text: save it as UTF-8"
+      : "the OBJ file '" + (folder / name).string() + "' is UTF-16 text: save it as UTF-8";
+    EXPECT_NE(result.errors().find(expected), std::string::npos) << result.errors();
+  }
+}
+
 TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
 {
   const TestFolder scratch("see-through");
