@@ -457,6 +457,14 @@ public:
         textureOf(*pbr, "baseColorTexture", where + ".pbrMetallicRoughness");
         textureOf(*pbr, "metallicRoughnessTexture", where + ".pbrMetallicRoughness");
       }
+      const auto extensions = material.find("extensions");
+      if (extensions != material.end() && extensions->is_object() &&
+        extensions->contains("KHR_materials_pbrSpecularGlossiness") &&
+        (*extensions)["KHR_materials_pbrSpecularGlossiness"].is_object())
+      {
+        textureOf((*extensions)["KHR_materials_pbrSpecularGlossiness"], "diffuseTexture",
+          where + ".extensions.KHR_materials_pbrSpecularGlossiness");
+      }
     }
     const Json& textures = this->array("textures");
     for (std::size_t i = 0; i < textures.size(); ++i)
@@ -1584,13 +1592,26 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
         ? name->get<std::string>()
         : "material_" + std::to_string(gltfIndex);
       const std::string what = "the glTF material " + named(material.name) + " of " + named(path);
-      const Json pbr = source.value("pbrMetallicRoughness", Json::object());
-      std::array<double, 3> base =
-        colourFactor(pbr, "baseColorFactor", 4, 1.0, where + ".pbrMetallicRoughness", failMaterial);
-      if (pbr.contains("baseColorTexture"))
+      // The diffuse colour of KHR_materials_pbrSpecularGlossiness, when the material has it,
+      // as its readers take it before the metal-rough fallback (Sketchfab's and older
+      // exporters' files have no other); else the base colour.
+      const Json extensions = source.value("extensions", Json::object());
+      const bool specularGlossiness = extensions.is_object() &&
+        extensions.contains("KHR_materials_pbrSpecularGlossiness") &&
+        extensions["KHR_materials_pbrSpecularGlossiness"].is_object();
+      const Json pbr = specularGlossiness ? extensions["KHR_materials_pbrSpecularGlossiness"]
+                                          : source.value("pbrMetallicRoughness", Json::object());
+      const char* factorKey = specularGlossiness ? "diffuseFactor" : "baseColorFactor";
+      const char* textureKey = specularGlossiness ? "diffuseTexture" : "baseColorTexture";
+      std::array<double, 3> base = colourFactor(pbr, factorKey, 4, 1.0,
+        where +
+          (specularGlossiness ? ".extensions.KHR_materials_pbrSpecularGlossiness"
+                              : ".pbrMetallicRoughness"),
+        failMaterial);
+      if (pbr.contains(textureKey))
       {
         const auto mean =
-          document.textureMean(pbr["baseColorTexture"]["index"].get<std::size_t>(), what, warn);
+          document.textureMean(pbr[textureKey]["index"].get<std::size_t>(), what, warn);
         for (std::size_t c = 0; c < 3; ++c)
         {
           base[c] *= mean[c];
@@ -1599,7 +1620,6 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       unclamped.push_back(base);
       material.reflectance = checkedReflectance(base, what, warnOfClamping);
       // Cut-outs (leaves, fences), glass and curtains: a radiosity surface is opaque.
-      const Json extensions = source.value("extensions", Json::object());
       const auto alpha = source.find("alphaMode");
       if ((alpha != source.end() && alpha->is_string() && *alpha != "OPAQUE") ||
         extensions.contains("KHR_materials_transmission"))

@@ -1270,6 +1270,46 @@ TEST(SceneReader, GltfSparseAccessorsMorphTargetsAndPunctualLights)
     << index.errors();
 }
 
+TEST(SceneReader, GltfSpecularGlossinessDiffuseIsTheReflectance)
+{
+  // KHR_materials_pbrSpecularGlossiness, as Sketchfab's and older exporters' files describe
+  // materials: the diffuse factor (times its texture) is the reflectance, before any
+  // metal-rough fallback. Without a pbrMetallicRoughness the material read as white (clamped
+  // to 0.99 with a warning), and with one its fallback colour was read.
+  const TestFolder scratch("gltf-specgloss");
+  const fs::path& folder = scratch.path;
+  std::string json = gltfJson(dataUri(gltfBuffer()));
+  replaceOnce(json,
+    R"({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [0.725, 0.71, 0.68, 1]}})",
+    R"({"name": "white", "extensions": {"KHR_materials_pbrSpecularGlossiness":
+      {"diffuseFactor": [0.725, 0.71, 0.68, 1], "specularFactor": [0.2, 0.2, 0.2]}}})");
+  replaceOnce(json,
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.63, 0.065, 0.05, 1]}})",
+    R"({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.1, 0.1, 1]},
+      "extensions": {"KHR_materials_pbrSpecularGlossiness":
+      {"diffuseFactor": [0.63, 0.065, 0.05, 1]}}})");
+  replaceOnce(json, R"("scene": 0,)", R"("scene": 0,
+  "extensionsUsed": ["KHR_materials_pbrSpecularGlossiness"],
+  "extensionsRequired": ["KHR_materials_pbrSpecularGlossiness"],)");
+  writeFile(folder / "specgloss.gltf", json);
+  const ReadResult result = readScene(folder / "specgloss.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectTwoMaterialScene(result.output, 1e-12);
+  EXPECT_EQ(result.warnings(), "");
+
+  // Its diffuse texture's index is checked as a base colour texture's is.
+  replaceOnce(json, R"("specularFactor": [0.2, 0.2, 0.2])",
+    R"("specularFactor": [0.2, 0.2, 0.2], "diffuseTexture": {"index": 3})");
+  writeFile(folder / "bad-texture.gltf", json);
+  const ReadResult bad = readScene(folder / "bad-texture.gltf");
+  EXPECT_FALSE(bad.succeeded);
+  EXPECT_NE(
+    bad.errors().find("materials[0].extensions.KHR_materials_pbrSpecularGlossiness.diffuseTexture"
+                      ".index = 3 but the file has 0 textures"),
+    std::string::npos)
+    << bad.errors();
+}
+
 TEST(SceneReader, GltfQuantizedPositionsAreRead)
 {
   // KHR_mesh_quantization, which gltfpack writes by default: positions as 16-bit integers
