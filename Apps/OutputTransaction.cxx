@@ -22,21 +22,32 @@ bool isSeriesFile(const std::string& name, const std::string& prefix, const std:
 
 namespace
 {
-/// Whether `name` is the hidden name of a file of a series (isSeriesFile) that a transaction
-/// staged (.NAME.partial) or set aside (.NAME.earlier).
-bool isLeftOver(const std::string& name, const std::string& prefix, const std::string& suffix)
+/// The endings of the hidden names of a staged file and of an earlier file set aside.
+constexpr const char* StagedEnding = ".partial";
+constexpr const char* AsideEnding = ".earlier";
+
+fs::path hiddenName(const fs::path& finalPath, const std::string& ending)
 {
-  for (const std::string ending : { ".partial", ".earlier" })
+  return finalPath.parent_path() / ("." + finalPath.filename().string() + ending);
+}
+}
+
+std::string OutputTransaction::shownNameOf(const std::string& name)
+{
+  for (const std::string ending : { StagedEnding, AsideEnding })
   {
     if (name.size() > 1 + ending.size() && name[0] == '.' &&
-      name.compare(name.size() - ending.size(), ending.size(), ending) == 0 &&
-      isSeriesFile(name.substr(1, name.size() - 1 - ending.size()), prefix, suffix))
+      name.compare(name.size() - ending.size(), ending.size(), ending) == 0)
     {
-      return true;
+      return name.substr(1, name.size() - 1 - ending.size());
     }
   }
-  return false;
+  return {};
 }
+
+OutputTransaction::OutputTransaction()
+  : Started(fs::file_time_type::clock::now())
+{
 }
 
 OutputTransaction::~OutputTransaction()
@@ -50,7 +61,7 @@ OutputTransaction::~OutputTransaction()
 
 fs::path OutputTransaction::temporaryOf(const fs::path& finalPath)
 {
-  return finalPath.parent_path() / ("." + finalPath.filename().string() + ".partial");
+  return hiddenName(finalPath, StagedEnding);
 }
 
 void OutputTransaction::createDirectories(const fs::path& directory)
@@ -141,8 +152,7 @@ void OutputTransaction::moveIntoPlace()
     std::error_code error;
     if (fs::is_regular_file(file.final, error))
     {
-      const fs::path aside =
-        file.final.parent_path() / ("." + file.final.filename().string() + ".earlier");
+      const fs::path aside = hiddenName(file.final, AsideEnding);
       fs::rename(file.final, aside, error);
       if (error)
       {
@@ -202,8 +212,10 @@ void OutputTransaction::finish()
       }
       // What a run killed before it could clean up (SIGKILL, out of memory) left of this
       // series: its staged files and the earlier ones it set aside. Every process that
-      // commits with this one has renamed its own by now.
-      else if (isLeftOver(name, series.prefix, series.suffix) && entry.is_regular_file())
+      // commits with this one has renamed its own by now; those of another run writing the
+      // same series now are newer than this transaction, and stay.
+      else if (isSeriesFile(shownNameOf(name), series.prefix, series.suffix) &&
+        entry.is_regular_file() && entry.last_write_time(error) < this->Started && !error)
       {
         fs::remove(entry.path(), error);
       }

@@ -25,7 +25,7 @@ bool isSeriesFile(const std::string& name, const std::string& prefix, const std:
 class OutputTransaction
 {
 public:
-  OutputTransaction() = default;
+  OutputTransaction();
   OutputTransaction(const OutputTransaction&) = delete;
   OutputTransaction& operator=(const OutputTransaction&) = delete;
   ~OutputTransaction();
@@ -38,7 +38,8 @@ public:
 
   /// At commit, also delete the files of `directory` named `prefix` + digits + `suffix` that
   /// were not staged: the frames of an earlier, longer series of the same name; and the
-  /// hidden files of such names that a killed run staged or set aside.
+  /// hidden files of such names that a killed run staged or set aside (older than this
+  /// transaction).
   void replaceSeries(
     const std::filesystem::path& directory, const std::string& prefix, const std::string& suffix);
 
@@ -71,6 +72,10 @@ public:
 
   /// The hidden name stage() writes `finalPath` under.
   static std::filesystem::path temporaryOf(const std::filesystem::path& finalPath);
+
+  /// The file name that the hidden file name `name` of a transaction stands for (.NAME.partial
+  /// staged, .NAME.earlier set aside: NAME), empty for any other name.
+  static std::string shownNameOf(const std::string& name);
 
 private:
   struct Staged
@@ -106,6 +111,9 @@ private:
   std::size_t Renamed = 0;
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> Asides;
   bool Committed = false;
+  /// When the transaction began: hidden files of its series older than this are a killed
+  /// run's.
+  std::filesystem::file_time_type Started;
 };
 
 } // namespace mlr::cli

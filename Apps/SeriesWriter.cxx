@@ -1,5 +1,7 @@
 #include "SeriesWriter.h"
 
+#include "OutputTransaction.h"
+
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -312,12 +314,10 @@ std::string xmlEscaped(const std::string& text)
 
 void failedWrite(const std::string& what, const std::filesystem::path& path)
 {
-  std::string name = path.filename().string();
-  const std::string staged = ".partial";
-  if (name.size() > staged.size() + 1 && name.front() == '.' &&
-    name.compare(name.size() - staged.size(), staged.size(), staged) == 0)
+  std::string name = OutputTransaction::shownNameOf(path.filename().string());
+  if (name.empty())
   {
-    name = name.substr(1, name.size() - staged.size() - 1);
+    name = path.filename().string();
   }
   throw std::runtime_error("cannot write " + what + " '" + (path.parent_path() / name).string() +
     "': check the disk space and the permissions of its directory");

@@ -178,7 +178,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
   const Scene& scene = animation.scene;
 
   // The tracer and the sides light can reach, built once for every chunk (SolveSetup); its
-  // share of the solve's progress by its rays. Unless given, the chunks' length is chosen
+  // share of the solve's progress by its expected cost. Unless given, the chunks' length is chosen
   // again from the memory those sides take, less than the bound of every side checked above
   // (a quarter less in the large room of Performance.md): longer chunks, fewer seams.
   const double sensorShare = options.sensors.empty() ? 0.0 : SensorShare;

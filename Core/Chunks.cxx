@@ -548,8 +548,7 @@ double chunkCost(const Scene& scene, const LightRig& rig, const SolverOptions& o
 {
   const std::size_t positions = plan.chunks[chunk].solveEnd - plan.chunks[chunk].solveBegin;
   return solveCost(scene, rig, options, positions) +
-    ChunkSideFrameCost * static_cast<double>(scene.elementCount()) *
-    (options.twoSided ? 2.0 : 1.0) * static_cast<double>(positions);
+    ChunkSideFrameCost * elementSides(scene, options) * static_cast<double>(positions);
 }
 }
 
@@ -615,7 +614,7 @@ Solution solveInChunks(const Scene& scene, const LightRig& rig, const SolverOpti
     chunkOptions.rank = 0;
   }
 
-  // Progress: the setup (unless given), then each chunk, by their expected rays.
+  // Progress: the setup (unless given), then each chunk, by their expected cost.
   const double setupCost = givenSetup ? 0.0 : SolveSetup::cost(scene, options);
   double solvesCost = 0;
   for (std::size_t k = rank; k < chunkCount; k += ranks)
@@ -990,7 +989,7 @@ Solution solveChunk(const Scene& scene, const LightRig& rig, const SolverOptions
   chunkOptions.storageScale = storageScaleFor(scene, rig);
   const std::size_t first = chunk > 0 ? chunk - 1 : chunk;
   // The setup of the whole animation, as solveInChunks has it, then the chunks, by their
-  // expected rays.
+  // expected cost.
   std::vector<double> costs{ SolveSetup::cost(scene, options) };
   for (std::size_t k = first; k <= chunk; ++k)
   {

@@ -376,14 +376,14 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
     ? "use fewer frames or a larger patch size, keep fewer frames in memory (the filter's "
       "CachedChunks: the others are solved again when shown), or raise the limit"
     : "use fewer frames or a larger patch size, or raise the limit";
-  if (framesPerChunk > 0 && options.framesPerChunk > 0)
+  if (framesPerChunk > MinimumFramesPerChunk && options.framesPerChunk > 0)
   {
     advice = "use fewer frames per chunk (FramesPerChunk, --frames-per-chunk; 0 lets the "
              "memory limit choose) or a larger patch size, or raise the limit";
   }
   else if (framesPerChunk > 0)
   {
-    // The limit chose the shortest chunks: fewer frames would not help.
+    // The shortest chunks, given or chosen by the limit: fewer frames would not help.
     advice = "even chunks of " + countOf(framesPerChunk, "frame") +
       " do not fit: use a larger patch size (fewer elements), or raise the limit";
   }

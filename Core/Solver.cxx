@@ -27,7 +27,7 @@ double secondsSince(Clock::time_point start)
 }
 
 /// The progress's cost model, in units of one shooting path's rays (shootingCost), measured
-/// in the Cornell box from 3,000 to 195,000 elements, 20,000 to 2 million paths and 30 to 300
+/// in the Cornell box from 12,116 to 194,896 elements, 20,000 to 2 million paths and 30 to 300
 /// frames (Documentation/Performance.md, "Progress"). Past a few thousand elements per
 /// hundred thousand paths, the work per element side and frame outweighs the rays.
 /// A probe ray of the setup, the tracer's build included.
@@ -40,12 +40,6 @@ constexpr double GatheringRayCost = 3.5;
 constexpr double ShootingSideFrameCost = 0.085;
 constexpr double GatheringSideFrameCost = 0.2;
 constexpr double BatchSideFrameCost = 0.09;
-
-/// The element sides of `scene`, which the work per side and frame scales with.
-double elementSides(const Scene& scene, const SolverOptions& options)
-{
-  return static_cast<double>(scene.elementCount()) * (options.twoSided ? 2.0 : 1.0);
-}
 
 /// The batches a solve runs (its first round's): 1 without an error estimate.
 double batchCount(const SolverOptions& options)
@@ -63,9 +57,14 @@ SolverOptions passOptions(const SolverOptions& options)
 }
 
 /// The expected cost of one pass's gathering: its k N rays, at least one per element side
-/// (per frame without reuse), and its work per side and frame.
+/// (per frame without reuse), and its work per side and frame; none without gathering (k = 0:
+/// the patches' light is copied, and the pass reports no gathering progress).
 double gatheringCost(const Scene& scene, std::size_t frames, const SolverOptions& pass)
 {
+  if (!(pass.gatheringRatio > 0))
+  {
+    return 0;
+  }
   const double rays = std::max(
     pass.gatheringRatio * static_cast<double>(pass.pathsPerFrame), elementSides(scene, pass));
   return GatheringRayCost * rays * (pass.reuseGathering ? 1.0 : static_cast<double>(frames)) +
@@ -516,6 +515,11 @@ double SolveSetup::cost(const Scene& scene, const SolverOptions& options)
 {
   return ProbeRayCost * static_cast<double>(scene.patchCount()) * (options.twoSided ? 2.0 : 1.0) *
     ReachabilityProbesPerSide;
+}
+
+double elementSides(const Scene& scene, const SolverOptions& options)
+{
+  return static_cast<double>(scene.elementCount()) * (options.twoSided ? 2.0 : 1.0);
 }
 
 double solveCost(

@@ -72,7 +72,8 @@ public:
   std::uint64_t reachabilityRays() const { return this->ReachabilityRays; }
   double seconds() const { return this->Seconds; }
 
-  /// The probe rays a setup of `scene` lit by `rig` casts, to weigh its share of progress.
+  /// The expected cost of a setup of `scene` (its probe rays and the tracer's build), in
+  /// solveCost's units, to weigh its share of progress.
   static double cost(const Scene& scene, const SolverOptions& options);
 
 private:
@@ -87,8 +88,14 @@ private:
 Solution solve(const Scene& scene, const LightRig& rig, const SolverOptions& options,
   const ProgressCallback& progress, const SolveSetup& setup);
 
-/// The ray casts a solve of `rig` (or, with `positions`, of a slice of that many positions
-/// of it) is expected to take, past its setup: shooting every source and gathering.
+/// The element sides of `scene` (two per element when options.twoSided), which the work per
+/// side and frame of a solve scales with.
+double elementSides(const Scene& scene, const SolverOptions& options);
+
+/// The expected cost of a solve of `rig` (or, with `positions`, of a slice of that many
+/// positions of it) past its setup, to weigh progress: shooting every source, gathering and
+/// the work per element side and frame of every batch, in units of one shooting path's rays
+/// (Documentation/Performance.md, "Progress").
 double solveCost(
   const Scene& scene, const LightRig& rig, const SolverOptions& options, std::size_t positions = 0);
 

@@ -62,9 +62,10 @@ struct SolverOptions
   /// solve, each of which completes its first round. The round count then depends on the
   /// machine's speed: the result is no longer reproducible.
   double timeLimitSeconds = 0;
-  /// With a target: run at most this many batches, all rounds together (0: only the path
-  /// limit). A chunk solved again runs the batches its first solve ran (solveChunk), so that
-  /// the cut of a time limit is repeated bit for bit, whatever the time it now takes.
+  /// With a target: start no more rounds once this many batches, all rounds together, have
+  /// run, and cut a round at it (0: only the path limit); the first round always completes.
+  /// A chunk solved again runs the batches its first solve ran (solveChunk), so that the cut
+  /// of a time limit is repeated bit for bit, whatever the time it now takes.
   std::uint64_t batchLimit = 0;
   /// The unit the results are stored in (Solution::storageScale), a power of two; 0 takes
   /// it from the scene and the rig solved (storageScaleFor). Solves whose results are

@@ -50,7 +50,7 @@ vtkPVArrayInformation* vtkSMMovingLightRadiosityRepresentationProxy::ForLogScale
   const int component = vtkSMPropertyHelper(lut, "VectorMode", true).GetAsInt() != 0
     ? vtkSMPropertyHelper(lut, "VectorComponent", true).GetAsInt()
     : -1;
-  if (component >= info->GetNumberOfComponents())
+  if (info->GetNumberOfComponents() == 0 || component >= info->GetNumberOfComponents())
   {
     return info;
   }
@@ -142,4 +142,6 @@ bool vtkSMMovingLightRadiosityRepresentationProxy::RescaleTransferFunctionToData
 void vtkSMMovingLightRadiosityRepresentationProxy::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "LogScaleInformation:\n";
+  this->LogScaleInformation->PrintSelf(os, indent.GetNextIndent());
 }

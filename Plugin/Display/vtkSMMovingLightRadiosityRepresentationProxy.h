@@ -75,6 +75,8 @@ private:
    */
   vtkPVArrayInformation* ForLogScale(vtkPVArrayInformation* info);
 
+  /// One copy per proxy: a later call rewrites what an earlier caller was given, which
+  /// ParaView reads at once.
   vtkNew<vtkPVArrayInformation> LogScaleInformation;
 
   vtkSMMovingLightRadiosityRepresentationProxy(

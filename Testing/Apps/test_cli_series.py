@@ -311,13 +311,17 @@ def test_a_commit_that_fails_halfway_keeps_the_earlier_series_whole(tmp_path):
 def test_the_next_run_removes_what_a_killed_run_left(tmp_path):
     """A run killed by SIGKILL (or the out-of-memory killer) cannot clean up: its staged frames
     (.s_0007.vtu.partial) and the earlier frames it had set aside (.s_0001.vtu.earlier) stay.
-    The next run of the series removes them when it commits, and only them."""
+    The next run of the series removes them when it commits, and only them: not the files of
+    another series, nor those newer than the run (another run writing the series now)."""
     out = tmp_path / "out"
     out.mkdir()
     left = [".s_0001.vtu.earlier", ".s_0007.vtu.partial", ".s_0012.vtu.partial"]
-    others = [".notes.partial", ".s_extra.vtu.partial", ".t_0001.vtu.partial", "s_0001.vtu.partial"]
+    others = [".notes.partial", ".s_extra.vtu.partial", ".t_0001.vtu.partial", "s_0001.vtu.partial",
+              ".s_0009.vtu.partial"]
     for name in left + others:
         (out / name).write_text("left over")
+    later = time.time() + 3600
+    os.utime(out / ".s_0009.vtu.partial", (later, later))
     result = run(["--scene", SCENE, "--light", LIGHT] + PATH +
                  ["--frames", "2", "--output", "out/s.pvd"] + FAST, tmp_path)
     assert result.returncode == 0, result.stderr

@@ -17,6 +17,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
 
 #include <cmath>
 #include <limits>
@@ -144,6 +145,12 @@ double fieldValue(vtkDataObject* data, const char* name)
     data && data->GetFieldData() ? data->GetFieldData()->GetArray(name) : nullptr;
   return array && array->GetNumberOfTuples() > 0 ? array->GetComponent(0, 0)
                                                  : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string stringValue(vtkFieldData* data, const char* name)
+{
+  auto* strings = vtkStringArray::SafeDownCast(data->GetAbstractArray(name));
+  return strings && strings->GetNumberOfValues() > 0 ? strings->GetValue(0) : std::string();
 }
 
 Vec3 triangleAreaVector(vtkPolyData* mesh, vtkIdType cell)

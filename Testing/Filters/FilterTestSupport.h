@@ -15,6 +15,7 @@
 class vtkAlgorithm;
 class vtkCallbackCommand;
 class vtkDataObject;
+class vtkFieldData;
 class vtkMovingLightRadiosity;
 class vtkPolyData;
 
@@ -66,6 +67,9 @@ std::vector<double> timeSteps(vtkAlgorithm* algorithm);
 
 /// The first value of the field data array `name`, or NaN when it is missing.
 double fieldValue(vtkDataObject* data, const char* name);
+
+/// The first string of the field data string array `name`, or "" when it is missing.
+std::string stringValue(vtkFieldData* data, const char* name);
 
 /// Twice the area times the unit normal (right-hand rule) of cell `cell` of a triangle mesh.
 Vec3 triangleAreaVector(vtkPolyData* mesh, vtkIdType cell);

@@ -24,12 +24,6 @@ namespace
 {
 constexpr std::size_t Frames = 3;
 
-std::string stringValue(vtkFieldData* data, const char* name)
-{
-  auto* strings = vtkStringArray::SafeDownCast(data->GetAbstractArray(name));
-  return strings && strings->GetNumberOfValues() > 0 ? strings->GetValue(0) : std::string();
-}
-
 /// The filter's error in an update that must fail, and that the outputs are empty.
 std::string failure(vtkMovingLightRadiosity* filter)
 {

@@ -276,6 +276,7 @@ TEST(FilterTime, AChunkSolvedAgainRepeatsTheRoundsATimeLimitCut)
     ASSERT_FALSE(first[name].empty()) << name;
   }
   const double p95 = fieldValue(filter->GetOutput(), "RelativeErrorP95");
+  ASSERT_EQ(stringValue(filter->GetOutput()->GetFieldData(), "StoppedBy"), "time limit");
   ASSERT_TRUE(filter->UpdateTimeStep(9));
   ASSERT_TRUE(filter->UpdateTimeStep(3));
   EXPECT_EQ(fieldValue(filter->GetOutput(), "ChunksSolvedAgain"), 2);
