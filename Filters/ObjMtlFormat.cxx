@@ -25,19 +25,27 @@ namespace mlr::scenefile
 
 namespace
 {
-/// The keyword of a line and the rest of it, without a trailing comment.
+/// The keyword of a line and the rest of it, without a trailing comment. A line that names a
+/// material or a file keeps its '#': 3ds Max names materials "Material #25", and assimp and
+/// others write such names as they are; only a line starting with '#' is a comment there.
 void splitKeyword(const std::string& line, std::string& keyword, std::string& rest)
 {
-  std::string text = line;
-  const auto hash = text.find('#');
-  if (hash != std::string::npos)
-  {
-    text.erase(hash);
-  }
-  text = trim(text);
+  static const std::set<std::string> naming = { "newmtl", "usemtl", "mtllib", "map_Kd", "map_Ke" };
+  std::string text = trim(line);
   const auto space = text.find_first_of(" \t");
   keyword = text.substr(0, space);
-  rest = space == std::string::npos ? std::string() : trim(text.substr(space));
+  if (keyword.empty() || keyword[0] == '#' || naming.count(keyword) == 0)
+  {
+    const auto hash = text.find('#');
+    if (hash != std::string::npos)
+    {
+      text.erase(hash);
+    }
+    text = trim(text);
+    keyword = text.substr(0, text.find_first_of(" \t"));
+  }
+  const auto end = text.find_first_of(" \t");
+  rest = end == std::string::npos ? std::string() : trim(text.substr(end));
 }
 
 /// FileError when `in` starts with a UTF-16 byte order mark (Windows tools save "Unicode"

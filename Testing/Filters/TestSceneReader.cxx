@@ -427,6 +427,30 @@ TEST(SceneReader, ObjOrMtlInUtf16IsRefusedSayingSo)
   }
 }
 
+TEST(SceneReader, ObjMaterialNamesWithAHashAreKeptWhole)
+{
+  // 3ds Max names materials "Material #25", and assimp's OBJ exporter writes such names as
+  // they are. Cut at the '#' as a comment, "Material #1" and "Material #2" were both
+  // "Material": one colour for both, a warning that it was defined again. Elsewhere a '#'
+  // still starts a comment.
+  const TestFolder scratch("hash-names");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "scene #1.mtl",
+    "# 3ds Max\nnewmtl Material #1\nKd 0.725 0.71 0.68 # white\nnewmtl Material #2\n"
+    "Kd 0.63 0.065 0.05\n");
+  std::string obj = twoMaterialObj("scene #1.mtl");
+  replaceOnce(obj, "usemtl white\n", "usemtl Material #1\n");
+  replaceOnce(obj, "usemtl red\n", "usemtl Material #2\n# usemtl Material #1\n");
+  replaceOnce(obj, "f 5 6 7\n", "f 5 6 7 # the wall\n");
+  writeFile(folder / "scene.obj", obj);
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectTwoMaterialScene(result.output, 1e-12);
+  EXPECT_EQ(
+    materialNames(result.output), (std::vector<std::string>{ "Material #1", "Material #2" }));
+  EXPECT_EQ(result.warnings(), "");
+}
+
 TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
 {
   const TestFolder scratch("see-through");
