@@ -25,6 +25,12 @@ namespace mlr::scenefile
 
 namespace
 {
+/// `text` before a '#' that may start a trailing comment, trimmed.
+std::string beforeHash(const std::string& text)
+{
+  return trim(text.substr(0, text.find('#')));
+}
+
 /// The keyword of a line and the rest of it, without a trailing comment. A line that names a
 /// material or a file keeps its '#': 3ds Max names materials "Material #25", and assimp and
 /// others write such names as they are; only a line starting with '#' is a comment there.
@@ -113,6 +119,13 @@ std::string mtlMapFile(const std::string& rest, const std::filesystem::path& fol
   }
   std::string name = trim(rest.substr(spans[i].first));
   std::replace(name.begin(), name.end(), '\\', '/');
+  // A '#' is kept in the name; when no such file exists, it may start a comment.
+  std::error_code error;
+  if (name.find('#') != std::string::npos && !std::filesystem::exists(folder / name, error) &&
+    !beforeHash(name).empty() && std::filesystem::exists(folder / beforeHash(name), error))
+  {
+    name = beforeHash(name);
+  }
   return (folder / name).string();
 }
 
@@ -240,6 +253,12 @@ std::vector<std::string> mtllibFiles(std::string rest, const std::filesystem::pa
   if (std::filesystem::is_regular_file(whole, error))
   {
     return { whole.string() };
+  }
+  // Not a file with a '#' in its name: the '#' starts a comment.
+  rest = beforeHash(rest);
+  if (!rest.empty() && std::filesystem::is_regular_file(folder / rest, error))
+  {
+    return { (folder / rest).string() };
   }
   std::vector<std::string> files;
   for (const auto& word : words(rest))
@@ -490,7 +509,33 @@ Scene readObj(
   {
     Material material;
     material.name = name;
-    const auto found = library.find(name == "none" && unnamedFromLibrary ? std::string() : name);
+    auto found = library.find(name == "none" && unnamedFromLibrary ? std::string() : name);
+    // A '#' kept in a name may have started a trailing comment ("usemtl wood # oak", or
+    // "newmtl wood # oak"): the names match before it when they do not as they are.
+    if (found == library.end() && !beforeHash(name).empty())
+    {
+      const std::string cut = beforeHash(name);
+      auto match = library.find(cut);
+      if (match == library.end())
+      {
+        std::size_t matches = 0;
+        for (auto candidate = library.begin(); candidate != library.end(); ++candidate)
+        {
+          if (beforeHash(candidate->first) == cut && matches++ == 0)
+          {
+            match = candidate;
+          }
+        }
+        match = matches == 1 ? match : library.end();
+      }
+      if (match != library.end())
+      {
+        warn("the material " + named(name) + " of " + named(path) +
+          " is not defined in its material libraries; " + named(match->first) +
+          " is used, the text after '#' taken as a comment");
+        found = match;
+      }
+    }
     const std::string what = "material " + named(name) + " of " + named(path);
     if (found != library.end())
     {

@@ -449,6 +449,21 @@ TEST(SceneReader, ObjMaterialNamesWithAHashAreKeptWhole)
   EXPECT_EQ(
     materialNames(result.output), (std::vector<std::string>{ "Material #1", "Material #2" }));
   EXPECT_EQ(result.warnings(), "");
+
+  // A '#' that starts a trailing comment on such a line still reads: names that differ as
+  // they are match before it (with a warning), and a file is looked for without it.
+  writeFile(folder / "commented.mtl",
+    "newmtl white # the floor\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\n");
+  std::string commented = twoMaterialObj("commented.mtl # materials");
+  replaceOnce(commented, "usemtl red\n", "usemtl red # the wall\n");
+  writeFile(folder / "commented.obj", commented);
+  const ReadResult trailing = readScene(folder / "commented.obj");
+  ASSERT_TRUE(trailing.succeeded) << trailing.errors();
+  expectTwoMaterialScene(trailing.output, 1e-12);
+  EXPECT_NE(trailing.warnings().find("'white # the floor' is used"), std::string::npos)
+    << trailing.warnings();
+  EXPECT_NE(trailing.warnings().find("the material 'red # the wall'"), std::string::npos)
+    << trailing.warnings();
 }
 
 TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
