@@ -26,6 +26,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace mlr::scenefile
@@ -239,7 +240,8 @@ public:
     // a texture that cannot be decoded: a warning, its factor alone is used. Geometry
     // compression is not supported.
     static const std::set<std::string> readable = { "KHR_texture_transform", "KHR_lights_punctual",
-      "EXT_texture_webp", "KHR_texture_basisu", "EXT_texture_avif", "KHR_mesh_quantization" };
+      "EXT_texture_webp", "KHR_texture_basisu", "EXT_texture_avif", "KHR_mesh_quantization",
+      "EXT_mesh_gpu_instancing" };
     for (const auto& required : this->array("extensionsRequired"))
     {
       const std::string name =
@@ -1101,13 +1103,20 @@ public:
       }
       return m;
     }
-    const auto t = numbers("translation", 3, { 0, 0, 0 });
-    const auto q = numbers("rotation", 4, { 0, 0, 0, 1 });
-    const auto s = numbers("scale", 3, { 1, 1, 1 });
+    return this->trs(numbers("translation", 3, { 0, 0, 0 }).data(),
+      numbers("rotation", 4, { 0, 0, 0, 1 }).data(), numbers("scale", 3, { 1, 1, 1 }).data(),
+      where + ".rotation");
+  }
+
+  /// The row-major matrix of translation t x rotation q (a quaternion x, y, z, w) x scale s.
+  std::array<double, 16> trs(
+    const double* t, const double* q, const double* s, const std::string& rotation) const
+  {
+    std::array<double, 16> m{};
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (norm == 0)
+    if (!(norm > 0) || !std::isfinite(norm))
     {
-      this->fail(where + ".rotation is a zero quaternion");
+      this->fail(rotation + " is a zero (or not a finite) quaternion");
     }
     const double x = q[0] / norm, y = q[1] / norm, z = q[2] / norm, w = q[3] / norm;
     const double r[3][3] = { { 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w) },
@@ -1177,6 +1186,109 @@ std::array<double, 3> colourFactor(const Json& holder, const char* key, std::siz
   }
   return rgb;
 }
+/// The EXT_mesh_gpu_instancing attributes of a node (TRANSLATION, ROTATION, SCALE: accessor
+/// indices, -1 when absent) and its number of instances; 0 instances when it has none.
+struct Instancing
+{
+  std::int64_t translation = -1, rotation = -1, scale = -1;
+  std::uint64_t count = 0;
+};
+
+Instancing instancingOf(const GltfChecks& checks, const Json& node, const std::string& where)
+{
+  Instancing instancing;
+  const auto extensions = node.find("extensions");
+  if (extensions == node.end() || !extensions->is_object() ||
+    !extensions->contains("EXT_mesh_gpu_instancing"))
+  {
+    return instancing;
+  }
+  const Json& extension = (*extensions)["EXT_mesh_gpu_instancing"];
+  const std::string at = where + ".extensions.EXT_mesh_gpu_instancing";
+  if (!extension.is_object() || !extension.contains("attributes") ||
+    !extension["attributes"].is_object())
+  {
+    checks.fail(at + " has no attributes object");
+  }
+  const Json& attributes = extension["attributes"];
+  const Json& accessors = checks.array("accessors");
+  std::int64_t count = -1;
+  for (const auto& [key, size, slot] : { std::make_tuple("TRANSLATION", 3, &instancing.translation),
+         std::make_tuple("ROTATION", 4, &instancing.rotation),
+         std::make_tuple("SCALE", 3, &instancing.scale) })
+  {
+    *slot = checks.index(attributes, key, "accessors", at + ".attributes");
+    if (*slot < 0)
+    {
+      continue;
+    }
+    const Json& accessor = accessors[static_cast<std::size_t>(*slot)];
+    const std::int64_t n = accessor["count"].get<std::int64_t>();
+    if (typeComponents(accessor["type"].get<std::string>()) != size || (count >= 0 && n != count))
+    {
+      checks.fail(at + ".attributes." + key + " is not a VEC" + std::to_string(size) +
+        " with one element per instance, as many as the other attributes");
+    }
+    count = n;
+  }
+  instancing.count = count > 0 ? static_cast<std::uint64_t>(count) : 1;
+  return instancing;
+}
+
+/// The transforms of the instances of a node's mesh in the node's frame: one identity without
+/// EXT_mesh_gpu_instancing, else each instance's translation x rotation x scale.
+std::vector<std::array<double, 16>> instanceTransforms(
+  const GltfDocument& document, const GltfChecks& checks, const Json& node, std::size_t index)
+{
+  const std::string where = "nodes[" + std::to_string(index) + "]";
+  const Instancing instancing = instancingOf(checks, node, where);
+  std::array<double, 16> identity{};
+  identity[0] = identity[5] = identity[10] = identity[15] = 1;
+  if (instancing.count == 0)
+  {
+    return { identity };
+  }
+  auto values = [&](std::int64_t accessor, std::size_t size, std::vector<double> fallback)
+  {
+    if (accessor < 0)
+    {
+      std::vector<double> repeated;
+      for (std::uint64_t i = 0; i < instancing.count; ++i)
+      {
+        repeated.insert(repeated.end(), fallback.begin(), fallback.end());
+      }
+      return repeated;
+    }
+    std::size_t components = 0;
+    std::vector<double> read = document.accessor(static_cast<std::size_t>(accessor), components);
+    if (components != size || read.size() != size * instancing.count)
+    {
+      document.fail(where + ": its EXT_mesh_gpu_instancing attributes do not give every instance");
+    }
+    return read;
+  };
+  const auto t = values(instancing.translation, 3, { 0, 0, 0 });
+  const auto q = values(instancing.rotation, 4, { 0, 0, 0, 1 });
+  const auto s = values(instancing.scale, 3, { 1, 1, 1 });
+  std::vector<std::array<double, 16>> transforms;
+  transforms.reserve(static_cast<std::size_t>(instancing.count));
+  for (std::size_t i = 0; i < instancing.count; ++i)
+  {
+    for (const double value :
+      { t[3 * i], t[3 * i + 1], t[3 * i + 2], s[3 * i], s[3 * i + 1], s[3 * i + 2] })
+    {
+      if (!std::isfinite(value))
+      {
+        document.fail(where + ": instance " + std::to_string(i) +
+          " of EXT_mesh_gpu_instancing has a translation or scale that is not finite");
+      }
+    }
+    transforms.push_back(document.trs(&t[3 * i], &q[4 * i], &s[3 * i],
+      where + ": the rotation of instance " + std::to_string(i) + " of EXT_mesh_gpu_instancing"));
+  }
+  return transforms;
+}
+
 /// The points and triangles the nodes under `roots` draw, counting each instance of a mesh:
 /// a mesh named by 10^5 nodes is drawn 10^5 times, and that is known before drawing any.
 std::pair<std::uint64_t, std::uint64_t> drawnSize(
@@ -1213,13 +1325,16 @@ std::pair<std::uint64_t, std::uint64_t> drawnSize(
   std::vector<std::size_t> stack(roots.begin(), roots.end());
   while (!stack.empty())
   {
-    const Json& node = nodes[stack.back()];
+    const std::size_t index = stack.back();
+    const Json& node = nodes[index];
     stack.pop_back();
     if (node.contains("mesh"))
     {
       const auto& [p, t] = perMesh[node["mesh"].get<std::size_t>()];
-      points = saturatingSum(points, p);
-      triangles = saturatingSum(triangles, t);
+      const std::uint64_t instances = std::max<std::uint64_t>(
+        1, instancingOf(checks, node, "nodes[" + std::to_string(index) + "]").count);
+      points = saturatingSum(points, saturatingProduct(p, instances));
+      triangles = saturatingSum(triangles, saturatingProduct(t, instances));
     }
     if (node.contains("children"))
     {
@@ -1381,155 +1496,160 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
       0.6 * static_cast<double>(visited++) /
         static_cast<double>(std::max<std::size_t>(1, nodes.size())));
     const Json& node = nodes[nodeIndex];
-    const std::array<double, 16> matrix = multiply(parent, document.localTransform(nodeIndex));
+    const std::array<double, 16> nodeMatrix = multiply(parent, document.localTransform(nodeIndex));
     const Json children = node.value("children", Json::array());
     for (auto child = children.rbegin(); child != children.rend(); ++child)
     {
-      stack.emplace_back(child->get<std::size_t>(), matrix);
+      stack.emplace_back(child->get<std::size_t>(), nodeMatrix);
     }
     if (!node.contains("mesh"))
     {
       continue;
     }
     const std::size_t meshIndex = node["mesh"].get<std::size_t>();
-    // A transform that mirrors (negative determinant) turns counter-clockwise into clockwise:
-    // glTF then takes the clockwise side as the front (a mirrored lamp still lights outward).
-    const bool mirrored = matrix[0] * (matrix[5] * matrix[10] - matrix[6] * matrix[9]) -
-        matrix[1] * (matrix[4] * matrix[10] - matrix[6] * matrix[8]) +
-        matrix[2] * (matrix[4] * matrix[9] - matrix[5] * matrix[8]) <
-      0;
-    for (const Json& primitive : meshes[meshIndex]["primitives"])
+    for (const auto& instance : instanceTransforms(document, checks, node, nodeIndex))
     {
-      const std::int64_t mode = primitive.value("mode", std::int64_t(4));
-      if (mode < 4)
+      const std::array<double, 16> matrix = multiply(nodeMatrix, instance);
+      // A transform that mirrors (negative determinant) turns counter-clockwise into clockwise:
+      // glTF then takes the clockwise side as the front (a mirrored lamp still lights outward).
+      const bool mirrored = matrix[0] * (matrix[5] * matrix[10] - matrix[6] * matrix[9]) -
+          matrix[1] * (matrix[4] * matrix[10] - matrix[6] * matrix[8]) +
+          matrix[2] * (matrix[4] * matrix[9] - matrix[5] * matrix[8]) <
+        0;
+      for (const Json& primitive : meshes[meshIndex]["primitives"])
       {
-        ++skippedPrimitives;
-        continue;
-      }
-      const Json& attributes = primitive["attributes"];
-      std::size_t components = 0;
-      std::vector<double> positions =
-        document.accessor(attributes["POSITION"].get<std::size_t>(), components);
-      const std::size_t vertexCount = positions.size() / 3;
-      morph(document, node, meshes[meshIndex], primitive, meshIndex, positions);
-      std::vector<std::size_t> indices;
-      if (primitive.contains("indices"))
-      {
-        for (double index : document.accessor(primitive["indices"].get<std::size_t>(), components))
+        const std::int64_t mode = primitive.value("mode", std::int64_t(4));
+        if (mode < 4)
         {
-          if (index >= static_cast<double>(vertexCount))
-          {
-            document.fail("a primitive of meshes[" + std::to_string(meshIndex) + "] names vertex " +
-              std::to_string(static_cast<std::uint64_t>(index)) + " but its POSITION has " +
-              std::to_string(vertexCount));
-          }
-          indices.push_back(static_cast<std::size_t>(index));
-        }
-      }
-      else
-      {
-        for (std::size_t i = 0; i < vertexCount; ++i)
-        {
-          indices.push_back(i);
-        }
-      }
-      std::vector<std::array<std::size_t, 3>> triangles;
-      for (std::size_t i = 0; i + 2 < indices.size(); i += mode == 4 ? 3 : 1)
-      {
-        if (mode == 4)
-        {
-          triangles.push_back({ { indices[i], indices[i + 1], indices[i + 2] } });
-        }
-        else if (mode == 5) // strip: every other triangle turns the other way
-        {
-          triangles.push_back(i % 2 == 0
-              ? std::array<std::size_t, 3>{ { indices[i], indices[i + 1], indices[i + 2] } }
-              : std::array<std::size_t, 3>{ { indices[i + 1], indices[i], indices[i + 2] } });
-        }
-        else // fan
-        {
-          triangles.push_back({ { indices[0], indices[i + 1], indices[i + 2] } });
-        }
-      }
-      const std::int64_t gltfMaterial = primitive.value("material", std::int64_t(-1));
-      const auto found = materialIds.find(gltfMaterial);
-      int material = 0;
-      if (found != materialIds.end())
-      {
-        material = found->second;
-      }
-      else
-      {
-        material = static_cast<int>(materialOrder.size());
-        materialIds[gltfMaterial] = material;
-        materialOrder.push_back(gltfMaterial);
-        usedWithoutColour.push_back(0);
-      }
-      std::vector<double> colours;
-      std::size_t colourComponents = 0;
-      if (attributes.contains("COLOR_0"))
-      {
-        colours = document.accessor(attributes["COLOR_0"].get<std::size_t>(), colourComponents);
-        if (colourComponents < 3 || colours.size() / colourComponents != vertexCount)
-        {
-          document.fail("a primitive of meshes[" + std::to_string(meshIndex) +
-            "] has a COLOR_0 that is not one RGB or RGBA colour per vertex");
-        }
-      }
-      if (colours.empty() && !triangles.empty())
-      {
-        usedWithoutColour[static_cast<std::size_t>(material)] = 1;
-      }
-      // Only the vertices the triangles use, each once: primitives often share one POSITION
-      // accessor of the whole mesh (an exporter's single vertex buffer), which copied whole
-      // per primitive made 86 primitives of a 560,569-vertex buffer 48 million points.
-      std::vector<vtkIdType> pointOf(vertexCount, -1);
-      for (const auto& triangle : triangles)
-      {
-        for (const std::size_t v : triangle)
-        {
-          pointOf[v] = 0;
-        }
-      }
-      for (std::size_t v = 0; v < vertexCount; ++v)
-      {
-        if (pointOf[v] < 0)
-        {
+          ++skippedPrimitives;
           continue;
         }
-        double p[3];
-        for (std::size_t r = 0; r < 3; ++r)
+        const Json& attributes = primitive["attributes"];
+        std::size_t components = 0;
+        std::vector<double> positions =
+          document.accessor(attributes["POSITION"].get<std::size_t>(), components);
+        const std::size_t vertexCount = positions.size() / 3;
+        morph(document, node, meshes[meshIndex], primitive, meshIndex, positions);
+        std::vector<std::size_t> indices;
+        if (primitive.contains("indices"))
         {
-          p[r] = matrix[4 * r] * positions[3 * v] + matrix[4 * r + 1] * positions[3 * v + 1] +
-            matrix[4 * r + 2] * positions[3 * v + 2] + matrix[4 * r + 3];
-        }
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-        {
-          document.fail(
-            "meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
-        }
-        pointOf[v] = scene.points->InsertNextPoint(p);
-      }
-      for (const auto& triangle : triangles)
-      {
-        const vtkIdType ids[3] = { pointOf[triangle[0]], pointOf[triangle[mirrored ? 2 : 1]],
-          pointOf[triangle[mirrored ? 1 : 2]] };
-        scene.polygons->InsertNextCell(3, ids);
-        scene.materialOfCell.push_back(material);
-        std::array<double, 3> mean{ { 1, 1, 1 } };
-        if (!colours.empty())
-        {
-          anyColour = true;
-          for (std::size_t c = 0; c < 3; ++c)
+          for (double index :
+            document.accessor(primitive["indices"].get<std::size_t>(), components))
           {
-            mean[c] = (colours[triangle[0] * colourComponents + c] +
-                        colours[triangle[1] * colourComponents + c] +
-                        colours[triangle[2] * colourComponents + c]) /
-              3.0;
+            if (index >= static_cast<double>(vertexCount))
+            {
+              document.fail("a primitive of meshes[" + std::to_string(meshIndex) +
+                "] names vertex " + std::to_string(static_cast<std::uint64_t>(index)) +
+                " but its POSITION has " + std::to_string(vertexCount));
+            }
+            indices.push_back(static_cast<std::size_t>(index));
           }
         }
-        vertexColourOfCell.push_back(mean);
-        cellHasColour.push_back(colours.empty() ? 0 : 1);
+        else
+        {
+          for (std::size_t i = 0; i < vertexCount; ++i)
+          {
+            indices.push_back(i);
+          }
+        }
+        std::vector<std::array<std::size_t, 3>> triangles;
+        for (std::size_t i = 0; i + 2 < indices.size(); i += mode == 4 ? 3 : 1)
+        {
+          if (mode == 4)
+          {
+            triangles.push_back({ { indices[i], indices[i + 1], indices[i + 2] } });
+          }
+          else if (mode == 5) // strip: every other triangle turns the other way
+          {
+            triangles.push_back(i % 2 == 0
+                ? std::array<std::size_t, 3>{ { indices[i], indices[i + 1], indices[i + 2] } }
+                : std::array<std::size_t, 3>{ { indices[i + 1], indices[i], indices[i + 2] } });
+          }
+          else // fan
+          {
+            triangles.push_back({ { indices[0], indices[i + 1], indices[i + 2] } });
+          }
+        }
+        const std::int64_t gltfMaterial = primitive.value("material", std::int64_t(-1));
+        const auto found = materialIds.find(gltfMaterial);
+        int material = 0;
+        if (found != materialIds.end())
+        {
+          material = found->second;
+        }
+        else
+        {
+          material = static_cast<int>(materialOrder.size());
+          materialIds[gltfMaterial] = material;
+          materialOrder.push_back(gltfMaterial);
+          usedWithoutColour.push_back(0);
+        }
+        std::vector<double> colours;
+        std::size_t colourComponents = 0;
+        if (attributes.contains("COLOR_0"))
+        {
+          colours = document.accessor(attributes["COLOR_0"].get<std::size_t>(), colourComponents);
+          if (colourComponents < 3 || colours.size() / colourComponents != vertexCount)
+          {
+            document.fail("a primitive of meshes[" + std::to_string(meshIndex) +
+              "] has a COLOR_0 that is not one RGB or RGBA colour per vertex");
+          }
+        }
+        if (colours.empty() && !triangles.empty())
+        {
+          usedWithoutColour[static_cast<std::size_t>(material)] = 1;
+        }
+        // Only the vertices the triangles use, each once: primitives often share one POSITION
+        // accessor of the whole mesh (an exporter's single vertex buffer), which copied whole
+        // per primitive made 86 primitives of a 560,569-vertex buffer 48 million points.
+        std::vector<vtkIdType> pointOf(vertexCount, -1);
+        for (const auto& triangle : triangles)
+        {
+          for (const std::size_t v : triangle)
+          {
+            pointOf[v] = 0;
+          }
+        }
+        for (std::size_t v = 0; v < vertexCount; ++v)
+        {
+          if (pointOf[v] < 0)
+          {
+            continue;
+          }
+          double p[3];
+          for (std::size_t r = 0; r < 3; ++r)
+          {
+            p[r] = matrix[4 * r] * positions[3 * v] + matrix[4 * r + 1] * positions[3 * v + 1] +
+              matrix[4 * r + 2] * positions[3 * v + 2] + matrix[4 * r + 3];
+          }
+          if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+          {
+            document.fail(
+              "meshes[" + std::to_string(meshIndex) + "] has a vertex that is not a finite point");
+          }
+          pointOf[v] = scene.points->InsertNextPoint(p);
+        }
+        for (const auto& triangle : triangles)
+        {
+          const vtkIdType ids[3] = { pointOf[triangle[0]], pointOf[triangle[mirrored ? 2 : 1]],
+            pointOf[triangle[mirrored ? 1 : 2]] };
+          scene.polygons->InsertNextCell(3, ids);
+          scene.materialOfCell.push_back(material);
+          std::array<double, 3> mean{ { 1, 1, 1 } };
+          if (!colours.empty())
+          {
+            anyColour = true;
+            for (std::size_t c = 0; c < 3; ++c)
+            {
+              mean[c] = (colours[triangle[0] * colourComponents + c] +
+                          colours[triangle[1] * colourComponents + c] +
+                          colours[triangle[2] * colourComponents + c]) /
+                3.0;
+            }
+          }
+          vertexColourOfCell.push_back(mean);
+          cellHasColour.push_back(colours.empty() ? 0 : 1);
+        }
       }
     }
   }

@@ -1349,6 +1349,57 @@ TEST(SceneReader, GltfSpecularGlossinessDiffuseIsTheReflectance)
     << bad.errors();
 }
 
+TEST(SceneReader, GltfGpuInstancesAreEachDrawn)
+{
+  // EXT_mesh_gpu_instancing (Blender's "GPU instances", gltfpack -mi, three.js' exporter): a
+  // node draws its mesh once per instance, each moved by its own translation, rotation and
+  // scale in the node's frame, a mirroring one keeping its front faces. Only the node's own
+  // transform was read: one copy of a forest of trees, and a file that required the
+  // extension was refused.
+  const TestFolder scratch("gltf-instancing");
+  const fs::path& folder = scratch.path;
+  std::string buffer = gltfBuffer();
+  const float instances[4][3] = { { 0, 0, 0 }, { 5, 0, 0 }, { 1, 1, 1 }, { 1, 1, -1 } };
+  buffer.append(reinterpret_cast<const char*>(instances), sizeof(instances));
+  std::string json = gltfJson(dataUri(buffer));
+  replaceOnce(json, R"("byteLength": 120})", R"("byteLength": 168})");
+  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
+    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 120, "byteLength": 48}])");
+  replaceOnce(json, R"("count": 6, "type": "SCALAR"}])", R"("count": 6, "type": "SCALAR"},
+    {"bufferView": 2, "componentType": 5126, "count": 2, "type": "VEC3"},
+    {"bufferView": 2, "byteOffset": 24, "componentType": 5126, "count": 2, "type": "VEC3"}])");
+  replaceOnce(json, R"({"mesh": 0})", R"({"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing":
+    {"attributes": {"TRANSLATION": 3, "SCALE": 4}}}})");
+  replaceOnce(json, R"("scene": 0,)", R"("scene": 0,
+  "extensionsUsed": ["EXT_mesh_gpu_instancing"], "extensionsRequired": ["EXT_mesh_gpu_instancing"],)");
+  writeFile(folder / "instanced.gltf", json);
+  const ReadResult result = readScene(folder / "instanced.gltf");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  ASSERT_EQ(result.output->GetNumberOfCells(), 8);
+  double bounds[6];
+  result.output->GetBounds(bounds);
+  const double expected[6] = { 0, 6, 0, 1, -1, 1 };
+  for (int i = 0; i < 6; ++i)
+  {
+    EXPECT_NEAR(bounds[i], expected[i], 1e-9) << i;
+  }
+  expectRgbNear(windingNormal(result.output, 0), 0, 0, 1, 1e-6, "first floor");
+  expectRgbNear(windingNormal(result.output, 4), 0, 0, -1, 1e-6, "mirrored floor");
+  expectRgbNear(windingNormal(result.output, 6), 1, 0, 0, 1e-6, "mirrored wall");
+  expectRgbNear(tuple3(result.output, "Reflectance", 6), Red[0], Red[1], Red[2], 1e-12);
+
+  // Attributes of different counts are refused, naming the node.
+  replaceOnce(json, R"("byteOffset": 24, "componentType": 5126, "count": 2)",
+    R"("byteOffset": 24, "componentType": 5126, "count": 1)");
+  writeFile(folder / "uneven.gltf", json);
+  const ReadResult uneven = readScene(folder / "uneven.gltf");
+  EXPECT_FALSE(uneven.succeeded);
+  EXPECT_NE(uneven.errors().find("nodes[1].extensions.EXT_mesh_gpu_instancing.attributes.SCALE"),
+    std::string::npos)
+    << uneven.errors();
+}
+
 TEST(SceneReader, GltfQuantizedPositionsAreRead)
 {
   // KHR_mesh_quantization, which gltfpack writes by default: positions as 16-bit integers
