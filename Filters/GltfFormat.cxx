@@ -135,6 +135,12 @@ public:
     return *found;
   }
 
+  /// "where.key", or "key" for a member of the document itself (`where` empty).
+  static std::string member(const std::string& where, const char* key)
+  {
+    return where.empty() ? std::string(key) : where + "." + key;
+  }
+
   /// An optional integer member; `fallback` when absent.
   std::int64_t integer(
     const Json& object, const char* key, const std::string& where, std::int64_t fallback = -1) const
@@ -146,7 +152,7 @@ public:
     }
     if (!found->is_number_integer())
     {
-      this->fail(where + "." + key + " is not a whole number");
+      this->fail(member(where, key) + " is not a whole number");
     }
     return found->get<std::int64_t>();
   }
@@ -159,7 +165,7 @@ public:
     if (object.contains(key) &&
       (value < 0 || value >= static_cast<std::int64_t>(this->array(into).size())))
     {
-      this->fail(where + "." + key + " = " + std::to_string(value) + " but the file has " +
+      this->fail(member(where, key) + " = " + std::to_string(value) + " but the file has " +
         std::to_string(this->array(into).size()) + " " + into);
     }
     return value;
@@ -592,7 +598,7 @@ public:
         }
       }
     }
-    this->index(this->Root, "scene", "scenes", "the file");
+    this->index(this->Root, "scene", "scenes", "");
     // Skins and animations read accessors and nodes too.
     const Json& skins = this->array("skins");
     for (std::size_t i = 0; i < skins.size(); ++i)
@@ -1441,8 +1447,8 @@ Scene readGltfDocument(const Json& root, const std::string& path, bool glb, std:
   const Json& scenes = checks.array("scenes");
   if (!scenes.empty())
   {
-    const std::size_t scene = static_cast<std::size_t>(
-      std::max<std::int64_t>(0, checks.integer(root, "scene", "the file", 0)));
+    const std::size_t scene =
+      static_cast<std::size_t>(std::max<std::int64_t>(0, checks.integer(root, "scene", "", 0)));
     for (const auto& node : scenes[scene].value("nodes", Json::array()))
     {
       roots.push_back(node.get<std::int64_t>());

@@ -1670,6 +1670,8 @@ TEST(SceneReader, BadFilesGiveAnErrorNamingTheFileAndAnEmptyOutput)
     { "empty.gltf", R"({"asset": {"version": "2.0"}})", "no triangles" },
     { "draco.gltf", draco, "requires the extension KHR_draco_mesh_compression" },
     { "version1.gltf", version1, "glTF version 1.0, not 2.x" },
+    { "noscenes.gltf", R"({"asset": {"version": "2.0"}, "scene": 0})",
+      "noscenes.gltf': scene = 0 but the file has 0 scenes" },
     { "nobin.gltf", gltfJson("missing.bin"), "missing.bin', which does not exist" },
     { "huge.gltf", gltfJson("huge.bin"), "huge.bin' is over the 4 GiB this reader takes" },
     { "base64.gltf", notBase64, "not base64" },
