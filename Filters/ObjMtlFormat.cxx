@@ -288,7 +288,10 @@ Scene readObj(
   std::vector<std::string> usedMaterials; // in order of first use
   std::map<std::string, int> materialIds;
   std::vector<std::pair<std::string, std::size_t>> libraries; // file, line of its mtllib
+  // The material of the faces that follow, named by the last 'usemtl' and counted once a face
+  // takes it: a 'usemtl' without faces (exporters write one per slot) is no material.
   int currentMaterial = -1;
+  std::string currentMaterialName = "none";
   std::size_t skippedPoints = 0, skippedLines = 0;
 
   auto materialId = [&](const std::string& name)
@@ -361,7 +364,7 @@ Scene readObj(
       }
       if (currentMaterial < 0)
       {
-        currentMaterial = materialId("none");
+        currentMaterial = materialId(currentMaterialName);
       }
       faceMaterial.push_back(currentMaterial);
     }
@@ -375,7 +378,8 @@ Scene readObj(
       }
       facesBeforeUsemtl = facesBeforeUsemtl || (!sawUsemtl && !faceStart.empty());
       sawUsemtl = true;
-      currentMaterial = materialId(rest.empty() ? "none" : rest);
+      currentMaterialName = rest.empty() ? "none" : rest;
+      currentMaterial = -1;
     }
     else if (keyword == "mtllib")
     {

@@ -466,6 +466,27 @@ TEST(SceneReader, ObjMaterialNamesWithAHashAreKeptWhole)
     << trailing.warnings();
 }
 
+TEST(SceneReader, ObjMaterialsWithoutFacesAreLeftOut)
+{
+  // Exporters write a 'usemtl' per material slot, some with no face after it (tinyobjloader's
+  // cornell_box.obj, 'blue'): such a material is not in MaterialNames, its ids do not move
+  // the others', and its Kd of 1.2 is not warned of.
+  const TestFolder scratch("unused-materials");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "scene.mtl",
+    "newmtl white\nKd 0.725 0.71 0.68\nnewmtl red\nKd 0.63 0.065 0.05\nnewmtl blue\n"
+    "Kd 1.2 1.2 1.2\n");
+  std::string obj = twoMaterialObj("scene.mtl");
+  replaceOnce(obj, "usemtl white\n", "usemtl blue\nusemtl white\n");
+  obj += "usemtl blue\n";
+  writeFile(folder / "scene.obj", obj);
+  const ReadResult result = readScene(folder / "scene.obj");
+  ASSERT_TRUE(result.succeeded) << result.errors();
+  expectTwoMaterialScene(result.output, 1e-12);
+  EXPECT_EQ(materialNames(result.output), (std::vector<std::string>{ "white", "red" }));
+  EXPECT_EQ(result.warnings(), "");
+}
+
 TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
 {
   const TestFolder scratch("see-through");
