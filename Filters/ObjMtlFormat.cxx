@@ -282,6 +282,10 @@ Scene readObj(
   ProgressPoll poll(progress, 0.0, 0.9);
 
   std::vector<double> coordinates;
+  // 'v x y z r g b' (MeshLab, ZBrush and scanners write the colour of each vertex so): its
+  // colour, and whether it has one.
+  std::vector<std::array<double, 3>> vertexColour;
+  std::vector<char> vertexHasColour;
   std::vector<long long> faceVertices; // resolved, 0-based, checked at the end
   std::vector<std::size_t> faceStart, faceLine;
   std::vector<int> faceMaterial;
@@ -330,6 +334,21 @@ Scene readObj(
           where() + ": 'v " + printable(rest) + "' is not a vertex (3 finite numbers x y z)");
       }
       coordinates.insert(coordinates.end(), xyz, xyz + 3);
+      std::array<double, 3> rgb{ { 1, 1, 1 } };
+      const bool coloured = parts.size() == 6;
+      if (coloured)
+      {
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+          if (!parseNumber(parts[3 + c], rgb[c]) || rgb[c] < 0 || rgb[c] > 1)
+          {
+            throw FileError(where() + ": 'v " + printable(rest) +
+              "' has a colour r g b that is not 3 numbers from 0 to 1");
+          }
+        }
+      }
+      vertexColour.push_back(rgb);
+      vertexHasColour.push_back(coloured ? 1 : 0);
     }
     else if (keyword == "f")
     {
@@ -509,8 +528,11 @@ Scene readObj(
 
   Scene scene;
   scene.format = "OBJ";
+  // Each material's Kd before it is clamped (1 without one), which vertex colours multiply.
+  std::vector<std::array<double, 3>> unclampedKd;
   for (const auto& name : usedMaterials)
   {
+    unclampedKd.push_back({ { 1, 1, 1 } });
     Material material;
     material.name = name;
     auto found = library.find(name == "none" && unnamedFromLibrary ? std::string() : name);
@@ -551,6 +573,7 @@ Scene readObj(
       }
       if (kd)
       {
+        unclampedKd.back() = *kd;
         material.reflectance = checkedReflectance(*kd, "the " + what, warn);
       }
       else
@@ -609,6 +632,45 @@ Scene readObj(
     scene.polygons->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
   }
   scene.materialOfCell = std::move(faceMaterial);
+  // A face whose vertices all have a colour: their mean times its material's Kd (as glTF's
+  // COLOR_0 times its factor), clamped once; the other faces keep their material's.
+  if (std::find(vertexHasColour.begin(), vertexHasColour.end(), 1) != vertexHasColour.end())
+  {
+    std::size_t clamped = 0;
+    scene.cellReflectance.resize(faceStart.size());
+    for (std::size_t f = 0; f < faceStart.size(); ++f)
+    {
+      const auto material = static_cast<std::size_t>(scene.materialOfCell[f]);
+      const std::size_t end = f + 1 < faceStart.size() ? faceStart[f + 1] : faceVertices.size();
+      std::array<double, 3> mean{ { 0, 0, 0 } };
+      bool coloured = true;
+      for (std::size_t k = faceStart[f]; k < end && coloured; ++k)
+      {
+        const auto v = static_cast<std::size_t>(faceVertices[k]);
+        coloured = vertexHasColour[v] != 0;
+        for (std::size_t c = 0; c < 3; ++c)
+        {
+          mean[c] += vertexColour[v][c] / static_cast<double>(end - faceStart[f]);
+        }
+      }
+      if (!coloured)
+      {
+        scene.cellReflectance[f] = scene.materials[material].reflectance;
+        continue;
+      }
+      for (std::size_t c = 0; c < 3; ++c)
+      {
+        const double value = unclampedKd[material][c] * mean[c];
+        clamped += value > MaxReflectance ? 1 : 0;
+        scene.cellReflectance[f][c] = std::min(value, MaxReflectance);
+      }
+    }
+    if (clamped > 0)
+    {
+      warn("the OBJ file " + named(path) + ": " + std::to_string(clamped) +
+        " reflectance components of faces coloured by their vertices are clamped to 0.99");
+    }
+  }
   poll(1.0);
   return scene;
 }

@@ -487,6 +487,38 @@ TEST(SceneReader, ObjMaterialsWithoutFacesAreLeftOut)
   EXPECT_EQ(result.warnings(), "");
 }
 
+TEST(SceneReader, ObjVertexColoursAreTheFacesReflectance)
+{
+  // MeshLab writes 'v x y z r g b'. A face whose vertices all have a colour reflects their
+  // mean times its material's Kd (1 without one), clamped once; a face with an uncoloured
+  // vertex keeps its material's reflectance.
+  const TestFolder scratch("vertex-colours");
+  const fs::path& folder = scratch.path;
+  writeFile(folder / "alone.obj",
+    "v 0 0 0 0.2 0.4 0.6\nv 1 0 0 0.2 0.4 0.6\nv 1 1 0 0.5 0.1 0.9\nv 0 1 0\n"
+    "f 1 2 3\nf 1 3 4\n");
+  const ReadResult alone = readScene(folder / "alone.obj");
+  ASSERT_TRUE(alone.succeeded) << alone.errors();
+  ASSERT_EQ(alone.output->GetNumberOfCells(), 2);
+  expectRgbNear(tuple3(alone.output, "Reflectance", 0), 0.3, 0.3, 0.7, 1e-12, "coloured");
+  expectRgbNear(tuple3(alone.output, "Reflectance", 1), 0.5, 0.5, 0.5, 1e-12, "uncoloured");
+
+  writeFile(folder / "bright.mtl", "newmtl bright\nKd 2 1 0.5\n");
+  writeFile(folder / "bright.obj",
+    "mtllib bright.mtl\nv 0 0 0 0.4 0.4 0.4\nv 1 0 0 0.4 0.4 0.4\nv 1 1 0 0.4 0.4 0.4\n"
+    "usemtl bright\nf 1 2 3\n");
+  const ReadResult bright = readScene(folder / "bright.obj");
+  ASSERT_TRUE(bright.succeeded) << bright.errors();
+  expectRgbNear(tuple3(bright.output, "Reflectance", 0), 0.8, 0.4, 0.2, 1e-12, "Kd x colour");
+
+  writeFile(folder / "bad.obj", "v 0 0 0 0.2 0.4 1.5\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  const ReadResult bad = readScene(folder / "bad.obj");
+  EXPECT_FALSE(bad.succeeded);
+  EXPECT_NE(
+    bad.errors().find("has a colour r g b that is not 3 numbers from 0 to 1"), std::string::npos)
+    << bad.errors();
+}
+
 TEST(SceneReader, ObjMaterialsThatLetLightThroughAreWarnedOfAndReadAsOpaque)
 {
   const TestFolder scratch("see-through");
