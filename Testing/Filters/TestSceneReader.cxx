@@ -1524,16 +1524,16 @@ TEST(SceneReader, GltfQuantizedPositionsAreRead)
     << refused.errors();
 }
 
-TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
+namespace
 {
-  const TestFolder scratch("gltf-colours");
-  const fs::path& folder = scratch.path;
-  // COLOR_0 (normalized 8-bit RGBA, linear) on the floor's primitive: every floor vertex
-  // (255, 128, 0), so its cells reflect White x (1, 128/255, 0); the wall keeps its factor.
+/// The two-material glTF scene with a COLOR_0 accessor (3) of normalized 8-bit RGBA, `rgba`
+/// at every vertex, that no primitive uses yet.
+std::string gltfJsonWithVertexColour(const std::string& rgba)
+{
   std::string buffer = gltfBuffer();
   for (int v = 0; v < 8; ++v)
   {
-    buffer += std::string("\xff\x80\x00\xff", 4);
+    buffer += rgba;
   }
   std::string json = gltfJson(dataUri(buffer));
   replaceOnce(json, R"("byteLength": 120)", R"("byteLength": 152)");
@@ -1543,6 +1543,17 @@ TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
   replaceOnce(json, R"("count": 6, "type": "SCALAR"}])",
     R"("count": 6, "type": "SCALAR"},
     {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"}])");
+  return json;
+}
+} // namespace
+
+TEST(SceneReader, GltfVertexColoursMultiplyTheBaseColourPerCell)
+{
+  const TestFolder scratch("gltf-colours");
+  const fs::path& folder = scratch.path;
+  // COLOR_0 (normalized 8-bit RGBA, linear) on the floor's primitive: every floor vertex
+  // (255, 128, 0), so its cells reflect White x (1, 128/255, 0); the wall keeps its factor.
+  std::string json = gltfJsonWithVertexColour(std::string("\xff\x80\x00\xff", 4));
   replaceOnce(
     json, R"("POSITION": 0}, "indices": 1)", R"("POSITION": 0, "COLOR_0": 3}, "indices": 1)");
   writeFile(folder / "colours.gltf", json);
@@ -1560,19 +1571,7 @@ TEST(SceneReader, GltfVertexColoursMultiplyTheFactorBeforeItIsClamped)
   // colours read 1% dark (0.198, 0.396, 0.594): a model painted by vertex colours alone.
   const TestFolder scratch("gltf-colours-default");
   const fs::path& folder = scratch.path;
-  std::string buffer = gltfBuffer();
-  for (int v = 0; v < 8; ++v)
-  {
-    buffer += std::string("\x33\x66\x99\xff", 4);
-  }
-  std::string json = gltfJson(dataUri(buffer));
-  replaceOnce(json, R"("byteLength": 120)", R"("byteLength": 152)");
-  replaceOnce(json, R"({"buffer": 0, "byteOffset": 96, "byteLength": 24}])",
-    R"({"buffer": 0, "byteOffset": 96, "byteLength": 24},
-    {"buffer": 0, "byteOffset": 120, "byteLength": 32}])");
-  replaceOnce(json, R"("count": 6, "type": "SCALAR"}])",
-    R"("count": 6, "type": "SCALAR"},
-    {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 8, "type": "VEC4"}])");
+  std::string json = gltfJsonWithVertexColour(std::string("\x33\x66\x99\xff", 4));
   replaceOnce(json, R"("POSITION": 0}, "indices": 1, "material": 0,)",
     R"("POSITION": 0, "COLOR_0": 3}, "indices": 1,)");
   writeFile(folder / "colours.gltf", json);
