@@ -121,11 +121,7 @@ Animation solveAnimation(const PolygonSoup& soup, const LightRig& lights,
       options.solver, lightCount, outputs, streamed, kept, reachable, firstHits);
     // Streamed in chunks, a chunk's positions are held, not the frames.
     const bool chunked = streamed && framesPerChunk < frames;
-    const std::size_t held = chunked
-      ? std::min(
-          frames, framesPerChunk + 2 * chunkOverlap(framesPerChunk, options.solver.chunkOverlap))
-      : frames;
-    checkSolveMemory(checkedBytes, held, patches, elements, options.solver, approximate, sensors,
+    checkSolveMemory(checkedBytes, frames, patches, elements, options.solver, approximate, sensors,
       saturatingSum(estimateSensorMemory(sensors, frames, elements, points, lights, soupEmits,
                       options.solver, options.sensorOptions),
         saturatingProduct({ options.outputBytesPerSensorFrame, sensors, frames })),

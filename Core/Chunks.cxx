@@ -533,10 +533,7 @@ void exchangeFrames(const SolverOptions& options, Solution& frames, double& seco
     sumStoredAcrossRanks(options, data->data(), data->size(), seconds);
   }
 }
-}
 
-namespace
-{
 /// Per element side and position of a chunk, in solveCost's units, past its solve: its
 /// estimates blended at the seams, its sides' totals and each frame's error figures (measured
 /// with solveCost's figures, Documentation/Performance.md, "Progress").

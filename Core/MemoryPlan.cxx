@@ -365,10 +365,12 @@ void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t pa
   std::uint64_t sensorBytes, bool couldStream, std::uint64_t skyBytes, std::size_t framesPerChunk)
 {
   const std::string about = approximate ? "about " : "";
+  const std::size_t overlap =
+    framesPerChunk > 0 ? chunkOverlap(framesPerChunk, options.chunkOverlap) : 0;
   std::string detail =
-    (framesPerChunk > 0 ? countOf(frames, "position") + " (a chunk of " +
-          countOf(framesPerChunk, "frame") + " and " +
-          std::to_string(chunkOverlap(framesPerChunk, options.chunkOverlap)) + " more on each side)"
+    (framesPerChunk > 0 ? countOf(std::min(frames, framesPerChunk + 2 * overlap), "position") +
+          " (a chunk of " + countOf(framesPerChunk, "frame") + " and " + std::to_string(overlap) +
+          " more on each side)"
                         : countOf(frames, "frame")) +
     " x (" + about + std::to_string(patches) + " patches + " + about + std::to_string(elements) +
     " elements) x 2 sides x RGB, plus per-thread buffers";

@@ -119,8 +119,8 @@ std::uint64_t memoryLimitBytes(const SolverOptions& options);
  * estimate are the `sensors`', and when they are most of it the advice is about them;
  * `couldStream`: every frame is kept where the frames could be kept a few chunks at a time,
  * which the advice then offers; `skyBytes` of the estimate are the skies' tables, likewise;
- * `framesPerChunk`: the frames are solved and handed on in chunks of this many, `frames`
- * being the positions a chunk solves, and the advice is about the chunks' length).
+ * `framesPerChunk`: the `frames` are solved and handed on in chunks of this many, and the
+ * message names a chunk's positions and advises about the chunks' length).
  */
 void checkSolveMemory(std::uint64_t estimate, std::size_t frames, std::size_t patches,
   std::size_t elements, const SolverOptions& options, bool approximate = false,
